@@ -1,0 +1,18 @@
+# The runtime proper: shared memory, module API, daemon and filters, the run supervisor.
+vrflow_add_library(runtime
+  SOURCES
+    src/ipc/doorbell.cpp
+    src/ipc/segment.cpp
+    src/module/message.cpp
+    src/module/module.cpp
+    src/daemon/filter.cpp
+    src/daemon/builtin_filters.cpp
+    src/daemon/graph.cpp
+    src/daemon/daemon.cpp
+    src/run/spawn.cpp
+    src/run/report.cpp
+    src/run/runner.cpp
+  PUBLIC_DEPS vrflow::message vrflow::app vrflow::base Threads::Threads
+  PRIVATE_DEPS nlohmann_json::nlohmann_json)
+
+vrflow_add_executable(vrflow SOURCES tools/vrflow_main.cpp DEPS vrflow::runtime CLI11::CLI11)

@@ -1,0 +1,90 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vrflow/app/model.hpp"
+#include "vrflow/app/catalog.hpp"
+#include "vrflow/base/result.hpp"
+#include "vrflow/ipc/control.hpp"
+#include "vrflow/ipc/segment.hpp"
+
+namespace vrflow::daemon {
+
+/// Settings of a host's daemon (defaults suit a desktop run).
+struct DaemonOptions {
+  std::size_t segmentBytes = std::size_t{1} << 30;  ///< sparse: only touched pages cost memory
+  uint64_t iterationLimit = 0;                        ///< per module; 0 = no limit
+  std::size_t defaultCapacity = 16;                   ///< messages buffered per connection
+  uint32_t hostId = 0x7f000001;                       ///< from the host's address
+  /// Warn when a connection's buffer has stayed full this long (ns).
+  uint64_t fullWarningNs = 2'000'000'000;
+};
+
+/// A module the daemon serves: what to start and where its shared state lives.
+struct ModuleProcess {
+  std::string id;
+  std::string host;
+  std::string executable;
+  int slotIndex = 0;
+};
+
+/// Counters of one connection, for the run report.
+struct ConnectionStats {
+  std::string from, to;
+  uint64_t messages = 0;
+  uint64_t bytes = 0;
+  uint64_t dropped = 0;
+  bool stayedFull = false;
+};
+
+/// The last message an output port sent, for the run report.
+struct OutputStats {
+  std::string module, port;
+  uint64_t messages = 0;
+  bool hasLast = false;
+  uint64_t lastDigest = 0;
+  uint64_t lastIteration = 0;
+};
+
+/// A host's daemon: owns the shared-memory segment, the control table of its modules, and the
+/// filter network between them, which it runs on its own thread. Routing goes through Sink
+/// objects, so destinations on other hosts slot in as another kind of sink.
+class Daemon {
+ public:
+  /// Builds the network of `application` (already validated against `catalog`).
+  static Result<std::unique_ptr<Daemon>> create(const app::Application& application,
+                                                const app::Catalog& catalog,
+                                                const DaemonOptions& options);
+  ~Daemon();
+  Daemon(const Daemon&) = delete;
+  Daemon& operator=(const Daemon&) = delete;
+
+  ipc::Segment& segment();
+  const std::vector<ModuleProcess>& modules() const;
+  ipc::ModuleSlot& slot(int index);
+
+  /// Starts the routing thread (filters' start() run first).
+  Status start();
+  /// Tells the daemon a module process has ended (its outputs close once drained).
+  void moduleEnded(int index);
+  /// Asks every module to stop and wakes them all.
+  void requestStop();
+  /// Stops the routing thread and drops every buffered message.
+  void shutdown();
+
+  /// Warnings raised while running (full queues, filter problems); thread-safe snapshot.
+  std::vector<std::string> takeWarnings();
+  /// Statistics; call after shutdown().
+  std::vector<ConnectionStats> connectionStats() const;
+  std::vector<OutputStats> outputStats() const;
+
+ private:
+  struct Impl;
+  Daemon();
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace vrflow::daemon

@@ -1,0 +1,74 @@
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+#include "vrflow/ipc/doorbell.hpp"
+
+namespace vrflow::ipc {
+
+inline constexpr int kMaxPortsPerModule = 32;
+inline constexpr int kNameBytes = 64;
+inline constexpr int kHistogramBuckets = 256;
+
+/// What a module is doing, as seen by the daemon (for deadlock reports and monitoring).
+enum class ModuleState : uint32_t { Starting = 0, Waiting, Computing, Putting, Finished };
+
+/// One port of a module, shared between the module and the daemon.
+struct PortSlot {
+  char name[kNameBytes] = {};
+  uint8_t isInput = 0;
+  uint8_t connected = 0;
+  uint8_t stampsOnly = 0;
+  uint8_t pad = 0;
+  std::atomic<uint32_t> closed{0};   ///< input: no message will ever come again
+  uint64_t ringOffset = 0;           ///< input: daemon -> module; output: module -> daemon
+  std::atomic<uint64_t> messages{0};
+  std::atomic<uint64_t> bytes{0};
+};
+
+/// One module process, shared between the module and the daemon.
+struct ModuleSlot {
+  char id[kNameBytes] = {};
+  char host[kNameBytes] = {};
+  uint32_t portCount = 0;
+  uint32_t declaredByModule = 0;
+  PortSlot ports[kMaxPortsPerModule];
+  Doorbell bell;                              ///< the daemon rings it when this module may go on
+  std::atomic<uint32_t> state{0};             ///< a ModuleState
+  std::atomic<int32_t> waitingPort{-1};       ///< port index while Waiting/Putting
+  std::atomic<uint64_t> iterations{0};
+  uint64_t iterationLimit = 0;                ///< 0: no limit
+  std::atomic<int32_t> pid{0};
+  uint64_t paramsOffset = 0;                  ///< "name=value\n" text
+  uint32_t paramsBytes = 0;
+  std::atomic<uint64_t> computeNs{0};         ///< total time between wait() returning and the next wait()
+  std::atomic<uint64_t> waitNs{0};            ///< total time spent in wait()
+  std::atomic<uint64_t> histogram[kHistogramBuckets];  ///< iteration durations, log-linear buckets
+};
+
+/// The run's table of modules, at SegmentHeader::controlOffset.
+struct ControlTable {
+  uint32_t moduleCount = 0;
+  uint32_t pad = 0;
+  uint64_t modulesOffset = 0;  ///< ModuleSlot[moduleCount]
+};
+
+/// Bucket of a duration in the log-linear histogram (4 sub-buckets per power of two).
+inline int histogramBucket(uint64_t ns) {
+  if (ns < 4) return static_cast<int>(ns);
+  const int msb = 63 - __builtin_clzll(ns);
+  const int sub = static_cast<int>((ns >> (msb - 2)) & 3);
+  const int bucket = msb * 4 + sub;
+  return bucket < kHistogramBuckets ? bucket : kHistogramBuckets - 1;
+}
+
+/// Upper bound (ns) of a histogram bucket.
+inline uint64_t histogramUpperNs(int bucket) {
+  if (bucket < 4) return static_cast<uint64_t>(bucket);
+  const int msb = bucket / 4;
+  const uint64_t sub = static_cast<uint64_t>(bucket % 4);
+  return (uint64_t{1} << msb) + ((sub + 1) << (msb - 2)) - 1;
+}
+
+}  // namespace vrflow::ipc

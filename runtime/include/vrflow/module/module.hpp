@@ -1,0 +1,115 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "vrflow/base/result.hpp"
+#include "vrflow/message/builder.hpp"
+#include "vrflow/module/message.hpp"
+
+namespace vrflow {
+
+class Module;
+
+/// An input port declared by a module.
+class InputPort {
+ public:
+  const std::string& name() const { return name_; }
+  /// True when the application connects something to this port.
+  bool connected() const;
+
+ private:
+  friend class Module;
+  std::string name_;
+  Module* module_ = nullptr;
+  int slot_ = -1;
+};
+
+/// An output port declared by a module.
+class OutputPort {
+ public:
+  const std::string& name() const { return name_; }
+  bool connected() const;
+
+ private:
+  friend class Module;
+  std::string name_;
+  Module* module_ = nullptr;
+  int slot_ = -1;
+};
+
+/// A message being written straight into shared memory; hand it to Module::put().
+class OutgoingMessage {
+ public:
+  OutgoingMessage(OutgoingMessage&&) noexcept;
+  OutgoingMessage& operator=(OutgoingMessage&&) noexcept;
+  ~OutgoingMessage();
+  /// The builder: add chunks, user stamps, set the simulation time.
+  msg::MessageBuilder& builder();
+
+ private:
+  friend class Module;
+  struct Impl;
+  explicit OutgoingMessage(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The module side of the runtime: declare ports, then loop on wait(), get(), put().
+/// One Module per process; it connects to the run that started the process.
+class Module {
+ public:
+  Module();
+  ~Module();
+  Module(const Module&) = delete;
+  Module& operator=(const Module&) = delete;
+
+  /// Declares an input port (as named in the package manifest).
+  InputPort& addInput(std::string name);
+  /// Declares an output port.
+  OutputPort& addOutput(std::string name);
+
+  /// Connects to the run (from the environment the runtime set) and checks the declared ports
+  /// against the application. On error the module should print it and exit non-zero.
+  Status init();
+
+  /// Ends the previous iteration and waits for one message on every connected input port.
+  /// False when the run stops (iteration limit, end of input, Ctrl-C): leave the loop then.
+  bool wait();
+
+  /// The message received on `port` in this iteration (invalid if the port is unconnected).
+  const Message& get(const InputPort& port) const;
+
+  /// Starts a message in shared memory; `sizeHint` bytes are reserved up front.
+  OutgoingMessage newMessage(std::size_t sizeHint = 256);
+  /// Sends a message on `port`; blocks while the port's buffer is full (backpressure).
+  Status put(const OutputPort& port, OutgoingMessage&& message);
+  /// Forwards a received message without copying its bytes.
+  Status put(const OutputPort& port, const Message& message);
+
+  /// This module's id in the application, and the iteration in progress (0-based).
+  const std::string& id() const;
+  uint64_t iteration() const;
+  /// Simulation time and step of this iteration: from the first input message's stamps.
+  double simTime() const;
+  double timeStep() const;
+  /// True once the run asked every module to stop.
+  bool stopRequested() const;
+
+  /// Parameters from the application file (defaults from the manifest filled in).
+  std::string param(std::string_view name, std::string_view fallback = {}) const;
+  double paramDouble(std::string_view name, double fallback) const;
+  int64_t paramInt(std::string_view name, int64_t fallback) const;
+
+  /// A new object or resource id, unique on this host across processes.
+  uint64_t newId();
+
+ private:
+  friend class InputPort;
+  friend class OutputPort;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace vrflow

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vrflow/app/catalog.hpp"
+#include "vrflow/app/model.hpp"
+
+namespace vrflow::run {
+
+/// Exit codes of `vrflow run`, stable for scripts and CI.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitRunFailed = 1,     ///< a module died, a deadlock, a runtime error
+  kExitInvalid = 2,       ///< bad command line or application file
+  kExitTimeout = 3,       ///< --timeout exceeded
+  kExitInterrupted = 130  ///< Ctrl-C or SIGTERM
+};
+
+/// How to run an application on this machine.
+struct RunOptions {
+  uint64_t iterations = 0;            ///< per module; 0 = until the modules end or Ctrl-C
+  double timeoutSeconds = 0;          ///< 0 = no limit
+  double deadlockSeconds = 10;        ///< no progress this long with every module waiting
+  std::size_t segmentBytes = std::size_t{1} << 30;
+  std::string reportPath;             ///< JSON report; empty = none
+  bool progress = false;              ///< live iterations/s on stderr
+  double stopGraceSeconds = 2;        ///< after a stop request, before SIGTERM then SIGKILL
+};
+
+/// What happened, for the report and the exit code.
+struct RunOutcome {
+  int exitCode = kExitOk;
+  std::string status = "ok";  ///< ok, failed, deadlock, timeout, interrupted
+  std::string error;          ///< one line a person can act on; empty on success
+};
+
+/// Runs `application` with every host mapped to this machine (the embedded default): one
+/// daemon in this process, each module in its own process. Returns when every process of the
+/// run has ended; nothing is left behind.
+RunOutcome runApplication(const app::Application& application, const app::Catalog& catalog,
+                          const RunOptions& options);
+
+}  // namespace vrflow::run

@@ -1,0 +1,28 @@
+// core/source: one raw resource chunk per iteration, `size` bytes, the first 8 holding the
+// iteration number. Used by the transport benchmark and the pipeline tests.
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include "vrflow/module/module.hpp"
+
+int main() {
+  using namespace vrflow;
+  Module module;
+  auto& out = module.addOutput("out");
+  if (auto status = module.init(); !status) {
+    std::fprintf(stderr, "vrflow-core-source: %s\n", status.error().message.c_str());
+    return 2;
+  }
+  const auto size = static_cast<std::size_t>(module.paramInt("size", 64));
+  std::vector<std::byte> payload(size < 8 ? 8 : size);
+  const uint64_t resource = module.newId();
+  while (module.wait()) {
+    const uint64_t counter = module.iteration();
+    std::memcpy(payload.data(), &counter, sizeof counter);
+    auto message = module.newMessage(payload.size() + 256);
+    message.builder().addRawResource(resource, true, payload);
+    if (!module.put(out, std::move(message))) break;
+  }
+  return 0;
+}

@@ -1,0 +1,454 @@
+#include "vrflow/daemon/daemon.hpp"
+
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "builtin_filters.hpp"
+#include "graph.hpp"
+#include "vrflow/message/digest.hpp"
+
+namespace vrflow::daemon {
+namespace {
+
+constexpr uint32_t kOutputRingCapacity = 16;
+constexpr uint32_t kInputRingCapacity = 16;
+constexpr int64_t kIdleSleepNs = 100'000'000;
+
+uint64_t nowNs() {
+  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::steady_clock::now().time_since_epoch())
+                                   .count());
+}
+
+void copyName(char (&dst)[ipc::kNameBytes], const std::string& src) {
+  std::strncpy(dst, src.c_str(), ipc::kNameBytes - 1);
+  dst[ipc::kNameBytes - 1] = '\0';
+}
+
+std::map<std::string, std::string> toMap(const std::vector<app::Param>& params) {
+  std::map<std::string, std::string> map;
+  for (const auto& p : params) map[p.name] = p.value;
+  return map;
+}
+
+}  // namespace
+
+struct Daemon::Impl {
+  DaemonOptions options;
+  ipc::Segment segment;
+  std::unique_ptr<Graph> graph;
+  std::vector<ModuleProcess> modules;
+  ipc::ModuleSlot* slots = nullptr;
+  std::vector<std::atomic<bool>> ended;
+  // Per module and port index: the node fed by that port (output filter) or feeding it.
+  std::map<std::pair<int, std::string>, Node*> portNodes;
+  std::map<std::string, Node*> filterNodes;
+  std::vector<std::pair<std::string, PortOutputFilter*>> outputFilters;  // "module.port"
+  std::thread thread;
+  std::atomic<bool> running{false};
+  std::size_t lastBuffered = 0;  ///< messages buffered after the previous pass
+  std::mutex warningsMutex;
+  std::vector<std::string> warnings;
+
+  Status build(const app::Application& application, const app::Catalog& catalog);
+  Result<Node*> addNode(const std::string& id, const std::string& type,
+                        std::map<std::string, std::string> params, std::vector<std::string> inputs,
+                        std::vector<std::string> outputs);
+  void loop();
+  bool pass();
+  void checkFullQueues(uint64_t now);
+  void publishWarnings();
+};
+
+Daemon::Daemon() : impl_(std::make_unique<Impl>()) {}
+
+Daemon::~Daemon() { shutdown(); }
+
+Result<std::unique_ptr<Daemon>> Daemon::create(const app::Application& application,
+                                               const app::Catalog& catalog,
+                                               const DaemonOptions& options) {
+  std::unique_ptr<Daemon> daemon(new Daemon());
+  Impl& d = *daemon->impl_;
+  d.options = options;
+  auto segment = ipc::Segment::create(options.segmentBytes, options.hostId);
+  if (!segment) return segment.error();
+  d.segment = std::move(*segment);
+  d.graph = std::make_unique<Graph>(d.segment);
+  if (auto status = d.build(application, catalog); !status) return status.error();
+  return daemon;
+}
+
+Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& type,
+                                    std::map<std::string, std::string> params,
+                                    std::vector<std::string> inputs,
+                                    std::vector<std::string> outputs) {
+  const FilterFactory* factory = FilterRegistry::instance().find(type);
+  if (factory == nullptr) return makeError("unknown filter type '" + type + "' for '" + id + "'");
+  auto node = std::make_unique<Node>(*graph, id, std::move(params));
+  node->inputNames = std::move(inputs);
+  node->outputNames = std::move(outputs);
+  node->outputs.resize(node->outputNames.size());
+  auto filter = (*factory)(*node);
+  if (!filter) return filter.error();
+  node->filter = std::move(*filter);
+  graph->nodes.push_back(std::move(node));
+  return graph->nodes.back().get();
+}
+
+Status Daemon::Impl::build(const app::Application& application, const app::Catalog& catalog) {
+  // The control table and one slot per module.
+  const uint64_t tableOffset = segment.reserve(sizeof(ipc::ControlTable));
+  const uint64_t slotsOffset = segment.reserve(sizeof(ipc::ModuleSlot) * application.modules.size());
+  if (tableOffset == 0 || (slotsOffset == 0 && !application.modules.empty())) {
+    return makeError("shared-memory segment too small for the control table");
+  }
+  auto* table = new (segment.at<void>(tableOffset)) ipc::ControlTable();
+  table->moduleCount = static_cast<uint32_t>(application.modules.size());
+  table->modulesOffset = slotsOffset;
+  slots = segment.at<ipc::ModuleSlot>(slotsOffset);
+  ended = std::vector<std::atomic<bool>>(application.modules.size());
+
+  // Which ports are connected.
+  std::map<std::pair<std::string, std::string>, int> fanIn;
+  std::map<std::pair<std::string, std::string>, int> fanOut;
+  for (const auto& c : application.connections) {
+    ++fanOut[{c.from.node, c.from.port}];
+    ++fanIn[{c.to.node, c.to.port}];
+  }
+
+  for (std::size_t m = 0; m < application.modules.size(); ++m) {
+    const app::Module& module = application.modules[m];
+    const app::ModuleType* type = catalog.findModule(module.package, module.type);
+    if (type == nullptr) {
+      return makeError("unknown module type '" + module.package + "/" + module.type + "'");
+    }
+    auto* slot = new (&slots[m]) ipc::ModuleSlot();
+    for (auto& bucket : slot->histogram) bucket.store(0);
+    copyName(slot->id, module.id);
+    const std::string host = app::effectiveHost(application, module.host);
+    copyName(slot->host, host);
+    slot->iterationLimit = options.iterationLimit;
+    modules.push_back({module.id, host, type->executable, static_cast<int>(m)});
+
+    // Parameters: manifest defaults, overridden by the file.
+    std::map<std::string, std::string> values;
+    for (const auto& spec : type->params) values[spec.name] = spec.defaultValue;
+    for (const auto& p : module.params) values[p.name] = p.value;
+    std::string text;
+    for (const auto& [name, value] : values) text += name + "=" + value + "\n";
+    slot->paramsOffset = segment.reserve(text.size() + 1, 8);
+    if (slot->paramsOffset == 0) return makeError("shared-memory segment too small");
+    std::memcpy(segment.at<char>(slot->paramsOffset), text.c_str(), text.size() + 1);
+    slot->paramsBytes = static_cast<uint32_t>(text.size());
+
+    const auto ports = catalog.portsOf(module);
+    if (ports.size() > ipc::kMaxPortsPerModule) {
+      return makeError("module '" + module.id + "' has more than " +
+                       std::to_string(ipc::kMaxPortsPerModule) + " ports");
+    }
+    slot->portCount = static_cast<uint32_t>(ports.size());
+    for (std::size_t p = 0; p < ports.size(); ++p) {
+      const app::PortSpec& spec = ports[p];
+      ipc::PortSlot& port = slot->ports[p];
+      copyName(port.name, spec.name);
+      port.isInput = spec.isInput ? 1 : 0;
+      port.stampsOnly = spec.stampsOnly ? 1 : 0;
+      const auto key = std::make_pair(module.id, spec.name);
+      const int fan = spec.isInput ? fanIn[key] : fanOut[key];
+      const app::InputConfig* config = spec.isInput ? app::findInputConfig(module, spec.name) : nullptr;
+      const int initial = config != nullptr ? config->initialMessages : 0;
+      // An input with only initial messages and no connection is still served: it gets them.
+      port.connected = (fan > 0 || initial > 0) ? 1 : 0;
+      uint32_t capacity = spec.isInput ? kInputRingCapacity : kOutputRingCapacity;
+      capacity = std::bit_ceil(std::max<uint32_t>(capacity, static_cast<uint32_t>(initial) + 1));
+      port.ringOffset = segment.reserve(ipc::Ring::bytesFor(capacity));
+      if (port.ringOffset == 0) return makeError("shared-memory segment too small for rings");
+      new (segment.at<void>(port.ringOffset)) ipc::Ring();
+      segment.at<ipc::Ring>(port.ringOffset)->init(capacity);
+      if (!port.connected) continue;
+
+      const std::string nodeId = module.id + "." + spec.name;
+      if (spec.isInput) {
+        std::map<std::string, std::string> params{{"initial", std::to_string(initial)}};
+        const bool latest = config != nullptr && config->mode == app::InputMode::Latest;
+        params["mode"] = latest ? "latest" : "fifo";
+        auto node = addNode(nodeId, "port-input", std::move(params), {}, {"out"});
+        if (!node) return node.error();
+        (*node)->outputs[0].push_back(
+            std::make_unique<RingSink>(segment, *slot, static_cast<int>(p), latest));
+        portNodes[{static_cast<int>(m), spec.name}] = *node;
+      } else {
+        auto node = addNode(nodeId, "port-output", {}, {"in"}, {"out"});
+        if (!node) return node.error();
+        Queue& queue = graph->newQueue();
+        queue.capacity = 4;
+        queue.from = nodeId;
+        queue.to = nodeId;
+        (*node)->inputs.push_back(&queue);
+        graph->sources.push_back({static_cast<int>(m), static_cast<int>(p), &queue, false});
+        portNodes[{static_cast<int>(m), spec.name}] = *node;
+        outputFilters.emplace_back(nodeId, static_cast<PortOutputFilter*>((*node)->filter.get()));
+      }
+    }
+  }
+
+  for (const app::Filter& filter : application.filters) {
+    std::vector<std::string> inputs, outputs;
+    for (const auto& spec : catalog.portsOf(filter)) {
+      (spec.isInput ? inputs : outputs).push_back(spec.name);
+    }
+    auto node = addNode(filter.id, filter.type, toMap(filter.params), inputs, outputs);
+    if (!node) return node.error();
+    (*node)->inputs.assign(inputs.size(), nullptr);
+    filterNodes[filter.id] = *node;
+  }
+
+  // Connections, in file order: each is a queue in front of its destination.
+  auto moduleIndex = [&](const std::string& id) {
+    for (std::size_t m = 0; m < application.modules.size(); ++m) {
+      if (application.modules[m].id == id) return static_cast<int>(m);
+    }
+    return -1;
+  };
+  for (const app::Connection& c : application.connections) {
+    Node* from = nullptr;
+    std::size_t fromOutput = 0;
+    if (const int m = moduleIndex(c.from.node); m >= 0) {
+      from = portNodes[{m, c.from.port}];
+    } else if (filterNodes.count(c.from.node) != 0) {
+      from = filterNodes[c.from.node];
+      const auto& names = from->outputNames;
+      fromOutput = static_cast<std::size_t>(
+          std::find(names.begin(), names.end(), c.from.port) - names.begin());
+      if (fromOutput == names.size()) from = nullptr;
+    }
+    Node* to = nullptr;
+    int toInput = -1;
+    if (const int m = moduleIndex(c.to.node); m >= 0) {
+      to = portNodes[{m, c.to.port}];
+    } else if (filterNodes.count(c.to.node) != 0) {
+      to = filterNodes[c.to.node];
+      const auto& names = to->inputNames;
+      toInput = static_cast<int>(std::find(names.begin(), names.end(), c.to.port) - names.begin());
+      if (toInput == static_cast<int>(names.size())) to = nullptr;
+    }
+    if (from == nullptr || to == nullptr) {
+      return makeError("connection " + app::toString(c.from) + " -> " + app::toString(c.to) +
+                       " names a missing port");
+    }
+    Queue& queue = graph->newQueue();
+    queue.capacity = c.capacity > 0 ? static_cast<std::size_t>(c.capacity) : options.defaultCapacity;
+    queue.policy = c.policy;
+    queue.from = app::toString(c.from);
+    queue.to = app::toString(c.to);
+    queue.isConnection = true;
+    if (toInput < 0) {
+      to->inputs.push_back(&queue);
+    } else {
+      if (to->inputs[static_cast<std::size_t>(toInput)] != nullptr) {
+        return makeError("filter input " + app::toString(c.to) + " has more than one connection");
+      }
+      to->inputs[static_cast<std::size_t>(toInput)] = &queue;
+    }
+    from->outputs[fromOutput].push_back(std::make_unique<QueueSink>(queue));
+  }
+  // A filter input left unconnected never receives anything.
+  for (auto& node : graph->nodes) {
+    for (auto& input : node->inputs) {
+      if (input == nullptr) {
+        Queue& queue = graph->newQueue();
+        queue.closed = true;
+        input = &queue;
+      }
+    }
+  }
+  segment.header().controlOffset = tableOffset;
+  return {};
+}
+
+ipc::Segment& Daemon::segment() { return impl_->segment; }
+const std::vector<ModuleProcess>& Daemon::modules() const { return impl_->modules; }
+ipc::ModuleSlot& Daemon::slot(int index) { return impl_->slots[index]; }
+
+Status Daemon::start() {
+  Impl& d = *impl_;
+  for (auto& node : d.graph->nodes) {
+    if (auto status = node->filter->start(*node); !status) return status;
+  }
+  d.running.store(true);
+  d.thread = std::thread([&d] { d.loop(); });
+  return {};
+}
+
+void Daemon::moduleEnded(int index) {
+  impl_->ended[static_cast<std::size_t>(index)].store(true, std::memory_order_release);
+  impl_->segment.header().daemonBell.ring();
+}
+
+void Daemon::requestStop() {
+  Impl& d = *impl_;
+  d.segment.header().stopRequested.store(1, std::memory_order_release);
+  for (const auto& module : d.modules) d.slots[module.slotIndex].bell.ring();
+  d.segment.header().daemonBell.ring();
+}
+
+void Daemon::shutdown() {
+  Impl& d = *impl_;
+  if (d.running.exchange(false)) {
+    d.segment.header().daemonBell.ring();
+    d.thread.join();
+  }
+  if (!d.graph) return;
+  // Route what the modules sent last (their processes have ended by now), so that the report
+  // sees every message that was put.
+  while (d.pass()) {
+  }
+  // Drop every message still buffered: in queues, and in the rings of every module.
+  for (auto& queue : d.graph->queues) queue.items.clear();
+  for (const auto& module : d.modules) {
+    auto& slot = d.slots[module.slotIndex];
+    for (uint32_t p = 0; p < slot.portCount; ++p) {
+      auto* ring = d.segment.at<ipc::Ring>(slot.ports[p].ringOffset);
+      uint64_t handle = 0;
+      while (ring->pop(handle)) {
+        if (d.segment.validHandle(handle)) d.segment.release(handle);
+      }
+    }
+  }
+}
+
+void Daemon::Impl::loop() {
+  auto& bell = segment.header().daemonBell;
+  uint64_t lastFullCheck = 0;
+  while (running.load(std::memory_order_acquire)) {
+    const uint32_t seen = bell.prepare();
+    bool progressed = false;
+    while (pass()) progressed = true;
+    const uint64_t now = nowNs();
+    if (now - lastFullCheck > 100'000'000) {
+      checkFullQueues(now);
+      lastFullCheck = now;
+    }
+    publishWarnings();
+    if (!progressed) bell.sleep(seen, kIdleSleepNs);
+  }
+}
+
+// One sweep over sources and filters; true if anything moved.
+bool Daemon::Impl::pass() {
+  const uint64_t before = graph->operations;
+  std::size_t buffered = 0;
+  for (auto& source : graph->sources) {
+    if (source.closed) continue;
+    ipc::ModuleSlot& slot = slots[source.module];
+    auto* ring = segment.at<ipc::Ring>(slot.ports[source.port].ringOffset);
+    bool popped = false;
+    uint64_t handle = 0;
+    while (source.queue->items.size() < source.queue->capacity && ring->pop(handle)) {
+      if (!segment.validHandle(handle)) {
+        graph->warnings.push_back(std::string("module '") + slot.id + "' sent an invalid handle on '" +
+                                  slot.ports[source.port].name + "'; dropped");
+        continue;
+      }
+      source.queue->items.emplace_back(&segment, handle);
+      ++source.queue->messages;
+      popped = true;
+      ++graph->operations;
+    }
+    if (popped) slot.bell.ring();  // room on the module's output ring
+    const bool moduleDone =
+        ended[static_cast<std::size_t>(source.module)].load(std::memory_order_acquire) ||
+        slot.state.load(std::memory_order_acquire) ==
+            static_cast<uint32_t>(ipc::ModuleState::Finished);
+    if (moduleDone && ring->empty()) {
+      source.closed = true;
+      source.queue->closed = true;
+      ++graph->operations;
+    }
+  }
+  for (auto& node : graph->nodes) {
+    if (node->closed) continue;
+    node->filter->process(*node);
+    if (node->filter->exhausted(*node)) {
+      node->closed = true;
+      for (auto& output : node->outputs) {
+        for (auto& sink : output) sink->close();
+      }
+      ++graph->operations;
+    }
+    for (auto* queue : node->inputs) buffered += queue->items.size();
+  }
+  const bool moved = graph->operations != before || buffered != lastBuffered;
+  lastBuffered = buffered;
+  return moved;
+}
+
+void Daemon::Impl::checkFullQueues(uint64_t now) {
+  for (auto& queue : graph->queues) {
+    if (!queue.isConnection) continue;
+    if (queue.items.size() < queue.capacity) {
+      queue.fullSinceNs = 0;
+      continue;
+    }
+    if (queue.fullSinceNs == 0) queue.fullSinceNs = now;
+    if (!queue.warnedFull && now - queue.fullSinceNs > options.fullWarningNs) {
+      queue.warnedFull = true;
+      queue.stayedFull = true;
+      const char* policy = queue.policy == app::QueuePolicy::Block      ? "block"
+                           : queue.policy == app::QueuePolicy::DropOldest ? "drop-oldest"
+                                                                            : "drop-newest";
+      graph->warnings.push_back("connection " + queue.from + " -> " + queue.to + " stayed full (" +
+                                std::to_string(queue.capacity) + " messages, policy " + policy +
+                                ")");
+    }
+  }
+}
+
+void Daemon::Impl::publishWarnings() {
+  if (graph->warnings.empty()) return;
+  std::lock_guard lock(warningsMutex);
+  for (auto& w : graph->warnings) warnings.push_back(std::move(w));
+  graph->warnings.clear();
+}
+
+std::vector<std::string> Daemon::takeWarnings() {
+  std::lock_guard lock(impl_->warningsMutex);
+  return std::exchange(impl_->warnings, {});
+}
+
+std::vector<ConnectionStats> Daemon::connectionStats() const {
+  std::vector<ConnectionStats> stats;
+  for (const auto& queue : impl_->graph->queues) {
+    if (!queue.isConnection) continue;
+    stats.push_back({queue.from, queue.to, queue.messages, queue.bytes, queue.dropped,
+                     queue.stayedFull});
+  }
+  return stats;
+}
+
+std::vector<OutputStats> Daemon::outputStats() const {
+  std::vector<OutputStats> stats;
+  for (const auto& [name, filter] : impl_->outputFilters) {
+    OutputStats s;
+    const auto dot = name.rfind('.');
+    s.module = name.substr(0, dot);
+    s.port = name.substr(dot + 1);
+    s.messages = filter->forwarded();
+    if (filter->last().valid()) {
+      if (auto view = filter->last().view()) {
+        s.hasLast = true;
+        s.lastDigest = msg::digest(*view);
+        s.lastIteration = view->stamps().iteration;
+      }
+    }
+    stats.push_back(std::move(s));
+  }
+  return stats;
+}
+
+}  // namespace vrflow::daemon

@@ -1,0 +1,116 @@
+#include "graph.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "../module/shm_sink.hpp"
+
+namespace vrflow::daemon {
+namespace {
+
+uint64_t wallNs() {
+  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::system_clock::now().time_since_epoch())
+                                   .count());
+}
+
+}  // namespace
+
+void QueueSink::push(MessageRef message) {
+  Queue& q = *queue_;
+  const std::size_t size = message.size();
+  if (q.items.size() >= q.capacity) {
+    if (q.policy == app::QueuePolicy::DropNewest) {
+      ++q.dropped;
+      return;
+    }
+    if (q.policy == app::QueuePolicy::DropOldest) {
+      q.items.pop_front();
+      ++q.dropped;
+    }
+  }
+  q.items.push_back(std::move(message));
+  ++q.messages;
+  q.bytes += size;
+}
+
+void RingSink::push(MessageRef message) {
+  const bool pushed = ring().push(message.handle());
+  if (pushed) {
+    message.release();  // the ring holds the reference now
+    slot_->bell.ring();
+  }
+}
+
+void RingSink::close() {
+  slot_->ports[port_].closed.store(1, std::memory_order_release);
+  slot_->bell.ring();
+}
+
+std::string Node::param(const std::string& key, const std::string& fallback) const {
+  const auto it = params_.find(key);
+  return it == params_.end() ? fallback : it->second;
+}
+
+bool Node::canEmit(std::size_t o) const {
+  return std::all_of(outputs[o].begin(), outputs[o].end(),
+                     [](const auto& sink) { return sink->hasSpace(); });
+}
+
+void Node::emit(std::size_t o, MessageRef message) {
+  ++emitted;
+  ++graph_->operations;
+  auto& sinks = outputs[o];
+  if (sinks.empty()) return;  // nothing connected: dropped here, as in FlowVR
+  for (std::size_t i = 0; i + 1 < sinks.size(); ++i) sinks[i]->push(message);
+  sinks.back()->push(std::move(message));
+}
+
+Result<MessageRef> Node::makeEmpty(uint64_t iteration, bool stampsOnly) {
+  detail::ShmSink sink(*graph_->segment, 128);
+  msg::MessageBuilder builder(sink);
+  builder.setSource(id_);
+  builder.setIteration(iteration);
+  builder.setSendTimeNs(wallNs());
+  builder.setStampsOnly(stampsOnly);
+  const std::size_t used = builder.finish();
+  if (used == 0 || sink.data() == nullptr) {
+    return makeError("filter '" + id_ + "': shared memory exhausted");
+  }
+  return MessageRef(graph_->segment, sink.take(used));
+}
+
+Result<MessageRef> Node::concatenate(std::span<const MessageRef> parts) {
+  std::size_t total = 128;
+  for (const auto& part : parts) total += part.size();
+  detail::ShmSink sink(*graph_->segment, total);
+  msg::MessageBuilder builder(sink);
+  bool first = true;
+  uint64_t iteration = 0;
+  double simTime = 0.0;
+  for (const auto& part : parts) {
+    auto view = part.view();
+    if (!view) return makeError("filter '" + id_ + "': malformed message: " + view.error().message);
+    const auto stamps = view->stamps();
+    if (first) {
+      builder.setSource(stamps.source);
+      builder.setTimeStep(stamps.timeStep);
+      builder.setSendTimeNs(stamps.sendTimeNs);
+      first = false;
+    }
+    iteration = std::max(iteration, stamps.iteration);
+    simTime = std::max(simTime, stamps.simTime);
+    builder.appendChunks(*view);
+  }
+  builder.setIteration(iteration);
+  builder.setSimTime(simTime);
+  const std::size_t used = builder.finish();
+  if (used == 0 || sink.data() == nullptr) {
+    return makeError("filter '" + id_ + "': shared memory exhausted");
+  }
+  return MessageRef(graph_->segment, sink.take(used));
+}
+
+void Node::warn(const std::string& message) { graph_->warnings.push_back(message); }
+
+}  // namespace vrflow::daemon

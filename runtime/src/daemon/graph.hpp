@@ -1,0 +1,132 @@
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vrflow/app/model.hpp"
+#include "vrflow/daemon/filter.hpp"
+#include "vrflow/ipc/control.hpp"
+#include "vrflow/ipc/ring.hpp"
+
+namespace vrflow::daemon {
+
+/// A bounded FIFO in front of a filter input: one per connection.
+struct Queue {
+  std::deque<MessageRef> items;
+  std::size_t capacity = 16;
+  app::QueuePolicy policy = app::QueuePolicy::Block;
+  bool closed = false;
+  std::string from, to;
+  uint64_t messages = 0, bytes = 0, dropped = 0;
+  uint64_t fullSinceNs = 0;
+  bool warnedFull = false;
+  bool stayedFull = false;
+  bool isConnection = false;  ///< false for the internal ring -> output-filter hop
+};
+
+/// Where an output's messages go: a filter's queue here, a module's input ring here, or (later)
+/// a peer daemon over the network.
+class Sink {
+ public:
+  virtual ~Sink() = default;
+  virtual bool hasSpace() const = 0;
+  virtual void push(MessageRef message) = 0;
+  virtual void close() = 0;
+};
+
+/// A sink that appends to a queue, honouring its capacity and policy.
+class QueueSink final : public Sink {
+ public:
+  explicit QueueSink(Queue& queue) : queue_(&queue) {}
+  bool hasSpace() const override {
+    return queue_->policy != app::QueuePolicy::Block || queue_->items.size() < queue_->capacity;
+  }
+  void push(MessageRef message) override;
+  void close() override { queue_->closed = true; }
+
+ private:
+  Queue* queue_;
+};
+
+/// A sink that hands messages to a module's input ring and wakes the module.
+class RingSink final : public Sink {
+ public:
+  RingSink(ipc::Segment& segment, ipc::ModuleSlot& slot, int port, bool onlyWhenEmpty)
+      : segment_(&segment), slot_(&slot), port_(port), onlyWhenEmpty_(onlyWhenEmpty) {}
+  bool hasSpace() const override {
+    const auto& ring = this->ring();
+    return onlyWhenEmpty_ ? ring.empty() : !ring.full();
+  }
+  void push(MessageRef message) override;
+  void close() override;
+
+ private:
+  ipc::Ring& ring() const {
+    return *segment_->at<ipc::Ring>(slot_->ports[port_].ringOffset);
+  }
+  ipc::Segment* segment_;
+  ipc::ModuleSlot* slot_;
+  int port_;
+  bool onlyWhenEmpty_;
+};
+
+class Graph;
+
+/// A filter with its inputs (queues) and outputs (sinks); also its FilterContext.
+class Node final : public FilterContext {
+ public:
+  Node(Graph& graph, std::string id, std::map<std::string, std::string> params)
+      : graph_(&graph), id_(std::move(id)), params_(std::move(params)) {}
+
+  const std::string& name() const override { return id_; }
+  std::string param(const std::string& key, const std::string& fallback) const override;
+  std::size_t inputCount() const override { return inputs.size(); }
+  std::deque<MessageRef>& input(std::size_t i) override { return inputs[i]->items; }
+  bool inputClosed(std::size_t i) const override { return inputs[i]->closed; }
+  std::size_t outputCount() const override { return outputs.size(); }
+  bool canEmit(std::size_t o) const override;
+  void emit(std::size_t o, MessageRef message) override;
+  Result<MessageRef> makeEmpty(uint64_t iteration, bool stampsOnly) override;
+  Result<MessageRef> concatenate(std::span<const MessageRef> parts) override;
+  void warn(const std::string& message) override;
+
+  std::unique_ptr<Filter> filter;
+  std::vector<Queue*> inputs;
+  std::vector<std::string> inputNames, outputNames;
+  std::vector<std::vector<std::unique_ptr<Sink>>> outputs;
+  bool closed = false;
+  uint64_t emitted = 0;
+
+ private:
+  Graph* graph_;
+  std::string id_;
+  std::map<std::string, std::string> params_;
+};
+
+/// A module output ring feeding the queue of its port's output filter.
+struct ModuleSource {
+  int module = 0;
+  int port = 0;
+  Queue* queue = nullptr;
+  bool closed = false;
+};
+
+/// The whole routing network of one daemon.
+class Graph {
+ public:
+  explicit Graph(ipc::Segment& shared) : segment(&shared) {}
+  Queue& newQueue() { return queues.emplace_back(); }
+
+  ipc::Segment* segment;
+  std::deque<Queue> queues;
+  std::vector<std::unique_ptr<Node>> nodes;
+  std::vector<ModuleSource> sources;
+  std::vector<std::string> warnings;
+  uint64_t operations = 0;  ///< bumped on every move, to detect progress
+};
+
+}  // namespace vrflow::daemon

@@ -1,0 +1,41 @@
+#include "vrflow/ipc/doorbell.hpp"
+
+#include <linux/futex.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <climits>
+#include <ctime>
+
+namespace vrflow::ipc {
+namespace {
+
+// Shared (not FUTEX_PRIVATE) futexes: the word lives in memory mapped by several processes.
+long futex(std::atomic<uint32_t>* word, int op, uint32_t value, const timespec* timeout) {
+  return syscall(SYS_futex, reinterpret_cast<uint32_t*>(word), op, value, timeout, nullptr, 0);
+}
+
+}  // namespace
+
+void Doorbell::sleep(uint32_t seen, int64_t timeoutNs) {
+  sleepers.fetch_add(1, std::memory_order_seq_cst);
+  // Re-check after announcing ourselves: a ring() between prepare() and here is not lost,
+  // because ring() increments the sequence before it reads the sleeper count.
+  if (sequence.load(std::memory_order_seq_cst) == seen) {
+    if (timeoutNs < 0) {
+      futex(&sequence, FUTEX_WAIT, seen, nullptr);
+    } else {
+      timespec ts{static_cast<time_t>(timeoutNs / 1'000'000'000),
+                  static_cast<long>(timeoutNs % 1'000'000'000)};
+      futex(&sequence, FUTEX_WAIT, seen, &ts);
+    }
+  }
+  sleepers.fetch_sub(1, std::memory_order_seq_cst);
+}
+
+void Doorbell::ring() {
+  sequence.fetch_add(1, std::memory_order_seq_cst);
+  if (sleepers.load(std::memory_order_seq_cst) != 0) futex(&sequence, FUTEX_WAKE, INT_MAX, nullptr);
+}
+
+}  // namespace vrflow::ipc

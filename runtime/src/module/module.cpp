@@ -1,0 +1,351 @@
+#include "vrflow/module/module.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <map>
+#include <vector>
+
+#include "shm_sink.hpp"
+#include "vrflow/base/assert.hpp"
+#include "vrflow/ipc/control.hpp"
+#include "vrflow/ipc/ring.hpp"
+
+namespace vrflow {
+namespace {
+
+uint64_t nowNs() {
+  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::steady_clock::now().time_since_epoch())
+                                   .count());
+}
+
+uint64_t wallNs() {
+  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::system_clock::now().time_since_epoch())
+                                   .count());
+}
+
+constexpr int64_t kPollNs = 200'000'000;  // re-check the stop flag at least this often
+
+}  // namespace
+
+struct OutgoingMessage::Impl {
+  Impl(ipc::Segment& segment, std::size_t hint) : sink(segment, hint), builder(sink) {}
+  detail::ShmSink sink;
+  msg::MessageBuilder builder;
+};
+
+OutgoingMessage::OutgoingMessage(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+OutgoingMessage::OutgoingMessage(OutgoingMessage&&) noexcept = default;
+OutgoingMessage& OutgoingMessage::operator=(OutgoingMessage&&) noexcept = default;
+OutgoingMessage::~OutgoingMessage() = default;
+msg::MessageBuilder& OutgoingMessage::builder() { return impl_->builder; }
+
+struct Module::Impl {
+  ipc::Segment segment;
+  ipc::ModuleSlot* slot = nullptr;
+  std::string id;
+  std::deque<InputPort> inputs;
+  std::deque<OutputPort> outputs;
+  std::vector<Message> current;         // by port slot index
+  std::vector<int> waitOrder;           // connected input slots, in port order
+  int endItSlot = -1;
+  bool started = false;
+  bool finished = false;
+  bool initialized = false;
+  uint64_t iteration = 0;
+  uint64_t iterationStartNs = 0;
+  double simTime = 0.0;
+  double timeStep = 0.0;
+  std::map<std::string, std::string, std::less<>> params;
+
+  ipc::Ring& ring(int portSlot) { return *segment.at<ipc::Ring>(slot->ports[portSlot].ringOffset); }
+  bool stopRequested() const {
+    return segment.header().stopRequested.load(std::memory_order_acquire) != 0;
+  }
+  int findPort(std::string_view name, bool input) const {
+    for (uint32_t i = 0; i < slot->portCount; ++i) {
+      const auto& port = slot->ports[i];
+      if ((port.isInput != 0) == input && name == port.name) return static_cast<int>(i);
+    }
+    return -1;
+  }
+  void setState(ipc::ModuleState state, int port = -1) {
+    slot->waitingPort.store(port, std::memory_order_relaxed);
+    slot->state.store(static_cast<uint32_t>(state), std::memory_order_release);
+  }
+  // Pushes a handle on an output ring, sleeping while it is full. False if the run stops.
+  bool push(int portSlot, uint64_t handle) {
+    ipc::Ring& out = ring(portSlot);
+    setState(ipc::ModuleState::Putting, portSlot);
+    while (!out.push(handle)) {
+      if (stopRequested()) return false;
+      const uint32_t seen = slot->bell.prepare();
+      if (out.push(handle)) break;
+      slot->bell.sleep(seen, kPollNs);
+    }
+    auto& port = slot->ports[portSlot];
+    port.messages.fetch_add(1, std::memory_order_relaxed);
+    port.bytes.fetch_add(segment.block(handle).used, std::memory_order_relaxed);
+    segment.header().daemonBell.ring();
+    setState(ipc::ModuleState::Computing);
+    return true;
+  }
+  void endIteration() {
+    const uint64_t now = nowNs();
+    const uint64_t took = now - iterationStartNs;
+    slot->computeNs.fetch_add(took, std::memory_order_relaxed);
+    slot->histogram[ipc::histogramBucket(took)].fetch_add(1, std::memory_order_relaxed);
+    if (endItSlot >= 0 && slot->ports[endItSlot].connected) {
+      detail::ShmSink sink(segment, 64);
+      msg::MessageBuilder builder(sink);
+      builder.setSource(id);
+      builder.setIteration(iteration);
+      builder.setSimTime(simTime);
+      builder.setTimeStep(timeStep);
+      builder.setSendTimeNs(wallNs());
+      builder.setStampsOnly(true);
+      const std::size_t used = builder.finish();
+      const uint64_t handle = sink.take(used);
+      if (!push(endItSlot, handle)) segment.release(handle);
+    }
+    ++iteration;
+    slot->iterations.store(iteration, std::memory_order_release);
+  }
+  void finish() {
+    if (finished) return;
+    finished = true;
+    current.clear();
+    setState(ipc::ModuleState::Finished);
+    segment.header().daemonBell.ring();
+  }
+};
+
+bool InputPort::connected() const {
+  return module_->impl_->slot && slot_ >= 0 && module_->impl_->slot->ports[slot_].connected;
+}
+bool OutputPort::connected() const {
+  return module_->impl_->slot && slot_ >= 0 && module_->impl_->slot->ports[slot_].connected;
+}
+
+Module::Module() : impl_(std::make_unique<Impl>()) {}
+
+Module::~Module() {
+  if (impl_->slot != nullptr) impl_->finish();
+}
+
+InputPort& Module::addInput(std::string name) {
+  VRFLOW_ASSERT(!impl_->initialized, "declare ports before init()");
+  auto& port = impl_->inputs.emplace_back();
+  port.name_ = std::move(name);
+  port.module_ = this;
+  return port;
+}
+
+OutputPort& Module::addOutput(std::string name) {
+  VRFLOW_ASSERT(!impl_->initialized, "declare ports before init()");
+  auto& port = impl_->outputs.emplace_back();
+  port.name_ = std::move(name);
+  port.module_ = this;
+  return port;
+}
+
+Status Module::init() {
+  Impl& m = *impl_;
+  const char* fdText = std::getenv("VRFLOW_SEGMENT_FD");
+  const char* indexText = std::getenv("VRFLOW_MODULE_INDEX");
+  if (fdText == nullptr || indexText == nullptr) {
+    return makeError("this program is a vrflow module: start it through an application "
+                     "(`vrflow run APP.xml`), not by hand");
+  }
+  const int fd = std::atoi(fdText);
+  const long index = std::atol(indexText);
+  auto segment = ipc::Segment::attach(fd);
+  if (!segment) return makeError("cannot join the run: " + segment.error().message);
+  m.segment = std::move(*segment);
+  const auto offset = m.segment.header().controlOffset;
+  if (offset == 0 || !m.segment.contains(offset, sizeof(ipc::ControlTable))) {
+    return makeError("cannot join the run: the segment has no control table");
+  }
+  const auto& table = *m.segment.at<ipc::ControlTable>(offset);
+  if (index < 0 || index >= static_cast<long>(table.moduleCount)) {
+    return makeError("cannot join the run: module index out of range");
+  }
+  m.slot = m.segment.at<ipc::ModuleSlot>(table.modulesOffset) + index;
+  m.id = m.slot->id;
+  m.slot->pid.store(static_cast<int32_t>(getpid()));
+  m.current.resize(m.slot->portCount);
+
+  // Parameters: "name=value" lines.
+  std::string_view text(m.segment.at<char>(m.slot->paramsOffset), m.slot->paramsBytes);
+  while (!text.empty()) {
+    const auto eol = text.find('\n');
+    const auto line = text.substr(0, eol);
+    const auto eq = line.find('=');
+    if (eq != std::string_view::npos) m.params.emplace(line.substr(0, eq), line.substr(eq + 1));
+    if (eol == std::string_view::npos) break;
+    text.remove_prefix(eol + 1);
+  }
+
+  // Match declared ports with the run's.
+  std::vector<bool> declared(m.slot->portCount, false);
+  for (auto& port : m.inputs) {
+    port.slot_ = m.findPort(port.name_, true);
+    if (port.slot_ < 0) {
+      return makeError("module '" + m.id + "' declares input port '" + port.name_ +
+                       "' that its package manifest does not list");
+    }
+    declared[static_cast<std::size_t>(port.slot_)] = true;
+  }
+  for (auto& port : m.outputs) {
+    port.slot_ = m.findPort(port.name_, false);
+    if (port.slot_ < 0) {
+      return makeError("module '" + m.id + "' declares output port '" + port.name_ +
+                       "' that its package manifest does not list");
+    }
+    declared[static_cast<std::size_t>(port.slot_)] = true;
+  }
+  for (uint32_t i = 0; i < m.slot->portCount; ++i) {
+    const auto& port = m.slot->ports[i];
+    const std::string_view name = port.name;
+    const bool implicit = name == "beginIt" || name == "endIt";
+    if (name == "endIt" && !port.isInput) m.endItSlot = static_cast<int>(i);
+    if (!declared[i] && !implicit && port.connected) {
+      return makeError("module '" + m.id + "' does not declare port '" + std::string(name) +
+                       "' that the application connects");
+    }
+    if (port.isInput && port.connected) m.waitOrder.push_back(static_cast<int>(i));
+  }
+  m.initialized = true;
+  m.setState(ipc::ModuleState::Computing);
+  return {};
+}
+
+bool Module::wait() {
+  Impl& m = *impl_;
+  VRFLOW_ASSERT(m.initialized, "call init() before wait()");
+  if (m.finished) return false;
+  if (m.started) m.endIteration();
+  m.started = true;
+  if (m.slot->iterationLimit != 0 && m.iteration >= m.slot->iterationLimit) {
+    m.finish();
+    return false;
+  }
+  const uint64_t waitStart = nowNs();
+  for (const int portSlot : m.waitOrder) {
+    auto& port = m.slot->ports[portSlot];
+    ipc::Ring& in = m.ring(portSlot);
+    m.setState(ipc::ModuleState::Waiting, portSlot);
+    uint64_t handle = 0;
+    for (;;) {
+      if (m.stopRequested()) {
+        m.finish();
+        return false;
+      }
+      const uint32_t seen = m.slot->bell.prepare();
+      if (in.pop(handle)) break;
+      if (port.closed.load(std::memory_order_acquire) != 0 && in.empty()) {
+        m.finish();  // end of input: every upstream module has ended
+        return false;
+      }
+      m.slot->bell.sleep(seen, kPollNs);
+    }
+    m.segment.header().daemonBell.ring();  // room freed on this ring
+    auto message = Message::adopt(m.segment, handle);
+    if (!message) {
+      std::fprintf(stderr, "vrflow: module '%s': malformed message on input '%s': %s\n",
+                   m.id.c_str(), port.name, message.error().message.c_str());
+      std::_Exit(3);
+    }
+    m.current[static_cast<std::size_t>(portSlot)] = std::move(*message);
+  }
+  const uint64_t now = nowNs();
+  m.slot->waitNs.fetch_add(now - waitStart, std::memory_order_relaxed);
+  m.iterationStartNs = now;
+  if (!m.waitOrder.empty()) {
+    const auto stamps = m.current[static_cast<std::size_t>(m.waitOrder.front())]->stamps();
+    m.simTime = stamps.simTime;
+    m.timeStep = stamps.timeStep;
+  }
+  m.setState(ipc::ModuleState::Computing);
+  return true;
+}
+
+const Message& Module::get(const InputPort& port) const {
+  VRFLOW_ASSERT(port.module_ == this && port.slot_ >= 0, "port of another module or before init()");
+  return impl_->current[static_cast<std::size_t>(port.slot_)];
+}
+
+OutgoingMessage Module::newMessage(std::size_t sizeHint) {
+  auto impl = std::make_unique<OutgoingMessage::Impl>(impl_->segment, sizeHint);
+  auto& builder = impl->builder;
+  builder.setSource(impl_->id);
+  builder.setIteration(impl_->iteration);
+  builder.setSimTime(impl_->simTime);
+  builder.setTimeStep(impl_->timeStep);
+  return OutgoingMessage(std::move(impl));
+}
+
+Status Module::put(const OutputPort& port, OutgoingMessage&& message) {
+  VRFLOW_ASSERT(port.module_ == this && port.slot_ >= 0, "port of another module or before init()");
+  auto& builder = message.impl_->builder;
+  builder.setSendTimeNs(wallNs());
+  const std::size_t used = builder.finish();
+  if (used == 0 || message.impl_->sink.data() == nullptr) {
+    return makeError("module '" + impl_->id + "': shared memory exhausted while building a message for '" +
+                     port.name_ + "' (raise --shm-size)");
+  }
+  const uint64_t handle = message.impl_->sink.take(used);
+  if (!impl_->push(port.slot_, handle)) {
+    impl_->segment.release(handle);
+    return makeError("run stopped");
+  }
+  return {};
+}
+
+Status Module::put(const OutputPort& port, const Message& message) {
+  VRFLOW_ASSERT(port.module_ == this && port.slot_ >= 0, "port of another module or before init()");
+  if (!message.valid()) return makeError("cannot forward an empty message");
+  impl_->segment.retain(message.handle());
+  if (!impl_->push(port.slot_, message.handle())) {
+    impl_->segment.release(message.handle());
+    return makeError("run stopped");
+  }
+  return {};
+}
+
+const std::string& Module::id() const { return impl_->id; }
+uint64_t Module::iteration() const { return impl_->iteration; }
+double Module::simTime() const { return impl_->simTime; }
+double Module::timeStep() const { return impl_->timeStep; }
+bool Module::stopRequested() const { return impl_->stopRequested(); }
+
+std::string Module::param(std::string_view name, std::string_view fallback) const {
+  const auto it = impl_->params.find(name);
+  return it == impl_->params.end() ? std::string(fallback) : it->second;
+}
+
+double Module::paramDouble(std::string_view name, double fallback) const {
+  const auto it = impl_->params.find(name);
+  if (it == impl_->params.end()) return fallback;
+  char* end = nullptr;
+  const double value = std::strtod(it->second.c_str(), &end);
+  return end != it->second.c_str() ? value : fallback;
+}
+
+int64_t Module::paramInt(std::string_view name, int64_t fallback) const {
+  const auto it = impl_->params.find(name);
+  if (it == impl_->params.end()) return fallback;
+  char* end = nullptr;
+  const long long value = std::strtoll(it->second.c_str(), &end, 10);
+  return end != it->second.c_str() ? value : fallback;
+}
+
+uint64_t Module::newId() { return impl_->segment.newId(); }
+
+}  // namespace vrflow

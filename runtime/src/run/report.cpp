@@ -1,0 +1,107 @@
+#include "report.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+namespace vrflow::run {
+namespace {
+
+double percentileMs(const ipc::ModuleSlot& slot, double fraction) {
+  uint64_t total = 0;
+  for (const auto& bucket : slot.histogram) total += bucket.load();
+  if (total == 0) return 0.0;
+  const auto target = static_cast<uint64_t>(fraction * static_cast<double>(total) + 0.999999);
+  uint64_t seen = 0;
+  for (int b = 0; b < ipc::kHistogramBuckets; ++b) {
+    seen += slot.histogram[b].load();
+    if (seen >= target) return static_cast<double>(ipc::histogramUpperNs(b)) / 1e6;
+  }
+  return 0.0;
+}
+
+std::string hex(uint64_t value) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+}  // namespace
+
+Status writeReport(const std::string& path, const app::Application& application,
+                   daemon::Daemon& daemon, const std::vector<ModuleEnd>& ends,
+                   const RunOutcome& outcome, const RunOptions& options, double wallSeconds,
+                   const std::vector<std::string>& warnings) {
+  using nlohmann::ordered_json;
+  ordered_json report;
+  report["format"] = "vrflow-run-report/1";
+  report["application"] = application.name;
+  report["file"] = application.file;
+  report["status"] = outcome.status;
+  report["error"] = outcome.error;
+  report["iterations_requested"] = options.iterations;
+
+  ordered_json modules = ordered_json::array();
+  for (std::size_t i = 0; i < daemon.modules().size(); ++i) {
+    const auto& module = daemon.modules()[i];
+    const ipc::ModuleSlot& slot = daemon.slot(module.slotIndex);
+    const uint64_t iterations = slot.iterations.load();
+    ordered_json m;
+    m["id"] = module.id;
+    m["host"] = module.host;
+    m["iterations"] = iterations;
+    m["exit"] = ends[i].exit;
+    ordered_json timing;
+    const double computeS = static_cast<double>(slot.computeNs.load()) / 1e9;
+    timing["iteration_ms_mean"] = iterations ? computeS * 1e3 / static_cast<double>(iterations) : 0.0;
+    timing["iteration_ms_p99"] = percentileMs(slot, 0.99);
+    timing["compute_s"] = computeS;
+    timing["wait_s"] = static_cast<double>(slot.waitNs.load()) / 1e9;
+    m["timing"] = timing;
+    modules.push_back(m);
+  }
+  report["modules"] = modules;
+
+  ordered_json connections = ordered_json::array();
+  for (const auto& c : daemon.connectionStats()) {
+    ordered_json j;
+    j["from"] = c.from;
+    j["to"] = c.to;
+    j["messages"] = c.messages;
+    j["bytes"] = c.bytes;
+    j["dropped"] = c.dropped;
+    j["stayed_full"] = c.stayedFull;
+    connections.push_back(j);
+  }
+  report["connections"] = connections;
+
+  ordered_json outputs = ordered_json::array();
+  for (const auto& o : daemon.outputStats()) {
+    ordered_json j;
+    j["module"] = o.module;
+    j["port"] = o.port;
+    j["messages"] = o.messages;
+    if (o.hasLast) {
+      j["last_iteration"] = o.lastIteration;
+      j["last_digest"] = hex(o.lastDigest);
+    } else {
+      j["last_iteration"] = nullptr;
+      j["last_digest"] = nullptr;
+    }
+    outputs.push_back(j);
+  }
+  report["outputs"] = outputs;
+  report["warnings"] = warnings;
+  ordered_json timing;
+  timing["wall_s"] = wallSeconds;
+  timing["segment_peak_bytes"] = daemon.segment().header().peakInUseBytes.load();
+  report["timing"] = timing;
+
+  std::ofstream out(path);
+  if (!out) return makeError("cannot write the report '" + path + "'");
+  out << report.dump(2) << "\n";
+  if (!out) return makeError("cannot write the report '" + path + "'");
+  return {};
+}
+
+}  // namespace vrflow::run

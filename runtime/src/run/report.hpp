@@ -1,0 +1,23 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "vrflow/daemon/daemon.hpp"
+#include "vrflow/run/runner.hpp"
+
+namespace vrflow::run {
+
+/// What the supervisor knows of one module at the end.
+struct ModuleEnd {
+  std::string exit;  ///< "status 0", "signal 9", "running" (killed at stop)
+};
+
+/// Writes the run report (JSON) described in the README. Deterministic fields first; timings
+/// are grouped under "timing" objects so that two runs can be diffed without them.
+Status writeReport(const std::string& path, const app::Application& application,
+                   daemon::Daemon& daemon, const std::vector<ModuleEnd>& ends,
+                   const RunOutcome& outcome, const RunOptions& options, double wallSeconds,
+                   const std::vector<std::string>& warnings);
+
+}  // namespace vrflow::run

@@ -1,0 +1,312 @@
+#include "vrflow/run/runner.hpp"
+
+#include <signal.h>
+#include <sys/ioctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <thread>
+
+#include "report.hpp"
+#include "spawn.hpp"
+#include "vrflow/daemon/daemon.hpp"
+#include "vrflow/message/ids.hpp"
+
+namespace vrflow::run {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+const char* stateName(uint32_t state) {
+  switch (static_cast<ipc::ModuleState>(state)) {
+    case ipc::ModuleState::Starting: return "starting";
+    case ipc::ModuleState::Waiting: return "waiting";
+    case ipc::ModuleState::Computing: return "computing";
+    case ipc::ModuleState::Putting: return "blocked sending";
+    case ipc::ModuleState::Finished: return "finished";
+  }
+  return "?";
+}
+
+// Who feeds an input port, for deadlock reports.
+std::string sourcesOf(const app::Application& application, const std::string& module,
+                      const std::string& port) {
+  std::string text;
+  for (const auto& c : application.connections) {
+    if (c.to.node == module && c.to.port == port) {
+      text += (text.empty() ? "" : ", ") + app::toString(c.from);
+    }
+  }
+  return text.empty() ? "initial messages only" : "from " + text;
+}
+
+class Supervisor {
+ public:
+  Supervisor(const app::Application& application, const RunOptions& options,
+             daemon::Daemon& daemon)
+      : application_(application), options_(options), daemon_(daemon) {}
+
+  RunOutcome run();
+
+ private:
+  struct Child {
+    pid_t pid = 0;
+    bool alive = false;
+    ModuleEnd end{"not started"};
+  };
+  void reap(RunOutcome& outcome, bool stopping);
+  void stopAll();
+  std::size_t liveCount() const;
+  bool deadlocked(std::string& detail);
+  void showProgress(bool final);
+
+  const app::Application& application_;
+  const RunOptions& options_;
+  daemon::Daemon& daemon_;
+  std::vector<Child> children_;
+  Clock::time_point start_ = Clock::now();
+  uint64_t lastIterationSum_ = 0;
+  Clock::time_point lastProgress_ = Clock::now();
+  Clock::time_point lastDisplay_ = Clock::now();
+  std::vector<uint64_t> lastDisplayIterations_;
+  bool displayed_ = false;
+
+ public:
+  std::vector<ModuleEnd> ends() const {
+    std::vector<ModuleEnd> result;
+    for (const auto& c : children_) result.push_back(c.end);
+    return result;
+  }
+};
+
+std::size_t Supervisor::liveCount() const {
+  std::size_t n = 0;
+  for (const auto& c : children_) n += c.alive ? 1 : 0;
+  return n;
+}
+
+void Supervisor::reap(RunOutcome& outcome, bool stopping) {
+  int status = 0;
+  pid_t pid = 0;
+  while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
+    for (std::size_t i = 0; i < children_.size(); ++i) {
+      Child& child = children_[i];
+      if (child.pid != pid || !child.alive) continue;
+      child.alive = false;
+      child.end.exit = WIFEXITED(status) ? "status " + std::to_string(WEXITSTATUS(status))
+                                         : "signal " + std::to_string(WTERMSIG(status));
+      daemon_.moduleEnded(static_cast<int>(i));
+      const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+      if (!clean && !stopping && outcome.exitCode == kExitOk) {
+        const auto& module = daemon_.modules()[i];
+        outcome.exitCode = kExitRunFailed;
+        outcome.status = "failed";
+        outcome.error = "module '" + module.id + "' (host " + module.host + ", pid " +
+                        std::to_string(pid) + ") " + describeWaitStatus(status);
+      }
+    }
+  }
+}
+
+bool Supervisor::deadlocked(std::string& detail) {
+  uint64_t sum = 0;
+  bool allWaiting = true;
+  for (std::size_t i = 0; i < children_.size(); ++i) {
+    const auto& slot = daemon_.slot(daemon_.modules()[i].slotIndex);
+    sum += slot.iterations.load();
+    if (!children_[i].alive) continue;
+    const auto state = static_cast<ipc::ModuleState>(slot.state.load());
+    if (state != ipc::ModuleState::Waiting && state != ipc::ModuleState::Putting) allWaiting = false;
+  }
+  const auto now = Clock::now();
+  if (sum != lastIterationSum_ || !allWaiting || liveCount() == 0) {
+    lastIterationSum_ = sum;
+    lastProgress_ = now;
+    return false;
+  }
+  if (std::chrono::duration<double>(now - lastProgress_).count() < options_.deadlockSeconds) {
+    return false;
+  }
+  detail.clear();
+  for (std::size_t i = 0; i < children_.size(); ++i) {
+    if (!children_[i].alive) continue;
+    const auto& module = daemon_.modules()[i];
+    const auto& slot = daemon_.slot(module.slotIndex);
+    const int port = slot.waitingPort.load();
+    const auto state = static_cast<ipc::ModuleState>(slot.state.load());
+    detail += (detail.empty() ? "" : "; ") + std::string("module '") + module.id + "' ";
+    if (port >= 0 && state == ipc::ModuleState::Waiting) {
+      detail += "waits on input '" + std::string(slot.ports[port].name) + "' (" +
+                sourcesOf(application_, module.id, slot.ports[port].name) + ")";
+    } else if (port >= 0) {
+      detail += "is blocked sending on '" + std::string(slot.ports[port].name) + "'";
+    } else {
+      detail += stateName(slot.state.load());
+    }
+    detail += " at iteration " + std::to_string(slot.iterations.load());
+  }
+  return true;
+}
+
+void Supervisor::showProgress(bool final) {
+  if (!options_.progress) return;
+  const auto now = Clock::now();
+  const double dt = std::chrono::duration<double>(now - lastDisplay_).count();
+  if (!final && dt < 1.0) return;
+  std::string line = "\r[vrflow " + std::to_string(static_cast<int>(secondsSince(start_))) + "s]";
+  lastDisplayIterations_.resize(children_.size(), 0);
+  for (std::size_t i = 0; i < children_.size(); ++i) {
+    const auto& module = daemon_.modules()[i];
+    const uint64_t it = daemon_.slot(module.slotIndex).iterations.load();
+    const double rate = dt > 0 ? static_cast<double>(it - lastDisplayIterations_[i]) / dt : 0.0;
+    lastDisplayIterations_[i] = it;
+    char text[128];
+    std::snprintf(text, sizeof text, "  %s %.0f it/s", module.id.c_str(), rate);
+    line += text;
+  }
+  winsize ws{};
+  if (ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 10 && line.size() > ws.ws_col) {
+    line.resize(ws.ws_col);
+  }
+  line += "\033[K";
+  std::fputs(line.c_str(), stderr);
+  if (final) std::fputs("\n", stderr);
+  displayed_ = true;
+  lastDisplay_ = now;
+}
+
+void Supervisor::stopAll() {
+  daemon_.requestStop();
+  RunOutcome ignored;
+  const auto graceEnd = Clock::now() + std::chrono::duration<double>(options_.stopGraceSeconds);
+  while (liveCount() > 0 && Clock::now() < graceEnd) {
+    reap(ignored, true);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  for (int round = 0; round < 2 && liveCount() > 0; ++round) {
+    const int sig = round == 0 ? SIGTERM : SIGKILL;
+    for (auto& child : children_) {
+      if (child.alive) kill(child.pid, sig);
+    }
+    const auto end = Clock::now() + std::chrono::seconds(1);
+    while (liveCount() > 0 && (round == 1 || Clock::now() < end)) {
+      reap(ignored, true);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+}
+
+RunOutcome Supervisor::run() {
+  RunOutcome outcome;
+  // Signals are blocked (by runApplication) and taken synchronously here; module processes
+  // restore them before exec.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGCHLD);
+  if (auto status = daemon_.start(); !status) {
+    return {kExitRunFailed, "failed", status.error().message};
+  }
+  const int fd = daemon_.segment().fd();
+  children_.resize(daemon_.modules().size());
+  for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
+    const auto& module = daemon_.modules()[i];
+    auto pid = spawnModule(module.executable, {}, fd,
+                           {"VRFLOW_SEGMENT_FD=" + std::to_string(fd),
+                            "VRFLOW_MODULE_INDEX=" + std::to_string(module.slotIndex),
+                            "VRFLOW_MODULE_ID=" + module.id, "VRFLOW_HOST=" + module.host});
+    if (!pid) {
+      outcome = {kExitRunFailed, "failed", "module '" + module.id + "': " + pid.error().message};
+      break;
+    }
+    children_[i].pid = *pid;
+    children_[i].alive = true;
+    children_[i].end.exit = "running";
+  }
+
+  while (outcome.exitCode == kExitOk && liveCount() > 0) {
+    timespec tick{0, 50'000'000};
+    siginfo_t info{};
+    const int sig = sigtimedwait(&signals, &info, &tick);
+    if (sig == SIGINT || sig == SIGTERM) {
+      outcome = {kExitInterrupted, "interrupted",
+                 std::string("interrupted by ") + (sig == SIGINT ? "SIGINT" : "SIGTERM")};
+      break;
+    }
+    reap(outcome, false);
+    showProgress(false);
+    if (options_.timeoutSeconds > 0 && secondsSince(start_) > options_.timeoutSeconds) {
+      char text[96];
+      std::snprintf(text, sizeof text, "timed out after %g s (--timeout)", options_.timeoutSeconds);
+      outcome = {kExitTimeout, "timeout", text};
+      break;
+    }
+    std::string detail;
+    if (outcome.exitCode == kExitOk && deadlocked(detail)) {
+      char text[64];
+      std::snprintf(text, sizeof text, "deadlock: no module progressed for %g s: ",
+                    options_.deadlockSeconds);
+      outcome = {kExitRunFailed, "deadlock", text + detail};
+    }
+  }
+  if (displayed_) showProgress(true);
+  stopAll();
+  return outcome;
+}
+
+}  // namespace
+
+RunOutcome runApplication(const app::Application& application, const app::Catalog& catalog,
+                          const RunOptions& options) {
+  daemon::DaemonOptions daemonOptions;
+  daemonOptions.segmentBytes = options.segmentBytes;
+  daemonOptions.iterationLimit = options.iterations;
+  if (!application.hosts.empty()) {
+    if (auto id = msg::hostIdFromAddress(application.hosts.front().address)) {
+      daemonOptions.hostId = *id;
+    }
+  }
+  // The daemon thread must not take the signals meant for the supervisor: block them before
+  // it is created (it inherits this mask).
+  sigset_t signals, previous;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGCHLD);
+  pthread_sigmask(SIG_BLOCK, &signals, &previous);
+
+  auto daemon = daemon::Daemon::create(application, catalog, daemonOptions);
+  if (!daemon) {
+    pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+    return {kExitRunFailed, "failed", daemon.error().message};
+  }
+  const auto start = Clock::now();
+  Supervisor supervisor(application, options, **daemon);
+  RunOutcome outcome = supervisor.run();
+  (*daemon)->shutdown();
+  std::vector<std::string> warnings = (*daemon)->takeWarnings();
+  for (const auto& w : warnings) std::fprintf(stderr, "vrflow: warning: %s\n", w.c_str());
+  if (!options.reportPath.empty()) {
+    auto status = writeReport(options.reportPath, application, **daemon, supervisor.ends(), outcome,
+                              options, secondsSince(start), warnings);
+    if (!status && outcome.exitCode == kExitOk) {
+      outcome = {kExitRunFailed, "failed", status.error().message};
+    }
+  }
+  // Signals that arrived while stopping are consumed here, not delivered on unblocking.
+  timespec zero{0, 0};
+  while (sigtimedwait(&signals, nullptr, &zero) > 0) {
+  }
+  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  return outcome;
+}
+
+}  // namespace vrflow::run

@@ -1,0 +1,65 @@
+#include "spawn.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+extern char** environ;
+
+namespace vrflow::run {
+
+Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::string>& args,
+                          int inheritFd, const std::vector<std::string>& extraEnvironment) {
+  if (access(executable.c_str(), X_OK) != 0) {
+    return makeError("cannot start '" + executable + "': " + std::strerror(errno));
+  }
+  // Everything the child needs is prepared before fork: after it, only async-signal-safe calls.
+  std::vector<std::string> envStrings;
+  for (char** e = environ; *e != nullptr; ++e) envStrings.emplace_back(*e);
+  for (const auto& e : extraEnvironment) envStrings.push_back(e);
+  std::vector<char*> envp;
+  for (auto& e : envStrings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  std::vector<std::string> argStrings{executable};
+  argStrings.insert(argStrings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argStrings) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t parent = getpid();
+
+  const pid_t pid = fork();
+  if (pid < 0) return makeError(std::string("fork failed: ") + std::strerror(errno));
+  if (pid == 0) {
+    setpgid(0, 0);
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);  // the runtime died before we set the death signal
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    signal(SIGPIPE, SIG_DFL);
+    if (inheritFd >= 0) fcntl(inheritFd, F_SETFD, 0);
+    execve(argv[0], argv.data(), envp.data());
+    const char* text = "vrflow: exec of a module failed\n";
+    (void)!write(2, text, std::strlen(text));
+    _exit(127);
+  }
+  setpgid(pid, pid);  // also from the parent, so there is no window where it is unset
+  return pid;
+}
+
+std::string describeWaitStatus(int status) {
+  if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) {
+    const int sig = WTERMSIG(status);
+    const char* name = strsignal(sig);
+    return "was killed by signal " + std::to_string(sig) + " (" + (name ? name : "?") + ")";
+  }
+  return "ended with wait status " + std::to_string(status);
+}
+
+}  // namespace vrflow::run

@@ -1,0 +1,31 @@
+// testing/crash: forwards its input, then fails at a chosen iteration (exit status or signal).
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+
+#include "vrflow/module/module.hpp"
+
+int main() {
+  vrflow::Module module;
+  auto& in = module.addInput("in");
+  auto& out = module.addOutput("out");
+  if (auto status = module.init(); !status) {
+    std::fprintf(stderr, "%s\n", status.error().message.c_str());
+    return 2;
+  }
+  const auto at = static_cast<uint64_t>(module.paramInt("at", 3));
+  const int status = static_cast<int>(module.paramInt("status", 7));
+  const int sig = static_cast<int>(module.paramInt("signal", 0));
+  while (module.wait()) {
+    if (module.iteration() == at) {
+      if (sig != 0) std::raise(sig);
+      std::_Exit(status);
+    }
+    if (in.connected()) {
+      if (!module.put(out, module.get(in))) break;
+    } else if (!module.put(out, module.newMessage())) {
+      break;
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,183 @@
+#include "process_helpers.hpp"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace vrflow::testing {
+namespace {
+
+// Orphans of the commands we run come back to us, so leftovers can be found precisely even
+// while other tests run in parallel.
+const bool gSubreaper = [] { return prctl(PR_SET_CHILD_SUBREAPER, 1) == 0; }();
+
+}  // namespace
+
+std::string binDir() {
+  const char* dir = std::getenv("VRFLOW_BIN_DIR");
+  return dir ? dir : "build/bin";
+}
+
+std::string sourceDir() {
+  const char* dir = std::getenv("VRFLOW_SOURCE_DIR");
+  return dir ? dir : ".";
+}
+
+CommandResult runCommand(const std::vector<std::string>& argv, double timeoutSeconds,
+                         double signalAfterSeconds, int signal) {
+  (void)gSubreaper;
+  int outPipe[2], errPipe[2];
+  if (pipe2(outPipe, O_CLOEXEC) != 0 || pipe2(errPipe, O_CLOEXEC) != 0) return {};
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(outPipe[1], 1);
+    dup2(errPipe[1], 2);
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  close(outPipe[1]);
+  close(errPipe[1]);
+  CommandResult result;
+  const auto start = std::chrono::steady_clock::now();
+  bool signalled = false, killed = false;
+  pollfd fds[2] = {{outPipe[0], POLLIN, 0}, {errPipe[0], POLLIN, 0}};
+  int open = 2;
+  while (open > 0) {
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (signalAfterSeconds > 0 && !signalled && elapsed >= signalAfterSeconds) {
+      kill(pid, signal);
+      signalled = true;
+    }
+    if (!killed && elapsed >= timeoutSeconds) {
+      kill(pid, SIGKILL);
+      killed = true;
+    }
+    if (poll(fds, 2, 20) <= 0) continue;
+    for (int i = 0; i < 2; ++i) {
+      if (fds[i].fd < 0 || (fds[i].revents & (POLLIN | POLLHUP)) == 0) continue;
+      char buffer[4096];
+      const ssize_t n = read(fds[i].fd, buffer, sizeof buffer);
+      if (n <= 0) {
+        close(fds[i].fd);
+        fds[i].fd = -1;
+        --open;
+      } else {
+        (i == 0 ? result.out : result.err).append(buffer, static_cast<std::size_t>(n));
+      }
+    }
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return result;
+}
+
+CommandResult runVrflow(std::vector<std::string> args, double timeoutSeconds,
+                        double signalAfterSeconds, int signal) {
+  std::vector<std::string> argv{binDir() + "/vrflow", "--packages",
+                                binDir() + "/../test-packages"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return runCommand(argv, timeoutSeconds, signalAfterSeconds, signal);
+}
+
+std::vector<std::string> leftoverProcesses() {
+  std::vector<std::string> left;
+  int rounds = 0;
+  // Give a dying process group a moment: the runtime has returned, its children are gone or
+  // reparented to us by now.
+  for (;;) {
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, WNOHANG);
+    if (pid > 0) {
+      std::ifstream cmd("/proc/" + std::to_string(pid) + "/cmdline");
+      left.push_back("pid " + std::to_string(pid) + " (reaped)");
+      continue;
+    }
+    if (pid == 0 && ++rounds < 500) {
+      // A child is still running: find and kill it.
+      DIR* proc = opendir("/proc");
+      bool any = false;
+      while (dirent* entry = proc ? readdir(proc) : nullptr) {
+        const int child = std::atoi(entry->d_name);
+        if (child <= 0) continue;
+        std::ifstream stat("/proc/" + std::string(entry->d_name) + "/stat");
+        std::string line;
+        std::getline(stat, line);
+        const auto close = line.rfind(')');
+        if (close == std::string::npos) continue;
+        std::istringstream rest(line.substr(close + 2));
+        char state;
+        int ppid;
+        rest >> state >> ppid;
+        if (ppid != getpid()) continue;
+        std::ifstream cmd("/proc/" + std::string(entry->d_name) + "/cmdline");
+        std::string text;
+        std::getline(cmd, text, '\0');
+        left.push_back(text);
+        kill(child, SIGKILL);
+        any = true;
+      }
+      if (proc) closedir(proc);
+      if (!any) usleep(10000);
+      continue;
+    }
+    break;  // ECHILD: no children at all
+  }
+  return left;
+}
+
+std::vector<std::string> vrflowShmEntries() {
+  std::vector<std::string> found;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/dev/shm", ec)) {
+    const auto name = entry.path().filename().string();
+    if (name.find("vrflow") != std::string::npos) found.push_back(name);
+  }
+  return found;
+}
+
+TempDir::TempDir() {
+  char pattern[] = "/tmp/vrflow-test-XXXXXX";
+  const char* made = mkdtemp(pattern);
+  path_ = made ? made : "/tmp";
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  if (path_ != "/tmp") std::filesystem::remove_all(path_, ec);
+}
+
+std::string TempDir::write(const std::string& name, const std::string& text) const {
+  std::ofstream(file(name)) << text;
+  return file(name);
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+std::vector<std::string> readLines(const std::string& path) {
+  std::vector<std::string> lines;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+}  // namespace vrflow::testing
