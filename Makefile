@@ -34,7 +34,7 @@ test: build
 demo: build
 	@mkdir -p out/demo
 	$(BUILD)/bin/vrflow run examples/pipeline/pipeline.xml --iterations 200 \
-	  --report out/demo/report.json --record out/demo
+	  --report out/demo/report.json
 	@echo "demo results in out/demo/"
 
 clean:

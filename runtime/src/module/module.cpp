@@ -308,6 +308,15 @@ Status Module::put(const OutputPort& port, OutgoingMessage&& message) {
   return {};
 }
 
+Result<Message> Module::seal(OutgoingMessage&& message) {
+  auto& builder = message.impl_->builder;
+  const std::size_t used = builder.finish();
+  if (used == 0 || message.impl_->sink.data() == nullptr) {
+    return makeError("module '" + impl_->id + "': shared memory exhausted while building a message");
+  }
+  return Message::adopt(impl_->segment, message.impl_->sink.take(used));
+}
+
 Status Module::put(const OutputPort& port, const Message& message) {
   VRFLOW_ASSERT(port.module_ == this && port.slot_ >= 0, "port of another module or before init()");
   if (!message.valid()) return makeError("cannot forward an empty message");

@@ -85,7 +85,9 @@ class Module {
   OutgoingMessage newMessage(std::size_t sizeHint = 256);
   /// Sends a message on `port`; blocks while the port's buffer is full (backpressure).
   Status put(const OutputPort& port, OutgoingMessage&& message);
-  /// Forwards a received message without copying its bytes.
+  /// Finishes a message without sending it, to send it (or keep it) later by reference.
+  Result<Message> seal(OutgoingMessage&& message);
+  /// Sends a message held by reference (received, or sealed) without copying its bytes.
   Status put(const OutputPort& port, const Message& message);
 
   /// This module's id in the application, and the iteration in progress (0-based).
