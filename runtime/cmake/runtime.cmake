@@ -16,3 +16,4 @@ vrflow_add_library(runtime
   PRIVATE_DEPS nlohmann_json::nlohmann_json)
 
 vrflow_add_executable(vrflow SOURCES tools/vrflow_main.cpp DEPS vrflow::runtime CLI11::CLI11)
+vrflow_add_executable(vrflow-daemon SOURCES tools/daemon_main.cpp DEPS vrflow::runtime CLI11::CLI11)

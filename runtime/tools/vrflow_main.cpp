@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
   validate->add_option("APP.xml", validateFile, "Application file")->required();
 
   auto* run = cli.add_subcommand("run", "Run an application with every host on this machine");
+  validate->fallthrough();
+  run->fallthrough();
   std::string runFile;
   vrflow::run::RunOptions options;
   double shmMiB = 1024;

@@ -24,13 +24,15 @@ const bool gSubreaper = [] { return prctl(PR_SET_CHILD_SUBREAPER, 1) == 0; }();
 }  // namespace
 
 std::string binDir() {
-  const char* dir = std::getenv("VRFLOW_BIN_DIR");
-  return dir ? dir : "build/bin";
+  if (const char* dir = std::getenv("VRFLOW_BIN_DIR")) return dir;
+  // The test executables are built into the same folder as the commands they run.
+  std::error_code ec;
+  return std::filesystem::read_symlink("/proc/self/exe", ec).parent_path().string();
 }
 
 std::string sourceDir() {
-  const char* dir = std::getenv("VRFLOW_SOURCE_DIR");
-  return dir ? dir : ".";
+  if (const char* dir = std::getenv("VRFLOW_SOURCE_DIR")) return dir;
+  return VRFLOW_TEST_SOURCE_DIR;
 }
 
 CommandResult runCommand(const std::vector<std::string>& argv, double timeoutSeconds,

@@ -2,6 +2,7 @@
 // iteration,source,source_iteration,sim_time,kind,id,values...
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include "vrflow/message/builtin_types.hpp"
@@ -16,6 +17,10 @@ int main() {
     return 2;
   }
   const std::string path = module.param("file", "recording.csv");
+  std::error_code ignored;  // a missing folder is created; a failure shows when opening
+  if (const auto parent = std::filesystem::path(path).parent_path(); !parent.empty()) {
+    std::filesystem::create_directories(parent, ignored);
+  }
   std::ofstream csv(path);
   if (!csv) {
     std::fprintf(stderr, "vrflow-core-recorder: module '%s': cannot write '%s'\n",

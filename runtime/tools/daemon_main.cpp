@@ -1,0 +1,95 @@
+// vrflow-daemon: the daemon of one host of an application, with that host's modules. The
+// launcher starts one per host; `vrflow run` embeds the same daemon for all hosts at once.
+// Until the TCP transport between daemons exists, a connection crossing hosts is refused.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "vrflow/app/catalog.hpp"
+#include "vrflow/app/diagnostic.hpp"
+#include "vrflow/app/loader.hpp"
+#include "vrflow/app/validate.hpp"
+#include "vrflow/run/runner.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App cli{"vrflow-daemon: serve one host of an application"};
+  std::string file, host;
+  std::vector<std::string> packageDirs;
+  vrflow::run::RunOptions options;
+  cli.add_option("APP.xml", file, "Application file")->required();
+  cli.add_option("--host", host, "Host id (as in the application file) this daemon serves")->required();
+  cli.add_option("--packages", packageDirs, "Extra folder of node packages (repeatable)");
+  cli.add_option("--iterations,-n", options.iterations, "Stop after N iterations of every module");
+  cli.add_option("--report", options.reportPath, "Write a JSON run report to FILE");
+  cli.add_option("--timeout", options.timeoutSeconds, "Fail if the run lasts longer (seconds)");
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return cli.exit(e) == 0 ? 0 : vrflow::run::kExitInvalid;
+  }
+
+  std::vector<std::string> dirs = packageDirs;
+  for (const auto& d : vrflow::app::searchPathFromEnvironment()) dirs.push_back(d);
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back((self.parent_path().parent_path() / "share/vrflow/packages").string());
+  vrflow::app::Catalog catalog;
+  if (auto status = catalog.loadSearchPath(dirs); !status) {
+    std::fprintf(stderr, "vrflow-daemon: %s\n", status.error().message.c_str());
+    return vrflow::run::kExitInvalid;
+  }
+  std::vector<vrflow::app::Diagnostic> problems;
+  auto application = vrflow::app::loadApplicationFile(file, &problems);
+  if (!application) {
+    std::fprintf(stderr, "%s\n", application.error().message.c_str());
+    return vrflow::run::kExitInvalid;
+  }
+  auto more = vrflow::app::validate(*application, catalog);
+  problems.insert(problems.end(), more.begin(), more.end());
+  for (const auto& d : problems) std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
+  if (vrflow::app::hasErrors(problems)) return vrflow::run::kExitInvalid;
+  if (vrflow::app::findHost(*application, host) == nullptr && host != "localhost") {
+    std::fprintf(stderr, "vrflow-daemon: %s: no host '%s' in the application\n", file.c_str(),
+                 host.c_str());
+    return vrflow::run::kExitInvalid;
+  }
+
+  // Keep this host's share of the network.
+  vrflow::app::Application local = *application;
+  local.modules.clear();
+  local.filters.clear();
+  local.connections.clear();
+  std::set<std::string> here;
+  for (const auto& m : application->modules) {
+    if (vrflow::app::effectiveHost(*application, m.host) == host) {
+      local.modules.push_back(m);
+      here.insert(m.id);
+    }
+  }
+  for (const auto& f : application->filters) {
+    if (vrflow::app::effectiveHost(*application, f.host) == host) {
+      local.filters.push_back(f);
+      here.insert(f.id);
+    }
+  }
+  for (const auto& c : application->connections) {
+    const bool from = here.count(c.from.node) != 0;
+    const bool to = here.count(c.to.node) != 0;
+    if (from != to) {
+      std::fprintf(stderr,
+                   "%s:%d:%d: error: connection %s -> %s crosses hosts; daemons do not exchange "
+                   "messages over the network yet: map both ends to host '%s' or use `vrflow run`\n",
+                   c.loc.file.c_str(), c.loc.line, c.loc.column,
+                   vrflow::app::toString(c.from).c_str(), vrflow::app::toString(c.to).c_str(),
+                   host.c_str());
+      return vrflow::run::kExitInvalid;
+    }
+    if (from) local.connections.push_back(c);
+  }
+  const auto outcome = vrflow::run::runApplication(local, catalog, options);
+  if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow-daemon: %s\n", outcome.error.c_str());
+  return outcome.exitCode;
+}

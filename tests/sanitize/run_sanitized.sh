@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Builds the runtime, its modules and the unit/end-to-end tests with a sanitizer (ASAN =
+# address + undefined behaviour, TSAN = threads) in a tree of their own, and runs those tests
+# there. Usage: run_sanitized.sh ASAN|TSAN SOURCE_DIR BUILD_DIR
+set -euo pipefail
+type=$1 src=$2 build=$3
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S "$src" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$type" -DVRFLOW_BUILD_BENCH=OFF \
+  -DVRFLOW_SANITIZER_TESTS=OFF -DVRFLOW_FUZZ_TESTS=OFF "${launcher[@]}" >/dev/null
+cmake --build "$build" -j "$(nproc)" >/dev/null
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
+cd "$build"
+ctest --output-on-failure -j "$(nproc)" -L 'runtime|message|app'
