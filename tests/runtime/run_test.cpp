@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 
 #include "process_helpers.hpp"
 
@@ -183,6 +184,35 @@ TEST_F(RunTest, DefaultInputFilterMergesOneMessageFromEachConnection) {
     EXPECT_NE(first.find("," + std::to_string(i) + ",64,"), std::string::npos) << first;
     EXPECT_NE(second.find("," + std::to_string(i) + ",64,"), std::string::npos) << second;
   }
+}
+
+// mode="latest": the newest pending message of each connection, older ones dropped, producers
+// never held back; every delivered message is newer than the previous one.
+TEST_F(RunTest, LatestModeDeliversOnlyNewerMessagesAndEndsWithTheNewest) {
+  const auto csv = dir.file("out.csv");
+  const auto file = dir.write(
+      "app.xml", app(module("a", "core/source") + module("b", "core/source") +
+                         module("rec", "core/recorder",
+                                param("file", csv) + "      <input port=\"in\" mode=\"latest\"/>\n"),
+                     connect("a.out", "rec.in") + connect("b.out", "rec.in")));
+  const auto result = runVrflow({"run", file, "-n", "200"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto lines = readLines(csv);
+  ASSERT_GE(lines.size(), 3u);
+  ASSERT_EQ((lines.size() - 1) % 2, 0u);  // always one chunk of each connection
+  long last[2] = {-1, -1};
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    // iteration,source,source_iteration,sim_time,resource,id,counter,size,
+    std::vector<std::string> f;
+    std::stringstream in(lines[i]);
+    for (std::string x; std::getline(in, x, ',');) f.push_back(x);
+    ASSERT_GE(f.size(), 8u) << lines[i];
+    const long counter = std::stol(f[6]);
+    const int which = static_cast<int>((i - 1) % 2);
+    EXPECT_GT(counter, last[which]) << lines[i];
+    last[which] = counter;
+  }
+  EXPECT_TRUE(last[0] == 199 || last[1] == 199);  // the newest message of one source at least
 }
 
 TEST_F(RunTest, MergeFilterConcatenatesItsInputsInOrder) {

@@ -180,7 +180,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         auto node = addNode(nodeId, "port-input", std::move(params), {}, {"out"});
         if (!node) return node.error();
         (*node)->outputs[0].push_back(
-            std::make_unique<RingSink>(segment, *slot, static_cast<int>(p), latest));
+            std::make_unique<RingSink>(segment, *slot, static_cast<int>(p), latest, ended[m]));
         portNodes[{static_cast<int>(m), spec.name}] = *node;
       } else {
         auto node = addNode(nodeId, "port-output", {}, {"in"}, {"out"});
@@ -372,7 +372,17 @@ bool Daemon::Impl::pass() {
     }
   }
   for (auto& node : graph->nodes) {
-    if (node->closed) continue;
+    if (node->closed) {
+      // Nothing will ever consume these: drop them so that producers are not held back.
+      for (auto* queue : node->inputs) {
+        if (!queue->items.empty()) {
+          queue->dropped += queue->items.size();
+          queue->items.clear();
+          ++graph->operations;
+        }
+      }
+      continue;
+    }
     node->filter->process(*node);
     if (node->filter->exhausted(*node)) {
       node->closed = true;

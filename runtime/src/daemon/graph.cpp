@@ -35,6 +35,7 @@ void QueueSink::push(MessageRef message) {
 }
 
 void RingSink::push(MessageRef message) {
+  if (ended()) return;  // dropped: nobody will ever read it
   const bool pushed = ring().push(message.handle());
   if (pushed) {
     message.release();  // the ring holds the reference now

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -55,9 +56,16 @@ class QueueSink final : public Sink {
 /// A sink that hands messages to a module's input ring and wakes the module.
 class RingSink final : public Sink {
  public:
-  RingSink(ipc::Segment& segment, ipc::ModuleSlot& slot, int port, bool onlyWhenEmpty)
-      : segment_(&segment), slot_(&slot), port_(port), onlyWhenEmpty_(onlyWhenEmpty) {}
+  RingSink(ipc::Segment& segment, ipc::ModuleSlot& slot, int port, bool onlyWhenEmpty,
+           const std::atomic<bool>& moduleEnded)
+      : segment_(&segment),
+        slot_(&slot),
+        port_(port),
+        onlyWhenEmpty_(onlyWhenEmpty),
+        moduleEnded_(&moduleEnded) {}
+  /// A module that has ended takes (and drops) everything, so its producers are never stuck.
   bool hasSpace() const override {
+    if (ended()) return true;
     const auto& ring = this->ring();
     return onlyWhenEmpty_ ? ring.empty() : !ring.full();
   }
@@ -68,10 +76,16 @@ class RingSink final : public Sink {
   ipc::Ring& ring() const {
     return *segment_->at<ipc::Ring>(slot_->ports[port_].ringOffset);
   }
+  bool ended() const {
+    return moduleEnded_->load(std::memory_order_acquire) ||
+           slot_->state.load(std::memory_order_acquire) ==
+               static_cast<uint32_t>(ipc::ModuleState::Finished);
+  }
   ipc::Segment* segment_;
   ipc::ModuleSlot* slot_;
   int port_;
   bool onlyWhenEmpty_;
+  const std::atomic<bool>* moduleEnded_;
 };
 
 class Graph;
