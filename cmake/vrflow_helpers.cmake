@@ -44,9 +44,10 @@ function(vrflow_add_test name)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 120)
   endif()
+  # Tests find the commands beside their own executable (build/bin) and the sources here.
+  target_compile_definitions(${name} PRIVATE VRFLOW_TEST_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   gtest_discover_tests(${name}
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
-    ENVIRONMENT "VRFLOW_BIN_DIR=${PROJECT_BINARY_DIR}/bin;VRFLOW_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
     DISCOVERY_TIMEOUT 60)
 endfunction()
 

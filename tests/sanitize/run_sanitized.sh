@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Builds the runtime, its modules and the unit/end-to-end tests with a sanitizer (ASAN =
 # address + undefined behaviour, TSAN = threads) in a tree of their own, and runs those tests
-# there. Usage: run_sanitized.sh ASAN|TSAN SOURCE_DIR BUILD_DIR
+# there. Warnings are not errors here: GCC 12 reports false maybe-uninitialized warnings in
+# libstdc++ under -fsanitize at -O1. Usage: run_sanitized.sh ASAN|TSAN SOURCE_DIR BUILD_DIR
 set -euo pipefail
 type=$1 src=$2 build=$3
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 cmake -S "$src" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$type" -DVRFLOW_BUILD_BENCH=OFF \
-  -DVRFLOW_SANITIZER_TESTS=OFF -DVRFLOW_FUZZ_TESTS=OFF "${launcher[@]}" >/dev/null
+  -DVRFLOW_SANITIZER_TESTS=OFF -DVRFLOW_FUZZ_TESTS=OFF -DVRFLOW_WARNINGS_AS_ERRORS=OFF \
+  "${launcher[@]}" >/dev/null
 cmake --build "$build" -j "$(nproc)" >/dev/null
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

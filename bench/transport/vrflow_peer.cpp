@@ -1,0 +1,143 @@
+// The vrflow side of the transport benchmark: two module processes exchanging messages through
+// the per-host daemon with the default filters, on the same plan as the other transports.
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "transport_bench.hpp"
+#include "vrflow/app/catalog.hpp"
+#include "vrflow/run/runner.hpp"
+
+namespace vrflow::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+app::Module peer(const std::string& id, std::vector<app::Param> params) {
+  app::Module module;
+  module.id = id;
+  module.package = "bench";
+  module.type = "peer";
+  module.params = std::move(params);
+  return module;
+}
+
+app::Connection connection(const std::string& from, const std::string& to) {
+  app::Connection c;
+  c.from = *app::parseEndpoint(from);
+  c.to = *app::parseEndpoint(to);
+  return c;
+}
+
+Result<app::Catalog> benchCatalog() {
+  std::vector<char> self(4096, '\0');
+  const ssize_t length = readlink("/proc/self/exe", self.data(), self.size() - 1);
+  if (length <= 0) return makeError("cannot find this executable's folder");
+  app::ModuleType type;
+  type.package = "bench";
+  type.type = "peer";
+  type.executable =
+      (fs::path(std::string(self.data(), static_cast<std::size_t>(length))).parent_path() /
+       "vrflow-bench-peer")
+          .string();
+  app::PortSpec in;
+  in.name = "in";
+  in.isInput = true;
+  app::PortSpec out;
+  out.name = "out";
+  out.isInput = false;
+  type.ports = {in, out};
+  for (const char* name : {"role", "size", "warmup", "results", "count"}) {
+    app::ParamSpec spec;
+    spec.name = name;
+    spec.type = app::ParamType::String;
+    type.params.push_back(spec);
+  }
+  app::Catalog catalog;
+  if (auto status = catalog.addModuleType(type); !status) return status.error();
+  return catalog;
+}
+
+Status runOnce(const app::Application& application, const app::Catalog& catalog,
+               const BenchSettings& settings) {
+  run::RunOptions options;
+  options.timeoutSeconds = static_cast<double>(settings.peerTimeout.count()) / 1000.0;
+  options.segmentBytes = std::size_t{2} << 30;
+  const auto outcome = run::runApplication(application, catalog, options);
+  if (outcome.exitCode != 0) return makeError("vrflow-shm: " + outcome.error);
+  return {};
+}
+
+}  // namespace
+
+Result<std::vector<BenchResult>> runVrflow(const BenchSettings& settings) {
+  auto catalog = benchCatalog();
+  if (!catalog) return catalog.error();
+  char pattern[] = "/tmp/vrflow-bench-XXXXXX";
+  if (mkdtemp(pattern) == nullptr) return makeError("cannot make a temporary folder");
+  const fs::path dir(pattern);
+  std::vector<BenchResult> results;
+  Status failure;
+  for (const std::size_t bytes : settings.sizes) {
+    const IterationPlan plan = iterationPlan(bytes, settings.quick);
+    const std::string size = std::to_string(bytes);
+    const std::string warmup = std::to_string(plan.warmupMessages);
+
+    // Ping-pong: a cycle started by one initial message on ping's input.
+    const auto rtt = (dir / ("rtt-" + size)).string();
+    app::Application pingPong;
+    pingPong.name = "bench-ping-pong";
+    pingPong.modules = {peer("ping", {{"role", "ping", {}},
+                                      {"size", size, {}},
+                                      {"warmup", warmup, {}},
+                                      {"results", rtt, {}}}),
+                        peer("pong", {{"role", "pong", {}}})};
+    app::InputConfig start;
+    start.port = "in";
+    start.initialMessages = 1;
+    pingPong.modules[0].inputs.push_back(start);
+    pingPong.connections = {connection("ping.out", "pong.in"), connection("pong.out", "ping.in")};
+    // ping runs warmup + timed iterations, then ends; pong ends when its input does.
+    pingPong.modules[0].params.push_back(
+        {"count", std::to_string(plan.warmupMessages + plan.pingPongs + 1), {}});
+    // The iteration limit is per run, so ping stops itself by count: see vrflow_bench_module.
+    if (failure = runOnce(pingPong, *catalog, settings); !failure) break;
+
+    // Streaming: send -> recv with backpressure, queue depth as the peers use it.
+    const auto rate = (dir / ("rate-" + size)).string();
+    app::Application stream;
+    stream.name = "bench-stream";
+    stream.modules = {
+        peer("send", {{"role", "send", {}},
+                      {"size", size, {}},
+                      {"count", std::to_string(plan.warmupMessages + plan.streamMessages), {}}}),
+        peer("recv", {{"role", "recv", {}}, {"warmup", warmup, {}}, {"results", rate, {}}})};
+    auto link = connection("send.out", "recv.in");
+    link.capacity = static_cast<int>(streamQueueDepth(bytes));
+    stream.connections = {link};
+    if (failure = runOnce(stream, *catalog, settings); !failure) break;
+
+    std::vector<std::int64_t> samples;
+    std::ifstream rttFile(rtt);
+    for (std::int64_t ns = 0; rttFile >> ns;) samples.push_back(ns);
+    double msgsPerS = 0;
+    std::ifstream(rate) >> msgsPerS;
+    if (samples.empty()) {
+      failure = makeError("vrflow-shm: no round trip measured at " + size + " bytes");
+      break;
+    }
+    results.push_back(
+        makeResult("vrflow-shm", bytes, samples, msgsPerS,
+                   "module -> daemon -> module over a memfd segment, default filters, "
+                   "futex wake-ups; payload re-sent by handle"));
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  if (!failure) return failure.error();
+  return results;
+}
+
+}  // namespace vrflow::bench

@@ -1,0 +1,18 @@
+# vrflow::message: the binary message layout (docs/message-layout.md): builder, checked
+# zero-copy reader, object types, ids and digests.
+vrflow_add_library(message
+  SOURCES
+    src/message/builder.cpp
+    src/message/builtin_types.cpp
+    src/message/byte_sink.cpp
+    src/message/chunk_views.cpp
+    src/message/digest.cpp
+    src/message/empty_message.cpp
+    src/message/ids.cpp
+    src/message/object_type.cpp
+    src/message/object_writer.cpp
+    src/message/parse.cpp
+    src/message/stamps.cpp
+    src/message/view.cpp
+  PUBLIC_DEPS vrflow::base
+  PRIVATE_DEPS PkgConfig::XXHASH)
