@@ -67,7 +67,15 @@ class RingSink final : public Sink {
   bool hasSpace() const override {
     if (ended()) return true;
     const auto& ring = this->ring();
-    return onlyWhenEmpty_ ? ring.empty() : !ring.full();
+    const bool space = onlyWhenEmpty_ ? ring.empty() : !ring.full();
+    if (!space) {
+      // Ask the module to ring the daemon when it takes a message; re-check, since it may
+      // have taken one before it could see the request.
+      slot_->ports[port_].wantsSpace.store(1, std::memory_order_seq_cst);
+      std::atomic_thread_fence(std::memory_order_seq_cst);
+      return onlyWhenEmpty_ ? ring.empty() : !ring.full();
+    }
+    return true;
   }
   void push(MessageRef message) override;
   void close() override;

@@ -255,7 +255,11 @@ bool Module::wait() {
       }
       m.slot->bell.sleep(seen, kPollNs);
     }
-    m.segment.header().daemonBell.ring();  // room freed on this ring
+    // Room freed on this ring: wake the daemon only if it is waiting for it.
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+    if (port.wantsSpace.load(std::memory_order_seq_cst) != 0 && port.wantsSpace.exchange(0) != 0) {
+      m.segment.header().daemonBell.ring();
+    }
     auto message = Message::adopt(m.segment, handle);
     if (!message) {
       std::fprintf(stderr, "vrflow: module '%s': malformed message on input '%s': %s\n",

@@ -1,0 +1,23 @@
+# vrflow::app — the application model: load, validate and save application files, read node
+# package manifests. Used by the runtime, the launcher and the editor.
+vrflow_add_library(app
+  SOURCES
+    src/app/application_reader.cpp
+    src/app/application_writer.cpp
+    src/app/builtin_filters.cpp
+    src/app/catalog.cpp
+    src/app/diagnostic.cpp
+    src/app/element_reader.cpp
+    src/app/file_io.cpp
+    src/app/graph.cpp
+    src/app/manifest_reader.cpp
+    src/app/model.cpp
+    src/app/package.cpp
+    src/app/source_location.cpp
+    src/app/source_text.cpp
+    src/app/text_util.cpp
+    src/app/validate.cpp
+    src/app/validate_connections.cpp
+    src/app/validate_cycles.cpp
+  PUBLIC_DEPS vrflow::base
+  PRIVATE_DEPS pugixml::pugixml)

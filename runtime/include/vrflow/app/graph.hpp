@@ -1,0 +1,43 @@
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vrflow/app/model.hpp"
+
+namespace vrflow::app {
+
+/// The connections arriving at one input port (or leaving one output port) of a module or
+/// filter, as indexes into Application::connections, in file order.
+struct PortEdges {
+  std::string node;
+  std::string port;
+  std::vector<std::size_t> connections;
+  int initialMessages = 0;           ///< inputs of modules: from the <input> settings
+  InputMode mode = InputMode::Fifo;  ///< inputs of modules: from the <input> settings
+};
+
+/// The connections of an application grouped by port: what the runtime wires up.
+struct ResolvedGraph {
+  /// One entry per connected input port, in the order of its first connection in the file.
+  std::vector<PortEdges> inputs;
+  /// One entry per connected output port, in the order of its first connection in the file.
+  std::vector<PortEdges> outputs;
+
+  /// The edges into `node.port`, or nullptr when nothing is connected there.
+  const PortEdges* findInput(std::string_view node, std::string_view port) const;
+  /// The edges out of `node.port`, or nullptr when nothing is connected there.
+  const PortEdges* findOutput(std::string_view node, std::string_view port) const;
+  /// The connected inputs of one node, in the order of `inputs`.
+  std::vector<const PortEdges*> inputsOf(std::string_view node) const;
+  /// The connected outputs of one node, in the order of `outputs`.
+  std::vector<const PortEdges*> outputsOf(std::string_view node) const;
+};
+
+/// Groups the connections by port. Needs no catalog and does not validate: run validate()
+/// first; connections naming missing nodes are grouped like the others.
+ResolvedGraph resolveGraph(const Application& app);
+
+}  // namespace vrflow::app

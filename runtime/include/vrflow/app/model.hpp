@@ -1,0 +1,154 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "vrflow/app/source_location.hpp"
+
+namespace vrflow::app {
+
+/// A `name = value` setting of a module or filter; the value is parsed by its declared type.
+struct Param {
+  std::string name;
+  std::string value;
+  SourceLocation loc;
+};
+
+/// A machine that runs modules and filters.
+struct Host {
+  std::string id;
+  std::string address = "127.0.0.1";
+  SourceLocation loc;
+};
+
+/// What a connection does when its bounded queue is full.
+enum class QueuePolicy { Block, DropOldest, DropNewest };
+
+/// Which message the default input filter hands to the module: the oldest pending per
+/// connection (Fifo) or the newest, dropping older ones (Latest).
+enum class InputMode { Fifo, Latest };
+
+/// Settings of a module's default input filter for one input port.
+struct InputConfig {
+  std::string port;
+  int initialMessages = 0;
+  InputMode mode = InputMode::Fifo;
+  SourceLocation loc;
+};
+
+/// A module instance: one OS process running `package/type` on `host`.
+struct Module {
+  std::string id;
+  std::string package;
+  std::string type;
+  std::string host;
+  std::vector<Param> params;
+  std::vector<InputConfig> inputs;
+  SourceLocation loc;
+};
+
+/// A filter instance, run by the daemon of `host`.
+struct Filter {
+  std::string id;
+  std::string type;
+  std::string host;
+  std::vector<Param> params;
+  SourceLocation loc;
+};
+
+/// One end of a connection: a port of a module or filter, written "node.port" in XML.
+struct Endpoint {
+  std::string node;
+  std::string port;
+};
+
+/// A bounded FIFO channel from an output port to an input port.
+struct Connection {
+  Endpoint from;
+  Endpoint to;
+  int capacity = 0;  ///< messages; 0 = the runtime's default
+  QueuePolicy policy = QueuePolicy::Block;
+  SourceLocation loc;
+};
+
+/// Where the editor draws a module or filter; the runtime ignores it.
+struct EditorNode {
+  EditorNode() = default;
+  /// Keeps `EditorNode{ref, x, y}` working without naming `loc`.
+  EditorNode(std::string inRef, double inX, double inY, SourceLocation inLoc = {})
+      : ref(std::move(inRef)), x(inX), y(inY), loc(std::move(inLoc)) {}
+
+  std::string ref;
+  double x = 0;
+  double y = 0;
+  SourceLocation loc;
+};
+
+/// A whole application file. Every vector keeps the order of the file.
+struct Application {
+  std::string name;
+  std::vector<Host> hosts;
+  std::vector<Module> modules;
+  std::vector<Filter> filters;
+  std::vector<Connection> connections;
+  std::vector<EditorNode> editor;
+  std::string file;  ///< the file it was loaded from; empty for a model built in code
+};
+
+/// The host the loader adds to a file that declares none.
+inline constexpr std::string_view kDefaultHostId = "localhost";
+/// The address of hosts that do not state one.
+inline constexpr std::string_view kDefaultHostAddress = "127.0.0.1";
+
+/// The module with this id, or nullptr.
+const Module* findModule(const Application& app, std::string_view id);
+/// The module with this id, or nullptr.
+Module* findModule(Application& app, std::string_view id);
+/// The filter with this id, or nullptr.
+const Filter* findFilter(const Application& app, std::string_view id);
+/// The filter with this id, or nullptr.
+Filter* findFilter(Application& app, std::string_view id);
+/// The host with this id, or nullptr.
+const Host* findHost(const Application& app, std::string_view id);
+/// The editor position of this module or filter, or nullptr.
+const EditorNode* findEditorNode(const Application& app, std::string_view ref);
+/// The `<input>` settings of one input port of a module, or nullptr when it has none.
+const InputConfig* findInputConfig(const Module& module, std::string_view port);
+/// The `<input>` settings of one port, or the defaults (no initial message, Fifo).
+InputConfig inputConfigOrDefault(const Module& module, std::string_view port);
+
+/// The parameter with this name, or nullptr.
+const Param* findParam(const std::vector<Param>& params, std::string_view name);
+/// A parameter's value as text, or `fallback` when it is absent.
+std::string paramString(const std::vector<Param>& params, std::string_view name,
+                        std::string_view fallback);
+/// A parameter's value as an integer, or `fallback` when absent or not an integer.
+long long paramInt(const std::vector<Param>& params, std::string_view name, long long fallback);
+/// A parameter's value as a finite float, or `fallback` when absent or not a finite number.
+double paramFloat(const std::vector<Param>& params, std::string_view name, double fallback);
+/// A parameter's value as a bool ("true"/"false"/"1"/"0"), or `fallback` otherwise.
+bool paramBool(const std::vector<Param>& params, std::string_view name, bool fallback);
+/// Sets a parameter, replacing its value when present, appending it otherwise.
+void setParam(std::vector<Param>& params, std::string_view name, std::string value);
+
+/// The "node.port" text of an endpoint.
+std::string toString(const Endpoint& endpoint);
+/// Splits "node.port" at its first '.'; nullopt when either side would be empty.
+std::optional<Endpoint> parseEndpoint(std::string_view text);
+
+/// "block", "drop-oldest" or "drop-newest".
+std::string toString(QueuePolicy policy);
+/// The policy written `text`, or nullopt.
+std::optional<QueuePolicy> parseQueuePolicy(std::string_view text);
+/// "fifo" or "latest".
+std::string toString(InputMode mode);
+/// The mode written `text`, or nullopt.
+std::optional<InputMode> parseInputMode(std::string_view text);
+
+/// The host a module or filter runs on: `host`, or the first host when empty.
+std::string effectiveHost(const Application& app, const std::string& host);
+
+}  // namespace vrflow::app

@@ -1,0 +1,101 @@
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vrflow/app/model.hpp"
+#include "vrflow/app/source_location.hpp"
+
+namespace vrflow::app {
+
+/// The data type that matches every other one.
+inline constexpr std::string_view kAnyData = "any";
+/// The implicit input every module has: when connected, each iteration also waits on it.
+inline constexpr std::string_view kBeginItPort = "beginIt";
+/// The implicit output every module has: a stamps-only message per finished iteration.
+inline constexpr std::string_view kEndItPort = "endIt";
+
+/// A port declared by a module or filter type.
+struct PortSpec {
+  std::string name;
+  bool isInput = true;
+  std::string data = std::string(kAnyData);  ///< data type name; "any" matches all
+  bool stampsOnly = false;                   ///< carries stamps without payload
+  bool required = false;                     ///< inputs only: must be connected
+  std::string doc;
+};
+
+/// The value types of parameters.
+enum class ParamType { Int, Float, Bool, String, Enum, Vec3, File };
+
+/// A parameter declared by a module or filter type.
+struct ParamSpec {
+  std::string name;
+  ParamType type = ParamType::String;
+  std::string defaultValue;
+  std::optional<double> min;         ///< int, float, vec3 (each component)
+  std::optional<double> max;         ///< int, float, vec3 (each component)
+  std::vector<std::string> choices;  ///< enum only
+  std::string doc;
+};
+
+/// What a module is for, as drawn by the editor.
+enum class ModuleKind { Animator, Interactor, Viewer, Input, Other };
+
+/// A module type of a node package, read from its vrflow-package.xml.
+struct ModuleType {
+  std::string package;
+  std::string type;
+  std::string executable;  ///< absolute when found next to the manifest, else as written
+  ModuleKind kind = ModuleKind::Other;
+  std::string doc;
+  std::vector<PortSpec> ports;  ///< declared ports, then beginIt and endIt
+  std::vector<ParamSpec> params;
+  SourceLocation loc;  ///< the <module> element in the manifest
+
+  /// The port with this name, or nullptr.
+  const PortSpec* findPort(std::string_view name) const;
+  /// The parameter with this name, or nullptr.
+  const ParamSpec* findParam(std::string_view name) const;
+};
+
+/// A filter type: run by the daemon; its ports may depend on its parameters.
+struct FilterType {
+  std::string name;
+  std::string doc;
+  std::vector<ParamSpec> params;
+  /// The ports of a filter with these parameter values (values already validated or not: it
+  /// must cope with bad ones by using defaults).
+  std::function<std::vector<PortSpec>(const std::vector<Param>&)> ports;
+  /// How many messages the filter emits at start-up without input (what breaks a cycle);
+  /// empty means none.
+  std::function<int(const std::vector<Param>&)> initialMessages;
+
+  /// The ports for these parameters (none when `ports` is empty).
+  std::vector<PortSpec> portsFor(const std::vector<Param>& values) const;
+  /// The start-up message count for these parameters (0 when `initialMessages` is empty).
+  int initialMessagesFor(const std::vector<Param>& values) const;
+  /// The parameter with this name, or nullptr.
+  const ParamSpec* findParam(std::string_view paramName) const;
+};
+
+/// "int", "float", "bool", "string", "enum", "vec3" or "file".
+std::string toString(ParamType type);
+/// The type written `text`, or nullopt.
+std::optional<ParamType> parseParamType(std::string_view text);
+/// "animator", "interactor", "viewer", "input" or "other".
+std::string toString(ModuleKind kind);
+/// The kind written `text`, or nullopt.
+std::optional<ModuleKind> parseModuleKind(std::string_view text);
+
+/// Why `value` is not a valid value of parameter `spec` ("expects an int, got 'x'", "is above
+/// its maximum 10", ...), or nullopt when it is valid.
+std::optional<std::string> checkParamValue(const ParamSpec& spec, std::string_view value);
+
+/// The port with this name in `ports`, or nullptr.
+const PortSpec* findPort(const std::vector<PortSpec>& ports, std::string_view name);
+
+}  // namespace vrflow::app

@@ -1,0 +1,18 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vrflow/app/diagnostic.hpp"
+#include "vrflow/app/model.hpp"
+
+namespace vrflow::app::detail {
+
+/// Reads an application, appending structural problems to `problems` (unsorted). Malformed
+/// XML gives nullopt and exactly one diagnostic. May throw std::bad_alloc.
+std::optional<Application> readApplication(std::string_view xml, const std::string& fileName,
+                                           std::vector<Diagnostic>& problems);
+
+}  // namespace vrflow::app::detail

@@ -1,0 +1,54 @@
+#include "vrflow/app/diagnostic.hpp"
+
+#include <algorithm>
+#include <tuple>
+
+namespace vrflow::app {
+
+std::string formatDiagnostic(const Diagnostic& diagnostic) {
+  std::string text = diagnostic.loc.file;
+  const SourceLocation& loc = diagnostic.loc;
+  if (loc.line > 0) {
+    if (!text.empty()) text += ':';
+    text += std::to_string(loc.line);
+    if (loc.column > 0) text += ":" + std::to_string(loc.column);
+  }
+  if (!text.empty()) text += ": ";
+  text += diagnostic.severity == Diagnostic::Error ? "error: " : "warning: ";
+  text += diagnostic.message;
+  return text;
+}
+
+std::string formatDiagnostics(const std::vector<Diagnostic>& diagnostics) {
+  std::string text;
+  for (const Diagnostic& diagnostic : diagnostics) text += formatDiagnostic(diagnostic) + "\n";
+  return text;
+}
+
+bool hasErrors(const std::vector<Diagnostic>& diagnostics) {
+  return std::any_of(diagnostics.begin(), diagnostics.end(),
+                     [](const Diagnostic& d) { return d.severity == Diagnostic::Error; });
+}
+
+void sortAndDeduplicate(std::vector<Diagnostic>& diagnostics) {
+  const auto place = [](const Diagnostic& d) {
+    return std::tie(d.loc.file, d.loc.line, d.loc.column);
+  };
+  std::stable_sort(diagnostics.begin(), diagnostics.end(),
+                   [&](const Diagnostic& a, const Diagnostic& b) { return place(a) < place(b); });
+  std::vector<Diagnostic> unique;
+  unique.reserve(diagnostics.size());
+  for (Diagnostic& diagnostic : diagnostics) {
+    // Sorted by place: only the kept diagnostics at the same place can repeat this one.
+    bool repeated = false;
+    for (auto kept = unique.rbegin(); kept != unique.rend() && place(*kept) == place(diagnostic);
+         ++kept) {
+      repeated = repeated ||
+                 (kept->severity == diagnostic.severity && kept->message == diagnostic.message);
+    }
+    if (!repeated) unique.push_back(std::move(diagnostic));
+  }
+  diagnostics = std::move(unique);
+}
+
+}  // namespace vrflow::app

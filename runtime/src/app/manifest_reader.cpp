@@ -1,0 +1,226 @@
+#include "manifest_reader.hpp"
+
+#include <filesystem>
+
+#include "element_reader.hpp"
+#include "source_text.hpp"
+#include "text_util.hpp"
+#include "vrflow/app/diagnostic.hpp"
+
+namespace vrflow::app::detail {
+namespace {
+
+PortSpec readPort(const ReadContext& context, const pugi::xml_node& node, bool isInput) {
+  const ElementReader reader =
+      isInput ? ElementReader(context, node, {"name", "data", "stamps-only", "required", "doc"})
+              : ElementReader(context, node, {"name", "data", "stamps-only", "doc"});
+  PortSpec port;
+  port.isInput = isInput;
+  port.name = reader.required("name");
+  port.data = reader.text("data", kAnyData);
+  if (port.data.empty()) reader.errorAt("data", "attribute 'data' must not be empty (use 'any')");
+  port.stampsOnly = reader.boolean("stamps-only", false);
+  port.required = isInput && reader.boolean("required", false);
+  port.doc = reader.text("doc");
+  if (port.name == kBeginItPort || port.name == kEndItPort) {
+    reader.errorAt("name", "port name '" + port.name +
+                               "' is reserved: every module has beginIt and endIt implicitly");
+  }
+  forEachChild(context, node, {}, [](const pugi::xml_node&) {});
+  return port;
+}
+
+ParamSpec readParamSpec(const ReadContext& context, const pugi::xml_node& node) {
+  const ElementReader reader(context, node,
+                             {"name", "type", "default", "min", "max", "choices", "doc"});
+  ParamSpec param;
+  param.name = reader.required("name");
+  const std::string typeText = reader.required("type");
+  if (const auto type = parseParamType(typeText)) {
+    param.type = *type;
+  } else if (!typeText.empty()) {
+    reader.errorAt("type", "unknown parameter type '" + typeText +
+                               "' (types: int, float, bool, string, enum, vec3, file)");
+  }
+  param.defaultValue = reader.text("default");
+  param.min = reader.optionalNumber("min");
+  param.max = reader.optionalNumber("max");
+  param.doc = reader.text("doc");
+  const bool numeric = param.type == ParamType::Int || param.type == ParamType::Float ||
+                       param.type == ParamType::Vec3;
+  for (const char* bound : {"min", "max"}) {
+    if (reader.has(bound) && !numeric) {
+      reader.errorAt(bound, "attribute '" + std::string(bound) +
+                                "' applies only to int, float and vec3 parameters");
+    }
+  }
+  if (param.min && param.max && *param.min > *param.max) {
+    reader.errorAt("min",
+                   "min " + formatNumber(*param.min) + " is above max " + formatNumber(*param.max));
+  }
+  if (reader.has("choices")) {
+    if (param.type != ParamType::Enum) {
+      reader.errorAt("choices", "attribute 'choices' applies only to enum parameters");
+    }
+    const std::string choices = reader.text("choices");
+    std::size_t start = 0;
+    while (start <= choices.size()) {
+      std::size_t end = choices.find(',', start);
+      if (end == std::string::npos) end = choices.size();
+      std::string choice = choices.substr(start, end - start);
+      while (!choice.empty() && choice.front() == ' ') choice.erase(choice.begin());
+      while (!choice.empty() && choice.back() == ' ') choice.pop_back();
+      if (choice.empty()) {
+        reader.errorAt("choices", "attribute 'choices' has an empty choice");
+      } else {
+        param.choices.push_back(std::move(choice));
+      }
+      start = end + 1;
+    }
+  } else if (param.type == ParamType::Enum && !typeText.empty()) {
+    context.error(reader.loc(), missingAttributeMessage("param", "choices") + " (enum)");
+  }
+  if (reader.has("default") && !param.name.empty()) {
+    if (const auto problem = checkParamValue(param, param.defaultValue)) {
+      reader.errorAt("default", "default of parameter '" + param.name + "' " + *problem);
+    }
+  }
+  forEachChild(context, node, {}, [](const pugi::xml_node&) {});
+  return param;
+}
+
+// Relative to the manifest's folder when that file exists there, else as written (looked up
+// on PATH when the module starts).
+std::string resolveExecutable(const std::string& executable, const std::string& manifestFile) {
+  namespace fs = std::filesystem;
+  if (executable.empty() || fs::path(executable).is_absolute()) return executable;
+  std::error_code ec;
+  const fs::path folder = fs::absolute(fs::path(manifestFile), ec).parent_path();
+  if (ec) return executable;
+  const fs::path candidate = (folder / executable).lexically_normal();
+  if (fs::is_regular_file(candidate, ec)) return candidate.string();
+  return executable;
+}
+
+ModuleType readModuleType(const ReadContext& context, const pugi::xml_node& node,
+                          const std::string& package) {
+  const ElementReader reader(context, node, {"type", "executable", "kind"});
+  ModuleType type;
+  type.package = package;
+  type.type = reader.required("type");
+  type.executable = resolveExecutable(reader.required("executable"), context.source.file());
+  type.kind = reader.keyword("kind", ModuleKind::Other, parseModuleKind,
+                             "animator, interactor, viewer, input, other");
+  type.loc = reader.loc();
+  type.loc.attributes.clear();
+  bool first = true;
+  forEachChild(context, node, {"doc", "input", "output", "param"},
+               [&](const pugi::xml_node& child) {
+                 const std::string_view name = child.name();
+                 const bool wasFirst = first;
+                 first = false;
+                 if (name == "doc") {
+                   const ElementReader docReader(context, child, {});
+                   if (!wasFirst) {
+                     context.error(docReader.loc(), "<doc> must be the first child of <module>");
+                   }
+                   type.doc = readTextElement(context, child);
+                   return;
+                 }
+                 if (name == "param") {
+                   const ParamSpec param = readParamSpec(context, child);
+                   if (!param.name.empty() && type.findParam(param.name) != nullptr) {
+                     context.error(
+                         context.source.element(child).attribute("name"),
+                         "parameter '" + param.name + "' is declared twice in '" + type.type + "'");
+                   }
+                   type.params.push_back(param);
+                   return;
+                 }
+                 const PortSpec port = readPort(context, child, name == "input");
+                 if (!port.name.empty() && type.findPort(port.name) != nullptr) {
+                   context.error(context.source.element(child).attribute("name"),
+                                 "port '" + port.name + "' is declared twice in '" + type.type +
+                                     "' (inputs and outputs share one namespace)");
+                 }
+                 type.ports.push_back(port);
+               });
+  addImplicitPorts(type);
+  return type;
+}
+
+}  // namespace
+
+void addImplicitPorts(ModuleType& type) {
+  if (type.findPort(kBeginItPort) == nullptr) {
+    PortSpec beginIt;
+    beginIt.name = std::string(kBeginItPort);
+    beginIt.isInput = true;
+    beginIt.stampsOnly = true;
+    beginIt.doc = "when connected, each iteration also waits for a message here";
+    type.ports.push_back(std::move(beginIt));
+  }
+  if (type.findPort(kEndItPort) == nullptr) {
+    PortSpec endIt;
+    endIt.name = std::string(kEndItPort);
+    endIt.isInput = false;
+    endIt.stampsOnly = true;
+    endIt.doc = "a stamps-only message each time the module finishes an iteration";
+    type.ports.push_back(std::move(endIt));
+  }
+}
+
+Result<PackageManifest> readPackageManifest(std::string_view xml, const std::string& fileName) {
+  try {
+    const SourceText source(xml, fileName);
+    pugi::xml_document document;
+    const pugi::xml_parse_result parsed =
+        document.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+    if (!parsed) return makeError(formatDiagnostic(parseFailure(source, parsed)));
+
+    std::vector<Diagnostic> problems;
+    const ReadContext context{source, problems};
+    PackageManifest manifest;
+    manifest.file = fileName;
+    const pugi::xml_node root = document.document_element();
+    if (std::string_view(root.name()) != "package") {
+      context.error(source.element(root),
+                    "root element must be <package>, found <" + std::string(root.name()) + ">");
+    } else {
+      const ElementReader reader(context, root, {"name", "version"});
+      manifest.name = reader.required("name");
+      manifest.version = reader.text("version");
+      if (manifest.name.find_first_of("/ \t\n") != std::string::npos) {
+        reader.errorAt("name",
+                       "package name '" + manifest.name + "' must not contain '/' or spaces");
+      }
+      forEachChild(context, root, {"doc", "module"}, [&](const pugi::xml_node& child) {
+        if (std::string_view(child.name()) == "doc") {
+          const ElementReader docReader(context, child, {});
+          manifest.doc = readTextElement(context, child);
+          return;
+        }
+        ModuleType type = readModuleType(context, child, manifest.name);
+        for (const ModuleType& previous : manifest.modules) {
+          if (!type.type.empty() && previous.type == type.type) {
+            context.error(source.element(child).attribute("type"),
+                          "module type '" + type.type + "' is declared twice (first at line " +
+                              std::to_string(previous.loc.line) + ")");
+          }
+        }
+        manifest.modules.push_back(std::move(type));
+      });
+    }
+    if (!problems.empty()) {
+      sortAndDeduplicate(problems);
+      std::string message = formatDiagnostics(problems);
+      message.pop_back();
+      return makeError(std::move(message));
+    }
+    return manifest;
+  } catch (const std::exception& e) {
+    return makeError(fileName + ": error: cannot read package manifest (" + e.what() + ")");
+  }
+}
+
+}  // namespace vrflow::app::detail

@@ -1,0 +1,141 @@
+#include "vrflow/app/model.hpp"
+
+#include <algorithm>
+
+#include "text_util.hpp"
+
+namespace vrflow::app {
+namespace {
+
+template <typename Items>
+auto findById(Items& items, std::string_view id) -> decltype(&items.front()) {
+  const auto it =
+      std::find_if(items.begin(), items.end(), [&](const auto& item) { return item.id == id; });
+  return it == items.end() ? nullptr : &*it;
+}
+
+}  // namespace
+
+const Module* findModule(const Application& app, std::string_view id) {
+  return findById(app.modules, id);
+}
+Module* findModule(Application& app, std::string_view id) {
+  return findById(app.modules, id);
+}
+const Filter* findFilter(const Application& app, std::string_view id) {
+  return findById(app.filters, id);
+}
+Filter* findFilter(Application& app, std::string_view id) {
+  return findById(app.filters, id);
+}
+const Host* findHost(const Application& app, std::string_view id) {
+  return findById(app.hosts, id);
+}
+
+const EditorNode* findEditorNode(const Application& app, std::string_view ref) {
+  const auto it = std::find_if(app.editor.begin(), app.editor.end(),
+                               [&](const EditorNode& node) { return node.ref == ref; });
+  return it == app.editor.end() ? nullptr : &*it;
+}
+
+const InputConfig* findInputConfig(const Module& module, std::string_view port) {
+  const auto it = std::find_if(module.inputs.begin(), module.inputs.end(),
+                               [&](const InputConfig& input) { return input.port == port; });
+  return it == module.inputs.end() ? nullptr : &*it;
+}
+
+InputConfig inputConfigOrDefault(const Module& module, std::string_view port) {
+  if (const InputConfig* config = findInputConfig(module, port)) return *config;
+  InputConfig config;
+  config.port = std::string(port);
+  return config;
+}
+
+const Param* findParam(const std::vector<Param>& params, std::string_view name) {
+  const auto it = std::find_if(params.begin(), params.end(),
+                               [&](const Param& param) { return param.name == name; });
+  return it == params.end() ? nullptr : &*it;
+}
+
+std::string paramString(const std::vector<Param>& params, std::string_view name,
+                        std::string_view fallback) {
+  const Param* param = findParam(params, name);
+  return param ? param->value : std::string(fallback);
+}
+
+long long paramInt(const std::vector<Param>& params, std::string_view name, long long fallback) {
+  const Param* param = findParam(params, name);
+  if (!param) return fallback;
+  return detail::parseInteger(param->value).value_or(fallback);
+}
+
+double paramFloat(const std::vector<Param>& params, std::string_view name, double fallback) {
+  const Param* param = findParam(params, name);
+  if (!param) return fallback;
+  return detail::parseFloat(param->value).value_or(fallback);
+}
+
+bool paramBool(const std::vector<Param>& params, std::string_view name, bool fallback) {
+  const Param* param = findParam(params, name);
+  if (!param) return fallback;
+  return detail::parseBool(param->value).value_or(fallback);
+}
+
+void setParam(std::vector<Param>& params, std::string_view name, std::string value) {
+  for (Param& param : params) {
+    if (param.name == name) {
+      param.value = std::move(value);
+      return;
+    }
+  }
+  Param param;
+  param.name = std::string(name);
+  param.value = std::move(value);
+  params.push_back(std::move(param));
+}
+
+std::string toString(const Endpoint& endpoint) {
+  return endpoint.node + "." + endpoint.port;
+}
+
+std::optional<Endpoint> parseEndpoint(std::string_view text) {
+  const std::size_t dot = text.find('.');
+  if (dot == std::string_view::npos || dot == 0 || dot + 1 == text.size()) return std::nullopt;
+  return Endpoint{std::string(text.substr(0, dot)), std::string(text.substr(dot + 1))};
+}
+
+std::string toString(QueuePolicy policy) {
+  switch (policy) {
+    case QueuePolicy::Block:
+      return "block";
+    case QueuePolicy::DropOldest:
+      return "drop-oldest";
+    case QueuePolicy::DropNewest:
+      return "drop-newest";
+  }
+  return "block";
+}
+
+std::optional<QueuePolicy> parseQueuePolicy(std::string_view text) {
+  if (text == "block") return QueuePolicy::Block;
+  if (text == "drop-oldest") return QueuePolicy::DropOldest;
+  if (text == "drop-newest") return QueuePolicy::DropNewest;
+  return std::nullopt;
+}
+
+std::string toString(InputMode mode) {
+  return mode == InputMode::Latest ? "latest" : "fifo";
+}
+
+std::optional<InputMode> parseInputMode(std::string_view text) {
+  if (text == "fifo") return InputMode::Fifo;
+  if (text == "latest") return InputMode::Latest;
+  return std::nullopt;
+}
+
+std::string effectiveHost(const Application& app, const std::string& host) {
+  if (!host.empty() || app.hosts.empty()) return host;
+  return app.hosts.front().id;
+}
+
+}  // namespace vrflow::app

@@ -1,0 +1,31 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace vrflow::app::detail {
+
+/// "a, b, c" (at most `limit` names, then "and N more"); "none" when empty.
+std::string joinNames(const std::vector<std::string>& names, std::size_t limit = 12);
+
+/// The candidate closest to `word` when it is a plausible typo of it (edit distance at most 2
+/// and less than half the word), or nullopt.
+std::optional<std::string> closestName(std::string_view word,
+                                       const std::vector<std::string>& candidates);
+
+/// "; did you mean 'x'?" when a close candidate exists, else "".
+std::string didYouMean(std::string_view word, const std::vector<std::string>& candidates);
+
+/// The shortest text that reads back as `value` ("10", "0.5", "1e+20").
+std::string formatNumber(double value);
+
+/// Parses a whole string as a decimal integer (optional '-'), or nullopt.
+std::optional<long long> parseInteger(std::string_view text);
+/// Parses a whole string as a finite decimal float, or nullopt.
+std::optional<double> parseFloat(std::string_view text);
+/// Parses "true"/"false"/"1"/"0" (xs:boolean), or nullopt.
+std::optional<bool> parseBool(std::string_view text);
+
+}  // namespace vrflow::app::detail

@@ -1,0 +1,44 @@
+#include "test_support.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "vrflow/app/validate.hpp"
+
+namespace vrflow::app::testing {
+
+std::string sourceDir() {
+  if (const char* dir = std::getenv("VRFLOW_SOURCE_DIR")) return dir;
+  return std::filesystem::path(__FILE__).parent_path().parent_path().parent_path().string();
+}
+
+std::string dataDir() {
+  return sourceDir() + "/tests/app/data";
+}
+
+const Catalog& testCatalog() {
+  static const Catalog catalog = [] {
+    Catalog loaded;
+    const Status status = loaded.addPackageDir(dataDir() + "/packages");
+    if (!status) throw std::runtime_error(status.error().message);
+    return loaded;
+  }();
+  return catalog;
+}
+
+std::vector<Diagnostic> check(std::string_view xml) {
+  return checkApplicationString(xml, "app.xml", testCatalog());
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::ostringstream content;
+  content << in.rdbuf();
+  return content.str();
+}
+
+}  // namespace vrflow::app::testing
