@@ -250,12 +250,12 @@ TEST_F(RunTest, ModuleThatExitsWithAnErrorStopsTheRunAndIsNamed) {
 TEST_F(RunTest, ModuleKilledBySignalIsReportedWithTheSignal) {
   const auto file = dir.write(
       "app.xml", app(module("src", "core/source") +
-                         module("bad", "testing/crash", param("at", "2") + param("signal", "11")),
+                         module("bad", "testing/crash", param("at", "2") + param("signal", "9")),
                      connect("src.out", "bad.in")));
   const auto result = runVrflow({"run", file});
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find("module 'bad'"), std::string::npos) << result.err;
-  EXPECT_NE(result.err.find("killed by signal 11"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("killed by signal 9 (Killed)"), std::string::npos) << result.err;
 }
 
 TEST_F(RunTest, SigtermStopsEveryProcess) {
