@@ -6,7 +6,7 @@ BUILD_TYPE ?= Release
 
 # Every Debian package the project needs to build, test and benchmark.
 PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-rt-14-dev \
-  libgtest-dev libgmock-dev libbenchmark-dev libpugixml-dev libcli11-dev libspdlog-dev libfmt-dev \
+  libgtest-dev libpugixml-dev libcli11-dev \
   nlohmann-json3-dev libxxhash-dev libzmq3-dev libopenmpi-dev openmpi-bin libxml2-utils procps
 
 .PHONY: deps build test demo clean

@@ -118,11 +118,17 @@ uint64_t Segment::allocate(std::size_t payloadBytes) {
       break;
     }
   }
+  BlockHeader* header = nullptr;
   if (handle == 0) {
     handle = reserve(std::size_t{1} << k, 64);
     if (handle == 0) return 0;
+    header = new (base_ + handle) BlockHeader();  // never seen by anyone before
+  } else {
+    // A popper that lost the race may still read `next` of this block: only atomic stores.
+    header = &block(handle);
+    header->next.store(0, std::memory_order_relaxed);
+    header->used = 0;
   }
-  auto* header = new (base_ + handle) BlockHeader();
   header->blockClass = static_cast<uint32_t>(k);
   header->refs.store(1, std::memory_order_relaxed);
   const uint64_t inUse =
