@@ -5,7 +5,6 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <filesystem>
 #include <set>
 
 #include "vrflow/app/catalog.hpp"
@@ -31,14 +30,9 @@ int main(int argc, char** argv) {
     return cli.exit(e) == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
-  std::vector<std::string> dirs = packageDirs;
-  for (const auto& d : vrflow::app::searchPathFromEnvironment()) dirs.push_back(d);
-  std::error_code ec;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) dirs.push_back((self.parent_path().parent_path() / "share/vrflow/packages").string());
-  vrflow::app::Catalog catalog;
-  if (auto status = catalog.loadSearchPath(dirs); !status) {
-    std::fprintf(stderr, "vrflow-daemon: %s\n", status.error().message.c_str());
+  auto catalog = vrflow::run::loadCatalog(packageDirs);
+  if (!catalog) {
+    std::fprintf(stderr, "vrflow-daemon: %s\n", catalog.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
   std::vector<vrflow::app::Diagnostic> problems;
@@ -47,7 +41,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
-  auto more = vrflow::app::validate(*application, catalog);
+  auto more = vrflow::app::validate(*application, *catalog);
   problems.insert(problems.end(), more.begin(), more.end());
   for (const auto& d : problems) std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
   if (vrflow::app::hasErrors(problems)) return vrflow::run::kExitInvalid;
@@ -89,7 +83,7 @@ int main(int argc, char** argv) {
     }
     if (from) local.connections.push_back(c);
   }
-  const auto outcome = vrflow::run::runApplication(local, catalog, options);
+  const auto outcome = vrflow::run::runApplication(local, *catalog, options);
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow-daemon: %s\n", outcome.error.c_str());
   return outcome.exitCode;
 }

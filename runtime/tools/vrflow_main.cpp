@@ -3,7 +3,6 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -14,21 +13,6 @@
 #include "vrflow/run/runner.hpp"
 
 namespace {
-
-namespace fs = std::filesystem;
-
-// Packages: --packages folders, then $VRFLOW_PACKAGE_PATH, then the ones installed beside
-// this executable (<bin>/../share/vrflow/packages).
-vrflow::Result<vrflow::app::Catalog> loadCatalog(const std::vector<std::string>& extra) {
-  std::vector<std::string> dirs = extra;
-  for (const auto& d : vrflow::app::searchPathFromEnvironment()) dirs.push_back(d);
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) dirs.push_back((self.parent_path().parent_path() / "share/vrflow/packages").string());
-  vrflow::app::Catalog catalog;
-  if (auto status = catalog.loadSearchPath(dirs); !status) return status.error();
-  return catalog;
-}
 
 // Loads and validates; prints every diagnostic. Returns the application when it has no error.
 std::optional<vrflow::app::Application> loadValid(const std::string& file,
@@ -85,7 +69,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
-  auto catalog = loadCatalog(packageDirs);
+  auto catalog = vrflow::run::loadCatalog(packageDirs);
   if (!catalog) {
     std::fprintf(stderr, "vrflow: %s\n", catalog.error().message.c_str());
     return vrflow::run::kExitInvalid;

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <thread>
 
@@ -263,6 +264,17 @@ RunOutcome Supervisor::run() {
 }
 
 }  // namespace
+
+Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs) {
+  std::vector<std::string> dirs = extraDirs;
+  for (const auto& d : app::searchPathFromEnvironment()) dirs.push_back(d);
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back((self.parent_path().parent_path() / "share/vrflow/packages").string());
+  app::Catalog catalog;
+  if (auto status = catalog.loadSearchPath(dirs); !status) return status.error();
+  return catalog;
+}
 
 RunOutcome runApplication(const app::Application& application, const app::Catalog& catalog,
                           const RunOptions& options) {

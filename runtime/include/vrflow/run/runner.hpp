@@ -37,6 +37,10 @@ struct RunOutcome {
   std::string error;          ///< one line a person can act on; empty on success
 };
 
+/// The node packages on the search path: `extraDirs` first, then $VRFLOW_PACKAGE_PATH, then
+/// <folder of this executable>/../share/vrflow/packages (the build tree and installs alike).
+Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs);
+
 /// Runs `application` with every host mapped to this machine (the embedded default): one
 /// daemon in this process, each module in its own process. Returns when every process of the
 /// run has ended; nothing is left behind.
