@@ -48,7 +48,7 @@ int main() {
     while (module.wait()) {
       if (!module.put(out, module.get(in))) break;
     }
-    return 0;
+    return module.exitStatus();
   }
   if (role == "ping") {
     auto payload = build();
@@ -77,7 +77,7 @@ int main() {
     while ((count == 0 || module.iteration() < count) && module.wait()) {
       if (!module.put(out, *payload)) break;
     }
-    return 0;
+    return module.exitStatus();
   }
   if (role == "recv") {
     uint64_t received = 0;

@@ -23,4 +23,5 @@ int main() {
     }
     if (!module.put(forces, std::move(out))) break;
   }
+  return module.exitStatus();                  // non-zero if put() reported an error
 }

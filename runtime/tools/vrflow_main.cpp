@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -34,6 +35,7 @@ std::optional<vrflow::app::Application> loadValid(const std::string& file,
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::signal(SIGPIPE, SIG_IGN);  // a closed stderr must not kill the run before its report
   CLI::App cli{"vrflow: run data-flow networks of physics modules"};
   cli.require_subcommand(1);
   std::vector<std::string> packageDirs;
@@ -51,7 +53,8 @@ int main(int argc, char** argv) {
   double shmMiB = 1024;
   bool noProgress = false;
   run->add_option("APP.xml", runFile, "Application file")->required();
-  run->add_option("--iterations,-n", options.iterations, "Stop after N iterations of every module");
+  run->add_option("--iterations,-n", options.iterations, "Stop after N iterations of every module")
+      ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 62));
   run->add_option("--report", options.reportPath, "Write a JSON run report to FILE");
   run->add_option("--timeout", options.timeoutSeconds, "Fail if the run lasts longer (seconds)")
       ->check(CLI::NonNegativeNumber);

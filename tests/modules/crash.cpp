@@ -27,5 +27,5 @@ int main() {
       break;
     }
   }
-  return 0;
+  return module.exitStatus();
 }

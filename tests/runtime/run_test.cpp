@@ -298,6 +298,42 @@ TEST_F(RunTest, TimeoutBoundsARun) {
   EXPECT_NE(result.err.find("timed out after 1 s"), std::string::npos) << result.err;
 }
 
+TEST_F(RunTest, UnconnectedOutputDropsMessagesWithoutBlockingTheModule) {
+  const auto file = dir.write("app.xml", app(module("src", "core/source"), ""));
+  const auto result = runVrflow({"run", file, "-n", "100", "--report", dir.file("r.json")});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(readJson(dir.file("r.json"))["modules"][0]["iterations"], 100);
+}
+
+TEST_F(RunTest, InputWithOnlyInitialMessagesGetsExactlyThoseThenEnds) {
+  const auto log = dir.file("log");
+  const auto file = dir.write(
+      "app.xml", app(module("p", "core/points", initial("events", 2) + param("log", log)), ""));
+  const auto result = runVrflow({"run", file, "-n", "10"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto lines = readLines(log);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "p 0 <- p.events@0 chunks=0");
+  EXPECT_EQ(lines[1], "p 1 <- p.events@1 chunks=0");
+}
+
+TEST_F(RunTest, ProgramThatNeverJoinsTheRunFailsIt) {
+  const auto file = dir.write("app.xml", app(module("x", "testing/nojoin"), ""));
+  const auto result = runVrflow({"run", file, "-n", "5"});
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("module 'x'"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("never called Module::init()"), std::string::npos) << result.err;
+}
+
+TEST_F(RunTest, ExhaustedSharedMemoryFailsTheRunWithAClearMessage) {
+  const auto file = dir.write(
+      "app.xml", app(module("src", "core/source", param("size", "4000000")) + module("r", "core/relay"),
+                     connect("src.out", "r.in")));
+  const auto result = runVrflow({"run", file, "-n", "10", "--shm-size", "2"});
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("module 'src': shared memory exhausted"), std::string::npos) << result.err;
+}
+
 TEST_F(RunTest, InvalidApplicationIsRefusedBeforeStartingAnything) {
   const auto file = dir.write("app.xml", app(module("x", "core/nosuch"), ""));
   const auto result = runVrflow({"run", file});

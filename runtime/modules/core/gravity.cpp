@@ -27,5 +27,5 @@ int main() {
     }
     if (!module.put(forces, std::move(out))) break;
   }
-  return 0;
+  return module.exitStatus();
 }

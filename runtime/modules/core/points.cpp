@@ -90,5 +90,5 @@ int main() {
     }
     if (!module.put(objects, std::move(out))) break;
   }
-  return 0;
+  return module.exitStatus();
 }

@@ -15,5 +15,5 @@ int main() {
   while (module.wait()) {
     if (!module.put(out, module.get(in))) break;
   }
-  return 0;
+  return module.exitStatus();
 }

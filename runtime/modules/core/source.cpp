@@ -24,5 +24,5 @@ int main() {
     message.builder().addRawResource(resource, true, payload);
     if (!module.put(out, std::move(message))) break;
   }
-  return 0;
+  return module.exitStatus();
 }

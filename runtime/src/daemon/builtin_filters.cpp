@@ -53,6 +53,7 @@ class MergeFilter final : public Filter {
  public:
   void process(FilterContext& context) override {
     const std::size_t n = context.inputCount();
+    if (n == 0) return;  // nothing will ever arrive
     for (;;) {
       for (std::size_t i = 0; i < n; ++i) {
         if (context.input(i).empty()) return;

@@ -18,6 +18,7 @@ namespace {
 constexpr uint32_t kOutputRingCapacity = 16;
 constexpr uint32_t kInputRingCapacity = 16;
 constexpr int64_t kIdleSleepNs = 100'000'000;
+constexpr int kMaxInitialMessages = 1'000'000;
 
 uint64_t nowNs() {
   return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -45,15 +46,19 @@ struct Daemon::Impl {
   std::vector<ModuleProcess> modules;
   ipc::ModuleSlot* slots = nullptr;
   std::vector<std::atomic<bool>> ended;
+  std::vector<std::vector<ipc::RingRef>> rings;  ///< per module and port, kept out of modules' reach
+  std::vector<std::vector<std::string>> outputNames;  ///< per module and port, for messages
   // Per module and port index: the node fed by that port (output filter) or feeding it.
   std::map<std::pair<int, std::string>, Node*> portNodes;
   std::map<std::string, Node*> filterNodes;
   std::vector<std::pair<std::string, PortOutputFilter*>> outputFilters;  // "module.port"
   std::thread thread;
   std::atomic<bool> running{false};
+  bool built = false;  ///< the network was fully built (shutdown() has something to drain)
   std::size_t lastBuffered = 0;  ///< messages buffered after the previous pass
   std::mutex warningsMutex;
   std::vector<std::string> warnings;
+  std::string fatal;  ///< first protocol violation by a module (guarded by warningsMutex)
 
   Status build(const app::Application& application, const app::Catalog& catalog);
   Result<Node*> addNode(const std::string& id, const std::string& type,
@@ -128,6 +133,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
       return makeError("unknown module type '" + module.package + "/" + module.type + "'");
     }
     auto* slot = new (&slots[m]) ipc::ModuleSlot();
+    rings.emplace_back();
+    outputNames.emplace_back();
     for (auto& bucket : slot->histogram) bucket.store(0);
     copyName(slot->id, module.id);
     const std::string host = app::effectiveHost(application, module.host);
@@ -156,20 +163,26 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
       const app::PortSpec& spec = ports[p];
       ipc::PortSlot& port = slot->ports[p];
       copyName(port.name, spec.name);
+      outputNames[m].push_back(spec.name);
       port.isInput = spec.isInput ? 1 : 0;
       port.stampsOnly = spec.stampsOnly ? 1 : 0;
       const auto key = std::make_pair(module.id, spec.name);
       const int fan = spec.isInput ? fanIn[key] : fanOut[key];
       const app::InputConfig* config = spec.isInput ? app::findInputConfig(module, spec.name) : nullptr;
       const int initial = config != nullptr ? config->initialMessages : 0;
+      if (initial < 0 || initial > kMaxInitialMessages) {
+        return makeError("module '" + module.id + "' input '" + spec.name + "': initial-messages must be 0 to " +
+                         std::to_string(kMaxInitialMessages));
+      }
       // An input with only initial messages and no connection is still served: it gets them.
       port.connected = (fan > 0 || initial > 0) ? 1 : 0;
       uint32_t capacity = spec.isInput ? kInputRingCapacity : kOutputRingCapacity;
       capacity = std::bit_ceil(std::max<uint32_t>(capacity, static_cast<uint32_t>(initial) + 1));
       port.ringOffset = segment.reserve(ipc::Ring::bytesFor(capacity));
       if (port.ringOffset == 0) return makeError("shared-memory segment too small for rings");
-      new (segment.at<void>(port.ringOffset)) ipc::Ring();
-      segment.at<ipc::Ring>(port.ringOffset)->init(capacity);
+      auto* ring = new (segment.at<void>(port.ringOffset)) ipc::Ring();
+      ring->init(capacity);
+      rings[m].emplace_back(ring);
       if (!port.connected) continue;
 
       const std::string nodeId = module.id + "." + spec.name;
@@ -180,7 +193,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         auto node = addNode(nodeId, "port-input", std::move(params), {}, {"out"});
         if (!node) return node.error();
         (*node)->outputs[0].push_back(
-            std::make_unique<RingSink>(segment, *slot, static_cast<int>(p), latest, ended[m]));
+            std::make_unique<RingSink>(rings[m][p], *slot, static_cast<int>(p), latest, ended[m]));
         portNodes[{static_cast<int>(m), spec.name}] = *node;
       } else {
         auto node = addNode(nodeId, "port-output", {}, {"in"}, {"out"});
@@ -190,7 +203,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         queue.from = nodeId;
         queue.to = nodeId;
         (*node)->inputs.push_back(&queue);
-        graph->sources.push_back({static_cast<int>(m), static_cast<int>(p), &queue, false});
+        graph->sources.push_back({static_cast<int>(m), static_cast<int>(p), rings[m][p], &queue, false});
         portNodes[{static_cast<int>(m), spec.name}] = *node;
         outputFilters.emplace_back(nodeId, static_cast<PortOutputFilter*>((*node)->filter.get()));
       }
@@ -268,6 +281,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     }
   }
   segment.header().controlOffset = tableOffset;
+  built = true;
   return {};
 }
 
@@ -303,19 +317,17 @@ void Daemon::shutdown() {
     d.segment.header().daemonBell.ring();
     d.thread.join();
   }
-  if (!d.graph) return;
+  if (!d.graph || !d.built) return;
   // Route what the modules sent last (their processes have ended by now), so that the report
   // sees every message that was put.
   while (d.pass()) {
   }
   // Drop every message still buffered: in queues, and in the rings of every module.
   for (auto& queue : d.graph->queues) queue.items.clear();
-  for (const auto& module : d.modules) {
-    auto& slot = d.slots[module.slotIndex];
-    for (uint32_t p = 0; p < slot.portCount; ++p) {
-      auto* ring = d.segment.at<ipc::Ring>(slot.ports[p].ringOffset);
+  for (const auto& moduleRings : d.rings) {
+    for (const auto& ring : moduleRings) {
       uint64_t handle = 0;
-      while (ring->pop(handle)) {
+      while (ring.pop(handle)) {
         if (d.segment.validHandle(handle)) d.segment.release(handle);
       }
     }
@@ -346,13 +358,32 @@ bool Daemon::Impl::pass() {
   for (auto& source : graph->sources) {
     if (source.closed) continue;
     ipc::ModuleSlot& slot = slots[source.module];
-    auto* ring = segment.at<ipc::Ring>(slot.ports[source.port].ringOffset);
+    const ipc::RingRef& ring = source.ring;
     bool popped = false;
     uint64_t handle = 0;
-    while (source.queue->items.size() < source.queue->capacity && ring->pop(handle)) {
+    while (source.queue->items.size() < source.queue->capacity && ring.pop(handle)) {
+      // A cheap check at the door, so that a bad message is blamed on the module that sent it
+      // (receivers check every byte when they read it).
+      const char* problem = nullptr;
       if (!segment.validHandle(handle)) {
-        graph->warnings.push_back(std::string("module '") + slot.id + "' sent an invalid handle on '" +
-                                  slot.ports[source.port].name + "'; dropped");
+        problem = "an invalid handle";
+      } else if (segment.block(handle).refs.load(std::memory_order_relaxed) == 0) {
+        problem = "a message it no longer holds";
+      } else {
+        const auto total = msg::MessageView::peekTotalSize(segment.bytes(handle));
+        if (!total || *total != segment.block(handle).used) problem = "a malformed message";
+      }
+      if (problem != nullptr) {
+        // A module that breaks the protocol has a bug: the run stops, naming it.
+        std::lock_guard lock(warningsMutex);
+        if (fatal.empty()) {
+          fatal = std::string("module '") + slot.id + "' sent " + problem + " on output '" +
+                  outputNames[static_cast<std::size_t>(source.module)][static_cast<std::size_t>(source.port)] +
+                  "'";
+        }
+        if (segment.validHandle(handle) && segment.block(handle).refs.load() != 0) {
+          segment.release(handle);
+        }
         continue;
       }
       source.queue->items.emplace_back(&segment, handle);
@@ -365,7 +396,7 @@ bool Daemon::Impl::pass() {
         ended[static_cast<std::size_t>(source.module)].load(std::memory_order_acquire) ||
         slot.state.load(std::memory_order_acquire) ==
             static_cast<uint32_t>(ipc::ModuleState::Finished);
-    if (moduleDone && ring->empty()) {
+    if (moduleDone && ring.empty()) {
       source.closed = true;
       source.queue->closed = true;
       ++graph->operations;
@@ -424,6 +455,11 @@ void Daemon::Impl::publishWarnings() {
   std::lock_guard lock(warningsMutex);
   for (auto& w : graph->warnings) warnings.push_back(std::move(w));
   graph->warnings.clear();
+}
+
+std::string Daemon::fatalError() {
+  std::lock_guard lock(impl_->warningsMutex);
+  return impl_->fatal;
 }
 
 std::vector<std::string> Daemon::takeWarnings() {

@@ -36,7 +36,7 @@ void QueueSink::push(MessageRef message) {
 
 void RingSink::push(MessageRef message) {
   if (ended()) return;  // dropped: nobody will ever read it
-  const bool pushed = ring().push(message.handle());
+  const bool pushed = ring_.push(message.handle());
   if (pushed) {
     message.release();  // the ring holds the reference now
     slot_->bell.ring();

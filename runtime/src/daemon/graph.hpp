@@ -56,9 +56,9 @@ class QueueSink final : public Sink {
 /// A sink that hands messages to a module's input ring and wakes the module.
 class RingSink final : public Sink {
  public:
-  RingSink(ipc::Segment& segment, ipc::ModuleSlot& slot, int port, bool onlyWhenEmpty,
+  RingSink(ipc::RingRef ring, ipc::ModuleSlot& slot, int port, bool onlyWhenEmpty,
            const std::atomic<bool>& moduleEnded)
-      : segment_(&segment),
+      : ring_(ring),
         slot_(&slot),
         port_(port),
         onlyWhenEmpty_(onlyWhenEmpty),
@@ -66,14 +66,13 @@ class RingSink final : public Sink {
   /// A module that has ended takes (and drops) everything, so its producers are never stuck.
   bool hasSpace() const override {
     if (ended()) return true;
-    const auto& ring = this->ring();
-    const bool space = onlyWhenEmpty_ ? ring.empty() : !ring.full();
+    const bool space = onlyWhenEmpty_ ? ring_.empty() : !ring_.full();
     if (!space) {
       // Ask the module to ring the daemon when it takes a message; re-check, since it may
       // have taken one before it could see the request.
       slot_->ports[port_].wantsSpace.store(1, std::memory_order_seq_cst);
       std::atomic_thread_fence(std::memory_order_seq_cst);
-      return onlyWhenEmpty_ ? ring.empty() : !ring.full();
+      return onlyWhenEmpty_ ? ring_.empty() : !ring_.full();
     }
     return true;
   }
@@ -81,15 +80,12 @@ class RingSink final : public Sink {
   void close() override;
 
  private:
-  ipc::Ring& ring() const {
-    return *segment_->at<ipc::Ring>(slot_->ports[port_].ringOffset);
-  }
   bool ended() const {
     return moduleEnded_->load(std::memory_order_acquire) ||
            slot_->state.load(std::memory_order_acquire) ==
                static_cast<uint32_t>(ipc::ModuleState::Finished);
   }
-  ipc::Segment* segment_;
+  ipc::RingRef ring_;
   ipc::ModuleSlot* slot_;
   int port_;
   bool onlyWhenEmpty_;
@@ -133,6 +129,7 @@ class Node final : public FilterContext {
 struct ModuleSource {
   int module = 0;
   int port = 0;
+  ipc::RingRef ring;
   Queue* queue = nullptr;
   bool closed = false;
 };

@@ -1,6 +1,10 @@
 #include "vrflow/module/module.hpp"
 
+#include <fcntl.h>
+#include <sys/prctl.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <chrono>
 #include <cstdio>
@@ -58,6 +62,7 @@ struct Module::Impl {
   bool started = false;
   bool finished = false;
   bool initialized = false;
+  bool failed = false;
   uint64_t iteration = 0;
   uint64_t iterationStartNs = 0;
   double simTime = 0.0;
@@ -81,15 +86,19 @@ struct Module::Impl {
   }
   // Pushes a handle on an output ring, sleeping while it is full. False if the run stops.
   bool push(int portSlot, uint64_t handle) {
+    auto& port = slot->ports[portSlot];
+    if (!port.connected) {
+      segment.release(handle);  // nothing listens: dropped here, as the output filter would
+      return true;
+    }
     ipc::Ring& out = ring(portSlot);
     setState(ipc::ModuleState::Putting, portSlot);
     while (!out.push(handle)) {
-      if (stopRequested()) return false;
       const uint32_t seen = slot->bell.prepare();
+      if (stopRequested()) return false;
       if (out.push(handle)) break;
       slot->bell.sleep(seen, kPollNs);
     }
-    auto& port = slot->ports[portSlot];
     port.messages.fetch_add(1, std::memory_order_relaxed);
     port.bytes.fetch_add(segment.block(handle).used, std::memory_order_relaxed);
     segment.header().daemonBell.ring();
@@ -111,11 +120,20 @@ struct Module::Impl {
       builder.setSendTimeNs(wallNs());
       builder.setStampsOnly(true);
       const std::size_t used = builder.finish();
-      const uint64_t handle = sink.take(used);
-      if (!push(endItSlot, handle)) segment.release(handle);
+      if (used == 0 || sink.data() == nullptr) {
+        fail("shared memory exhausted while sending endIt");
+      } else {
+        const uint64_t handle = sink.take(used);
+        if (!push(endItSlot, handle)) segment.release(handle);
+      }
     }
     ++iteration;
     slot->iterations.store(iteration, std::memory_order_release);
+  }
+  // Reports an error once; the module's exit status becomes non-zero.
+  void fail(const std::string& message) {
+    if (!failed) std::fprintf(stderr, "vrflow: module '%s': %s\n", id.c_str(), message.c_str());
+    failed = true;
   }
   void finish() {
     if (finished) return;
@@ -167,6 +185,10 @@ Status Module::init() {
   const long index = std::atol(indexText);
   auto segment = ipc::Segment::attach(fd);
   if (!segment) return makeError("cannot join the run: " + segment.error().message);
+  // Die with the runtime even when started through a wrapper, and do not hand the segment on
+  // to processes this module starts.
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  fcntl(fd, F_SETFD, FD_CLOEXEC);
   m.segment = std::move(*segment);
   const auto offset = m.segment.header().controlOffset;
   if (offset == 0 || !m.segment.contains(offset, sizeof(ipc::ControlTable))) {
@@ -243,11 +265,11 @@ bool Module::wait() {
     m.setState(ipc::ModuleState::Waiting, portSlot);
     uint64_t handle = 0;
     for (;;) {
+      const uint32_t seen = m.slot->bell.prepare();
       if (m.stopRequested()) {
         m.finish();
         return false;
       }
-      const uint32_t seen = m.slot->bell.prepare();
       if (in.pop(handle)) break;
       if (port.closed.load(std::memory_order_acquire) != 0 && in.empty()) {
         m.finish();  // end of input: every upstream module has ended
@@ -301,8 +323,10 @@ Status Module::put(const OutputPort& port, OutgoingMessage&& message) {
   builder.setSendTimeNs(wallNs());
   const std::size_t used = builder.finish();
   if (used == 0 || message.impl_->sink.data() == nullptr) {
-    return makeError("module '" + impl_->id + "': shared memory exhausted while building a message for '" +
-                     port.name_ + "' (raise --shm-size)");
+    Error error{"shared memory exhausted while building a message for '" + port.name_ +
+                "' (raise vrflow run --shm-size)"};
+    impl_->fail(error.message);
+    return error;
   }
   const uint64_t handle = message.impl_->sink.take(used);
   if (!impl_->push(port.slot_, handle)) {
@@ -316,7 +340,9 @@ Result<Message> Module::seal(OutgoingMessage&& message) {
   auto& builder = message.impl_->builder;
   const std::size_t used = builder.finish();
   if (used == 0 || message.impl_->sink.data() == nullptr) {
-    return makeError("module '" + impl_->id + "': shared memory exhausted while building a message");
+    Error error{"shared memory exhausted while building a message (raise vrflow run --shm-size)"};
+    impl_->fail(error.message);
+    return error;
   }
   return Message::adopt(impl_->segment, message.impl_->sink.take(used));
 }
@@ -360,5 +386,7 @@ int64_t Module::paramInt(std::string_view name, int64_t fallback) const {
 }
 
 uint64_t Module::newId() { return impl_->segment.newId(); }
+
+int Module::exitStatus() const { return impl_->failed ? 1 : 0; }
 
 }  // namespace vrflow

@@ -66,6 +66,9 @@ class Supervisor {
   void stopAll();
   std::size_t liveCount() const;
   bool deadlocked(std::string& detail);
+  bool notJoined(std::string& detail);
+  bool lingering(std::string& detail);
+  Clock::time_point finishedSince_{};
   void showProgress(bool final);
 
   const app::Application& application_;
@@ -104,16 +107,58 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
       child.end.exit = WIFEXITED(status) ? "status " + std::to_string(WEXITSTATUS(status))
                                          : "signal " + std::to_string(WTERMSIG(status));
       daemon_.moduleEnded(static_cast<int>(i));
+      const auto& module = daemon_.modules()[i];
       const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-      if (!clean && !stopping && outcome.exitCode == kExitOk) {
-        const auto& module = daemon_.modules()[i];
+      const bool joined = daemon_.slot(module.slotIndex).state.load() !=
+                          static_cast<uint32_t>(ipc::ModuleState::Starting);
+      if ((!clean || !joined) && !stopping && outcome.exitCode == kExitOk) {
         outcome.exitCode = kExitRunFailed;
         outcome.status = "failed";
         outcome.error = "module '" + module.id + "' (host " + module.host + ", pid " +
-                        std::to_string(pid) + ") " + describeWaitStatus(status);
+                        std::to_string(pid) + ") " + describeWaitStatus(status) +
+                        (joined ? "" : " before joining the run (it never called Module::init())");
       }
     }
   }
+}
+
+// Every live module finished its iterations long ago but has not exited.
+bool Supervisor::lingering(std::string& detail) {
+  bool all = liveCount() > 0;
+  std::string names;
+  for (std::size_t i = 0; i < children_.size() && all; ++i) {
+    if (!children_[i].alive) continue;
+    const auto& module = daemon_.modules()[i];
+    all = daemon_.slot(module.slotIndex).state.load() ==
+          static_cast<uint32_t>(ipc::ModuleState::Finished);
+    names += (names.empty() ? "'" : ", '") + module.id + "'";
+  }
+  if (!all) {
+    finishedSince_ = Clock::time_point{};
+    return false;
+  }
+  if (finishedSince_ == Clock::time_point{}) finishedSince_ = Clock::now();
+  if (secondsSince(finishedSince_) < options_.lingerSeconds) return false;
+  detail = "module(s) " + names + " finished but did not exit; stopping them";
+  return true;
+}
+
+// A module still not attached to the run long after its start (it never called init()).
+bool Supervisor::notJoined(std::string& detail) {
+  if (secondsSince(start_) < options_.joinSeconds) return false;
+  for (std::size_t i = 0; i < children_.size(); ++i) {
+    const auto& module = daemon_.modules()[i];
+    if (children_[i].alive && daemon_.slot(module.slotIndex).state.load() ==
+                                  static_cast<uint32_t>(ipc::ModuleState::Starting)) {
+      char text[64];
+      std::snprintf(text, sizeof text, "%g s", options_.joinSeconds);
+      detail = "module '" + module.id + "' (host " + module.host + ", pid " +
+               std::to_string(children_[i].pid) + ") did not join the run within " + text +
+               " (it never called Module::init())";
+      return true;
+    }
+  }
+  return false;
 }
 
 bool Supervisor::deadlocked(std::string& detail) {
@@ -140,7 +185,8 @@ bool Supervisor::deadlocked(std::string& detail) {
     if (!children_[i].alive) continue;
     const auto& module = daemon_.modules()[i];
     const auto& slot = daemon_.slot(module.slotIndex);
-    const int port = slot.waitingPort.load();
+    int port = slot.waitingPort.load();
+    if (port >= static_cast<int>(std::min<uint32_t>(slot.portCount, ipc::kMaxPortsPerModule))) port = -1;
     const auto state = static_cast<ipc::ModuleState>(slot.state.load());
     detail += (detail.empty() ? "" : "; ") + std::string("module '") + module.id + "' ";
     if (port >= 0 && state == ipc::ModuleState::Waiting) {
@@ -194,7 +240,7 @@ void Supervisor::stopAll() {
   for (int round = 0; round < 2 && liveCount() > 0; ++round) {
     const int sig = round == 0 ? SIGTERM : SIGKILL;
     for (auto& child : children_) {
-      if (child.alive) kill(child.pid, sig);
+      if (child.alive) kill(-child.pid, sig);  // its whole process group: wrappers too
     }
     const auto end = Clock::now() + std::chrono::seconds(1);
     while (liveCount() > 0 && (round == 1 || Clock::now() < end)) {
@@ -250,7 +296,19 @@ RunOutcome Supervisor::run() {
       outcome = {kExitTimeout, "timeout", text};
       break;
     }
+    if (auto fatal = daemon_.fatalError(); !fatal.empty()) {
+      outcome = {kExitRunFailed, "failed", fatal};
+      break;
+    }
     std::string detail;
+    if (lingering(detail)) {
+      std::fprintf(stderr, "vrflow: warning: %s\n", detail.c_str());
+      break;  // their work is done: stopAll() ends them, and the run counts as a success
+    }
+    if (notJoined(detail)) {
+      outcome = {kExitRunFailed, "failed", detail};
+      break;
+    }
     if (outcome.exitCode == kExitOk && deadlocked(detail)) {
       char text[64];
       std::snprintf(text, sizeof text, "deadlock: no module progressed for %g s: ",
@@ -305,7 +363,6 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   RunOutcome outcome = supervisor.run();
   (*daemon)->shutdown();
   std::vector<std::string> warnings = (*daemon)->takeWarnings();
-  for (const auto& w : warnings) std::fprintf(stderr, "vrflow: warning: %s\n", w.c_str());
   if (!options.reportPath.empty()) {
     auto status = writeReport(options.reportPath, application, **daemon, supervisor.ends(), outcome,
                               options, secondsSince(start), warnings);
@@ -313,6 +370,7 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
       outcome = {kExitRunFailed, "failed", status.error().message};
     }
   }
+  for (const auto& w : warnings) std::fprintf(stderr, "vrflow: warning: %s\n", w.c_str());
   // Signals that arrived while stopping are consumed here, not delivered on unblocking.
   timespec zero{0, 0};
   while (sigtimedwait(&signals, nullptr, &zero) > 0) {

@@ -6,7 +6,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 
 extern char** environ;
@@ -15,17 +17,37 @@ namespace vrflow::run {
 
 Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::string>& args,
                           int inheritFd, const std::vector<std::string>& extraEnvironment) {
-  if (access(executable.c_str(), X_OK) != 0) {
+  std::string path = executable;
+  if (path.find('/') == std::string::npos) {  // a bare name: looked up on PATH
+    const char* searchPath = std::getenv("PATH");
+    std::string dirs = searchPath ? searchPath : "/usr/local/bin:/usr/bin:/bin";
+    for (std::size_t start = 0; start <= dirs.size();) {
+      const std::size_t end = std::min(dirs.find(':', start), dirs.size());
+      const std::string candidate = dirs.substr(start, end - start) + "/" + executable;
+      if (access(candidate.c_str(), X_OK) == 0) {
+        path = candidate;
+        break;
+      }
+      start = end + 1;
+    }
+  }
+  if (access(path.c_str(), X_OK) != 0) {
     return makeError("cannot start '" + executable + "': " + std::strerror(errno));
   }
   // Everything the child needs is prepared before fork: after it, only async-signal-safe calls.
   std::vector<std::string> envStrings;
-  for (char** e = environ; *e != nullptr; ++e) envStrings.emplace_back(*e);
+  for (char** e = environ; *e != nullptr; ++e) {
+    if (std::strncmp(*e, "VRFLOW_SEGMENT_FD=", 18) == 0 || std::strncmp(*e, "VRFLOW_MODULE_", 14) == 0 ||
+        std::strncmp(*e, "VRFLOW_HOST=", 12) == 0) {
+      continue;  // ours are set below; inherited ones would shadow them
+    }
+    envStrings.emplace_back(*e);
+  }
   for (const auto& e : extraEnvironment) envStrings.push_back(e);
   std::vector<char*> envp;
   for (auto& e : envStrings) envp.push_back(e.data());
   envp.push_back(nullptr);
-  std::vector<std::string> argStrings{executable};
+  std::vector<std::string> argStrings{path};
   argStrings.insert(argStrings.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : argStrings) argv.push_back(a.data());

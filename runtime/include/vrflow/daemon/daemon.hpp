@@ -75,6 +75,8 @@ class Daemon {
   /// Stops the routing thread and drops every buffered message.
   void shutdown();
 
+  /// The first protocol violation by a module (bad handle, malformed message), or empty.
+  std::string fatalError();
   /// Warnings raised while running (full queues, filter problems); thread-safe snapshot.
   std::vector<std::string> takeWarnings();
   /// Statistics; call after shutdown().

@@ -49,3 +49,47 @@ struct Ring {
 };
 
 }  // namespace vrflow::ipc
+
+namespace vrflow::ipc {
+
+/// The daemon's view of a ring in memory that modules can write: capacity and mask are kept
+/// privately (set when the ring was made), so a module scribbling over the ring's header can
+/// lose its own messages but never make the daemon read or write outside the ring.
+class RingRef {
+ public:
+  RingRef() = default;
+  explicit RingRef(Ring* ring) : ring_(ring), capacity_(ring->capacity), mask_(ring->capacity - 1) {}
+
+  bool push(uint64_t value) const {
+    const uint64_t t = ring_->tail.load(std::memory_order_relaxed);
+    const uint64_t h = ring_->head.load(std::memory_order_acquire);
+    if (t - h >= capacity_) return false;
+    ring_->slots()[t & mask_] = value;
+    ring_->tail.store(t + 1, std::memory_order_release);
+    return true;
+  }
+  /// False when empty, or when the indexes are inconsistent (then nothing is read).
+  bool pop(uint64_t& value) const {
+    const uint64_t h = ring_->head.load(std::memory_order_relaxed);
+    const uint64_t t = ring_->tail.load(std::memory_order_acquire);
+    if (h == t || t - h > capacity_) return false;
+    value = ring_->slots()[h & mask_];
+    ring_->head.store(h + 1, std::memory_order_release);
+    return true;
+  }
+  uint64_t size() const {
+    const uint64_t n = ring_->tail.load(std::memory_order_acquire) -
+                       ring_->head.load(std::memory_order_acquire);
+    return n > capacity_ ? capacity_ : n;
+  }
+  bool empty() const { return size() == 0; }
+  bool full() const { return size() >= capacity_; }
+  bool valid() const { return ring_ != nullptr; }
+
+ private:
+  Ring* ring_ = nullptr;
+  uint32_t capacity_ = 0;
+  uint32_t mask_ = 0;
+};
+
+}  // namespace vrflow::ipc

@@ -107,6 +107,10 @@ class Module {
   /// A new object or resource id, unique on this host across processes.
   uint64_t newId();
 
+  /// What main() should return: 1 if an error was reported (e.g. shared memory exhausted in
+  /// put()), else 0. A put() that fails because the run stops is not an error.
+  int exitStatus() const;
+
  private:
   friend class InputPort;
   friend class OutputPort;

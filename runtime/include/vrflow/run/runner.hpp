@@ -28,6 +28,8 @@ struct RunOptions {
   std::string reportPath;             ///< JSON report; empty = none
   bool progress = false;              ///< live iterations/s on stderr
   double stopGraceSeconds = 2;        ///< after a stop request, before SIGTERM then SIGKILL
+  double joinSeconds = 20;            ///< a module must call Module::init() within this
+  double lingerSeconds = 5;           ///< a module that finished must exit within this
 };
 
 /// What happened, for the report and the exit code.
