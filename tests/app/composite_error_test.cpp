@@ -201,6 +201,29 @@ TEST(CompositeErrors, HugeRepeatCountIsRefusedQuicklyInsteadOfExpanded) {
   EXPECT_ONLY_ERROR_AT(found, 4, 20, "the expansion makes more than 100000");
 }
 
+TEST(CompositeErrors, HugeAttributeTextIsRefusedBeforeMemoryRunsOut) {
+  const std::string big(4000, 'x');
+  const Result<Application> app = loadApplicationString(oneInstance(R"(
+      <param name="big" default=")" + big + R"("/>
+      <modules><repeat var="i" count="40000">
+        <module id="m${i}" package="core" type="source"><param name="label" value="${big}"/></module>
+      </repeat></modules>)"),
+                                                        "app.xml");
+  ASSERT_TRUE(app.ok()) << app.error().message;
+  std::vector<Diagnostic> problems;
+  const Result<Application> flat = expandComposites(*app, {}, &problems);
+  ASSERT_TRUE(flat.ok());
+  EXPECT_ONLY_ERROR_AT(problems, 6, 57, "the expansion makes more than 64 MiB of attribute text");
+  EXPECT_LT(flat->modules.size(), 20000u);
+}
+
+TEST(CompositeErrors, AProblemRepeatedByEveryIterationIsReportedOnce) {
+  const std::vector<Diagnostic> found = checkComposed(oneInstance(R"(
+      <modules><repeat var="i" count="5000"><module id="m${j}" package="core" type="relay"/></repeat></modules>)"));
+  EXPECT_ONLY_ERROR_AT(found, 4, 53,
+                       "attribute 'id' of <module>: unknown name 'j' in '${j}' (known: i)");
+}
+
 TEST(CompositeErrors, IdsInsideACompositeMustNotHoldTheSeparator) {
   EXPECT_ONLY_ERROR_AT(checkComposed(oneInstance(R"(
       <modules><module id="a:b" package="core" type="relay"/></modules>)")),

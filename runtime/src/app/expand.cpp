@@ -60,6 +60,11 @@ Expander::Expander(const Application& app, const CompositeSources& sources,
     : app_(app), sources_(sources), problems_(problems) {}
 
 void Expander::error(const SourceLocation& at, std::string message) {
+  // A problem in a <repeat> comes back at every iteration: keep one, so that memory stays
+  // bounded by the distinct problems (sortAndDeduplicate() would keep the first one too).
+  std::string key =
+      at.file + ":" + std::to_string(at.line) + ":" + std::to_string(at.column) + ":" + message;
+  if (!reported_.insert(std::move(key)).second) return;
   Diagnostic diagnostic{at, Diagnostic::Error, std::move(message)};
   diagnostic.loc.attributes.clear();
   problems_.push_back(std::move(diagnostic));

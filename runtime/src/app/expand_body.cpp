@@ -49,6 +49,14 @@ std::optional<Values> Expander::substitute(const TemplateElement& element, const
       ok = false;
       continue;
     }
+    bytes_ += value->size();
+    if (bytes_ > kMaxExpandedBytes && !tooLarge_) {
+      tooLarge_ = true;
+      error(located(element.loc, frame),
+            "the expansion makes more than " + std::to_string(kMaxExpandedBytes >> 20) +
+                " MiB of attribute text; check the repeat counts and the parameters");
+    }
+    if (tooLarge_) return std::nullopt;
     values[attribute.name] = std::move(*value);
   }
   if (!ok) return std::nullopt;

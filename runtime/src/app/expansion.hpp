@@ -103,7 +103,9 @@ class Expander {
   std::map<std::string, std::unique_ptr<Composite>, std::less<>> loaded_;  ///< null: none
   std::set<std::string, std::less<>> badFiles_;    ///< files found but not usable (reported)
   std::optional<std::vector<std::string>> known_;  ///< names for "unknown composite" messages
+  std::set<std::string, std::less<>> reported_;    ///< "file:line:column:message" of each error
   std::size_t spent_ = 0;
+  std::size_t bytes_ = 0;  ///< attribute text made by substitution
   bool tooLarge_ = false;
 };
 

@@ -171,6 +171,13 @@ std::string_view trimmed(std::string_view text) {
   return text;
 }
 
+// Quotes template text in a message, shortened so that a huge value cannot make huge messages.
+std::string quoted(std::string_view text) {
+  constexpr std::size_t kLongest = 60;
+  if (text.size() <= kLongest) return "'" + std::string(text) + "'";
+  return "'" + std::string(text.substr(0, kLongest - 3)) + "...'";
+}
+
 }  // namespace
 
 bool isTemplateName(std::string_view text) {
@@ -208,22 +215,22 @@ Result<std::string> substituteTemplate(std::string_view text, const TemplateScop
     }
     const std::size_t close = text.find('}', dollar + 2);
     if (close == std::string_view::npos) {
-      return makeError("'${' without a closing '}' in '" + std::string(text) + "'");
+      return makeError("'${' without a closing '}' in " + quoted(text));
     }
     const std::string_view inner = trimmed(text.substr(dollar + 2, close - dollar - 2));
-    const std::string written(text.substr(dollar, close + 1 - dollar));
+    const std::string written = quoted(text.substr(dollar, close + 1 - dollar));
     if (isTemplateName(inner)) {
       const auto it = scope.find(inner);
       if (it == scope.end()) {
         std::vector<std::string> known;
         for (const auto& [name, value] : scope) known.push_back(name);
-        return makeError("unknown name '" + std::string(inner) + "' in '" + written +
-                         "' (known: " + joinNames(known) + ")" + didYouMean(inner, known));
+        return makeError("unknown name '" + std::string(inner) + "' in " + written +
+                         " (known: " + joinNames(known) + ")" + didYouMean(inner, known));
       }
       out += it->second;
     } else {
       const Result<long long> value = evaluateExpression(inner, scope);
-      if (!value) return makeError("cannot evaluate '" + written + "': " + value.error().message);
+      if (!value) return makeError("cannot evaluate " + written + ": " + value.error().message);
       out += std::to_string(*value);
     }
     pos = close + 1;

@@ -27,6 +27,8 @@ CompositeSources defaultCompositeSources(const Application& app,
 
 /// Most modules, filters, connections and <repeat> iterations one expansion may make.
 inline constexpr std::size_t kMaxExpandedElements = 100'000;
+/// Most bytes of attribute text one expansion may make by substitution.
+inline constexpr std::size_t kMaxExpandedBytes = std::size_t{64} << 20;
 /// Deepest nesting of composite instances.
 inline constexpr std::size_t kMaxCompositeDepth = 32;
 
