@@ -1,5 +1,9 @@
 // Problems in applications that use composites: where they are reported and what they say.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 #include "composite_support.hpp"
 #include "test_support.hpp"
@@ -126,6 +130,26 @@ TEST(CompositeErrors, UnknownCompositeSuggestsTheClosestNameAndSaysWhereItLooked
   EXPECT_NE(found[0].message.find("searched for wrkers.vrc.xml in: " + testing::compositeDir()),
             std::string::npos);
   EXPECT_NE(found[0].message.find("did you mean 'workers'?"), std::string::npos);
+}
+
+TEST(CompositeErrors, CompositeFileMustBeNamedAfterTheCompositeItDefines) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("vrflow-composites-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "misnamed.vrc.xml") << "<composite name=\"other\" version=\"1\"/>\n";
+  const Result<Application> app = loadApplicationString(
+      R"(<application><instances><instance id="m" composite="misnamed"/></instances></application>)",
+      "app.xml");
+  ASSERT_TRUE(app.ok());
+  CompositeSources sources;
+  sources.searchPath.push_back(dir.string());
+  std::vector<Diagnostic> problems;
+  ASSERT_TRUE(expandComposites(*app, sources, &problems).ok());
+  std::filesystem::remove_all(dir);
+  EXPECT_ONLY_ERROR_AT(problems, 1, 12,
+                       "this file defines composite 'other', but composite 'misnamed' is looked "
+                       "up in it (a composite's file is named NAME.vrc.xml)");
+  EXPECT_EQ(problems[0].loc.file, (dir / "misnamed.vrc.xml").string());
 }
 
 TEST(CompositeErrors, ParametersAreCheckedAgainstTheCompositesDeclarations) {

@@ -92,6 +92,7 @@ const Composite* Expander::loadFromSearchPath(const std::string& name) {
     std::optional<Composite> composite = readCompositeFile(*text, path, problems_);
     if (!composite) return nullptr;
     if (composite->name != name) {
+      if (composite->name.empty()) return nullptr;  // no usable root: reported while reading
       error(composite->loc.attribute("name"),
             "this file defines composite '" + composite->name + "', but composite '" + name +
                 "' is looked up in it (a composite's file is named NAME" +
