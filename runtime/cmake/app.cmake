@@ -6,8 +6,13 @@ vrflow_add_library(app
     src/app/application_writer.cpp
     src/app/builtin_filters.cpp
     src/app/catalog.cpp
+    src/app/composite.cpp
+    src/app/composite_reader.cpp
+    src/app/composite_writer.cpp
     src/app/diagnostic.cpp
     src/app/element_reader.cpp
+    src/app/expand.cpp
+    src/app/expand_body.cpp
     src/app/file_io.cpp
     src/app/graph.cpp
     src/app/manifest_reader.cpp
@@ -15,9 +20,11 @@ vrflow_add_library(app
     src/app/package.cpp
     src/app/source_location.cpp
     src/app/source_text.cpp
+    src/app/template_text.cpp
     src/app/text_util.cpp
     src/app/validate.cpp
     src/app/validate_connections.cpp
     src/app/validate_cycles.cpp
+    src/app/xml_out.cpp
   PUBLIC_DEPS vrflow::base
   PRIVATE_DEPS pugixml::pugixml)

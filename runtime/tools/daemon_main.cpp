@@ -9,6 +9,7 @@
 
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/diagnostic.hpp"
+#include "vrflow/app/expand.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/validate.hpp"
 #include "vrflow/run/runner.hpp"
@@ -21,6 +22,9 @@ int main(int argc, char** argv) {
   cli.add_option("APP.xml", file, "Application file")->required();
   cli.add_option("--host", host, "Host id (as in the application file) this daemon serves")->required();
   cli.add_option("--packages", packageDirs, "Extra folder of node packages (repeatable)");
+  std::vector<std::string> compositeDirs;
+  cli.add_option("--composites", compositeDirs,
+                 "Extra folder of composite files NAME.vrc.xml (repeatable)");
   cli.add_option("--iterations,-n", options.iterations, "Stop after N iterations of every module");
   cli.add_option("--report", options.reportPath, "Write a JSON run report to FILE");
   cli.add_option("--timeout", options.timeoutSeconds, "Fail if the run lasts longer (seconds)");
@@ -41,8 +45,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
+  application = vrflow::app::expandComposites(
+      *application, vrflow::app::defaultCompositeSources(*application, compositeDirs), &problems);
+  if (!application) {
+    std::fprintf(stderr, "%s\n", application.error().message.c_str());
+    return vrflow::run::kExitInvalid;
+  }
   auto more = vrflow::app::validate(*application, *catalog);
   problems.insert(problems.end(), more.begin(), more.end());
+  vrflow::app::sortAndDeduplicate(problems);
   for (const auto& d : problems) std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
   if (vrflow::app::hasErrors(problems)) return vrflow::run::kExitInvalid;
   if (vrflow::app::findHost(*application, host) == nullptr && host != "localhost") {

@@ -1,4 +1,4 @@
-// The `vrflow` command: validate and run application files.
+// The `vrflow` command: validate, expand and run application files.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -9,27 +9,40 @@
 
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/diagnostic.hpp"
+#include "vrflow/app/expand.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/validate.hpp"
+#include "vrflow/app/writer.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace {
 
-// Loads and validates; prints every diagnostic. Returns the application when it has no error.
-std::optional<vrflow::app::Application> loadValid(const std::string& file,
-                                                  const vrflow::app::Catalog& catalog) {
+// Loads the file and expands its composites (search path: the file's folder, --composites,
+// $VRFLOW_COMPOSITE_PATH); validates the flat application when a catalog is given. Prints every
+// diagnostic; returns the flat application when there is no error.
+std::optional<vrflow::app::Application> loadFlat(const std::string& file,
+                                                 const std::vector<std::string>& compositeDirs,
+                                                 const vrflow::app::Catalog* catalog) {
   std::vector<vrflow::app::Diagnostic> problems;
   auto application = vrflow::app::loadApplicationFile(file, &problems);
   if (!application) {
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return std::nullopt;
   }
-  auto more = vrflow::app::validate(*application, catalog);
-  problems.insert(problems.end(), more.begin(), more.end());
+  const auto sources = vrflow::app::defaultCompositeSources(*application, compositeDirs);
+  auto flat = vrflow::app::expandComposites(*application, sources, &problems);
+  if (!flat) {
+    std::fprintf(stderr, "%s\n", flat.error().message.c_str());
+    return std::nullopt;
+  }
+  if (catalog != nullptr) {
+    auto more = vrflow::app::validate(*flat, *catalog);
+    problems.insert(problems.end(), more.begin(), more.end());
+  }
   vrflow::app::sortAndDeduplicate(problems);
   for (const auto& d : problems) std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
   if (vrflow::app::hasErrors(problems)) return std::nullopt;
-  return std::move(*application);
+  return std::move(*flat);
 }
 
 }  // namespace
@@ -40,13 +53,21 @@ int main(int argc, char** argv) {
   cli.require_subcommand(1);
   std::vector<std::string> packageDirs;
   cli.add_option("--packages", packageDirs, "Extra folder of node packages (repeatable)");
+  std::vector<std::string> compositeDirs;
+  cli.add_option("--composites", compositeDirs,
+                 "Extra folder of composite files NAME.vrc.xml (repeatable)");
 
   auto* validate = cli.add_subcommand("validate", "Check an application file; exit 0 when valid");
   std::string validateFile;
   validate->add_option("APP.xml", validateFile, "Application file")->required();
 
+  auto* expand = cli.add_subcommand("expand", "Print the application with its composites expanded");
+  std::string expandFile;
+  expand->add_option("APP.xml", expandFile, "Application file")->required();
+
   auto* run = cli.add_subcommand("run", "Run an application with every host on this machine");
   validate->fallthrough();
+  expand->fallthrough();
   run->fallthrough();
   std::string runFile;
   vrflow::run::RunOptions options;
@@ -72,15 +93,21 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
+  if (expand->parsed()) {
+    const auto flat = loadFlat(expandFile, compositeDirs, nullptr);
+    if (!flat) return 1;
+    std::fputs(vrflow::app::saveApplication(*flat).c_str(), stdout);
+    return 0;
+  }
   auto catalog = vrflow::run::loadCatalog(packageDirs);
   if (!catalog) {
     std::fprintf(stderr, "vrflow: %s\n", catalog.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
   if (validate->parsed()) {
-    return loadValid(validateFile, *catalog) ? 0 : 1;
+    return loadFlat(validateFile, compositeDirs, &*catalog) ? 0 : 1;
   }
-  auto application = loadValid(runFile, *catalog);
+  auto application = loadFlat(runFile, compositeDirs, &*catalog);
   if (!application) return vrflow::run::kExitInvalid;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
   options.progress = !noProgress && isatty(STDERR_FILENO) != 0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 
+#include "composite_reader.hpp"
 #include "element_reader.hpp"
 #include "file_io.hpp"
 #include "source_text.hpp"
@@ -15,15 +16,17 @@ namespace {
 using detail::ElementReader;
 using detail::ReadContext;
 
-constexpr std::array<std::string_view, 5> kSections = {"hosts", "modules", "filters", "connections",
-                                                       "editor"};
+constexpr std::array<std::string_view, 7> kSections = {
+    "hosts", "composites", "modules", "instances", "filters", "connections", "editor"};
 
 // Reports text or elements inside an element that holds neither.
 void expectEmpty(const ReadContext& context, const pugi::xml_node& node) {
   detail::forEachChild(context, node, {}, [](const pugi::xml_node&) {});
 }
 
-Param readParam(const ReadContext& context, const pugi::xml_node& node) {
+}  // namespace
+
+Param detail::readParam(const ReadContext& context, const pugi::xml_node& node) {
   const ElementReader reader(context, node, {"name", "value"});
   Param param;
   param.name = reader.required("name");
@@ -35,6 +38,8 @@ Param readParam(const ReadContext& context, const pugi::xml_node& node) {
   expectEmpty(context, node);
   return param;
 }
+
+namespace {
 
 Host readHost(const ReadContext& context, const pugi::xml_node& node) {
   const ElementReader reader(context, node, {"id", "address"});
@@ -133,6 +138,10 @@ void readSection(const ReadContext& context, const pugi::xml_node& section, Appl
     detail::forEachChild(context, section, {"module"}, [&](const pugi::xml_node& child) {
       app.modules.push_back(readModule(context, child));
     });
+  } else if (name == "composites") {
+    detail::readComposites(context, section, app);
+  } else if (name == "instances") {
+    detail::readInstances(context, section, app);
   } else if (name == "filters") {
     detail::forEachChild(context, section, {"filter"}, [&](const pugi::xml_node& child) {
       app.filters.push_back(readFilter(context, child));
@@ -169,7 +178,8 @@ void readRoot(const ReadContext& context, const pugi::xml_node& root, Applicatio
                                                         "> appears twice; merge the two sections"
                                                   : "<" + std::string(section.name()) +
                                                         "> is out of order (sections go: hosts, "
-                                                        "modules, filters, connections, editor)");
+                                                        "composites, modules, instances, filters, "
+                                                        "connections, editor)");
                          }
                          next = std::max(next, index + 1);
                          readSection(context, section, app);
@@ -190,6 +200,9 @@ void applyHostDefaults(Application& app) {
   }
   for (Filter& filter : app.filters) {
     if (filter.host.empty()) filter.host = first;
+  }
+  for (Instance& instance : app.instances) {
+    if (instance.host.empty()) instance.host = first;
   }
 }
 

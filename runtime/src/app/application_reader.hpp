@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include "element_reader.hpp"
 #include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/model.hpp"
 
@@ -14,5 +15,8 @@ namespace vrflow::app::detail {
 /// XML gives nullopt and exactly one diagnostic. May throw std::bad_alloc.
 std::optional<Application> readApplication(std::string_view xml, const std::string& fileName,
                                            std::vector<Diagnostic>& problems);
+
+/// Reads a <param name="..." value="..."/> element.
+Param readParam(const ReadContext& context, const pugi::xml_node& node);
 
 }  // namespace vrflow::app::detail

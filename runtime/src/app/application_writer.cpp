@@ -1,77 +1,16 @@
 #include <string_view>
 
+#include "composite_writer.hpp"
 #include "file_io.hpp"
 #include "text_util.hpp"
 #include "vrflow/app/writer.hpp"
+#include "xml_out.hpp"
 
 namespace vrflow::app {
 namespace {
 
-// Escapes what a double-quoted attribute value cannot hold as is; whitespace other than the
-// space is escaped too, since XML attribute normalisation would turn it into spaces.
-void appendEscaped(std::string& out, std::string_view value) {
-  for (const char c : value) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\n':
-        out += "&#10;";
-        break;
-      case '\r':
-        out += "&#13;";
-        break;
-      case '\t':
-        out += "&#9;";
-        break;
-      default:
-        out += c;
-    }
-  }
-}
-
-// Builds one element line: `<name a="1" b="2"` then "/>" or ">".
-class Tag {
- public:
-  Tag(std::string& out, int depth, std::string_view name) : out_(out) {
-    out_.append(static_cast<std::size_t>(depth) * 2, ' ');
-    out_ += '<';
-    out_ += name;
-  }
-  Tag& attribute(std::string_view name, std::string_view value) {
-    out_ += ' ';
-    out_ += name;
-    out_ += "=\"";
-    appendEscaped(out_, value);
-    out_ += '"';
-    return *this;
-  }
-  Tag& attributeUnless(std::string_view name, std::string_view value, std::string_view omitted) {
-    if (value != omitted) attribute(name, value);
-    return *this;
-  }
-  void close() { out_ += "/>\n"; }
-  void open() { out_ += ">\n"; }
-
- private:
-  std::string& out_;
-};
-
-void closeTag(std::string& out, int depth, std::string_view name) {
-  out.append(static_cast<std::size_t>(depth) * 2, ' ');
-  out += "</";
-  out += name;
-  out += ">\n";
-}
+using detail::closeTag;
+using detail::Tag;
 
 void writeParams(std::string& out, int depth, const std::vector<Param>& params) {
   for (const Param& param : params) {
@@ -188,15 +127,18 @@ std::string saveApplication(const Application& app) {
   Tag root(out, 0, "application");
   if (!app.name.empty()) root.attribute("name", app.name);
   root.attribute("version", "1");
-  const bool empty = onlyImplicitHost(app) && app.modules.empty() && app.filters.empty() &&
-                     app.connections.empty() && app.editor.empty();
+  const bool empty = onlyImplicitHost(app) && app.composites.empty() && app.modules.empty() &&
+                     app.instances.empty() && app.filters.empty() && app.connections.empty() &&
+                     app.editor.empty();
   if (empty) {
     root.close();
     return out;
   }
   root.open();
   writeHosts(out, app);
+  detail::writeComposites(out, app);
   writeModules(out, app);
+  detail::writeInstances(out, app);
   writeFilters(out, app);
   writeConnections(out, app);
   writeEditor(out, app);

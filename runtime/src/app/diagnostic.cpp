@@ -5,17 +5,31 @@
 
 namespace vrflow::app {
 
-std::string formatDiagnostic(const Diagnostic& diagnostic) {
-  std::string text = diagnostic.loc.file;
-  const SourceLocation& loc = diagnostic.loc;
-  if (loc.line > 0) {
+namespace {
+
+// "FILE:LINE:COLUMN: " without the parts that are unknown.
+std::string placeText(const std::string& file, int line, int column) {
+  std::string text = file;
+  if (line > 0) {
     if (!text.empty()) text += ':';
-    text += std::to_string(loc.line);
-    if (loc.column > 0) text += ":" + std::to_string(loc.column);
+    text += std::to_string(line);
+    if (column > 0) text += ":" + std::to_string(column);
   }
   if (!text.empty()) text += ": ";
+  return text;
+}
+
+}  // namespace
+
+std::string formatDiagnostic(const Diagnostic& diagnostic) {
+  const SourceLocation& loc = diagnostic.loc;
+  std::string text = placeText(loc.file, loc.line, loc.column);
   text += diagnostic.severity == Diagnostic::Error ? "error: " : "warning: ";
   text += diagnostic.message;
+  for (const InstanceSite& site : loc.expandedFrom) {
+    text += "\n" + placeText(site.file, site.line, site.column) + "note: in instance '" +
+            site.instance + "' of composite '" + site.composite + "'";
+  }
   return text;
 }
 

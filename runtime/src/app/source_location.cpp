@@ -7,6 +7,7 @@ SourceLocation SourceLocation::attribute(std::string_view name) const {
   loc.file = file;
   loc.line = line;
   loc.column = column;
+  loc.expandedFrom = expandedFrom;
   for (const AttributeLocation& attribute : attributes) {
     if (attribute.name == name) {
       loc.line = attribute.line;

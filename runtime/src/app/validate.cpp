@@ -5,6 +5,7 @@
 #include "file_io.hpp"
 #include "text_util.hpp"
 #include "validation.hpp"
+#include "vrflow/app/expand.hpp"
 
 namespace vrflow::app {
 namespace detail {
@@ -221,6 +222,9 @@ void checkNodes(Validation& v) {
 }  // namespace detail
 
 std::vector<Diagnostic> validate(const Application& app, const Catalog& catalog) {
+  if (!app.instances.empty()) {
+    return validateWithComposites(app, catalog, defaultCompositeSources(app));
+  }
   try {
     detail::Validation validation(app, catalog);
     detail::checkNodes(validation);

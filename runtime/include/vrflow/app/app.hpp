@@ -1,11 +1,14 @@
 #pragma once
 
 /// The application model library in one include: model, load, save, catalog, validation.
-#include "vrflow/app/catalog.hpp"     // IWYU pragma: export
-#include "vrflow/app/diagnostic.hpp"  // IWYU pragma: export
-#include "vrflow/app/graph.hpp"       // IWYU pragma: export
-#include "vrflow/app/loader.hpp"      // IWYU pragma: export
-#include "vrflow/app/model.hpp"       // IWYU pragma: export
-#include "vrflow/app/package.hpp"     // IWYU pragma: export
-#include "vrflow/app/validate.hpp"    // IWYU pragma: export
-#include "vrflow/app/writer.hpp"      // IWYU pragma: export
+#include "vrflow/app/catalog.hpp"         // IWYU pragma: export
+#include "vrflow/app/composite.hpp"       // IWYU pragma: export
+#include "vrflow/app/composite_file.hpp"  // IWYU pragma: export
+#include "vrflow/app/diagnostic.hpp"      // IWYU pragma: export
+#include "vrflow/app/expand.hpp"          // IWYU pragma: export
+#include "vrflow/app/graph.hpp"           // IWYU pragma: export
+#include "vrflow/app/loader.hpp"          // IWYU pragma: export
+#include "vrflow/app/model.hpp"           // IWYU pragma: export
+#include "vrflow/app/package.hpp"         // IWYU pragma: export
+#include "vrflow/app/validate.hpp"        // IWYU pragma: export
+#include "vrflow/app/writer.hpp"          // IWYU pragma: export

@@ -16,7 +16,9 @@ struct Diagnostic {
 };
 
 /// "FILE:LINE:COLUMN: error: MESSAGE" (or "warning:"); parts of the location that are unknown
-/// (empty file, line 0, column 0) are left out.
+/// (empty file, line 0, column 0) are left out. A problem inside a composite is followed by one
+/// line per instance it came through, innermost first:
+/// "APP.xml:12:5: note: in instance 'w' of composite 'workers'".
 std::string formatDiagnostic(const Diagnostic& diagnostic);
 
 /// All diagnostics, formatted, one per line (each line ends with '\n').
@@ -26,7 +28,8 @@ std::string formatDiagnostics(const std::vector<Diagnostic>& diagnostics);
 bool hasErrors(const std::vector<Diagnostic>& diagnostics);
 
 /// Sorts by file, line and column (stable, so problems at one place keep their order) and
-/// drops exact repeats, so that each problem is reported once.
+/// drops exact repeats, so that each problem is reported once. A problem inside a composite
+/// that several instances show is kept once, with the first instance's notes.
 void sortAndDeduplicate(std::vector<Diagnostic>& diagnostics);
 
 }  // namespace vrflow::app

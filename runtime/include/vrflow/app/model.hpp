@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "vrflow/app/composite.hpp"
 #include "vrflow/app/source_location.hpp"
 
 namespace vrflow::app {
@@ -74,6 +75,16 @@ struct Connection {
   SourceLocation loc;
 };
 
+/// A use of a composite: its modules, filters and connections, with ids prefixed by "id:".
+/// Connections write `id.port` for the composite's exposed ports.
+struct Instance {
+  std::string id;
+  std::string composite;
+  std::string host;  ///< where its nodes without a host run; resolved to the first host on load
+  std::vector<Param> params;
+  SourceLocation loc;
+};
+
 /// Where the editor draws a module or filter; the runtime ignores it.
 struct EditorNode {
   EditorNode() = default;
@@ -91,7 +102,9 @@ struct EditorNode {
 struct Application {
   std::string name;
   std::vector<Host> hosts;
+  std::vector<Composite> composites;  ///< defined in the file; see expandComposites()
   std::vector<Module> modules;
+  std::vector<Instance> instances;  ///< composites used; see expandComposites()
   std::vector<Filter> filters;
   std::vector<Connection> connections;
   std::vector<EditorNode> editor;
@@ -111,6 +124,10 @@ Module* findModule(Application& app, std::string_view id);
 const Filter* findFilter(const Application& app, std::string_view id);
 /// The filter with this id, or nullptr.
 Filter* findFilter(Application& app, std::string_view id);
+/// The composite instance with this id, or nullptr.
+const Instance* findInstance(const Application& app, std::string_view id);
+/// The composite defined in the file with this name, or nullptr.
+const Composite* findComposite(const Application& app, std::string_view name);
 /// The host with this id, or nullptr.
 const Host* findHost(const Application& app, std::string_view id);
 /// The editor position of this module or filter, or nullptr.

@@ -14,6 +14,9 @@ namespace vrflow::app {
 /// filter types, parameters, ports and connections, unconnected required inputs, and cycles
 /// that no initial message starts (they would deadlock). Each diagnostic points at the element
 /// or attribute at fault. Works on models built in code too (locations then have line 0).
+/// An application with composite instances is expanded first (validateWithComposites() with
+/// defaultCompositeSources(app)); problems inside a composite carry the instances they came
+/// through.
 std::vector<Diagnostic> validate(const Application& app, const Catalog& catalog);
 
 /// Everything wrong with an application file, in one list sorted by line: malformed XML (one
