@@ -9,6 +9,8 @@ vrflow_add_library(app
     src/app/diagnostic.cpp
     src/app/element_reader.cpp
     src/app/file_io.cpp
+    src/app/filter_types_routing.cpp
+    src/app/filter_types_sampling.cpp
     src/app/graph.cpp
     src/app/manifest_reader.cpp
     src/app/model.cpp
