@@ -7,6 +7,15 @@ vrflow_add_library(runtime
     src/module/module.cpp
     src/daemon/filter.cpp
     src/daemon/builtin_filters.cpp
+    src/daemon/filters/common.cpp
+    src/daemon/filters/gate.cpp
+    src/daemon/filters/latest.cpp
+    src/daemon/filters/max_frequency.cpp
+    src/daemon/filters/multiplex.cpp
+    src/daemon/filters/rotate.cpp
+    src/daemon/filters/scatter.cpp
+    src/daemon/filters/stamp_filter.cpp
+    src/daemon/filters/type_filter.cpp
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
     src/run/spawn.cpp
