@@ -12,6 +12,7 @@
 #include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/validate.hpp"
+#include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
 
 int main(int argc, char** argv) {
@@ -41,12 +42,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "vrflow-daemon: %s\n", status.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
+  const auto plugins = vrflow::daemon::filterPluginsFromEnvironment();
+  if (auto status = vrflow::daemon::loadFilterPlugins(plugins, catalog); !status) {
+    std::fprintf(stderr, "vrflow-daemon: %s\n", status.error().message.c_str());
+    return vrflow::run::kExitInvalid;
+  }
   std::vector<vrflow::app::Diagnostic> problems;
   auto application = vrflow::app::loadApplicationFile(file, &problems);
   if (!application) {
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
+  auto loaded = vrflow::daemon::loadApplicationPlugins(*application, catalog);
+  problems.insert(problems.end(), loaded.begin(), loaded.end());
   auto more = vrflow::app::validate(*application, catalog);
   problems.insert(problems.end(), more.begin(), more.end());
   for (const auto& d : problems) std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());

@@ -11,6 +11,7 @@
 #include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/validate.hpp"
+#include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace {
@@ -18,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Packages: --packages folders, then $VRFLOW_PACKAGE_PATH, then the ones installed beside
-// this executable (<bin>/../share/vrflow/packages).
+// this executable (<bin>/../share/vrflow/packages). Filter plugins: $VRFLOW_FILTER_PATH.
 vrflow::Result<vrflow::app::Catalog> loadCatalog(const std::vector<std::string>& extra) {
   std::vector<std::string> dirs = extra;
   for (const auto& d : vrflow::app::searchPathFromEnvironment()) dirs.push_back(d);
@@ -27,18 +28,25 @@ vrflow::Result<vrflow::app::Catalog> loadCatalog(const std::vector<std::string>&
   if (!ec) dirs.push_back((self.parent_path().parent_path() / "share/vrflow/packages").string());
   vrflow::app::Catalog catalog;
   if (auto status = catalog.loadSearchPath(dirs); !status) return status.error();
+  const auto plugins = vrflow::daemon::filterPluginsFromEnvironment();
+  if (auto status = vrflow::daemon::loadFilterPlugins(plugins, catalog); !status) {
+    return status.error();
+  }
   return catalog;
 }
 
-// Loads and validates; prints every diagnostic. Returns the application when it has no error.
+// Loads, loads the filter plugins it names, and validates; prints every diagnostic. Returns
+// the application when it has no error.
 std::optional<vrflow::app::Application> loadValid(const std::string& file,
-                                                  const vrflow::app::Catalog& catalog) {
+                                                  vrflow::app::Catalog& catalog) {
   std::vector<vrflow::app::Diagnostic> problems;
   auto application = vrflow::app::loadApplicationFile(file, &problems);
   if (!application) {
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return std::nullopt;
   }
+  auto plugins = vrflow::daemon::loadApplicationPlugins(*application, catalog);
+  problems.insert(problems.end(), plugins.begin(), plugins.end());
   auto more = vrflow::app::validate(*application, catalog);
   problems.insert(problems.end(), more.begin(), more.end());
   vrflow::app::sortAndDeduplicate(problems);
