@@ -57,8 +57,9 @@ class FilterContext {
 
   /// Monotonic clock, ns (the clock wakeAfter counts on).
   virtual uint64_t nowNs() const = 0;
-  /// Asks the daemon to call process() again within `delayNs` even if no message moves (a
-  /// timer). The request holds until the next call of process(); ask again there if needed.
+  /// Asks the daemon to call process() again once `delayNs` have passed, even if no message
+  /// moves (a timer; it may come earlier, when something else happens). The request holds
+  /// until the next call of process(): ask again there while the filter still waits.
   virtual void wakeAfter(uint64_t delayNs) = 0;
   /// Reports a problem with the data flowing through this filter (logged; the run goes on).
   virtual void warn(const std::string& message) = 0;
