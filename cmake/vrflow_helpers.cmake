@@ -35,6 +35,38 @@ function(vrflow_add_executable name)
   target_link_libraries(${name} PRIVATE vrflow_warnings ${ARG_DEPS})
 endfunction()
 
+# The vrflow libraries a filter plugin may call, in link order.
+set(VRFLOW_PLUGIN_API_LIBRARIES vrflow_runtime vrflow_app vrflow_message vrflow_base)
+
+# vrflow_add_plugin_host(NAME SOURCES ... [DEPS ...]): a program that loads filter plugins. It
+# links the vrflow libraries whole and exports their symbols (-rdynamic), so that a plugin, which
+# links none of them, finds every public function of the runtime in the process, and there is
+# one copy of each (one FilterRegistry, one object type registry).
+function(vrflow_add_plugin_host name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  vrflow_add_executable(${name} SOURCES ${ARG_SOURCES} DEPS ${ARG_DEPS})
+  set_target_properties(${name} PROPERTIES ENABLE_EXPORTS ON)
+  foreach(library IN LISTS VRFLOW_PLUGIN_API_LIBRARIES)
+    target_link_libraries(${name} PRIVATE "$<LINK_LIBRARY:WHOLE_ARCHIVE,${library}>")
+    set_property(TARGET ${name} PROPERTY LINK_LIBRARY_OVERRIDE_${library} WHOLE_ARCHIVE)
+  endforeach()
+endfunction()
+
+# vrflow_add_filter_plugin(NAME SOURCES ... [OUTPUT_DIRECTORY dir]): a filter plugin, a shared
+# library loaded by `vrflow` at run time. It sees the vrflow headers and links no vrflow library
+# (see vrflow_add_plugin_host).
+function(vrflow_add_filter_plugin name)
+  cmake_parse_arguments(ARG "" "OUTPUT_DIRECTORY" "SOURCES" ${ARGN})
+  add_library(${name} MODULE ${ARG_SOURCES})
+  target_include_directories(${name} PRIVATE
+    $<TARGET_PROPERTY:vrflow_runtime,INTERFACE_INCLUDE_DIRECTORIES>)
+  target_link_libraries(${name} PRIVATE vrflow_warnings)
+  set_target_properties(${name} PROPERTIES PREFIX "lib")
+  if(ARG_OUTPUT_DIRECTORY)
+    set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY})
+  endif()
+endfunction()
+
 # vrflow_add_test(NAME SOURCES ... DEPS ... LABELS ...): one GoogleTest executable, registered
 # with CTest test by test, with the given labels.
 function(vrflow_add_test name)

@@ -14,6 +14,8 @@ vrflow_add_library(app
     src/app/expand.cpp
     src/app/expand_body.cpp
     src/app/file_io.cpp
+    src/app/filter_types_routing.cpp
+    src/app/filter_types_sampling.cpp
     src/app/graph.cpp
     src/app/manifest_reader.cpp
     src/app/model.cpp

@@ -7,13 +7,24 @@ vrflow_add_library(runtime
     src/module/module.cpp
     src/daemon/filter.cpp
     src/daemon/builtin_filters.cpp
+    src/daemon/filters/common.cpp
+    src/daemon/filters/gate.cpp
+    src/daemon/filters/latest.cpp
+    src/daemon/filters/max_frequency.cpp
+    src/daemon/filters/multiplex.cpp
+    src/daemon/filters/rotate.cpp
+    src/daemon/filters/scatter.cpp
+    src/daemon/filters/stamp_filter.cpp
+    src/daemon/filters/type_filter.cpp
+    src/daemon/plugin_loader.cpp
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
     src/run/spawn.cpp
     src/run/report.cpp
     src/run/runner.cpp
   PUBLIC_DEPS vrflow::message vrflow::app vrflow::base Threads::Threads
-  PRIVATE_DEPS nlohmann_json::nlohmann_json)
+  PRIVATE_DEPS nlohmann_json::nlohmann_json ${CMAKE_DL_LIBS})
 
-vrflow_add_executable(vrflow SOURCES tools/vrflow_main.cpp DEPS vrflow::runtime CLI11::CLI11)
-vrflow_add_executable(vrflow-daemon SOURCES tools/daemon_main.cpp DEPS vrflow::runtime CLI11::CLI11)
+# The programs that load filter plugins export the whole runtime (docs/filters.md, "Plugins").
+vrflow_add_plugin_host(vrflow SOURCES tools/vrflow_main.cpp DEPS CLI11::CLI11)
+vrflow_add_plugin_host(vrflow-daemon SOURCES tools/daemon_main.cpp DEPS CLI11::CLI11)

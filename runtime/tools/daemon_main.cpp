@@ -12,6 +12,7 @@
 #include "vrflow/app/expand.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/validate.hpp"
+#include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
 
 int main(int argc, char** argv) {
@@ -51,6 +52,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
+  auto loaded = vrflow::daemon::loadApplicationPlugins(*application, *catalog);
+  problems.insert(problems.end(), loaded.begin(), loaded.end());
   auto more = vrflow::app::validate(*application, *catalog);
   problems.insert(problems.end(), more.begin(), more.end());
   vrflow::app::sortAndDeduplicate(problems);

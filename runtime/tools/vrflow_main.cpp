@@ -13,6 +13,7 @@
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/validate.hpp"
 #include "vrflow/app/writer.hpp"
+#include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace {
@@ -22,7 +23,7 @@ namespace {
 // diagnostic; returns the flat application when there is no error.
 std::optional<vrflow::app::Application> loadFlat(const std::string& file,
                                                  const std::vector<std::string>& compositeDirs,
-                                                 const vrflow::app::Catalog* catalog) {
+                                                 vrflow::app::Catalog* catalog) {
   std::vector<vrflow::app::Diagnostic> problems;
   auto application = vrflow::app::loadApplicationFile(file, &problems);
   if (!application) {
@@ -36,6 +37,8 @@ std::optional<vrflow::app::Application> loadFlat(const std::string& file,
     return std::nullopt;
   }
   if (catalog != nullptr) {
+    auto plugins = vrflow::daemon::loadApplicationPlugins(*flat, *catalog);
+    problems.insert(problems.end(), plugins.begin(), plugins.end());
     auto more = vrflow::app::validate(*flat, *catalog);
     problems.insert(problems.end(), more.begin(), more.end());
   }

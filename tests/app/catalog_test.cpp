@@ -84,7 +84,10 @@ TEST(Catalog, RegistersTheBuiltinFilters) {
   const Catalog catalog;
   std::vector<std::string> names;
   for (const FilterType* type : catalog.filterTypes()) names.push_back(type->name);
-  EXPECT_EQ(names, (std::vector<std::string>{"broadcast", "initial", "merge", "passthrough"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"broadcast", "gate", "gather", "initial", "latest",
+                                      "maxfrequency", "merge", "multiplex", "passthrough", "rotate",
+                                      "scatter", "stampfilter", "typefilter", "unrotate"}));
   const FilterType* merge = catalog.findFilter("merge");
   EXPECT_EQ(namesOf(merge->portsFor({})), (std::vector<std::string>{"in0", "in1", "out"}));
   EXPECT_EQ(namesOf(merge->portsFor({Param{"inputs", "3", {}}})),
@@ -96,6 +99,38 @@ TEST(Catalog, RegistersTheBuiltinFilters) {
   EXPECT_EQ(catalog.findFilter("broadcast")->initialMessagesFor({}), 0);
   EXPECT_EQ(namesOf(catalog.findFilter("passthrough")->portsFor({})),
             (std::vector<std::string>{"in", "out"}));
+}
+
+TEST(Catalog, StandardFiltersDeclareTheirPortsFromTheirParameters) {
+  const Catalog catalog;
+  const auto portsOf = [&](const char* type, std::vector<Param> params) {
+    return namesOf(catalog.findFilter(type)->portsFor(params));
+  };
+  using Names = std::vector<std::string>;
+  EXPECT_EQ(portsOf("multiplex", {Param{"inputs", "3", {}}}), (Names{"in0", "in1", "in2", "out"}));
+  EXPECT_EQ(portsOf("gate", {}), (Names{"in", "open", "out"}));
+  EXPECT_EQ(portsOf("rotate", {Param{"outputs", "3", {}}}), (Names{"in", "out0", "out1", "out2"}));
+  EXPECT_EQ(portsOf("unrotate", {}), (Names{"in0", "in1", "out"}));
+  EXPECT_EQ(portsOf("scatter", {Param{"outputs", "4", {}}}),
+            (Names{"in", "out0", "out1", "out2", "out3"}));
+  EXPECT_EQ(portsOf("gather", {Param{"inputs", "1", {}}}), (Names{"in0", "out"}));
+  EXPECT_EQ(portsOf("latest", {}), (Names{"in", "sync", "out"}));
+  EXPECT_EQ(portsOf("maxfrequency", {}), (Names{"in", "out"}));
+  EXPECT_EQ(portsOf("stampfilter", {}), (Names{"in", "order", "out"}));
+  EXPECT_EQ(portsOf("typefilter", {}), (Names{"in", "out"}));
+  // Every input is required; every parameter has a default that is a valid value.
+  for (const FilterType* type : catalog.filterTypes()) {
+    for (const PortSpec& port : type->portsFor({})) {
+      EXPECT_TRUE(port.required || !port.isInput) << type->name << "." << port.name;
+    }
+    for (const ParamSpec& param : type->params) {
+      EXPECT_FALSE(checkParamValue(param, param.defaultValue).has_value())
+          << type->name << "." << param.name;
+    }
+  }
+  // latest starts its reader -> sync cycle with initial-sync triggers.
+  EXPECT_EQ(catalog.findFilter("latest")->initialMessagesFor({}), 1);
+  EXPECT_EQ(catalog.findFilter("latest")->initialMessagesFor({Param{"initial-sync", "0", {}}}), 0);
 }
 
 TEST(Catalog, PortsOfAnInstanceFollowItsType) {

@@ -116,8 +116,9 @@ TEST(Validate, UnknownFilterTypeListsTheKnownFilters) {
 </application>
 )"),
                        3, 20,
-                       "unknown filter type 'mrge' (known: broadcast, initial, merge, "
-                       "passthrough); did you mean 'merge'?");
+                       "unknown filter type 'mrge' (known: broadcast, gate, gather, initial, "
+                       "latest, maxfrequency, merge, multiplex, passthrough, rotate, scatter, "
+                       "stampfilter and 2 more); did you mean 'merge'?");
 }
 
 TEST(Validate, ConnectionFromAMissingNodeIsReportedAtFrom) {
@@ -427,6 +428,44 @@ TEST(Validate, FilterParametersAreCheckedAndShapeItsPorts) {
 )");
   EXPECT_ONLY_ERROR_AT(found, 11, 28,
                        "parameter 'inputs' of filter 'bad' (merge) is 0, below its minimum 1");
+}
+
+TEST(Validate, ParametersThatMustAgreeAreCheckedTogether) {
+  const std::vector<Diagnostic> found = check(R"(<application>
+  <modules>
+    <module id="a" package="core" type="source"/>
+    <module id="b" package="core" type="sink"/>
+  </modules>
+  <filters>
+    <filter id="s" type="scatter">
+      <param name="by" value="type"/>
+      <param name="outputs" value="3"/>
+      <param name="types" value="rigid, point"/>
+    </filter>
+    <filter id="t" type="typefilter"/>
+    <filter id="ok" type="typefilter">
+      <param name="types" value="rigid"/>
+    </filter>
+  </filters>
+  <connections>
+    <connection from="a.out" to="s.in"/>
+    <connection from="s.out0" to="b.in"/>
+    <connection from="a.out" to="t.in"/>
+    <connection from="t.out" to="b.in"/>
+    <connection from="a.out" to="ok.in"/>
+    <connection from="ok.out" to="b.in"/>
+  </connections>
+</application>
+)");
+  ASSERT_EQ(found.size(), 2u) << formatDiagnostics(found);
+  EXPECT_EQ(found[0].loc.line, 7);
+  EXPECT_EQ(found[0].message,
+            "filter 's' (scatter): by=\"type\" needs one type name in 'types' per output: 3 "
+            "outputs, 2 names");
+  EXPECT_EQ(found[1].loc.line, 12);
+  EXPECT_NE(found[1].message.find("filter 't' (typefilter): parameter 'types' must list"),
+            std::string::npos)
+      << found[1].message;
 }
 
 TEST(Validate, NegativeCapacityIsReportedAtTheAttribute) {

@@ -207,6 +207,34 @@ TEST(MessageBuilder, AppendChunksCopiesAnotherMessagesChunksVerbatim) {
   EXPECT_TRUE(std::equal(original.begin(), original.end(), copied.begin()));
 }
 
+TEST(MessageBuilder, AppendChunkCopiesOneChunkVerbatim) {
+  const auto sample = sampleMessage();
+  const auto source = MessageView::parse(sample);
+  ASSERT_TRUE(source.ok());
+  VectorSink sink;
+  MessageBuilder builder(sink);
+  builder.setSource("scatter");
+  std::vector<ChunkView> picked;
+  for (const ChunkView chunk : *source) {
+    if (chunk.index() % 2 == 1) {
+      builder.appendChunk(chunk);
+      picked.push_back(chunk);
+    }
+  }
+  const auto subset = finished(builder);
+  const auto view = MessageView::parse(subset);
+  ASSERT_TRUE(view.ok()) << view.error().message;
+  ASSERT_EQ(view->chunkCount(), picked.size());
+  std::size_t i = 0;
+  for (const ChunkView chunk : *view) {
+    EXPECT_EQ(chunk.kind(), picked[i].kind());
+    EXPECT_EQ(chunk.id(), picked[i].id());
+    EXPECT_TRUE(std::equal(chunk.bytes().begin(), chunk.bytes().end(), picked[i].bytes().begin(),
+                           picked[i].bytes().end()));
+    ++i;
+  }
+}
+
 TEST(MessageBuilder, StampsOnlyMessagesRefuseChunks) {
   ThrowOnAssert guard;
   VectorSink sink;

@@ -59,5 +59,22 @@ TEST(Examples, MinimalModuleOscillatesWithTheSpringPeriod) {
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 
+// The README's plugin: a filter type added by a shared library that the file names.
+TEST(Examples, FilterPluginKeepsOneMessageInN) {
+  TempDir dir;
+  const auto result = runCommand({"/bin/sh", "-c",
+                                  "cd " + dir.path() + " && " + binDir() + "/vrflow run " +
+                                      sourceDir() + "/examples/filter_plugin/every_nth.xml"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto lines = readLines(dir.file("every_nth.csv"));
+  ASSERT_EQ(lines.size(), 1u + 4u);  // header + messages 0, 5, 10, 15 of 20
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const auto f = split(lines[i]);  // iteration,source,source_iteration,sim_time,kind,id,counter
+    ASSERT_GE(f.size(), 7u) << lines[i];
+    EXPECT_EQ(f[6], std::to_string(5 * (i - 1))) << lines[i];
+  }
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
 }  // namespace
 }  // namespace vrflow::testing

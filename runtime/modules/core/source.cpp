@@ -1,5 +1,6 @@
 // core/source: one raw resource chunk per iteration, `size` bytes, the first 8 holding the
-// iteration number. Used by the transport benchmark and the pipeline tests.
+// iteration number; stops after `count` iterations (0: runs until the run stops). Used by the
+// transport benchmark, the pipeline tests and the filter tests.
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -15,10 +16,12 @@ int main() {
     return 2;
   }
   const auto size = static_cast<std::size_t>(module.paramInt("size", 64));
+  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
   std::vector<std::byte> payload(size < 8 ? 8 : size);
   const uint64_t resource = module.newId();
   while (module.wait()) {
     const uint64_t counter = module.iteration();
+    if (count != 0 && counter >= count) break;
     std::memcpy(payload.data(), &counter, sizeof counter);
     auto message = module.newMessage(payload.size() + 256);
     message.builder().addRawResource(resource, true, payload);

@@ -81,11 +81,12 @@ Module readModule(const ReadContext& context, const pugi::xml_node& node) {
 }
 
 Filter readFilter(const ReadContext& context, const pugi::xml_node& node) {
-  const ElementReader reader(context, node, {"id", "type", "host"});
+  const ElementReader reader(context, node, {"id", "type", "host", "plugin"});
   Filter filter;
   filter.id = reader.required("id");
   filter.type = reader.required("type");
   filter.host = reader.text("host");
+  filter.plugin = reader.text("plugin");
   filter.loc = reader.loc();
   detail::forEachChild(context, node, {"param"}, [&](const pugi::xml_node& child) {
     filter.params.push_back(readParam(context, child));

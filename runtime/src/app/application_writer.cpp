@@ -76,6 +76,7 @@ void writeFilters(std::string& out, const Application& app) {
     Tag tag(out, 2, "filter");
     tag.attribute("id", filter.id).attribute("type", filter.type);
     if (!filter.host.empty()) tag.attributeUnless("host", filter.host, firstHost);
+    if (!filter.plugin.empty()) tag.attribute("plugin", filter.plugin);
     if (filter.params.empty()) {
       tag.close();
       continue;

@@ -6,16 +6,30 @@
 namespace vrflow::app::detail {
 namespace {
 
-constexpr long long kMaxMergeInputs = 256;
 constexpr long long kMaxInitialMessages = 1000000;
+
+}  // namespace
 
 PortSpec filterPort(std::string name, bool isInput, std::string doc) {
   PortSpec port;
   port.name = std::move(name);
   port.isInput = isInput;
-  port.required = isInput;  // a filter with an unconnected input never fires
+  port.required = isInput;
   port.doc = std::move(doc);
   return port;
+}
+
+std::vector<PortSpec> numberedPorts(const std::string& prefix, long long count, bool isInput,
+                                    const std::string& doc) {
+  std::vector<PortSpec> ports;
+  for (long long i = 0; i < count; ++i) {
+    ports.push_back(filterPort(prefix + std::to_string(i), isInput, doc));
+  }
+  return ports;
+}
+
+long long portCount(const std::vector<Param>& params, const char* name, long long fallback) {
+  return std::clamp(paramInt(params, name, fallback), 1LL, kMaxFilterPorts);
 }
 
 ParamSpec intParam(std::string name, std::string defaultValue, double min, double max,
@@ -30,12 +44,45 @@ ParamSpec intParam(std::string name, std::string defaultValue, double min, doubl
   return param;
 }
 
+ParamSpec floatParam(std::string name, std::string defaultValue, double min, double max,
+                     std::string doc) {
+  ParamSpec param = intParam(std::move(name), std::move(defaultValue), min, max, std::move(doc));
+  param.type = ParamType::Float;
+  return param;
+}
+
+ParamSpec boolParam(std::string name, std::string defaultValue, std::string doc) {
+  ParamSpec param;
+  param.name = std::move(name);
+  param.type = ParamType::Bool;
+  param.defaultValue = std::move(defaultValue);
+  param.doc = std::move(doc);
+  return param;
+}
+
+ParamSpec enumParam(std::string name, std::vector<std::string> choices, std::string doc) {
+  ParamSpec param;
+  param.name = std::move(name);
+  param.type = ParamType::Enum;
+  param.defaultValue = choices.front();
+  param.choices = std::move(choices);
+  param.doc = std::move(doc);
+  return param;
+}
+
+ParamSpec stringParam(std::string name, std::string defaultValue, std::string doc) {
+  ParamSpec param;
+  param.name = std::move(name);
+  param.type = ParamType::String;
+  param.defaultValue = std::move(defaultValue);
+  param.doc = std::move(doc);
+  return param;
+}
+
 std::vector<PortSpec> inToOut(const std::vector<Param>& /*params*/) {
   return {filterPort("in", true, "messages to forward"),
           filterPort("out", false, "the forwarded messages")};
 }
-
-}  // namespace
 
 std::vector<FilterType> builtinFilterTypes() {
   std::vector<FilterType> types;
@@ -50,13 +97,10 @@ std::vector<FilterType> builtinFilterTypes() {
   merge.name = "merge";
   merge.doc = "Waits for one message on each of in0..in{N-1} and emits their concatenation on out.";
   merge.params.push_back(
-      intParam("inputs", "2", 1, static_cast<double>(kMaxMergeInputs), "number of inputs N"));
+      intParam("inputs", "2", 1, static_cast<double>(kMaxFilterPorts), "number of inputs N"));
   merge.ports = [](const std::vector<Param>& params) {
-    const long long count = std::clamp(paramInt(params, "inputs", 2), 1LL, kMaxMergeInputs);
-    std::vector<PortSpec> ports;
-    for (long long i = 0; i < count; ++i) {
-      ports.push_back(filterPort("in" + std::to_string(i), true, "one of the merged inputs"));
-    }
+    auto ports =
+        numberedPorts("in", portCount(params, "inputs", 2), true, "one of the merged inputs");
     ports.push_back(filterPort("out", false, "the merged messages"));
     return ports;
   };
@@ -83,6 +127,8 @@ std::vector<FilterType> builtinFilterTypes() {
   broadcast.ports = inToOut;
   types.push_back(std::move(broadcast));
 
+  addRoutingFilterTypes(types);
+  addSamplingFilterTypes(types);
   return types;
 }
 

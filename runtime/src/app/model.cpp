@@ -81,6 +81,20 @@ bool paramBool(const std::vector<Param>& params, std::string_view name, bool fal
   return detail::parseBool(param->value).value_or(fallback);
 }
 
+std::vector<std::string> splitList(std::string_view text) {
+  std::vector<std::string> items;
+  while (!text.empty()) {
+    const std::size_t comma = text.find(',');
+    std::string_view item = text.substr(0, comma);
+    while (!item.empty() && (item.front() == ' ' || item.front() == '\t')) item.remove_prefix(1);
+    while (!item.empty() && (item.back() == ' ' || item.back() == '\t')) item.remove_suffix(1);
+    if (!item.empty()) items.emplace_back(item);
+    if (comma == std::string_view::npos) break;
+    text.remove_prefix(comma + 1);
+  }
+  return items;
+}
+
 void setParam(std::vector<Param>& params, std::string_view name, std::string value) {
   for (Param& param : params) {
     if (param.name == name) {

@@ -214,6 +214,11 @@ void checkNodes(Validation& v) {
     checkFilterType(v, filter);
     if (const FilterType* type = v.catalog.findFilter(filter.type)) {
       checkParams(v, filter.params, type->params, filterLabel(filter));
+      if (type->check) {
+        if (const auto problem = type->check(filter.params)) {
+          v.error(filter.loc, filterLabel(filter) + ": " + *problem);
+        }
+      }
     }
   }
   checkEditor(v);

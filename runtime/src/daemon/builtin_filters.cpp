@@ -2,6 +2,8 @@
 
 #include <vector>
 
+#include "filters/filters.hpp"
+
 namespace vrflow::daemon {
 namespace {
 
@@ -122,13 +124,6 @@ class PortInputFilter final : public Filter {
   MergeFilter merge_;
 };
 
-template <typename T>
-FilterFactory factoryOf() {
-  return [](const FilterContext&) -> Result<std::unique_ptr<Filter>> {
-    return std::unique_ptr<Filter>(std::make_unique<T>());
-  };
-}
-
 }  // namespace
 
 void PortOutputFilter::process(FilterContext& context) {
@@ -142,12 +137,22 @@ void PortOutputFilter::process(FilterContext& context) {
 }
 
 void registerBuiltinFilters(FilterRegistry& registry) {
+  using filters::factoryOf;
   registry.add("passthrough", factoryOf<PassthroughFilter>());
   registry.add("broadcast", factoryOf<PassthroughFilter>());
   registry.add("initial", factoryOf<InitialFilter>());
   registry.add("merge", factoryOf<MergeFilter>());
+  registry.add("gather", factoryOf<MergeFilter>());
   registry.add("port-input", factoryOf<PortInputFilter>());
   registry.add("port-output", factoryOf<PortOutputFilter>());
+  filters::registerMultiplex(registry);
+  filters::registerGate(registry);
+  filters::registerRotate(registry);
+  filters::registerScatter(registry);
+  filters::registerLatest(registry);
+  filters::registerMaxFrequency(registry);
+  filters::registerStampFilter(registry);
+  filters::registerTypeFilter(registry);
 }
 
 }  // namespace vrflow::daemon

@@ -1,5 +1,6 @@
 #include "vrflow/daemon/daemon.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <chrono>
@@ -97,6 +98,8 @@ Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& ty
   auto node = std::make_unique<Node>(*graph, id, std::move(params));
   node->inputNames = std::move(inputs);
   node->outputNames = std::move(outputs);
+  // Named inputs get their queues when connected; a factory already sees how many there are.
+  node->inputs.assign(node->inputNames.size(), nullptr);
   node->outputs.resize(node->outputNames.size());
   auto filter = (*factory)(*node);
   if (!filter) return filter.error();
@@ -202,7 +205,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         queue.capacity = 4;
         queue.from = nodeId;
         queue.to = nodeId;
-        (*node)->inputs.push_back(&queue);
+        (*node)->inputs[0] = &queue;
         graph->sources.push_back({static_cast<int>(m), static_cast<int>(p), rings[m][p], &queue, false});
         portNodes[{static_cast<int>(m), spec.name}] = *node;
         outputFilters.emplace_back(nodeId, static_cast<PortOutputFilter*>((*node)->filter.get()));
@@ -215,9 +218,14 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     for (const auto& spec : catalog.portsOf(filter)) {
       (spec.isInput ? inputs : outputs).push_back(spec.name);
     }
-    auto node = addNode(filter.id, filter.type, toMap(filter.params), inputs, outputs);
+    // Parameters: the catalog's defaults, overridden by the file.
+    std::map<std::string, std::string> params;
+    if (const app::FilterType* type = catalog.findFilter(filter.type)) {
+      for (const auto& spec : type->params) params[spec.name] = spec.defaultValue;
+    }
+    for (auto& [name, value] : toMap(filter.params)) params[name] = value;
+    auto node = addNode(filter.id, filter.type, std::move(params), inputs, outputs);
     if (!node) return node.error();
-    (*node)->inputs.assign(inputs.size(), nullptr);
     filterNodes[filter.id] = *node;
   }
 
@@ -347,13 +355,23 @@ void Daemon::Impl::loop() {
       lastFullCheck = now;
     }
     publishWarnings();
-    if (!progressed) bell.sleep(seen, kIdleSleepNs);
+    if (progressed) continue;
+    // Sleep until a message moves, or until the earliest timer a filter asked for.
+    int64_t sleepNs = kIdleSleepNs;
+    if (graph->wakeAtNs != 0) {
+      const uint64_t current = nowNs();
+      sleepNs = graph->wakeAtNs <= current
+                    ? 0
+                    : std::min<int64_t>(sleepNs, static_cast<int64_t>(graph->wakeAtNs - current));
+    }
+    if (sleepNs > 0) bell.sleep(seen, sleepNs);
   }
 }
 
 // One sweep over sources and filters; true if anything moved.
 bool Daemon::Impl::pass() {
   const uint64_t before = graph->operations;
+  graph->wakeAtNs = 0;  // filters that still need a timer ask again in process()
   std::size_t buffered = 0;
   for (auto& source : graph->sources) {
     if (source.closed) continue;

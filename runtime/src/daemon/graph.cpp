@@ -68,12 +68,48 @@ void Node::emit(std::size_t o, MessageRef message) {
 }
 
 Result<MessageRef> Node::makeEmpty(uint64_t iteration, bool stampsOnly) {
-  detail::ShmSink sink(*graph_->segment, 128);
+  return compose(128, [&](msg::MessageBuilder& builder) {
+    builder.setIteration(iteration);
+    builder.setStampsOnly(stampsOnly);
+  });
+}
+
+Result<MessageRef> Node::concatenate(std::span<const MessageRef> parts) {
+  std::size_t total = 128;
+  std::vector<msg::MessageView> views;
+  views.reserve(parts.size());
+  for (const auto& part : parts) {
+    auto view = part.view();
+    if (!view) return makeError("filter '" + id_ + "': malformed message: " + view.error().message);
+    views.push_back(*view);
+    total += part.size();
+  }
+  return compose(total, [&](msg::MessageBuilder& builder) {
+    uint64_t iteration = 0;
+    double simTime = 0.0;
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const auto stamps = views[i].stamps();
+      if (i == 0) {
+        builder.setSource(stamps.source);
+        builder.setTimeStep(stamps.timeStep);
+        builder.setSendTimeNs(stamps.sendTimeNs);
+      }
+      iteration = std::max(iteration, stamps.iteration);
+      simTime = std::max(simTime, stamps.simTime);
+      builder.appendChunks(views[i]);
+    }
+    builder.setIteration(iteration);
+    builder.setSimTime(simTime);
+  });
+}
+
+Result<MessageRef> Node::compose(std::size_t sizeHint,
+                                 const std::function<void(msg::MessageBuilder&)>& fill) {
+  detail::ShmSink sink(*graph_->segment, std::max<std::size_t>(sizeHint, 128));
   msg::MessageBuilder builder(sink);
   builder.setSource(id_);
-  builder.setIteration(iteration);
   builder.setSendTimeNs(wallNs());
-  builder.setStampsOnly(stampsOnly);
+  fill(builder);
   const std::size_t used = builder.finish();
   if (used == 0 || sink.data() == nullptr) {
     return makeError("filter '" + id_ + "': shared memory exhausted");
@@ -81,35 +117,15 @@ Result<MessageRef> Node::makeEmpty(uint64_t iteration, bool stampsOnly) {
   return MessageRef(graph_->segment, sink.take(used));
 }
 
-Result<MessageRef> Node::concatenate(std::span<const MessageRef> parts) {
-  std::size_t total = 128;
-  for (const auto& part : parts) total += part.size();
-  detail::ShmSink sink(*graph_->segment, total);
-  msg::MessageBuilder builder(sink);
-  bool first = true;
-  uint64_t iteration = 0;
-  double simTime = 0.0;
-  for (const auto& part : parts) {
-    auto view = part.view();
-    if (!view) return makeError("filter '" + id_ + "': malformed message: " + view.error().message);
-    const auto stamps = view->stamps();
-    if (first) {
-      builder.setSource(stamps.source);
-      builder.setTimeStep(stamps.timeStep);
-      builder.setSendTimeNs(stamps.sendTimeNs);
-      first = false;
-    }
-    iteration = std::max(iteration, stamps.iteration);
-    simTime = std::max(simTime, stamps.simTime);
-    builder.appendChunks(*view);
-  }
-  builder.setIteration(iteration);
-  builder.setSimTime(simTime);
-  const std::size_t used = builder.finish();
-  if (used == 0 || sink.data() == nullptr) {
-    return makeError("filter '" + id_ + "': shared memory exhausted");
-  }
-  return MessageRef(graph_->segment, sink.take(used));
+uint64_t Node::nowNs() const {
+  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::steady_clock::now().time_since_epoch())
+                                   .count());
+}
+
+void Node::wakeAfter(uint64_t delayNs) {
+  const uint64_t at = nowNs() + delayNs;
+  if (graph_->wakeAtNs == 0 || at < graph_->wakeAtNs) graph_->wakeAtNs = at;
 }
 
 void Node::warn(const std::string& message) { graph_->warnings.push_back(message); }

@@ -110,6 +110,10 @@ class Node final : public FilterContext {
   void emit(std::size_t o, MessageRef message) override;
   Result<MessageRef> makeEmpty(uint64_t iteration, bool stampsOnly) override;
   Result<MessageRef> concatenate(std::span<const MessageRef> parts) override;
+  Result<MessageRef> compose(std::size_t sizeHint,
+                             const std::function<void(msg::MessageBuilder&)>& fill) override;
+  uint64_t nowNs() const override;
+  void wakeAfter(uint64_t delayNs) override;
   void warn(const std::string& message) override;
 
   std::unique_ptr<Filter> filter;
@@ -146,6 +150,7 @@ class Graph {
   std::vector<ModuleSource> sources;
   std::vector<std::string> warnings;
   uint64_t operations = 0;  ///< bumped on every move, to detect progress
+  uint64_t wakeAtNs = 0;    ///< earliest time a filter asked to be run again; 0 = none
 };
 
 }  // namespace vrflow::daemon

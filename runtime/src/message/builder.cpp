@@ -262,22 +262,28 @@ void MessageBuilder::addEvent(std::uint64_t id, std::uint16_t kind,
 }
 
 void MessageBuilder::appendChunks(const MessageView& other) {
+  appendVerbatim(other.chunkBytes(), other.chunkCount());
+}
+
+void MessageBuilder::appendChunk(const ChunkView& chunk) {
+  appendVerbatim(chunk.bytes(), 1);
+}
+
+void MessageBuilder::appendVerbatim(std::span<const std::byte> chunks, std::uint32_t count) {
   VRFLOW_ASSERT((flags_ & kFlagStampsOnly) == 0, "a stamps-only message holds no chunk");
-  const std::span<const std::byte> chunks = other.chunkBytes();
-  VRFLOW_ASSERT(
-      std::uint64_t{chunkCount_} + other.chunkCount() <= std::numeric_limits<std::uint32_t>::max(),
-      "too many chunks");
+  VRFLOW_ASSERT(std::uint64_t{chunkCount_} + count <= std::numeric_limits<std::uint32_t>::max(),
+                "too many chunks");
   if (base_ != nullptr && !chunks.empty()) {
     const auto* begin = reinterpret_cast<const unsigned char*>(chunks.data());
     const auto* ours = reinterpret_cast<const unsigned char*>(base_);
     VRFLOW_ASSERT(std::less<>{}(begin, ours) || !std::less<>{}(begin, ours + capacity_),
-                  "appendChunks: the source message lives in this builder's sink");
+                  "appending chunks that live in this builder's own sink");
   }
   openObject_ = 0;
   if (!ensure(size_ + chunks.size())) return;
   if (!chunks.empty()) std::memcpy(base_ + size_, chunks.data(), chunks.size());
   size_ += chunks.size();
-  chunkCount_ += other.chunkCount();
+  chunkCount_ += count;
 }
 
 std::size_t MessageBuilder::finish() {

@@ -14,6 +14,7 @@
 #include "report.hpp"
 #include "spawn.hpp"
 #include "vrflow/daemon/daemon.hpp"
+#include "vrflow/daemon/plugin.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow::run {
@@ -331,6 +332,8 @@ Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs) {
   if (!ec) dirs.push_back((self.parent_path().parent_path() / "share/vrflow/packages").string());
   app::Catalog catalog;
   if (auto status = catalog.loadSearchPath(dirs); !status) return status.error();
+  const auto plugins = daemon::filterPluginsFromEnvironment();
+  if (auto status = daemon::loadFilterPlugins(plugins, catalog); !status) return status.error();
   return catalog;
 }
 

@@ -56,6 +56,8 @@ struct Filter {
   std::string id;
   std::string type;
   std::string host;
+  /// Shared library that defines `type` (docs/filters.md, "Plugins"); empty for built-ins.
+  std::string plugin;
   std::vector<Param> params;
   SourceLocation loc;
 };
@@ -150,6 +152,9 @@ double paramFloat(const std::vector<Param>& params, std::string_view name, doubl
 bool paramBool(const std::vector<Param>& params, std::string_view name, bool fallback);
 /// Sets a parameter, replacing its value when present, appending it otherwise.
 void setParam(std::vector<Param>& params, std::string_view name, std::string value);
+/// The items of a comma-separated list ("point, rigid"), spaces around items removed and empty
+/// items dropped.
+std::vector<std::string> splitList(std::string_view text);
 
 /// The "node.port" text of an endpoint.
 std::string toString(const Endpoint& endpoint);

@@ -73,6 +73,9 @@ struct FilterType {
   /// How many messages the filter emits at start-up without input (what breaks a cycle);
   /// empty means none.
   std::function<int(const std::vector<Param>&)> initialMessages;
+  /// Problems the parameters have together (a list whose length must match a count, ...):
+  /// a message, or nullopt when they fit. Empty means no such rule. Must cope with bad values.
+  std::function<std::optional<std::string>(const std::vector<Param>&)> check;
 
   /// The ports for these parameters (none when `ports` is empty).
   std::vector<PortSpec> portsFor(const std::vector<Param>& values) const;

@@ -11,6 +11,7 @@
 
 #include "vrflow/base/result.hpp"
 #include "vrflow/daemon/message_ref.hpp"
+#include "vrflow/message/builder.hpp"
 
 namespace vrflow::daemon {
 
@@ -22,8 +23,13 @@ class FilterContext {
 
   /// The filter's id (for messages) and its parameters from the application file.
   virtual const std::string& name() const = 0;
+  /// Parameters hold the file's values over the catalog's defaults for the filter type.
   virtual std::string param(const std::string& key, const std::string& fallback) const = 0;
+  /// The parameter read as an integer / finite number / bool (true, false, 1, 0); `fallback`
+  /// when it is absent or unreadable.
   long paramInt(const std::string& key, long fallback) const;
+  double paramFloat(const std::string& key, double fallback) const;
+  bool paramBool(const std::string& key, bool fallback) const;
 
   virtual std::size_t inputCount() const = 0;
   /// Messages buffered on input `i`, oldest first. Pop what you consume.
@@ -42,6 +48,19 @@ class FilterContext {
   /// A new message holding the chunks of `parts` in order; stamps from the first, the
   /// iteration and simulation time the largest among them.
   virtual Result<MessageRef> concatenate(std::span<const MessageRef> parts) = 0;
+  /// A new message written by `fill` straight into shared memory (`sizeHint` bytes reserved up
+  /// front; the block grows as needed). The builder starts with this filter as the source;
+  /// `fill` may replace every stamp (setStamps) and copy chunks (appendChunk, appendChunks).
+  /// Fails when shared memory is exhausted.
+  virtual Result<MessageRef> compose(std::size_t sizeHint,
+                                     const std::function<void(msg::MessageBuilder&)>& fill) = 0;
+
+  /// Monotonic clock, ns (the clock wakeAfter counts on).
+  virtual uint64_t nowNs() const = 0;
+  /// Asks the daemon to call process() again once `delayNs` have passed, even if no message
+  /// moves (a timer; it may come earlier, when something else happens). The request holds
+  /// until the next call of process(): ask again there while the filter still waits.
+  virtual void wakeAfter(uint64_t delayNs) = 0;
   /// Reports a problem with the data flowing through this filter (logged; the run goes on).
   virtual void warn(const std::string& message) = 0;
 };
@@ -61,18 +80,26 @@ class Filter {
   virtual bool exhausted(FilterContext& context) const;
 };
 
+/// Makes a filter for one node of the network. It may read the node's name, parameters and
+/// port counts (not its queues); an error (a parameter it cannot use) stops the run's start.
 using FilterFactory = std::function<Result<std::unique_ptr<Filter>>(const FilterContext&)>;
 
-/// Filter types by name. Built-ins: passthrough, merge, initial, broadcast, and the default
-/// per-port filters `port-input` and `port-output`.
+/// Filter types by name: the standard library (docs/filters.md), the default per-port filters
+/// `port-input` and `port-output`, and what plugins add (vrflow/daemon/plugin.hpp).
 class FilterRegistry {
  public:
+  /// The process's registry, holding the built-in filters; the daemon builds from it.
   static FilterRegistry& instance();
+  /// An empty registry (plugins register into one first, so that they are checked).
+  FilterRegistry() = default;
+  /// Adds or replaces the factory of `type`.
   void add(std::string type, FilterFactory factory);
+  /// The factory of `type`, or nullptr.
   const FilterFactory* find(const std::string& type) const;
+  /// Every registered type name, sorted.
+  std::vector<std::string> types() const;
 
  private:
-  FilterRegistry();
   std::map<std::string, FilterFactory> factories_;
 };
 

@@ -15,6 +15,7 @@
 
 namespace vrflow::msg {
 
+class ChunkView;
 class MessageView;
 
 /// Writes one message (docs/message-layout.md) straight into a ByteSink: set the stamps, add
@@ -75,6 +76,9 @@ class MessageBuilder {
   void addEvent(std::uint64_t id, std::uint16_t kind, std::span<const std::byte> payload);
   /// Copies every chunk of `other` verbatim (merging); `other` must not live in this sink.
   void appendChunks(const MessageView& other);
+  /// Copies one chunk of another message verbatim (to forward a subset of its chunks);
+  /// the chunk must not live in this builder's sink.
+  void appendChunk(const ChunkView& chunk);
 
   /// Writes the header and returns the message size, or 0 when the sink could not grow.
   /// The builder may go on (add more, finish again).
@@ -93,6 +97,7 @@ class MessageBuilder {
   friend class ObjectWriter;
 
   bool ensure(std::size_t needed);
+  void appendVerbatim(std::span<const std::byte> chunks, std::uint32_t count);
   bool splice(std::size_t offset, std::size_t oldLength, std::size_t newLength);
   std::byte* replaceInStamps(std::size_t at, std::size_t oldLength, std::size_t newLength);
   std::byte* addUserStamp(std::string_view name, StampType type, std::size_t valueLength);

@@ -40,7 +40,8 @@ struct RunOutcome {
 };
 
 /// The node packages on the search path: `extraDirs` first, then $VRFLOW_PACKAGE_PATH, then
-/// <folder of this executable>/../share/vrflow/packages (the build tree and installs alike).
+/// <folder of this executable>/../share/vrflow/packages (the build tree and installs alike);
+/// plus the filter plugins of $VRFLOW_FILTER_PATH.
 Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs);
 
 /// Runs `application` with every host mapped to this machine (the embedded default): one

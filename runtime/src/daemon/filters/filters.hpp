@@ -1,0 +1,55 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "vrflow/daemon/filter.hpp"
+#include "vrflow/message/reader.hpp"
+
+// The standard filter library (docs/filters.md): one register function per file.
+
+namespace vrflow::daemon::filters {
+
+void registerMultiplex(FilterRegistry& registry);
+void registerGate(FilterRegistry& registry);
+void registerRotate(FilterRegistry& registry);  ///< rotate and unrotate
+void registerScatter(FilterRegistry& registry);
+void registerLatest(FilterRegistry& registry);
+void registerMaxFrequency(FilterRegistry& registry);
+void registerStampFilter(FilterRegistry& registry);
+void registerTypeFilter(FilterRegistry& registry);
+
+/// A factory for a filter built without arguments.
+template <typename T>
+FilterFactory factoryOf() {
+  return [](const FilterContext&) -> Result<std::unique_ptr<Filter>> {
+    return std::unique_ptr<Filter>(std::make_unique<T>());
+  };
+}
+
+/// True when every input is closed and drained (for filters that go on while any input may
+/// still bring something).
+bool allInputsDone(FilterContext& context);
+
+/// The message's parsed view, or nullopt after warning that it is malformed.
+std::optional<msg::MessageView> viewOrWarn(FilterContext& context, const MessageRef& message);
+
+/// A copy of `message` (stamps, flag, chunks) with its iteration stamp replaced.
+Result<MessageRef> restamp(FilterContext& context, const msg::MessageView& message,
+                           uint64_t iteration);
+
+/// Remembers the iteration stamp of the message at the head of one input, so that a filter
+/// that looks at it on every pass parses it once. It holds a reference to that message, so
+/// its block cannot be reused for another message while remembered.
+class HeadIteration {
+ public:
+  /// The iteration of `message`, or nullopt (after a warning) when it is malformed.
+  std::optional<uint64_t> of(FilterContext& context, const MessageRef& message);
+
+ private:
+  MessageRef message_;
+  uint64_t iteration_ = 0;
+};
+
+}  // namespace vrflow::daemon::filters

@@ -1,0 +1,64 @@
+// latest: greedy sampling. Keeps the newest message of `in`; each `sync` message forwards it.
+#include "filters.hpp"
+
+namespace vrflow::daemon::filters {
+namespace {
+
+constexpr std::size_t kIn = 0;
+constexpr std::size_t kSync = 1;
+
+class LatestFilter final : public Filter {
+ public:
+  explicit LatestFilter(bool repeat) : repeat_(repeat) {}
+
+  Status start(FilterContext& context) override {
+    const long initial = context.paramInt("initial-sync", 1);
+    if (initial < 0) return makeError("filter '" + context.name() + "': initial-sync must be >= 0");
+    triggers_ = static_cast<uint64_t>(initial);
+    return {};
+  }
+
+  void process(FilterContext& context) override {
+    auto& in = context.input(kIn);
+    while (in.size() > 1) in.pop_front();  // only the newest matters: the producer never waits
+    auto& sync = context.input(kSync);
+    triggers_ += sync.size();
+    sync.clear();
+    while (triggers_ > 0 && context.canEmit(0)) {
+      if (!in.empty()) {
+        if (repeat_) last_ = in.front();
+        context.emit(0, std::move(in.front()));
+        in.pop_front();
+      } else if (repeat_ && last_.valid()) {
+        context.emit(0, last_);
+      } else {
+        return;  // the trigger waits for the next message
+      }
+      --triggers_;
+    }
+  }
+
+  // Ends with the data (no new message will come) or with the triggers.
+  bool exhausted(FilterContext& context) const override {
+    const bool dataDone = context.inputClosed(kIn) && context.input(kIn).empty();
+    const bool syncDone =
+        context.inputClosed(kSync) && context.input(kSync).empty() && triggers_ == 0;
+    return dataDone || syncDone;
+  }
+
+ private:
+  bool repeat_;
+  uint64_t triggers_ = 0;
+  MessageRef last_;
+};
+
+}  // namespace
+
+void registerLatest(FilterRegistry& registry) {
+  registry.add("latest", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+    return std::unique_ptr<Filter>(
+        std::make_unique<LatestFilter>(context.paramBool("repeat", false)));
+  });
+}
+
+}  // namespace vrflow::daemon::filters

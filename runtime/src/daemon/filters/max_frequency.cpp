@@ -1,0 +1,53 @@
+// maxfrequency: at most F messages per second, on the daemon's timer.
+#include <cmath>
+
+#include "filters.hpp"
+
+namespace vrflow::daemon::filters {
+namespace {
+
+class MaxFrequencyFilter final : public Filter {
+ public:
+  MaxFrequencyFilter(uint64_t periodNs, bool keepLatest)
+      : periodNs_(periodNs), keepLatest_(keepLatest) {}
+
+  void process(FilterContext& context) override {
+    auto& in = context.input(0);
+    if (keepLatest_) {
+      while (in.size() > 1) in.pop_front();
+    }
+    if (in.empty()) return;
+    const uint64_t now = context.nowNs();
+    if (now < nextNs_) {
+      context.wakeAfter(nextNs_ - now);
+      return;
+    }
+    if (!context.canEmit(0)) return;
+    context.emit(0, std::move(in.front()));
+    in.pop_front();
+    // From the actual send time, so that two messages are never closer than the period.
+    nextNs_ = now + periodNs_;
+    if (!in.empty()) context.wakeAfter(periodNs_);
+  }
+
+ private:
+  uint64_t periodNs_;
+  bool keepLatest_;
+  uint64_t nextNs_ = 0;
+};
+
+}  // namespace
+
+void registerMaxFrequency(FilterRegistry& registry) {
+  registry.add("maxfrequency", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+    const double frequency = context.paramFloat("frequency", 30.0);
+    if (!(frequency > 0.0) || !std::isfinite(frequency)) {
+      return makeError("filter '" + context.name() + "': frequency must be a positive number");
+    }
+    const auto periodNs = static_cast<uint64_t>(std::llround(1e9 / frequency));
+    return std::unique_ptr<Filter>(
+        std::make_unique<MaxFrequencyFilter>(periodNs, context.param("mode", "wait") == "latest"));
+  });
+}
+
+}  // namespace vrflow::daemon::filters

@@ -1,0 +1,74 @@
+// typefilter: drops the object chunks whose type is not listed (and, if asked, every
+// resource and event chunk).
+#include <algorithm>
+#include <vector>
+
+#include "filters.hpp"
+#include "vrflow/app/model.hpp"
+#include "vrflow/message/ids.hpp"
+
+namespace vrflow::daemon::filters {
+namespace {
+
+class TypeFilter final : public Filter {
+ public:
+  TypeFilter(std::vector<uint32_t> typeIds, bool dropOthers)
+      : typeIds_(std::move(typeIds)), dropOthers_(dropOthers) {}
+
+  void process(FilterContext& context) override {
+    auto& in = context.input(0);
+    while (!in.empty() && context.canEmit(0)) {
+      MessageRef message = std::move(in.front());
+      in.pop_front();
+      const auto view = viewOrWarn(context, message);
+      if (!view) continue;
+      std::size_t keptBytes = 0;
+      uint32_t kept = 0;
+      for (const msg::ChunkView chunk : *view) {
+        if (!keeps(chunk)) continue;
+        keptBytes += chunk.bytes().size();
+        ++kept;
+      }
+      if (kept == view->chunkCount()) {
+        context.emit(0, std::move(message));  // nothing to drop: by reference
+        continue;
+      }
+      const std::size_t fixed = message.size() - view->chunkBytes().size();
+      auto filtered = context.compose(fixed + keptBytes, [&](msg::MessageBuilder& builder) {
+        builder.setStamps(view->stamps().toStamps());
+        for (const msg::ChunkView chunk : *view) {
+          if (keeps(chunk)) builder.appendChunk(chunk);
+        }
+      });
+      if (!filtered) {
+        context.warn(filtered.error().message);
+        continue;
+      }
+      context.emit(0, std::move(*filtered));
+    }
+  }
+
+ private:
+  bool keeps(const msg::ChunkView& chunk) const {
+    if (chunk.kind() != msg::ChunkKind::Object) return !dropOthers_;
+    return std::find(typeIds_.begin(), typeIds_.end(), chunk.typeId()) != typeIds_.end();
+  }
+
+  std::vector<uint32_t> typeIds_;
+  bool dropOthers_;
+};
+
+}  // namespace
+
+void registerTypeFilter(FilterRegistry& registry) {
+  registry.add("typefilter", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+    std::vector<uint32_t> typeIds;
+    for (const auto& name : app::splitList(context.param("types", ""))) {
+      typeIds.push_back(msg::fnv1a32(name));
+    }
+    return std::unique_ptr<Filter>(
+        std::make_unique<TypeFilter>(std::move(typeIds), context.paramBool("drop-others", false)));
+  });
+}
+
+}  // namespace vrflow::daemon::filters

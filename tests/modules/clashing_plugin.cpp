@@ -1,0 +1,26 @@
+// A filter plugin that defines `merge`, a built-in type: the loader must refuse it and keep the
+// built-in.
+#include "vrflow/daemon/plugin.hpp"
+
+namespace {
+
+class NothingFilter final : public vrflow::daemon::Filter {
+ public:
+  void process(vrflow::daemon::FilterContext& /*context*/) override {}
+};
+
+}  // namespace
+
+VRFLOW_FILTER_PLUGIN()
+
+extern "C" void vrflowRegisterFilters(vrflow::daemon::FilterRegistry& registry,
+                                      vrflow::app::Catalog& catalog) {
+  registry.add("merge",
+               [](const vrflow::daemon::FilterContext&)
+                   -> vrflow::Result<std::unique_ptr<vrflow::daemon::Filter>> {
+                 return std::unique_ptr<vrflow::daemon::Filter>(std::make_unique<NothingFilter>());
+               });
+  vrflow::app::FilterType type;
+  type.name = "merge";
+  (void)catalog.addFilterType(std::move(type));
+}

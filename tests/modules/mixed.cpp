@@ -1,0 +1,49 @@
+// testing/mixed: per iteration, `points` point objects, `rigids` rigid objects, one raw
+// resource whose first 8 bytes count iterations, and one force on the first point (or on
+// object 0), in that order; ends after `count` iterations (0: never). For the filters that
+// split or select chunks.
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include "vrflow/message/builtin_types.hpp"
+#include "vrflow/module/module.hpp"
+
+int main() {
+  using namespace vrflow;
+  Module module;
+  auto& out = module.addOutput("out");
+  if (auto status = module.init(); !status) {
+    std::fprintf(stderr, "%s\n", status.error().message.c_str());
+    return 2;
+  }
+  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
+  std::vector<uint64_t> points(static_cast<std::size_t>(module.paramInt("points", 3)));
+  std::vector<uint64_t> rigids(static_cast<std::size_t>(module.paramInt("rigids", 2)));
+  for (auto& id : points) id = module.newId();
+  for (auto& id : rigids) id = module.newId();
+  const uint64_t resource = module.newId();
+  while (module.wait()) {
+    const uint64_t it = module.iteration();
+    if (count != 0 && it >= count) break;
+    auto message = module.newMessage(1024);
+    auto& builder = message.builder();
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      builder.addObject(points[k], msg::pointType())
+          .set(msg::PointParam::kPosition,
+               msg::Vec3{static_cast<double>(k), static_cast<double>(it), 0.0});
+    }
+    for (std::size_t k = 0; k < rigids.size(); ++k) {
+      builder.addObject(rigids[k], msg::rigidType())
+          .set(msg::RigidParam::kPosition,
+               msg::Vec3{static_cast<double>(k), static_cast<double>(it), 1.0});
+    }
+    std::byte counter[8];
+    std::memcpy(counter, &it, sizeof it);
+    builder.addRawResource(resource, true, counter);
+    builder.addForce(points.empty() ? 0 : points.front(),
+                     msg::ForceEvent{{0, 1, 0}, {0, 0, 0}, {0, 0, 0}, 0.01});
+    if (!module.put(out, std::move(message))) break;
+  }
+  return 0;
+}

@@ -1,0 +1,26 @@
+// testing/orders: one empty message per iteration i with user stamp iteration = offset + i * step,
+// for a stampfilter's order port. Ends after `count` iterations (0: never).
+#include <cstdio>
+
+#include "vrflow/module/module.hpp"
+
+int main() {
+  using namespace vrflow;
+  Module module;
+  auto& out = module.addOutput("out");
+  if (auto status = module.init(); !status) {
+    std::fprintf(stderr, "%s\n", status.error().message.c_str());
+    return 2;
+  }
+  const int64_t step = module.paramInt("step", 1);
+  const int64_t offset = module.paramInt("offset", 0);
+  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
+  while (module.wait()) {
+    const uint64_t it = module.iteration();
+    if (count != 0 && it >= count) break;
+    auto message = module.newMessage();
+    message.builder().addInt64Stamp("iteration", offset + static_cast<int64_t>(it) * step);
+    if (!module.put(out, std::move(message))) break;
+  }
+  return 0;
+}

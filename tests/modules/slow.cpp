@@ -1,0 +1,33 @@
+// testing/slow: a worker. Sleeps `delay-ms` per iteration, then forwards its input by reference
+// (`copy` false: the stamps stay the sender's) or as a new message of its own holding the same
+// chunks (`copy` true: its own stamps, iteration counted from 0).
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+#include "vrflow/module/module.hpp"
+
+int main() {
+  using namespace vrflow;
+  Module module;
+  auto& in = module.addInput("in");
+  auto& out = module.addOutput("out");
+  if (auto status = module.init(); !status) {
+    std::fprintf(stderr, "%s\n", status.error().message.c_str());
+    return 2;
+  }
+  const auto delay = std::chrono::milliseconds(module.paramInt("delay-ms", 1));
+  const bool copy = module.param("copy", "false") == "true";
+  while (module.wait()) {
+    std::this_thread::sleep_for(delay);
+    const Message& received = module.get(in);
+    if (!copy) {
+      if (!module.put(out, received)) break;
+      continue;
+    }
+    auto message = module.newMessage(received->bytes().size() + 256);
+    message.builder().appendChunks(received.view());
+    if (!module.put(out, std::move(message))) break;
+  }
+  return 0;
+}
