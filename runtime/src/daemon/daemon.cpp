@@ -395,7 +395,7 @@ bool Daemon::Impl::pass() {
         // A module that breaks the protocol has a bug: the run stops, naming it.
         std::lock_guard lock(warningsMutex);
         if (fatal.empty()) {
-          fatal = std::string("module '") + slot.id + "' sent " + problem + " on output '" +
+          fatal = "module '" + modules[static_cast<std::size_t>(source.module)].id + "' sent " + problem + " on output '" +
                   outputNames[static_cast<std::size_t>(source.module)][static_cast<std::size_t>(source.port)] +
                   "'";
         }

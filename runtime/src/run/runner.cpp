@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <thread>
@@ -35,6 +36,11 @@ const char* stateName(uint32_t state) {
     case ipc::ModuleState::Finished: return "finished";
   }
   return "?";
+}
+
+// A port's name as the module's memory holds it (bounded: that memory is the module's to write).
+std::string portName(const ipc::PortSlot& port) {
+  return std::string(port.name, strnlen(port.name, sizeof port.name));
 }
 
 // Who feeds an input port, for deadlock reports.
@@ -191,10 +197,10 @@ bool Supervisor::deadlocked(std::string& detail) {
     const auto state = static_cast<ipc::ModuleState>(slot.state.load());
     detail += (detail.empty() ? "" : "; ") + std::string("module '") + module.id + "' ";
     if (port >= 0 && state == ipc::ModuleState::Waiting) {
-      detail += "waits on input '" + std::string(slot.ports[port].name) + "' (" +
-                sourcesOf(application_, module.id, slot.ports[port].name) + ")";
+      const std::string name = portName(slot.ports[port]);
+      detail += "waits on input '" + name + "' (" + sourcesOf(application_, module.id, name) + ")";
     } else if (port >= 0) {
-      detail += "is blocked sending on '" + std::string(slot.ports[port].name) + "'";
+      detail += "is blocked sending on '" + portName(slot.ports[port]) + "'";
     } else {
       detail += stateName(slot.state.load());
     }
