@@ -1,5 +1,7 @@
 #include "vrflow/ipc/segment.hpp"
 
+#include "vrflow/message/ids.hpp"
+
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -167,7 +169,7 @@ bool Segment::validHandle(uint64_t handle) const {
 
 uint64_t Segment::newId() const {
   const uint32_t counter = header_->idCounter.fetch_add(1, std::memory_order_relaxed) + 1;
-  return (uint64_t{header_->hostId} << 32) | counter;
+  return msg::makeId(header_->hostId, counter);
 }
 
 }  // namespace vrflow::ipc

@@ -33,7 +33,7 @@ struct ModuleSlot {
   char id[kNameBytes] = {};
   char host[kNameBytes] = {};
   uint32_t portCount = 0;
-  uint32_t declaredByModule = 0;
+  uint32_t pad = 0;
   PortSlot ports[kMaxPortsPerModule];
   Doorbell bell;                              ///< the daemon rings it when this module may go on
   std::atomic<uint32_t> state{0};             ///< a ModuleState
