@@ -242,6 +242,50 @@ TEST(Validate, StampsOnlyOutputIntoAFullMessageInputIsReported) {
                        "'a.endIt' sends stamps-only messages but 'b.in' expects full messages");
 }
 
+TEST(Validate, StampsOnlyMessagesThroughFiltersIntoAFullMessageInputAreReported) {
+  EXPECT_ONLY_ERROR_AT(check(R"(<application>
+  <modules>
+    <module id="a" package="core" type="relay"/>
+    <module id="b" package="core" type="relay"/>
+  </modules>
+  <filters>
+    <filter id="p" type="passthrough"/>
+    <filter id="q" type="passthrough"/>
+  </filters>
+  <connections>
+    <connection from="a.endIt" to="p.in"/>
+    <connection from="p.out" to="q.in"/>
+    <connection from="q.out" to="b.in"/>
+  </connections>
+</application>
+)"),
+                       13, 5,
+                       "'q.out' sends stamps-only messages (all its inputs are stamps-only) but "
+                       "'b.in' expects full messages");
+}
+
+TEST(Validate, FilterWithAFullInputMayFeedAFullMessageInput) {
+  EXPECT_TRUE(check(R"(<application>
+  <modules>
+    <module id="a" package="core" type="relay">
+      <input port="in" initial-messages="1"/>
+    </module>
+    <module id="b" package="core" type="relay"/>
+  </modules>
+  <filters>
+    <filter id="m" type="merge"/>
+  </filters>
+  <connections>
+    <connection from="a.endIt" to="m.in0"/>
+    <connection from="a.out" to="m.in1"/>
+    <connection from="m.out" to="b.in"/>
+    <connection from="b.out" to="a.in"/>
+  </connections>
+</application>
+)")
+                  .empty());
+}
+
 TEST(Validate, FullMessagesIntoAStampsOnlyInputAreFine) {
   EXPECT_TRUE(check(R"(<application>
   <modules>

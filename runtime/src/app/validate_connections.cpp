@@ -58,32 +58,68 @@ const PortSpec* resolveEnd(Validation& v, const Connection& connection, bool sou
   return port;
 }
 
+// Filters forward whatever reaches them: a filter whose inputs are all fed, directly or through
+// other filters, by stamps-only outputs sends stamps-only messages. Found by a fixpoint.
+std::set<std::string> stampsOnlyFilters(Validation& v) {
+  std::set<std::string> result;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (const NodeInfo& node : v.nodes) {
+      if (node.filter == nullptr || result.count(node.id()) != 0) continue;
+      bool any = false;
+      bool all = true;
+      for (const Connection& c : v.app.connections) {
+        if (c.to.node != node.id()) continue;
+        any = true;
+        const NodeInfo* from = v.find(c.from.node);
+        if (from == nullptr) {
+          all = false;
+        } else if (from->filter != nullptr) {
+          all = all && result.count(from->id()) != 0;
+        } else {
+          const PortSpec* port = findPort(from->ports, c.from.port);
+          all = all && port != nullptr && port->stampsOnly;
+        }
+      }
+      if (any && all) {
+        result.insert(node.id());
+        changed = true;
+      }
+    }
+  }
+  return result;
+}
+
 void checkPortTypes(Validation& v, const Connection& connection, const NodeInfo& fromNode,
-                    const PortSpec& from, const NodeInfo& toNode, const PortSpec& to) {
+                    const PortSpec& from, const NodeInfo& toNode, const PortSpec& to,
+                    const std::set<std::string>& stampsOnly) {
   const std::string fromText = toString(connection.from);
   const std::string toText = toString(connection.to);
   if (from.data != to.data && from.data != kAnyData && to.data != kAnyData) {
     v.error(connection.loc, "port data types differ: '" + fromText + "' sends '" + from.data +
                                 "' but '" + toText + "' expects '" + to.data + "'");
   }
-  // Filters forward whatever reaches them, so their ports take both kinds of message.
-  const bool throughFilter = fromNode.filter != nullptr || toNode.filter != nullptr;
-  if (!throughFilter && from.stampsOnly && !to.stampsOnly) {
-    v.error(connection.loc, "'" + fromText + "' sends stamps-only messages but '" + toText +
-                                "' expects full messages");
+  if (toNode.filter != nullptr || to.stampsOnly) return;  // filter inputs take both kinds
+  const bool sendsStampsOnly =
+      fromNode.filter != nullptr ? stampsOnly.count(fromNode.id()) != 0 : from.stampsOnly;
+  if (sendsStampsOnly) {
+    v.error(connection.loc, "'" + fromText + "' sends stamps-only messages" +
+                                (fromNode.filter != nullptr ? " (all its inputs are stamps-only)" : "") +
+                                " but '" + toText + "' expects full messages");
   }
 }
 
 void checkEachConnection(Validation& v) {
   std::map<std::tuple<std::string, std::string, std::string, std::string>, const SourceLocation*>
       seen;
+  const std::set<std::string> stampsOnly = stampsOnlyFilters(v);
   for (const Connection& connection : v.app.connections) {
     const NodeInfo* fromNode = nullptr;
     const NodeInfo* toNode = nullptr;
     const PortSpec* from = resolveEnd(v, connection, /*source=*/true, &fromNode);
     const PortSpec* to = resolveEnd(v, connection, /*source=*/false, &toNode);
     if (from != nullptr && to != nullptr) {
-      checkPortTypes(v, connection, *fromNode, *from, *toNode, *to);
+      checkPortTypes(v, connection, *fromNode, *from, *toNode, *to, stampsOnly);
     }
     if (connection.capacity < 0) {
       v.error(connection.loc.attribute("capacity"), "capacity must not be negative, got " +
