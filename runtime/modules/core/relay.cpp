@@ -1,5 +1,8 @@
-// core/relay: forwards each message it receives; the bytes are not copied.
+// core/relay: forwards each message it receives; the bytes are not copied. With `delay-ms`
+// > 0 it sleeps that long before forwarding each message (a slow worker, for examples).
+#include <chrono>
 #include <cstdio>
+#include <thread>
 
 #include "vrflow/module/module.hpp"
 
@@ -12,7 +15,9 @@ int main() {
     std::fprintf(stderr, "vrflow-core-relay: %s\n", status.error().message.c_str());
     return 2;
   }
+  const auto delay = std::chrono::milliseconds(module.paramInt("delay-ms", 0));
   while (module.wait()) {
+    if (delay.count() > 0) std::this_thread::sleep_for(delay);
     if (!module.put(out, module.get(in))) break;
   }
   return module.exitStatus();
