@@ -1,7 +1,9 @@
 // testing/mixed: per iteration, `points` point objects, `rigids` rigid objects, one raw
 // resource whose first 8 bytes count iterations, and one force on the first point (or on
-// object 0), in that order; ends after `count` iterations (0: never). For the filters that
-// split or select chunks.
+// object 0), in that order; ends after `count` iterations (0: never). Point k sits at
+// (k, iteration, 0), rigid k at (k, iteration, 1); with `extent` > 0, rigid k carries bounds
+// (k, iteration, 1) +- extent in the first iteration only (later updates have none). For the
+// filters that split or select chunks.
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -22,6 +24,7 @@ int main() {
   std::vector<uint64_t> rigids(static_cast<std::size_t>(module.paramInt("rigids", 2)));
   for (auto& id : points) id = module.newId();
   for (auto& id : rigids) id = module.newId();
+  const double extent = module.paramDouble("extent", 0.0);
   const uint64_t resource = module.newId();
   while (module.wait()) {
     const uint64_t it = module.iteration();
@@ -34,9 +37,14 @@ int main() {
                msg::Vec3{static_cast<double>(k), static_cast<double>(it), 0.0});
     }
     for (std::size_t k = 0; k < rigids.size(); ++k) {
-      builder.addObject(rigids[k], msg::rigidType())
-          .set(msg::RigidParam::kPosition,
-               msg::Vec3{static_cast<double>(k), static_cast<double>(it), 1.0});
+      const msg::Vec3 position{static_cast<double>(k), static_cast<double>(it), 1.0};
+      auto object = builder.addObject(rigids[k], msg::rigidType());
+      object.set(msg::RigidParam::kPosition, position);
+      if (extent > 0 && it == 0) {
+        object.set(msg::RigidParam::kBounds,
+                   msg::Aabb{{position.x - extent, position.y - extent, position.z - extent},
+                             {position.x + extent, position.y + extent, position.z + extent}});
+      }
     }
     std::byte counter[8];
     std::memcpy(counter, &it, sizeof it);

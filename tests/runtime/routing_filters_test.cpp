@@ -222,5 +222,69 @@ TEST_F(RoutingFilters, ScatterByTypeSendsEachListedTypeToItsOutput) {
   EXPECT_EQ(count(only, "object", true), 10u);
 }
 
+// Points at x = 0, 1, 2; rigid k at x = k with bounds x +- 0.75 in the first message only, so
+// rigid 0 meets the slabs below 0.5 and [0.5, 1.5), rigid 1 all three; later updates carry no
+// bounds and follow the latest known ones.
+TEST_F(RoutingFilters, ScatterByBoundsSendsObjectsToEverySlabTheirBoundsMeet) {
+  run(appXml(moduleXml("mix", "testing/mixed",
+                       paramXml("points", "3") + paramXml("rigids", "2") +
+                           paramXml("count", "5") + paramXml("extent", "0.75")) +
+                 recorder("a", "a.csv") + recorder("b", "b.csv") + recorder("c", "c.csv") +
+                 recorder("low", "low.csv") + recorder("high", "high.csv"),
+             filterXml("s", "scatter",
+                       paramXml("outputs", "3") + paramXml("by", "bounds") +
+                           paramXml("axis", "x") + paramXml("cuts", "0.5, 1.5")) +
+                 filterXml("d", "scatter",
+                           paramXml("by", "bounds") + paramXml("cuts", "1.5") +
+                               paramXml("others", "drop")),
+             connectXml("mix.out", "s.in") + connectXml("s.out0", "a.in") +
+                 connectXml("s.out1", "b.in") + connectXml("s.out2", "c.in") +
+                 connectXml("mix.out", "d.in") + connectXml("d.out0", "low.in") +
+                 connectXml("d.out1", "high.in")));
+  struct Seen {
+    std::multiset<double> pointXs;
+    std::map<std::string, std::size_t> rigids;  // id -> chunks
+    std::size_t resources = 0, events = 0;
+    std::set<long> iterations;
+  };
+  const auto seen = [&](const std::string& csv) {
+    Seen result;
+    for (const auto& row : readRecording(dir.file(csv))) {
+      result.iterations.insert(row.sourceIteration);
+      if (row.kind == "object" && !row.x.empty()) result.pointXs.insert(std::stod(row.x));
+      if (row.kind == "object" && row.x.empty()) ++result.rigids[row.id];
+      result.resources += row.kind == "resource";
+      result.events += row.kind == "event";
+    }
+    return result;
+  };
+  const Seen a = seen("a.csv"), b = seen("b.csv"), c = seen("c.csv");
+  const Seen low = seen("low.csv"), high = seen("high.csv");
+  EXPECT_EQ(a.pointXs, (std::multiset<double>{0, 0, 0, 0, 0}));
+  EXPECT_EQ(b.pointXs, (std::multiset<double>{1, 1, 1, 1, 1}));
+  EXPECT_EQ(c.pointXs, (std::multiset<double>{2, 2, 2, 2, 2}));
+  // Both rigids meet out0 and out1 in every message (latest bounds); only rigid 1 meets out2.
+  ASSERT_EQ(a.rigids.size(), 2u);
+  EXPECT_EQ(b.rigids, a.rigids);
+  ASSERT_EQ(c.rigids.size(), 1u);
+  for (const auto& [id, chunks] : a.rigids) EXPECT_EQ(chunks, 5u) << id;
+  EXPECT_EQ(c.rigids.begin()->second, 5u);
+  EXPECT_TRUE(a.rigids.count(c.rigids.begin()->first));
+  for (const Seen* out : {&a, &b, &c}) {  // others=all: resources and events to every output
+    EXPECT_EQ(out->resources, 5u);
+    EXPECT_EQ(out->events, 5u);
+    EXPECT_EQ(out->iterations.size(), 5u);
+  }
+  // others=drop, one cut at 1.5: points 0 and 1 and both rigids low; point 2 and rigid 1 high.
+  EXPECT_EQ(low.pointXs, (std::multiset<double>{0, 0, 0, 0, 0, 1, 1, 1, 1, 1}));
+  EXPECT_EQ(high.pointXs, (std::multiset<double>{2, 2, 2, 2, 2}));
+  EXPECT_EQ(low.rigids, a.rigids);
+  EXPECT_EQ(high.rigids, c.rigids);
+  for (const Seen* out : {&low, &high}) {
+    EXPECT_EQ(out->resources, 0u);
+    EXPECT_EQ(out->events, 0u);
+  }
+}
+
 }  // namespace
 }  // namespace vrflow::testing
