@@ -3,8 +3,10 @@
 // object 0), in that order; ends after `count` iterations (0: never). Point k sits at
 // (k, iteration, 0), rigid k at (k, iteration, 1); with `extent` > 0, rigid k carries bounds
 // (k, iteration, 1) +- extent in the first iteration only (later updates have none). For the
-// filters that split or select chunks.
+// filters that split or select chunks. With `payload` > 8, the raw resource holds `payload`
+// bytes: the counter, then byte i = (7 i + iteration) mod 256.
 #include <cstdio>
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -25,11 +27,12 @@ int main() {
   for (auto& id : points) id = module.newId();
   for (auto& id : rigids) id = module.newId();
   const double extent = module.paramDouble("extent", 0.0);
+  const auto payload = static_cast<std::size_t>(std::max<int64_t>(8, module.paramInt("payload", 8)));
   const uint64_t resource = module.newId();
   while (module.wait()) {
     const uint64_t it = module.iteration();
     if (count != 0 && it >= count) break;
-    auto message = module.newMessage(1024);
+    auto message = module.newMessage(1024 + payload);
     auto& builder = message.builder();
     for (std::size_t k = 0; k < points.size(); ++k) {
       builder.addObject(points[k], msg::pointType())
@@ -42,12 +45,13 @@ int main() {
       object.set(msg::RigidParam::kPosition, position);
       if (extent > 0 && it == 0) {
         object.set(msg::RigidParam::kBounds,
-                   msg::Aabb{{position.x - extent, position.y - extent, position.z - extent},
-                             {position.x + extent, position.y + extent, position.z + extent}});
+                   msg::Aabb{{position[0] - extent, position[1] - extent, position[2] - extent},
+                             {position[0] + extent, position[1] + extent, position[2] + extent}});
       }
     }
-    std::byte counter[8];
-    std::memcpy(counter, &it, sizeof it);
+    std::vector<std::byte> counter(payload);
+    std::memcpy(counter.data(), &it, sizeof it);
+    for (std::size_t i = 8; i < payload; ++i) counter[i] = static_cast<std::byte>((7 * i + it) & 0xff);
     builder.addRawResource(resource, true, counter);
     builder.addForce(points.empty() ? 0 : points.front(),
                      msg::ForceEvent{{0, 1, 0}, {0, 0, 0}, {0, 0, 0}, 0.01});

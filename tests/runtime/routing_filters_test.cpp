@@ -286,5 +286,52 @@ TEST_F(RoutingFilters, ScatterByBoundsSendsObjectsToEverySlabTheirBoundsMeet) {
   }
 }
 
+// 100 bytes of 8-byte elements in 3 parts: 12 elements as 4 + 4 + 4, the 4 bytes left over in
+// the last part; each part prefixed by its offset and the total size.
+TEST_F(RoutingFilters, ScatterBySizeThenGatherRebuildsTheOriginalBytes) {
+  run(appXml(moduleXml("mix", "testing/mixed",
+                       paramXml("points", "2") + paramXml("rigids", "1") +
+                           paramXml("count", "6") + paramXml("payload", "100")) +
+                 recorder("joined", "joined.csv") + recorder("first", "first.csv") +
+                 moduleXml("check", "testing/rebuild", paramXml("file", dir.file("rebuild.csv"))),
+             filterXml("s", "scatter",
+                       paramXml("outputs", "3") + paramXml("by", "size") +
+                           paramXml("element-size", "8") + paramXml("others", "drop")) +
+                 filterXml("g", "gather", paramXml("inputs", "3")) +
+                 filterXml("a", "scatter",
+                           paramXml("outputs", "2") + paramXml("by", "size") +
+                               paramXml("element-size", "8")),
+             connectXml("mix.out", "s.in") + connectXml("s.out0", "g.in0") +
+                 connectXml("s.out1", "g.in1") + connectXml("s.out2", "g.in2") +
+                 connectXml("g.out", "joined.in") + connectXml("g.out", "check.in") +
+                 connectXml("mix.out", "a.in") + connectXml("a.out0", "first.in")));
+  const auto joined = readRecording(dir.file("joined.csv"));
+  ASSERT_EQ(joined.size(), 6u * 3u) << "three resource parts per message, nothing else";
+  for (std::size_t i = 0; i < joined.size(); ++i) {
+    EXPECT_EQ(joined[i].kind, "resource");
+    EXPECT_EQ(joined[i].sourceIteration, static_cast<long>(i / 3));
+    EXPECT_EQ(joined[i].x, std::to_string(std::vector<int>{0, 32, 64}[i % 3])) << "offset";
+    EXPECT_EQ(joined[i].y, std::to_string(std::vector<int>{48, 48, 52}[i % 3])) << "size";
+  }
+  const std::string rebuilt = readFile(dir.file("rebuild.csv"));
+  std::string expected = "iteration,parts,total,ok\n";
+  for (int it = 0; it < 6; ++it) expected += std::to_string(it) + ",3,100,ok\n";
+  EXPECT_EQ(rebuilt, expected);
+  // others=all: objects and events go with every part; 100 bytes = 12 elements, 6 + 6 + 4.
+  std::size_t objects = 0, events = 0, resources = 0;
+  for (const auto& row : readRecording(dir.file("first.csv"))) {
+    objects += row.kind == "object";
+    events += row.kind == "event";
+    if (row.kind == "resource") {
+      ++resources;
+      EXPECT_EQ(row.x, "0");
+      EXPECT_EQ(row.y, "64");
+    }
+  }
+  EXPECT_EQ(objects, 6u * 3u);
+  EXPECT_EQ(events, 6u);
+  EXPECT_EQ(resources, 6u);
+}
+
 }  // namespace
 }  // namespace vrflow::testing

@@ -93,9 +93,13 @@ FilterType scatter() {
       "near-equal count; `id`: chunk to out{splitmix64(id) mod N}; `type`: objects of the "
       "k-th name of `types` to out{k}, other chunks by `others`; `bounds`: objects to every "
       "slab of `axis` cut at `cuts` that their bounds (a point: its position) meet, an object "
-      "without bounds in a message where its latest bounds sent it, other chunks by `others`.";
+      "without bounds in a message where its latest bounds sent it, other chunks by `others`; "
+      "`size`: every raw resource cut into N parts of whole `element-size` elements, each a "
+      "raw resource of the same id prefixed by its u64 offset and u64 total size.";
   type.params.push_back(intParam("outputs", "2", 1, kMaxPorts, "number of outputs N"));
-  type.params.push_back(enumParam("by", {"chunk", "id", "type", "bounds"}, "how chunks are split"));
+  type.params.push_back(enumParam("by", {"chunk", "id", "type", "bounds", "size"}, "how chunks are split"));
+  type.params.push_back(intParam("element-size", "1", 1, 1 << 30,
+                                 "by=size: bytes per element; parts hold whole elements"));
   type.params.push_back(
       stringParam("types", "", "by=type: N object type names, comma-separated, one per output"));
   type.params.push_back(
@@ -105,8 +109,8 @@ FilterType scatter() {
       "by=bounds: N-1 strictly increasing numbers, comma-separated; out{k} is the slab "
       "[cut{k-1}, cut{k}), out0 unbounded below, out{N-1} unbounded above"));
   type.params.push_back(enumParam("others", {"all", "drop"},
-                                  "by=type, by=bounds: chunks that are no object of a listed type go to "
-                                  "every output (all) or nowhere (drop)"));
+                                  "chunks not split by type, bounds or size (by=type, bounds, "
+                                  "size) go to every output (all) or nowhere (drop)"));
   type.ports = [](const std::vector<Param>& params) {
     std::vector<PortSpec> ports{filterPort("in", true, "messages to split")};
     for (auto& port : numberedPorts("out", portCount(params, "outputs", 2), false,

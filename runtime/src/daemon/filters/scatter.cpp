@@ -20,7 +20,10 @@ namespace {
 constexpr uint32_t kEveryOutput = UINT32_MAX;
 constexpr uint32_t kNoOutput = UINT32_MAX - 1;
 
-enum class SplitBy { Chunk, Id, Type, Bounds };
+enum class SplitBy { Chunk, Id, Type, Bounds, Size };
+
+// by=size: the header in front of each part's bytes (docs/filters.md).
+constexpr std::size_t kPartHeaderSize = 16;
 
 // The finalizer of splitmix64: spreads consecutive ids (a host's counter) evenly.
 uint64_t mixId(uint64_t id) {
@@ -33,8 +36,9 @@ uint64_t mixId(uint64_t id) {
 class ScatterFilter final : public Filter {
  public:
   ScatterFilter(SplitBy by, std::vector<uint32_t> typeIds, bool othersToAll, int axis = 0,
-                std::vector<double> cuts = {})
+                std::vector<double> cuts = {}, uint64_t elementSize = 1)
       : by_(by),
+        elementSize_(elementSize == 0 ? 1 : elementSize),
         typeIds_(std::move(typeIds)),
         othersToAll_(othersToAll),
         axis_(axis),
@@ -87,7 +91,7 @@ class ScatterFilter final : public Filter {
     return std::nullopt;
   }
 
-  double axisOf(const msg::Vec3& v) const { return axis_ == 0 ? v.x : axis_ == 1 ? v.y : v.z; }
+  double axisOf(const msg::Vec3& v) const { return v[static_cast<std::size_t>(axis_)]; }
 
   // by=bounds: the outputs [first, last] an object chunk goes to; updates the latest bounds.
   std::pair<uint32_t, uint32_t> boundsTargets(const msg::ChunkView& chunk, uint32_t n) {
@@ -133,6 +137,7 @@ class ScatterFilter final : public Filter {
         }
         return othersToAll_ ? kEveryOutput : kNoOutput;
       case SplitBy::Bounds:
+      case SplitBy::Size:
         break;
     }
     return kNoOutput;
@@ -140,6 +145,10 @@ class ScatterFilter final : public Filter {
 
   void split(FilterContext& context, const MessageRef& message, const msg::MessageView& view) {
     const auto n = static_cast<uint32_t>(context.outputCount());
+    if (by_ == SplitBy::Size) {
+      splitBySize(context, message, view);
+      return;
+    }
     if (n == 1 && by_ != SplitBy::Type && by_ != SplitBy::Bounds) {
       context.emit(0, message);
       return;
@@ -186,7 +195,49 @@ class ScatterFilter final : public Filter {
     }
   }
 
+  // by=size: every raw resource cut into N parts of whole elements, each a raw resource with
+  // the same id whose bytes are a header (u64 offset, u64 total size, little-endian) and the
+  // part; other chunks follow `others`.
+  void splitBySize(FilterContext& context, const MessageRef& message,
+                   const msg::MessageView& view) {
+    const auto n = static_cast<uint32_t>(context.outputCount());
+    const msg::Stamps stamps = view.stamps().toStamps();
+    for (uint32_t o = 0; o < n; ++o) {
+      auto part = context.compose(message.size() + n * (msg::kChunkHeaderSize + kPartHeaderSize + 8),
+                                  [&](msg::MessageBuilder& builder) {
+        builder.setStamps(stamps);
+        builder.setStampsOnly(view.stampsOnly());
+        for (const msg::ChunkView chunk : view) {
+          const auto resource = chunk.asResource();
+          if (!resource || resource->kind() != msg::ResourceKind::Raw) {
+            if (othersToAll_) builder.appendChunk(chunk);
+            continue;
+          }
+          const auto bytes = resource->raw();
+          const uint64_t total = bytes.size(), elements = total / elementSize_;
+          const uint64_t first = elements * o / n * elementSize_;
+          const uint64_t last = o + 1 == n ? total : elements * (o + 1) / n * elementSize_;
+          std::vector<std::byte> body(kPartHeaderSize + (last - first));
+          for (int b = 0; b < 8; ++b) {
+            body[b] = static_cast<std::byte>((first >> (8 * b)) & 0xff);
+            body[8 + b] = static_cast<std::byte>((total >> (8 * b)) & 0xff);
+          }
+          std::copy(bytes.begin() + static_cast<std::ptrdiff_t>(first),
+                    bytes.begin() + static_cast<std::ptrdiff_t>(last),
+                    body.begin() + kPartHeaderSize);
+          builder.addRawResource(resource->id(), resource->dynamic(), body);
+        }
+      });
+      if (!part) {
+        context.warn(part.error().message);
+        continue;
+      }
+      context.emit(o, std::move(*part));
+    }
+  }
+
   SplitBy by_;
+  uint64_t elementSize_;
   std::vector<uint32_t> typeIds_;
   bool othersToAll_;
   int axis_;
@@ -204,6 +255,7 @@ void registerScatter(FilterRegistry& registry) {
     const SplitBy split = by == "id"       ? SplitBy::Id
                           : by == "type"   ? SplitBy::Type
                           : by == "bounds" ? SplitBy::Bounds
+                          : by == "size"   ? SplitBy::Size
                                            : SplitBy::Chunk;
     std::vector<uint32_t> typeIds;
     for (const auto& name : app::splitList(context.param("types", ""))) {
@@ -229,7 +281,8 @@ void registerScatter(FilterRegistry& registry) {
     }
     return std::unique_ptr<Filter>(std::make_unique<ScatterFilter>(
         split, std::move(typeIds), context.param("others", "all") != "drop", axis,
-        std::move(cuts)));
+        std::move(cuts),
+        static_cast<uint64_t>(std::strtoull(context.param("element-size", "1").c_str(), nullptr, 10))));
   });
 }
 
