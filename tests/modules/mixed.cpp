@@ -5,8 +5,8 @@
 // (k, iteration, 1) +- extent in the first iteration only (later updates have none). For the
 // filters that split or select chunks. With `payload` > 8, the raw resource holds `payload`
 // bytes: the counter, then byte i = (7 i + iteration) mod 256.
-#include <cstdio>
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -27,7 +27,8 @@ int main() {
   for (auto& id : points) id = module.newId();
   for (auto& id : rigids) id = module.newId();
   const double extent = module.paramDouble("extent", 0.0);
-  const auto payload = static_cast<std::size_t>(std::max<int64_t>(8, module.paramInt("payload", 8)));
+  const auto payload =
+      static_cast<std::size_t>(std::max<int64_t>(8, module.paramInt("payload", 8)));
   const uint64_t resource = module.newId();
   while (module.wait()) {
     const uint64_t it = module.iteration();
@@ -51,7 +52,8 @@ int main() {
     }
     std::vector<std::byte> counter(payload);
     std::memcpy(counter.data(), &it, sizeof it);
-    for (std::size_t i = 8; i < payload; ++i) counter[i] = static_cast<std::byte>((7 * i + it) & 0xff);
+    for (std::size_t i = 8; i < payload; ++i)
+      counter[i] = static_cast<std::byte>((7 * i + it) & 0xff);
     builder.addRawResource(resource, true, counter);
     builder.addForce(points.empty() ? 0 : points.front(),
                      msg::ForceEvent{{0, 1, 0}, {0, 0, 0}, {0, 0, 0}, 0.01});

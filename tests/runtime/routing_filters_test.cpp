@@ -226,21 +226,21 @@ TEST_F(RoutingFilters, ScatterByTypeSendsEachListedTypeToItsOutput) {
 // rigid 0 meets the slabs below 0.5 and [0.5, 1.5), rigid 1 all three; later updates carry no
 // bounds and follow the latest known ones.
 TEST_F(RoutingFilters, ScatterByBoundsSendsObjectsToEverySlabTheirBoundsMeet) {
-  run(appXml(moduleXml("mix", "testing/mixed",
-                       paramXml("points", "3") + paramXml("rigids", "2") +
-                           paramXml("count", "5") + paramXml("extent", "0.75")) +
-                 recorder("a", "a.csv") + recorder("b", "b.csv") + recorder("c", "c.csv") +
-                 recorder("low", "low.csv") + recorder("high", "high.csv"),
-             filterXml("s", "scatter",
-                       paramXml("outputs", "3") + paramXml("by", "bounds") +
-                           paramXml("axis", "x") + paramXml("cuts", "0.5, 1.5")) +
-                 filterXml("d", "scatter",
-                           paramXml("by", "bounds") + paramXml("cuts", "1.5") +
-                               paramXml("others", "drop")),
-             connectXml("mix.out", "s.in") + connectXml("s.out0", "a.in") +
-                 connectXml("s.out1", "b.in") + connectXml("s.out2", "c.in") +
-                 connectXml("mix.out", "d.in") + connectXml("d.out0", "low.in") +
-                 connectXml("d.out1", "high.in")));
+  run(appXml(
+      moduleXml("mix", "testing/mixed",
+                paramXml("points", "3") + paramXml("rigids", "2") + paramXml("count", "5") +
+                    paramXml("extent", "0.75")) +
+          recorder("a", "a.csv") + recorder("b", "b.csv") + recorder("c", "c.csv") +
+          recorder("low", "low.csv") + recorder("high", "high.csv"),
+      filterXml("s", "scatter",
+                paramXml("outputs", "3") + paramXml("by", "bounds") + paramXml("axis", "x") +
+                    paramXml("cuts", "0.5, 1.5")) +
+          filterXml(
+              "d", "scatter",
+              paramXml("by", "bounds") + paramXml("cuts", "1.5") + paramXml("others", "drop")),
+      connectXml("mix.out", "s.in") + connectXml("s.out0", "a.in") + connectXml("s.out1", "b.in") +
+          connectXml("s.out2", "c.in") + connectXml("mix.out", "d.in") +
+          connectXml("d.out0", "low.in") + connectXml("d.out1", "high.in")));
   struct Seen {
     std::multiset<double> pointXs;
     std::map<std::string, std::size_t> rigids;  // id -> chunks
@@ -290,8 +290,8 @@ TEST_F(RoutingFilters, ScatterByBoundsSendsObjectsToEverySlabTheirBoundsMeet) {
 // the last part; each part prefixed by its offset and the total size.
 TEST_F(RoutingFilters, ScatterBySizeThenGatherRebuildsTheOriginalBytes) {
   run(appXml(moduleXml("mix", "testing/mixed",
-                       paramXml("points", "2") + paramXml("rigids", "1") +
-                           paramXml("count", "6") + paramXml("payload", "100")) +
+                       paramXml("points", "2") + paramXml("rigids", "1") + paramXml("count", "6") +
+                           paramXml("payload", "100")) +
                  recorder("joined", "joined.csv") + recorder("first", "first.csv") +
                  moduleXml("check", "testing/rebuild", paramXml("file", dir.file("rebuild.csv"))),
              filterXml("s", "scatter",

@@ -97,17 +97,18 @@ FilterType scatter() {
       "`size`: every raw resource cut into N parts of whole `element-size` elements, each a "
       "raw resource of the same id prefixed by its u64 offset and u64 total size.";
   type.params.push_back(intParam("outputs", "2", 1, kMaxPorts, "number of outputs N"));
-  type.params.push_back(enumParam("by", {"chunk", "id", "type", "bounds", "size"}, "how chunks are split"));
+  type.params.push_back(
+      enumParam("by", {"chunk", "id", "type", "bounds", "size"}, "how chunks are split"));
   type.params.push_back(intParam("element-size", "1", 1, 1 << 30,
                                  "by=size: bytes per element; parts hold whole elements"));
   type.params.push_back(
       stringParam("types", "", "by=type: N object type names, comma-separated, one per output"));
   type.params.push_back(
       enumParam("axis", {"x", "y", "z"}, "by=bounds: the axis the cuts are taken along"));
-  type.params.push_back(stringParam(
-      "cuts", "",
-      "by=bounds: N-1 strictly increasing numbers, comma-separated; out{k} is the slab "
-      "[cut{k-1}, cut{k}), out0 unbounded below, out{N-1} unbounded above"));
+  type.params.push_back(
+      stringParam("cuts", "",
+                  "by=bounds: N-1 strictly increasing numbers, comma-separated; out{k} is the slab "
+                  "[cut{k-1}, cut{k}), out0 unbounded below, out{N-1} unbounded above"));
   type.params.push_back(enumParam("others", {"all", "drop"},
                                   "chunks not split by type, bounds or size (by=type, bounds, "
                                   "size) go to every output (all) or nowhere (drop)"));

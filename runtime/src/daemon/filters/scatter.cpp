@@ -95,8 +95,9 @@ class ScatterFilter final : public Filter {
 
   // by=bounds: the outputs [first, last] an object chunk goes to; updates the latest bounds.
   std::pair<uint32_t, uint32_t> boundsTargets(const msg::ChunkView& chunk, uint32_t n) {
-    const std::pair<uint32_t, uint32_t> others =
-        othersToAll_ ? std::pair<uint32_t, uint32_t>{0, n - 1} : std::pair<uint32_t, uint32_t>{1, 0};
+    const std::pair<uint32_t, uint32_t> others = othersToAll_
+                                                     ? std::pair<uint32_t, uint32_t>{0, n - 1}
+                                                     : std::pair<uint32_t, uint32_t>{1, 0};
     if (chunk.kind() != msg::ChunkKind::Object) return others;
     const auto object = chunk.asObject();
     if (!object) return others;
@@ -203,31 +204,32 @@ class ScatterFilter final : public Filter {
     const auto n = static_cast<uint32_t>(context.outputCount());
     const msg::Stamps stamps = view.stamps().toStamps();
     for (uint32_t o = 0; o < n; ++o) {
-      auto part = context.compose(message.size() + n * (msg::kChunkHeaderSize + kPartHeaderSize + 8),
-                                  [&](msg::MessageBuilder& builder) {
-        builder.setStamps(stamps);
-        builder.setStampsOnly(view.stampsOnly());
-        for (const msg::ChunkView chunk : view) {
-          const auto resource = chunk.asResource();
-          if (!resource || resource->kind() != msg::ResourceKind::Raw) {
-            if (othersToAll_) builder.appendChunk(chunk);
-            continue;
-          }
-          const auto bytes = resource->raw();
-          const uint64_t total = bytes.size(), elements = total / elementSize_;
-          const uint64_t first = elements * o / n * elementSize_;
-          const uint64_t last = o + 1 == n ? total : elements * (o + 1) / n * elementSize_;
-          std::vector<std::byte> body(kPartHeaderSize + (last - first));
-          for (int b = 0; b < 8; ++b) {
-            body[b] = static_cast<std::byte>((first >> (8 * b)) & 0xff);
-            body[8 + b] = static_cast<std::byte>((total >> (8 * b)) & 0xff);
-          }
-          std::copy(bytes.begin() + static_cast<std::ptrdiff_t>(first),
-                    bytes.begin() + static_cast<std::ptrdiff_t>(last),
-                    body.begin() + kPartHeaderSize);
-          builder.addRawResource(resource->id(), resource->dynamic(), body);
-        }
-      });
+      auto part = context.compose(
+          message.size() + n * (msg::kChunkHeaderSize + kPartHeaderSize + 8),
+          [&](msg::MessageBuilder& builder) {
+            builder.setStamps(stamps);
+            builder.setStampsOnly(view.stampsOnly());
+            for (const msg::ChunkView chunk : view) {
+              const auto resource = chunk.asResource();
+              if (!resource || resource->kind() != msg::ResourceKind::Raw) {
+                if (othersToAll_) builder.appendChunk(chunk);
+                continue;
+              }
+              const auto bytes = resource->raw();
+              const uint64_t total = bytes.size(), elements = total / elementSize_;
+              const uint64_t first = elements * o / n * elementSize_;
+              const uint64_t last = o + 1 == n ? total : elements * (o + 1) / n * elementSize_;
+              std::vector<std::byte> body(kPartHeaderSize + (last - first));
+              for (int b = 0; b < 8; ++b) {
+                body[b] = static_cast<std::byte>((first >> (8 * b)) & 0xff);
+                body[8 + b] = static_cast<std::byte>((total >> (8 * b)) & 0xff);
+              }
+              std::copy(bytes.begin() + static_cast<std::ptrdiff_t>(first),
+                        bytes.begin() + static_cast<std::ptrdiff_t>(last),
+                        body.begin() + kPartHeaderSize);
+              builder.addRawResource(resource->id(), resource->dynamic(), body);
+            }
+          });
       if (!part) {
         context.warn(part.error().message);
         continue;
@@ -280,9 +282,9 @@ void registerScatter(FilterRegistry& registry) {
       return makeError("filter '" + context.name() + "': by=bounds needs N-1 cuts for N outputs");
     }
     return std::unique_ptr<Filter>(std::make_unique<ScatterFilter>(
-        split, std::move(typeIds), context.param("others", "all") != "drop", axis,
-        std::move(cuts),
-        static_cast<uint64_t>(std::strtoull(context.param("element-size", "1").c_str(), nullptr, 10))));
+        split, std::move(typeIds), context.param("others", "all") != "drop", axis, std::move(cuts),
+        static_cast<uint64_t>(
+            std::strtoull(context.param("element-size", "1").c_str(), nullptr, 10))));
   });
 }
 
