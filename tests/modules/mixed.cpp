@@ -1,9 +1,10 @@
 // testing/mixed: per iteration, `points` point objects, `rigids` rigid objects, one raw
 // resource whose first 8 bytes count iterations, and one force on the first point (or on
-// object 0), in that order; ends after `count` iterations (0: never). Point k sits at
-// (k, iteration, 0), rigid k at (k, iteration, 1); with `extent` > 0, rigid k carries bounds
-// (k, iteration, 1) +- extent in the first iteration only (later updates have none). For the
-// filters that split or select chunks. With `payload` > 8, the raw resource holds `payload`
+// object 0), in that order; ends after `count` iterations (0: never). For the filters that
+// split or select chunks. Point k sits at (k, iteration, 0), rigid k at (k, iteration, 1).
+// With `extent` > 0, rigid k carries bounds (k, iteration, 1) +- extent in the first
+// iteration only (later updates have none). With `delete-at` > 0, the rigids are deleted at
+// that iteration and sent no more. With `payload` > 8, the raw resource holds `payload`
 // bytes: the counter, then byte i = (7 i + iteration) mod 256.
 #include <algorithm>
 #include <cstdio>
@@ -27,6 +28,7 @@ int main() {
   for (auto& id : points) id = module.newId();
   for (auto& id : rigids) id = module.newId();
   const double extent = module.paramDouble("extent", 0.0);
+  const auto deleteAt = static_cast<uint64_t>(module.paramInt("delete-at", 0));
   const auto payload =
       static_cast<std::size_t>(std::max<int64_t>(8, module.paramInt("payload", 8)));
   const uint64_t resource = module.newId();
@@ -40,7 +42,11 @@ int main() {
           .set(msg::PointParam::kPosition,
                msg::Vec3{static_cast<double>(k), static_cast<double>(it), 0.0});
     }
-    for (std::size_t k = 0; k < rigids.size(); ++k) {
+    for (std::size_t k = 0; k < rigids.size() && (deleteAt == 0 || it <= deleteAt); ++k) {
+      if (deleteAt != 0 && it == deleteAt) {
+        builder.addDelete(rigids[k], msg::rigidType());
+        continue;
+      }
       const msg::Vec3 position{static_cast<double>(k), static_cast<double>(it), 1.0};
       auto object = builder.addObject(rigids[k], msg::rigidType());
       object.set(msg::RigidParam::kPosition, position);

@@ -224,7 +224,7 @@ TEST_F(RoutingFilters, ScatterByTypeSendsEachListedTypeToItsOutput) {
 
 // Points at x = 0, 1, 2; rigid k at x = k with bounds x +- 0.75 in the first message only, so
 // rigid 0 meets the slabs below 0.5 and [0.5, 1.5), rigid 1 all three; later updates carry no
-// bounds and follow the latest known ones.
+// bounds and follow the latest known ones, and so do the deletes of the rigids in the last one.
 TEST_F(RoutingFilters, ScatterByBoundsSendsObjectsToEverySlabTheirBoundsMeet) {
   run(appXml(
       moduleXml("mix", "testing/mixed",
