@@ -512,6 +512,54 @@ TEST(Validate, ParametersThatMustAgreeAreCheckedTogether) {
       << found[1].message;
 }
 
+TEST(Validate, ScatterByBoundsNeedsOneCutFewerThanOutputsIncreasing) {
+  const std::vector<Diagnostic> found = check(R"(<application>
+  <modules>
+    <module id="a" package="core" type="source"/>
+    <module id="b" package="core" type="sink"/>
+  </modules>
+  <filters>
+    <filter id="n" type="scatter">
+      <param name="by" value="bounds"/><param name="outputs" value="3"/><param name="cuts" value="1"/>
+    </filter>
+    <filter id="d" type="scatter">
+      <param name="by" value="bounds"/><param name="outputs" value="3"/><param name="cuts" value="2,1"/>
+    </filter>
+    <filter id="w" type="scatter">
+      <param name="by" value="bounds"/><param name="cuts" value="wide"/>
+    </filter>
+    <filter id="c" type="scatter">
+      <param name="cuts" value="1"/>
+    </filter>
+    <filter id="ok" type="scatter">
+      <param name="by" value="bounds"/><param name="outputs" value="3"/><param name="axis" value="z"/>
+      <param name="cuts" value="-1.5, 2"/>
+    </filter>
+  </filters>
+  <connections>
+    <connection from="a.out" to="n.in"/>
+    <connection from="n.out0" to="b.in"/>
+    <connection from="a.out" to="d.in"/>
+    <connection from="d.out0" to="b.in"/>
+    <connection from="a.out" to="w.in"/>
+    <connection from="w.out0" to="b.in"/>
+    <connection from="a.out" to="c.in"/>
+    <connection from="c.out0" to="b.in"/>
+    <connection from="a.out" to="ok.in"/>
+    <connection from="ok.out0" to="b.in"/>
+  </connections>
+</application>
+)");
+  ASSERT_EQ(found.size(), 4u) << formatDiagnostics(found);
+  EXPECT_EQ(found[0].message,
+            "filter 'n' (scatter): by=\"bounds\" needs N-1 numbers in 'cuts' for N outputs: 3 "
+            "outputs, 1 cuts");
+  EXPECT_EQ(found[1].message, "filter 'd' (scatter): 'cuts' must be strictly increasing");
+  EXPECT_EQ(found[2].message, "filter 'w' (scatter): 'cuts': 'wide' is not a finite number");
+  EXPECT_EQ(found[3].message,
+            "filter 'c' (scatter): parameter 'cuts' applies only with by=\"bounds\"");
+}
+
 TEST(Validate, NegativeCapacityIsReportedAtTheAttribute) {
   EXPECT_ONLY_ERROR_AT(check(R"(<application>
   <modules>

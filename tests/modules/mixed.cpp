@@ -1,7 +1,12 @@
 // testing/mixed: per iteration, `points` point objects, `rigids` rigid objects, one raw
 // resource whose first 8 bytes count iterations, and one force on the first point (or on
 // object 0), in that order; ends after `count` iterations (0: never). For the filters that
-// split or select chunks.
+// split or select chunks. Point k sits at (k, iteration, 0), rigid k at (k, iteration, 1).
+// With `extent` > 0, rigid k carries bounds (k, iteration, 1) +- extent in the first
+// iteration only (later updates have none). With `delete-at` > 0, the rigids are deleted at
+// that iteration and sent no more. With `payload` > 8, the raw resource holds `payload`
+// bytes: the counter, then byte i = (7 i + iteration) mod 256.
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -22,24 +27,39 @@ int main() {
   std::vector<uint64_t> rigids(static_cast<std::size_t>(module.paramInt("rigids", 2)));
   for (auto& id : points) id = module.newId();
   for (auto& id : rigids) id = module.newId();
+  const double extent = module.paramDouble("extent", 0.0);
+  const auto deleteAt = static_cast<uint64_t>(module.paramInt("delete-at", 0));
+  const auto payload =
+      static_cast<std::size_t>(std::max<int64_t>(8, module.paramInt("payload", 8)));
   const uint64_t resource = module.newId();
   while (module.wait()) {
     const uint64_t it = module.iteration();
     if (count != 0 && it >= count) break;
-    auto message = module.newMessage(1024);
+    auto message = module.newMessage(1024 + payload);
     auto& builder = message.builder();
     for (std::size_t k = 0; k < points.size(); ++k) {
       builder.addObject(points[k], msg::pointType())
           .set(msg::PointParam::kPosition,
                msg::Vec3{static_cast<double>(k), static_cast<double>(it), 0.0});
     }
-    for (std::size_t k = 0; k < rigids.size(); ++k) {
-      builder.addObject(rigids[k], msg::rigidType())
-          .set(msg::RigidParam::kPosition,
-               msg::Vec3{static_cast<double>(k), static_cast<double>(it), 1.0});
+    for (std::size_t k = 0; k < rigids.size() && (deleteAt == 0 || it <= deleteAt); ++k) {
+      if (deleteAt != 0 && it == deleteAt) {
+        builder.addDelete(rigids[k], msg::rigidType());
+        continue;
+      }
+      const msg::Vec3 position{static_cast<double>(k), static_cast<double>(it), 1.0};
+      auto object = builder.addObject(rigids[k], msg::rigidType());
+      object.set(msg::RigidParam::kPosition, position);
+      if (extent > 0 && it == 0) {
+        object.set(msg::RigidParam::kBounds,
+                   msg::Aabb{{position[0] - extent, position[1] - extent, position[2] - extent},
+                             {position[0] + extent, position[1] + extent, position[2] + extent}});
+      }
     }
-    std::byte counter[8];
-    std::memcpy(counter, &it, sizeof it);
+    std::vector<std::byte> counter(payload);
+    std::memcpy(counter.data(), &it, sizeof it);
+    for (std::size_t i = 8; i < payload; ++i)
+      counter[i] = static_cast<std::byte>((7 * i + it) & 0xff);
     builder.addRawResource(resource, true, counter);
     builder.addForce(points.empty() ? 0 : points.front(),
                      msg::ForceEvent{{0, 1, 0}, {0, 0, 0}, {0, 0, 0}, 0.01});

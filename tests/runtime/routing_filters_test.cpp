@@ -222,5 +222,116 @@ TEST_F(RoutingFilters, ScatterByTypeSendsEachListedTypeToItsOutput) {
   EXPECT_EQ(count(only, "object", true), 10u);
 }
 
+// Points at x = 0, 1, 2; rigid k at x = k with bounds x +- 0.75 in the first message only, so
+// rigid 0 meets the slabs below 0.5 and [0.5, 1.5), rigid 1 all three; later updates carry no
+// bounds and follow the latest known ones, and so do the deletes of the rigids in the last one.
+TEST_F(RoutingFilters, ScatterByBoundsSendsObjectsToEverySlabTheirBoundsMeet) {
+  run(appXml(
+      moduleXml("mix", "testing/mixed",
+                paramXml("points", "3") + paramXml("rigids", "2") + paramXml("count", "5") +
+                    paramXml("extent", "0.75")) +
+          recorder("a", "a.csv") + recorder("b", "b.csv") + recorder("c", "c.csv") +
+          recorder("low", "low.csv") + recorder("high", "high.csv"),
+      filterXml("s", "scatter",
+                paramXml("outputs", "3") + paramXml("by", "bounds") + paramXml("axis", "x") +
+                    paramXml("cuts", "0.5, 1.5")) +
+          filterXml(
+              "d", "scatter",
+              paramXml("by", "bounds") + paramXml("cuts", "1.5") + paramXml("others", "drop")),
+      connectXml("mix.out", "s.in") + connectXml("s.out0", "a.in") + connectXml("s.out1", "b.in") +
+          connectXml("s.out2", "c.in") + connectXml("mix.out", "d.in") +
+          connectXml("d.out0", "low.in") + connectXml("d.out1", "high.in")));
+  struct Seen {
+    std::multiset<double> pointXs;
+    std::map<std::string, std::size_t> rigids;  // id -> chunks
+    std::size_t resources = 0, events = 0;
+    std::set<long> iterations;
+  };
+  const auto seen = [&](const std::string& csv) {
+    Seen result;
+    for (const auto& row : readRecording(dir.file(csv))) {
+      result.iterations.insert(row.sourceIteration);
+      if (row.kind == "object" && !row.x.empty()) result.pointXs.insert(std::stod(row.x));
+      if (row.kind == "object" && row.x.empty()) ++result.rigids[row.id];
+      result.resources += row.kind == "resource";
+      result.events += row.kind == "event";
+    }
+    return result;
+  };
+  const Seen a = seen("a.csv"), b = seen("b.csv"), c = seen("c.csv");
+  const Seen low = seen("low.csv"), high = seen("high.csv");
+  EXPECT_EQ(a.pointXs, (std::multiset<double>{0, 0, 0, 0, 0}));
+  EXPECT_EQ(b.pointXs, (std::multiset<double>{1, 1, 1, 1, 1}));
+  EXPECT_EQ(c.pointXs, (std::multiset<double>{2, 2, 2, 2, 2}));
+  // Both rigids meet out0 and out1 in every message (latest bounds); only rigid 1 meets out2.
+  ASSERT_EQ(a.rigids.size(), 2u);
+  EXPECT_EQ(b.rigids, a.rigids);
+  ASSERT_EQ(c.rigids.size(), 1u);
+  for (const auto& [id, chunks] : a.rigids) EXPECT_EQ(chunks, 5u) << id;
+  EXPECT_EQ(c.rigids.begin()->second, 5u);
+  EXPECT_TRUE(a.rigids.count(c.rigids.begin()->first));
+  for (const Seen* out : {&a, &b, &c}) {  // others=all: resources and events to every output
+    EXPECT_EQ(out->resources, 5u);
+    EXPECT_EQ(out->events, 5u);
+    EXPECT_EQ(out->iterations.size(), 5u);
+  }
+  // others=drop, one cut at 1.5: points 0 and 1 and both rigids low; point 2 and rigid 1 high.
+  EXPECT_EQ(low.pointXs, (std::multiset<double>{0, 0, 0, 0, 0, 1, 1, 1, 1, 1}));
+  EXPECT_EQ(high.pointXs, (std::multiset<double>{2, 2, 2, 2, 2}));
+  EXPECT_EQ(low.rigids, a.rigids);
+  EXPECT_EQ(high.rigids, c.rigids);
+  for (const Seen* out : {&low, &high}) {
+    EXPECT_EQ(out->resources, 0u);
+    EXPECT_EQ(out->events, 0u);
+  }
+}
+
+// 100 bytes of 8-byte elements in 3 parts: 12 elements as 4 + 4 + 4, the 4 bytes left over in
+// the last part; each part prefixed by its offset and the total size.
+TEST_F(RoutingFilters, ScatterBySizeThenGatherRebuildsTheOriginalBytes) {
+  run(appXml(moduleXml("mix", "testing/mixed",
+                       paramXml("points", "2") + paramXml("rigids", "1") + paramXml("count", "6") +
+                           paramXml("payload", "100")) +
+                 recorder("joined", "joined.csv") + recorder("first", "first.csv") +
+                 moduleXml("check", "testing/rebuild", paramXml("file", dir.file("rebuild.csv"))),
+             filterXml("s", "scatter",
+                       paramXml("outputs", "3") + paramXml("by", "size") +
+                           paramXml("element-size", "8") + paramXml("others", "drop")) +
+                 filterXml("g", "gather", paramXml("inputs", "3")) +
+                 filterXml("a", "scatter",
+                           paramXml("outputs", "2") + paramXml("by", "size") +
+                               paramXml("element-size", "8")),
+             connectXml("mix.out", "s.in") + connectXml("s.out0", "g.in0") +
+                 connectXml("s.out1", "g.in1") + connectXml("s.out2", "g.in2") +
+                 connectXml("g.out", "joined.in") + connectXml("g.out", "check.in") +
+                 connectXml("mix.out", "a.in") + connectXml("a.out0", "first.in")));
+  const auto joined = readRecording(dir.file("joined.csv"));
+  ASSERT_EQ(joined.size(), 6u * 3u) << "three resource parts per message, nothing else";
+  for (std::size_t i = 0; i < joined.size(); ++i) {
+    EXPECT_EQ(joined[i].kind, "resource");
+    EXPECT_EQ(joined[i].sourceIteration, static_cast<long>(i / 3));
+    EXPECT_EQ(joined[i].x, std::to_string(std::vector<int>{0, 32, 64}[i % 3])) << "offset";
+    EXPECT_EQ(joined[i].y, std::to_string(std::vector<int>{48, 48, 52}[i % 3])) << "size";
+  }
+  const std::string rebuilt = readFile(dir.file("rebuild.csv"));
+  std::string expected = "iteration,parts,total,ok\n";
+  for (int it = 0; it < 6; ++it) expected += std::to_string(it) + ",3,100,ok\n";
+  EXPECT_EQ(rebuilt, expected);
+  // others=all: objects and events go with every part; 100 bytes = 12 elements, 6 + 6 + 4.
+  std::size_t objects = 0, events = 0, resources = 0;
+  for (const auto& row : readRecording(dir.file("first.csv"))) {
+    objects += row.kind == "object";
+    events += row.kind == "event";
+    if (row.kind == "resource") {
+      ++resources;
+      EXPECT_EQ(row.x, "0");
+      EXPECT_EQ(row.y, "64");
+    }
+  }
+  EXPECT_EQ(objects, 6u * 3u);
+  EXPECT_EQ(events, 6u);
+  EXPECT_EQ(resources, 6u);
+}
+
 }  // namespace
 }  // namespace vrflow::testing

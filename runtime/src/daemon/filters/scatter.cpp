@@ -1,9 +1,17 @@
-// scatter: one message split into N parts by chunk position, object id or object type.
+// scatter: one message split into N parts by chunk position, object id, object type or
+// bounding volume.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <optional>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "filters.hpp"
 #include "vrflow/app/model.hpp"
+#include "vrflow/message/builtin_types.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow::daemon::filters {
@@ -12,7 +20,10 @@ namespace {
 constexpr uint32_t kEveryOutput = UINT32_MAX;
 constexpr uint32_t kNoOutput = UINT32_MAX - 1;
 
-enum class SplitBy { Chunk, Id, Type };
+enum class SplitBy { Chunk, Id, Type, Bounds, Size };
+
+// by=size: the header in front of each part's bytes (docs/filters.md).
+constexpr std::size_t kPartHeaderSize = 16;
 
 // The finalizer of splitmix64: spreads consecutive ids (a host's counter) evenly.
 uint64_t mixId(uint64_t id) {
@@ -24,8 +35,14 @@ uint64_t mixId(uint64_t id) {
 
 class ScatterFilter final : public Filter {
  public:
-  ScatterFilter(SplitBy by, std::vector<uint32_t> typeIds, bool othersToAll)
-      : by_(by), typeIds_(std::move(typeIds)), othersToAll_(othersToAll) {}
+  ScatterFilter(SplitBy by, std::vector<uint32_t> typeIds, bool othersToAll, int axis = 0,
+                std::vector<double> cuts = {}, uint64_t elementSize = 1)
+      : by_(by),
+        elementSize_(elementSize == 0 ? 1 : elementSize),
+        typeIds_(std::move(typeIds)),
+        othersToAll_(othersToAll),
+        axis_(axis),
+        cuts_(std::move(cuts)) {}
 
   void process(FilterContext& context) override {
     auto& in = context.input(0);
@@ -41,6 +58,67 @@ class ScatterFilter final : public Filter {
   }
 
  private:
+  // The slab [cuts[k-1], cuts[k]) holding coordinate v (slab 0 below the first cut).
+  uint32_t slabOf(double v) const {
+    uint32_t k = 0;
+    while (k < cuts_.size() && v >= cuts_[k]) ++k;
+    return k;
+  }
+
+  // The extent of an object along the axis, if this chunk carries its bounds (or, for a point,
+  // its position as a degenerate box).
+  std::optional<std::pair<double, double>> extentOf(const msg::ObjectView& object) const {
+    const uint32_t type = object.typeId();
+    std::optional<uint32_t> boundsParam;
+    if (type == msg::rigidType().id()) boundsParam = msg::RigidParam::kBounds;
+    if (type == msg::massSpringType().id()) boundsParam = msg::MassSpringParam::kBounds;
+    if (type == msg::fluidType().id()) boundsParam = msg::FluidParam::kBounds;
+    if (type == msg::userType().id()) boundsParam = msg::UserParam::kBounds;
+    if (boundsParam) {
+      const auto box = object.aabb(*boundsParam);
+      if (!box) return std::nullopt;
+      const double lo = axisOf(box->min), hi = axisOf(box->max);
+      if (!std::isfinite(lo) || !std::isfinite(hi)) return std::nullopt;
+      return std::pair{std::min(lo, hi), std::max(lo, hi)};
+    }
+    if (type == msg::pointType().id()) {
+      const auto position = object.vec3(msg::PointParam::kPosition);
+      if (!position) return std::nullopt;
+      const double v = axisOf(*position);
+      if (!std::isfinite(v)) return std::nullopt;
+      return std::pair{v, v};
+    }
+    return std::nullopt;
+  }
+
+  double axisOf(const msg::Vec3& v) const { return v[static_cast<std::size_t>(axis_)]; }
+
+  // by=bounds: the outputs [first, last] an object chunk goes to; updates the latest bounds.
+  std::pair<uint32_t, uint32_t> boundsTargets(const msg::ChunkView& chunk, uint32_t n) {
+    const std::pair<uint32_t, uint32_t> others = othersToAll_
+                                                     ? std::pair<uint32_t, uint32_t>{0, n - 1}
+                                                     : std::pair<uint32_t, uint32_t>{1, 0};
+    if (chunk.kind() != msg::ChunkKind::Object) return others;
+    const auto object = chunk.asObject();
+    if (!object) return others;
+    const uint64_t id = chunk.id();
+    if (object->op() == msg::ObjectOp::Delete) {
+      const auto it = latest_.find(id);
+      if (it == latest_.end()) return others;
+      const auto range = it->second;
+      latest_.erase(it);
+      return range;
+    }
+    if (const auto extent = extentOf(*object)) {
+      const std::pair<uint32_t, uint32_t> range{std::min(slabOf(extent->first), n - 1),
+                                                std::min(slabOf(extent->second), n - 1)};
+      latest_[id] = range;
+      return range;
+    }
+    const auto it = latest_.find(id);
+    return it == latest_.end() ? others : it->second;
+  }
+
   // Which output chunk `index` (of `count`) goes to.
   uint32_t outputOf(const msg::ChunkView& chunk, uint32_t count, uint32_t n) const {
     switch (by_) {
@@ -59,13 +137,20 @@ class ScatterFilter final : public Filter {
           }
         }
         return othersToAll_ ? kEveryOutput : kNoOutput;
+      case SplitBy::Bounds:
+      case SplitBy::Size:
+        break;
     }
     return kNoOutput;
   }
 
   void split(FilterContext& context, const MessageRef& message, const msg::MessageView& view) {
     const auto n = static_cast<uint32_t>(context.outputCount());
-    if (n == 1 && by_ != SplitBy::Type) {
+    if (by_ == SplitBy::Size) {
+      splitBySize(context, message, view);
+      return;
+    }
+    if (n == 1 && by_ != SplitBy::Type && by_ != SplitBy::Bounds) {
       context.emit(0, message);
       return;
     }
@@ -74,10 +159,17 @@ class ScatterFilter final : public Filter {
     std::vector<uint32_t> chunks(n, 0);
     const std::size_t fixed = message.size() - view.chunkBytes().size();
     for (const msg::ChunkView chunk : view) {
-      const uint32_t target = outputOf(chunk, view.chunkCount(), n);
+      std::pair<uint32_t, uint32_t> target;
+      if (by_ == SplitBy::Bounds) {
+        target = boundsTargets(chunk, n);
+      } else {
+        const uint32_t one = outputOf(chunk, view.chunkCount(), n);
+        target = one == kEveryOutput ? std::pair<uint32_t, uint32_t>{0, n - 1}
+                 : one == kNoOutput  ? std::pair<uint32_t, uint32_t>{1, 0}
+                                     : std::pair<uint32_t, uint32_t>{one, one};
+      }
       targets_.push_back(target);
-      for (uint32_t o = 0; o < n; ++o) {
-        if (target != o && target != kEveryOutput) continue;
+      for (uint32_t o = target.first; o <= target.second && o < n; ++o) {
         bytes[o] += chunk.bytes().size();
         ++chunks[o];
       }
@@ -92,8 +184,8 @@ class ScatterFilter final : public Filter {
         builder.setStamps(stamps);
         builder.setStampsOnly(view.stampsOnly());
         for (const msg::ChunkView chunk : view) {
-          const uint32_t target = targets_[chunk.index()];
-          if (target == o || target == kEveryOutput) builder.appendChunk(chunk);
+          const auto target = targets_[chunk.index()];
+          if (target.first <= o && o <= target.second) builder.appendChunk(chunk);
         }
       });
       if (!part) {
@@ -104,10 +196,57 @@ class ScatterFilter final : public Filter {
     }
   }
 
+  // by=size: every raw resource cut into N parts of whole elements, each a raw resource with
+  // the same id whose bytes are a header (u64 offset, u64 total size, little-endian) and the
+  // part; other chunks follow `others`.
+  void splitBySize(FilterContext& context, const MessageRef& message,
+                   const msg::MessageView& view) {
+    const auto n = static_cast<uint32_t>(context.outputCount());
+    const msg::Stamps stamps = view.stamps().toStamps();
+    for (uint32_t o = 0; o < n; ++o) {
+      auto part = context.compose(
+          message.size() + n * (msg::kChunkHeaderSize + kPartHeaderSize + 8),
+          [&](msg::MessageBuilder& builder) {
+            builder.setStamps(stamps);
+            builder.setStampsOnly(view.stampsOnly());
+            for (const msg::ChunkView chunk : view) {
+              const auto resource = chunk.asResource();
+              if (!resource || resource->kind() != msg::ResourceKind::Raw) {
+                if (othersToAll_) builder.appendChunk(chunk);
+                continue;
+              }
+              const auto bytes = resource->raw();
+              const uint64_t total = bytes.size(), elements = total / elementSize_;
+              const uint64_t first = elements * o / n * elementSize_;
+              const uint64_t last = o + 1 == n ? total : elements * (o + 1) / n * elementSize_;
+              std::vector<std::byte> body(kPartHeaderSize + (last - first));
+              for (int b = 0; b < 8; ++b) {
+                body[b] = static_cast<std::byte>((first >> (8 * b)) & 0xff);
+                body[8 + b] = static_cast<std::byte>((total >> (8 * b)) & 0xff);
+              }
+              std::copy(bytes.begin() + static_cast<std::ptrdiff_t>(first),
+                        bytes.begin() + static_cast<std::ptrdiff_t>(last),
+                        body.begin() + kPartHeaderSize);
+              builder.addRawResource(resource->id(), resource->dynamic(), body);
+            }
+          });
+      if (!part) {
+        context.warn(part.error().message);
+        continue;
+      }
+      context.emit(o, std::move(*part));
+    }
+  }
+
   SplitBy by_;
+  uint64_t elementSize_;
   std::vector<uint32_t> typeIds_;
   bool othersToAll_;
-  std::vector<uint32_t> targets_;
+  int axis_;
+  std::vector<double> cuts_;
+  // by=bounds: the outputs each object's latest known bounds sent it to.
+  std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> latest_;
+  std::vector<std::pair<uint32_t, uint32_t>> targets_;
 };
 
 }  // namespace
@@ -115,7 +254,11 @@ class ScatterFilter final : public Filter {
 void registerScatter(FilterRegistry& registry) {
   registry.add("scatter", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
     const std::string by = context.param("by", "chunk");
-    const SplitBy split = by == "id" ? SplitBy::Id : by == "type" ? SplitBy::Type : SplitBy::Chunk;
+    const SplitBy split = by == "id"       ? SplitBy::Id
+                          : by == "type"   ? SplitBy::Type
+                          : by == "bounds" ? SplitBy::Bounds
+                          : by == "size"   ? SplitBy::Size
+                                           : SplitBy::Chunk;
     std::vector<uint32_t> typeIds;
     for (const auto& name : app::splitList(context.param("types", ""))) {
       typeIds.push_back(msg::fnv1a32(name));
@@ -123,8 +266,25 @@ void registerScatter(FilterRegistry& registry) {
     if (split == SplitBy::Type && typeIds.size() != context.outputCount()) {
       return makeError("filter '" + context.name() + "': by=type needs one type name per output");
     }
+    const std::string axisName = context.param("axis", "x");
+    const int axis = axisName == "y" ? 1 : axisName == "z" ? 2 : 0;
+    std::vector<double> cuts;
+    for (const auto& text : app::splitList(context.param("cuts", ""))) {
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(v) ||
+          (!cuts.empty() && v <= cuts.back())) {
+        return makeError("filter '" + context.name() + "': bad 'cuts' value '" + text + "'");
+      }
+      cuts.push_back(v);
+    }
+    if (split == SplitBy::Bounds && cuts.size() + 1 != context.outputCount()) {
+      return makeError("filter '" + context.name() + "': by=bounds needs N-1 cuts for N outputs");
+    }
     return std::unique_ptr<Filter>(std::make_unique<ScatterFilter>(
-        split, std::move(typeIds), context.param("others", "all") != "drop"));
+        split, std::move(typeIds), context.param("others", "all") != "drop", axis, std::move(cuts),
+        static_cast<uint64_t>(
+            std::strtoull(context.param("element-size", "1").c_str(), nullptr, 10))));
   });
 }
 
