@@ -84,6 +84,11 @@ TEST_F(BuffersTest, BlockingPolicyHoldsTheProducerBackWithFlatMemory) {
   EXPECT_EQ(json["modules"][1]["iterations"], 3000) << "nothing is lost";
   EXPECT_EQ(json["connections"][0]["dropped"], 0);
   EXPECT_LT(json["timing"]["segment_peak_bytes"].get<uint64_t>(), 1u << 20);
+  // The queue is full for the whole run (over 3 s): reported once, naming it and its policy.
+  EXPECT_EQ(json["connections"][0]["stayed_full"], true);
+  ASSERT_EQ(json["warnings"].size(), 1u) << json["warnings"];
+  EXPECT_EQ(json["warnings"][0], "connection fast.out -> slow.in stayed full (8 messages, policy block)");
+  EXPECT_NE(result.err.find("warning: connection fast.out -> slow.in stayed full"), std::string::npos);
 }
 
 }  // namespace
