@@ -246,22 +246,9 @@ std::optional<Application> readApplication(std::string_view xml, const std::stri
 
 Result<Application> loadApplicationString(std::string_view xml, std::string fileName,
                                           std::vector<Diagnostic>* problems) {
-  try {
-    std::vector<Diagnostic> found;
-    std::optional<Application> app = detail::readApplication(xml, fileName, found);
-    if (!app) return makeError(formatDiagnostic(found.front()));
-    sortAndDeduplicate(found);
-    if (problems != nullptr) {
-      problems->insert(problems->end(), found.begin(), found.end());
-    } else if (!found.empty()) {
-      std::string message = formatDiagnostics(found);
-      message.pop_back();  // the final newline
-      return makeError(std::move(message));
-    }
-    return std::move(*app);
-  } catch (const std::exception& e) {
-    return makeError(fileName + ": error: cannot load application (" + e.what() + ")");
-  }
+  return detail::finishLoad<Application>(
+      [&](std::vector<Diagnostic>& found) { return detail::readApplication(xml, fileName, found); },
+      fileName, "application", problems);
 }
 
 Result<Application> loadApplicationFile(const std::string& path,

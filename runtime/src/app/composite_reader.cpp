@@ -313,22 +313,11 @@ namespace vrflow::app {
 
 Result<Composite> loadCompositeString(std::string_view xml, std::string fileName,
                                       std::vector<Diagnostic>* problems) {
-  try {
-    std::vector<Diagnostic> found;
-    std::optional<Composite> composite = detail::readCompositeFile(xml, fileName, found);
-    if (!composite) return makeError(formatDiagnostic(found.front()));
-    sortAndDeduplicate(found);
-    if (problems != nullptr) {
-      problems->insert(problems->end(), found.begin(), found.end());
-    } else if (!found.empty()) {
-      std::string message = formatDiagnostics(found);
-      message.pop_back();  // the final newline
-      return makeError(std::move(message));
-    }
-    return std::move(*composite);
-  } catch (const std::exception& e) {
-    return makeError(fileName + ": error: cannot load composite (" + e.what() + ")");
-  }
+  return detail::finishLoad<Composite>(
+      [&](std::vector<Diagnostic>& found) {
+        return detail::readCompositeFile(xml, fileName, found);
+      },
+      fileName, "composite", problems);
 }
 
 Result<Composite> loadCompositeFile(const std::string& path, std::vector<Diagnostic>* problems) {
