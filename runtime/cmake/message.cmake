@@ -4,6 +4,7 @@ vrflow_add_library(message
   SOURCES
     src/message/builder.cpp
     src/message/builtin_types.cpp
+    src/message/shape.cpp
     src/message/byte_sink.cpp
     src/message/chunk_views.cpp
     src/message/digest.cpp

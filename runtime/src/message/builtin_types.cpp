@@ -39,6 +39,7 @@ const ObjectType& massSpringType() {
                                     {"pinned", ParamKind::Bytes},
                                     {"springs", ParamKind::Bytes},
                                     {"bounds", ParamKind::Aabb},
+                                    {"surface", ParamKind::Bytes},
                                 });
   return type;
 }

@@ -37,7 +37,8 @@ struct MassSpringParam {
     kMasses,      ///< DoubleArray
     kPinned,      ///< Bytes, one per mass (0 free, 1 pinned)
     kSprings,     ///< Bytes, node-defined spring records
-    kBounds       ///< Aabb
+    kBounds,      ///< Aabb
+    kSurface      ///< Bytes, u32 mass indices, three per triangle: the net's surface for drawing
   };
 };
 
