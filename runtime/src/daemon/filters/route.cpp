@@ -203,6 +203,24 @@ class RouteFilter final : public Filter {
     }
   }
 
+  // True when an object the receiver holds refers to `resource` (an object that left since it
+  // asked for it does not count; it asks again when it comes back).
+  bool holdsReferrer(const Receiver& receiver, uint64_t resource) const {
+    for (const uint64_t id : receiver.objects) {
+      const auto found = objects_.find(id);
+      if (found == objects_.end() || found->second.type == nullptr) continue;
+      const ObjectState& object = found->second;
+      for (const auto& [index, value] : object.params) {
+        if (index < object.type->paramCount() &&
+            object.type->param(index).kind == msg::ParamKind::Id && value.size() == 8 &&
+            std::memcmp(value.data(), &resource, 8) == 0) {
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+
   void updateObject(const msg::ChunkView& chunk, const msg::ObjectView& object) {
     auto& state = objects_[chunk.id()];
     if (object.op() == msg::ObjectOp::Add || state.typeId != object.typeId()) {
@@ -289,7 +307,7 @@ class RouteFilter final : public Filter {
           for (auto& receiver : receivers_) {
             if (receiver.resources.count(id) != 0) {
               receiver.actions.push_back({Action::Chunk, index});  // an update of one it has
-            } else if (receiver.wanted.erase(id) != 0) {
+            } else if (receiver.wanted.erase(id) != 0 && holdsReferrer(receiver, id)) {
               receiver.resources.insert(id);
               receiver.actions.push_back({Action::Chunk, index});
             }
