@@ -2,6 +2,8 @@
 // `width` (wrapping around), spread over y. Iteration 0 sends `meshes` mesh resources (static)
 // and every body's full state (add: position, orientation, velocities, mass, inertia, bounds,
 // shape = one of the meshes); later iterations update position, linear velocity and bounds.
+// `meshes-at` sends the meshes at a later iteration instead (after the bodies that use them);
+// `delete-at` deletes body 0 at that iteration (0: never).
 // Body i: size 1, x = (i * 7.3 + speed_i * t) mod width with speed_i = 0.5 + (i mod 5) * 0.25,
 // y = (i mod 8) * 1.5, z = 0; t = iteration * dt.
 #include <cmath>
@@ -25,6 +27,8 @@ int main() {
   const double width = module.paramDouble("width", 40);
   const double dt = module.paramDouble("dt", 0.1);
   const auto triangles = static_cast<std::size_t>(module.paramInt("mesh-triangles", 200));
+  const auto meshesAt = static_cast<uint64_t>(module.paramInt("meshes-at", 0));
+  const auto deleteAt = static_cast<uint64_t>(module.paramInt("delete-at", 0));
 
   std::vector<uint64_t> meshIds, bodyIds;
   for (std::size_t m = 0; m < meshCount; ++m) meshIds.push_back(module.newId());
@@ -38,7 +42,7 @@ int main() {
     auto& builder = out.builder();
     builder.setSimTime(t);
     builder.setTimeStep(dt);
-    if (it == 0) {
+    if (it == meshesAt) {
       for (std::size_t m = 0; m < meshCount; ++m) {  // a fan of triangles, different per mesh
         std::vector<float> xyz;
         std::vector<uint32_t> indices;
@@ -52,6 +56,10 @@ int main() {
       }
     }
     for (std::size_t i = 0; i < count; ++i) {
+      if (i == 0 && deleteAt != 0 && it >= deleteAt) {
+        if (it == deleteAt) builder.addDelete(bodyIds[0], rigid);
+        continue;
+      }
       const double speed = 0.5 + static_cast<double>(i % 5) * 0.25;
       const double x = std::fmod(static_cast<double>(i) * 7.3 + speed * t, width);
       const double y = static_cast<double>(i % 8) * 1.5;

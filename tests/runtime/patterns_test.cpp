@@ -321,6 +321,76 @@ TEST_F(Patterns, RouteForwardsExactlyTheIntersectingObjectsAndTheirStateOnEntry)
   check(dir.file("tile5.csv"), [](long) { return Tile{30, 35}; }, 22, expected, resources);
 }
 
+// Meshes sent after the bodies that use them (iteration 3) reach a viewer only if it holds such
+// a body; a delete reaches only the viewers that hold the body.
+TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
+  std::string modules = moduleXml(
+      "scene", "routing/movers",
+      paramXml("count", "16") + paramXml("meshes", "8") + paramXml("iterations", "12") +
+          paramXml("meshes-at", "3") + paramXml("delete-at", "6") +
+          "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
+  std::string connections = connectXml("scene.objects", "wall.in");
+  const char* boxes[] = {"0 -1 -1 10 12 1", "20 -1 -1 30 12 1", "all"};
+  for (int k = 0; k < 3; ++k) {
+    const std::string id = "v" + std::to_string(k);
+    modules += moduleXml(id, "routing/tile-viewer",
+                         paramXml("box", boxes[k]) + paramXml("file", dir.file(id + ".csv")));
+    connections += connectXml("wall.out" + std::to_string(k), id + ".objects") +
+                   connectXml(id + ".interest", "wall.interest" + std::to_string(k)) +
+                   connectXml(id + ".endIt", "scene.beginIt");
+  }
+  const auto result = run(dir.write(
+      "late.xml",
+      appXml(modules, filterXml("wall", "route", paramXml("outputs", "3")), connections)));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto all = byIteration(dir.file("v2.csv"));
+  std::string first;  // body 0: the first body added
+  std::map<std::string, std::string> shapeOf;
+  for (const auto& c : all.at(1)) {
+    if (first.empty()) first = c.id;
+    shapeOf[c.id] = c.ref;
+  }
+  ASSERT_EQ(shapeOf.size(), 16u);
+  for (int k = 0; k < 3; ++k) {
+    const auto got = byIteration(dir.file("v" + std::to_string(k) + ".csv"));
+    std::set<std::string> refs, resources, heldAt3;
+    std::map<std::string, std::string> refOf;
+    bool holdsFirst = false, deleted = false;
+    for (const auto& [it, chunks] : got) {
+      for (const auto& c : chunks) {
+        if (c.kind == "resource") {
+          EXPECT_TRUE(resources.insert(c.id).second) << "once";
+          EXPECT_GE(it, 3) << "no mesh before the scene sends it";
+          continue;
+        }
+        if (c.op == "add") {
+          refOf[c.id] = c.ref;
+          if (it >= 3) {
+            EXPECT_TRUE(resources.count(c.ref)) << "the mesh comes before the body";
+          }
+        }
+        if (it == 3 && c.op == "update") heldAt3.insert(c.id);
+        if (c.id == first && c.op != "delete") holdsFirst = true;
+        if (c.id == first && c.op == "delete") {
+          EXPECT_EQ(it, 6);
+          deleted = true;
+        } else if (c.id == first) {
+          EXPECT_LT(it, 6) << "nothing about a deleted body";
+        }
+      }
+      if (it == 3) {
+        std::set<std::string> needed;
+        for (const auto& id : heldAt3) needed.insert(refOf[id]);
+        EXPECT_EQ(resources, needed) << "viewer " << k << ": exactly the meshes of its bodies";
+      }
+    }
+    for (const auto& [id, ref] : refOf) refs.insert(ref);
+    for (const auto& r : resources) EXPECT_TRUE(refs.count(r)) << "viewer " << k << ": unasked mesh";
+    EXPECT_EQ(deleted, holdsFirst) << "viewer " << k;
+  }
+  EXPECT_EQ(byIteration(dir.file("v2.csv")).at(3).size(), 16u + 8u) << "all: 8 meshes, 16 bodies";
+}
+
 TEST_F(Patterns, RouteExampleCutsTheBytesToEachTile) {
   const auto result = run(example("dynamic_routing/dynamic_routing.xml"), "--report report.json");
   ASSERT_EQ(result.exitCode, 0) << result.err;
@@ -361,6 +431,37 @@ TEST_F(Patterns, ValidateExplainsBadPatternParameters) {
                  connectXml("w.out0", "rec.in")));
   const auto ok = runVrflow({"validate", good});
   EXPECT_EQ(ok.exitCode, 0) << ok.err;
+}
+
+// ---- greedy sampling -----------------------------------------------------------------------
+
+// A writer of 10,000 messages and a reader that takes 10 ms per message, joined by `latest`
+// synced by the reader's endIt: the writer never waits for the reader (if it did, the run would
+// need 100 s and hit its timeout), the reader gets increasing samples, and shared memory stays
+// bounded by the buffers.
+TEST_F(Patterns, GreedySamplingNeverBlocksTheWriterAndKeepsMemoryFlat) {
+  const auto file = dir.write(
+      "greedy.xml",
+      appXml(moduleXml("fast", "core/source", paramXml("size", "4096") + paramXml("count", "10000")) +
+                 moduleXml("slow", "testing/slow", paramXml("delay-ms", "10")) +
+                 moduleXml("rec", "core/recorder", paramXml("file", dir.file("sampled.csv"))),
+             filterXml("sample", "latest"),
+             connectXml("fast.out", "sample.in") + connectXml("sample.out", "slow.in") +
+                 connectXml("slow.endIt", "sample.sync") + connectXml("slow.out", "rec.in")));
+  const auto result = runVrflow({"run", file, "--report", dir.file("report.json"), "--timeout", "60"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto json = report("report.json");
+  std::map<std::string, long> iterations;
+  for (const auto& m : json["modules"]) iterations[m["id"]] = m["iterations"].get<long>();
+  EXPECT_EQ(iterations["fast"], 10000);
+  EXPECT_LT(iterations["slow"], 10000);
+  EXPECT_GE(iterations["slow"], 1);
+  for (const auto& c : json["connections"]) EXPECT_EQ(c["stayed_full"], false) << c["from"];
+  EXPECT_LT(json["timing"]["segment_peak_bytes"].get<uint64_t>(), 1u << 20);
+  const auto counters = recordedCounters(dir.file("sampled.csv"));
+  ASSERT_FALSE(counters.empty());
+  for (std::size_t i = 1; i < counters.size(); ++i) EXPECT_GT(counters[i], counters[i - 1]);
+  EXPECT_EQ(counters.back(), 9999) << "the newest message is the last one read";
 }
 
 // ---- module duplication --------------------------------------------------------------------
