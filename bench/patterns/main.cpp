@@ -39,7 +39,9 @@ struct Context {
   fs::path work;      // scratch folder
 };
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
+std::string q(const std::string& s) {
+  return "'" + s + "'";
+}
 
 // Runs `vrflow run app` in ctx.work; the report as JSON, or an error.
 bool runApp(const Context& ctx, const std::string& name, const std::string& xml,
@@ -97,13 +99,16 @@ bool broadcast(const Context& ctx, const std::string& mode, int n, int messages,
                param("file", "received" + std::to_string(i) + ".csv") + "    </module>\n";
   }
   if (mode == "flat") {
-    for (int i = 0; i < n; ++i) connections += connection("src.out", "r" + std::to_string(i) + ".in");
+    for (int i = 0; i < n; ++i)
+      connections += connection("src.out", "r" + std::to_string(i) + ".in");
   } else {
     const int m = (n + fanout - 3) / (fanout - 1);  // broadcast filters: a heap, as the composite
-    for (int k = 0; k < m; ++k) filters += "    <filter id=\"b" + std::to_string(k) + "\" type=\"broadcast\"/>\n";
+    for (int k = 0; k < m; ++k)
+      filters += "    <filter id=\"b" + std::to_string(k) + "\" type=\"broadcast\"/>\n";
     connections += connection("src.out", "b0.in");
     for (int x = 1; x < m; ++x) {
-      connections += connection("b" + std::to_string((x - 1) / fanout) + ".out", "b" + std::to_string(x) + ".in");
+      connections += connection("b" + std::to_string((x - 1) / fanout) + ".out",
+                                "b" + std::to_string(x) + ".in");
     }
     for (int i = 0; i < n; ++i) {
       connections += connection("b" + std::to_string((m + i - 1) / fanout) + ".out",
@@ -147,16 +152,17 @@ bool broadcast(const Context& ctx, const std::string& mode, int n, int messages,
 }
 
 bool routing(const Context& ctx, const std::string& mode, int bodies, int iterations) {
-  std::string modules = "  <modules>\n    <module id=\"scene\" package=\"routing\" type=\"movers\">\n" +
-                        param("count", std::to_string(bodies)) +
-                        param("iterations", std::to_string(iterations)) +
-                        "      <input port=\"beginIt\" initial-messages=\"1\"/>\n    </module>\n";
+  std::string modules =
+      "  <modules>\n    <module id=\"scene\" package=\"routing\" type=\"movers\">\n" +
+      param("count", std::to_string(bodies)) + param("iterations", std::to_string(iterations)) +
+      "      <input port=\"beginIt\" initial-messages=\"1\"/>\n    </module>\n";
   std::string connections;
   for (int k = 0; k < 4; ++k) {
     const std::string id = "tile" + std::to_string(k);
-    modules += "    <module id=\"" + id + "\" package=\"routing\" type=\"tile-viewer\">\n" +
-               param("box", std::to_string(10 * k) + " -1 -1 " + std::to_string(10 * k + 10) + " 12 1") +
-               "    </module>\n";
+    modules +=
+        "    <module id=\"" + id + "\" package=\"routing\" type=\"tile-viewer\">\n" +
+        param("box", std::to_string(10 * k) + " -1 -1 " + std::to_string(10 * k + 10) + " 12 1") +
+        "    </module>\n";
     if (mode == "none") {
       connections += connection("scene.objects", id + ".objects");
     } else {
@@ -198,7 +204,8 @@ int main(int argc, char** argv) {
   bool quick = false;
   std::string only;
   cli.add_option("--receivers", receiversText, "broadcast receiver counts, comma-separated");
-  cli.add_option("--messages", messages, "1 MiB messages per broadcast case")->check(CLI::Range(1, 100000));
+  cli.add_option("--messages", messages, "1 MiB messages per broadcast case")
+      ->check(CLI::Range(1, 100000));
   cli.add_option("--fanout", fanout, "fan-out of the broadcast tree")->check(CLI::Range(2, 256));
   cli.add_option("--bodies", bodies, "bodies of the routing scene")->check(CLI::Range(1, 1000000));
   cli.add_option("--iterations", iterations, "routing iterations")->check(CLI::Range(2, 1000000));
@@ -216,7 +223,8 @@ int main(int argc, char** argv) {
   for (std::string item; std::getline(list, item, ',');) {
     const int n = std::atoi(item.c_str());
     if (n < 2 || n > 4096) {
-      std::fprintf(stderr, "vrflow-bench-patterns: --receivers: %s is not in [2, 4096]\n", item.c_str());
+      std::fprintf(stderr, "vrflow-bench-patterns: --receivers: %s is not in [2, 4096]\n",
+                   item.c_str());
       return 2;
     }
     receivers.push_back(n);
@@ -234,7 +242,8 @@ int main(int argc, char** argv) {
   bool ok = true;
   if (only.empty() || only == "broadcast") {
     for (const int n : receivers) {
-      for (const char* mode : {"flat", "tree"}) ok = broadcast(ctx, mode, n, messages, fanout) && ok;
+      for (const char* mode : {"flat", "tree"})
+        ok = broadcast(ctx, mode, n, messages, fanout) && ok;
     }
   }
   if (only.empty() || only == "routing") {

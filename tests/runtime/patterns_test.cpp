@@ -93,10 +93,11 @@ TEST_F(Patterns, MultiRateRunsTenInnerStepsOfDtOverTenPerOuterStep) {
 TEST_F(Patterns, TheSameSpringStepRunAtTheOuterDtExplodes) {
   const auto app = dir.write(
       "single_rate.xml",
-      appXml(moduleXml("outer", "multirate/clock", paramXml("dt", "0.2") + paramXml("count", "10")) +
-                 moduleXml("net", "multirate/oscillator", paramXml("stiffness", "225")) +
-                 moduleXml("log", "core/recorder", paramXml("file", "single.csv")),
-             "", connectXml("outer.ticks", "net.clock") + connectXml("net.state", "log.in")));
+      appXml(
+          moduleXml("outer", "multirate/clock", paramXml("dt", "0.2") + paramXml("count", "10")) +
+              moduleXml("net", "multirate/oscillator", paramXml("stiffness", "225")) +
+              moduleXml("log", "core/recorder", paramXml("file", "single.csv")),
+          "", connectXml("outer.ticks", "net.clock") + connectXml("net.state", "log.in")));
   const auto result = run(app);
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto single = states(dir.file("single.csv"));
@@ -109,14 +110,14 @@ TEST_F(Patterns, TheSameSpringStepRunAtTheOuterDtExplodes) {
 TEST_F(Patterns, RepeatThenDecimateGivesBackTheStreamAndDecimateCanForwardByReference) {
   const auto app = dir.write(
       "roundtrip.xml",
-      appXml(moduleXml("src", "core/source", paramXml("count", "12")) +
-                 moduleXml("relay", "core/relay") +
-                 moduleXml("rec", "core/recorder", paramXml("file", dir.file("out.csv"))),
-             filterXml("up", "repeat", paramXml("count", "3")) +
-                 filterXml("down", "decimate",
-                           paramXml("count", "3") + paramXml("restamp", "false")),
-             connectXml("src.out", "up.in") + connectXml("up.out", "relay.in") +
-                 connectXml("relay.out", "down.in") + connectXml("down.out", "rec.in")));
+      appXml(
+          moduleXml("src", "core/source", paramXml("count", "12")) +
+              moduleXml("relay", "core/relay") +
+              moduleXml("rec", "core/recorder", paramXml("file", dir.file("out.csv"))),
+          filterXml("up", "repeat", paramXml("count", "3")) +
+              filterXml("down", "decimate", paramXml("count", "3") + paramXml("restamp", "false")),
+          connectXml("src.out", "up.in") + connectXml("up.out", "relay.in") +
+              connectXml("relay.out", "down.in") + connectXml("down.out", "rec.in")));
   ASSERT_EQ(run(app).exitCode, 0);
   const auto rows = readRecording(dir.file("out.csv"));
   ASSERT_EQ(rows.size(), 12u);
@@ -168,8 +169,7 @@ TEST_F(Patterns, TreeBroadcastWithFanOutThreeAndAnUnevenCount) {
   replace("name=\"count\" value=\"20\"", "name=\"count\" value=\"9\"");
   replace("value=\"1048576\"", "value=\"4096\"");
   const auto app = dir.write("tree3.xml", text);
-  const auto result =
-      run(app, "--report report.json --composites " + example("tree_broadcast"));
+  const auto result = run(app, "--report report.json --composites " + example("tree_broadcast"));
   ASSERT_EQ(result.exitCode, 0) << result.err;
   expectEveryMessageOnceInOrder(dir, 7, 9);
   const auto json = report("report.json");
@@ -213,8 +213,9 @@ std::string routingApp(const std::string& folder, long iterations) {
                                       paramXml("iterations", std::to_string(iterations)) +
                                       "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
   std::string connections = connectXml("scene.objects", "wall.in");
-  const char* boxes[] = {"0 -1 -1 10 12 1", "10 -1 -1 20 12 1", "20 -1 -1 30 12 1",
-                         "30 -1 -1 40 12 1", "all", "0 -1 -1 5 12 1"};
+  const char* boxes[] = {
+      "0 -1 -1 10 12 1", "10 -1 -1 20 12 1", "20 -1 -1 30 12 1", "30 -1 -1 40 12 1", "all",
+      "0 -1 -1 5 12 1"};
   for (int k = 0; k < 6; ++k) {
     const std::string id = "tile" + std::to_string(k);
     std::string params = paramXml("box", boxes[k]) + paramXml("file", folder + "/" + id + ".csv");
@@ -244,8 +245,7 @@ TEST_F(Patterns, RouteForwardsExactlyTheIntersectingObjectsAndTheirStateOnEntry)
   ASSERT_EQ(x.size(), static_cast<std::size_t>(iterations - 1));
   for (const auto& [it, bodies] : x) ASSERT_EQ(bodies.size(), 48u) << it;
 
-  const auto check = [&](const std::string& csv, auto tileAt, long from,
-                         std::set<std::string> held,
+  const auto check = [&](const std::string& csv, auto tileAt, long from, std::set<std::string> held,
                          std::set<std::string> resources) -> std::pair<long, long> {
     const auto got = byIteration(csv);
     long entries = 0, leaves = 0;
@@ -318,17 +318,22 @@ TEST_F(Patterns, RouteForwardsExactlyTheIntersectingObjectsAndTheirStateOnEntry)
   }
   EXPECT_FALSE(expected.empty());
   EXPECT_EQ(added, expected);
-  check(dir.file("tile5.csv"), [](long) { return Tile{30, 35}; }, 22, expected, resources);
+  check(
+      dir.file("tile5.csv"),
+      [](long) {
+        return Tile{30, 35};
+      },
+      22, expected, resources);
 }
 
 // Meshes sent after the bodies that use them (iteration 3) reach a viewer only if it holds such
 // a body; a delete reaches only the viewers that hold the body.
 TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
-  std::string modules = moduleXml(
-      "scene", "routing/movers",
-      paramXml("count", "16") + paramXml("meshes", "8") + paramXml("iterations", "12") +
-          paramXml("meshes-at", "3") + paramXml("delete-at", "6") +
-          "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
+  std::string modules =
+      moduleXml("scene", "routing/movers",
+                paramXml("count", "16") + paramXml("meshes", "8") + paramXml("iterations", "12") +
+                    paramXml("meshes-at", "3") + paramXml("delete-at", "6") +
+                    "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
   std::string connections = connectXml("scene.objects", "wall.in");
   const char* boxes[] = {"0 -1 -1 10 12 1", "20 -1 -1 30 12 1", "all"};
   for (int k = 0; k < 3; ++k) {
@@ -385,7 +390,8 @@ TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
       }
     }
     for (const auto& [id, ref] : refOf) refs.insert(ref);
-    for (const auto& r : resources) EXPECT_TRUE(refs.count(r)) << "viewer " << k << ": unasked mesh";
+    for (const auto& r : resources)
+      EXPECT_TRUE(refs.count(r)) << "viewer " << k << ": unasked mesh";
     EXPECT_EQ(deleted, holdsFirst) << "viewer " << k;
   }
   EXPECT_EQ(byIteration(dir.file("v2.csv")).at(3).size(), 16u + 8u) << "all: 8 meshes, 16 bodies";
@@ -424,13 +430,24 @@ TEST_F(Patterns, ValidateExplainsBadPatternParameters) {
       << refused.err;
   // A receiver -> interest cycle needs no initial message: interest does not gate out.
   const auto good = dir.write(
-      "good.xml",
-      appXml(moduleXml("src", "core/source") + moduleXml("rec", "core/recorder"),
-             filterXml("w", "route"),
-             connectXml("src.out", "w.in") + connectXml("rec.endIt", "w.interest0") +
-                 connectXml("w.out0", "rec.in")));
+      "good.xml", appXml(moduleXml("src", "core/source") + moduleXml("rec", "core/recorder"),
+                         filterXml("w", "route"),
+                         connectXml("src.out", "w.in") + connectXml("rec.endIt", "w.interest0") +
+                             connectXml("w.out0", "rec.in")));
   const auto ok = runVrflow({"validate", good});
   EXPECT_EQ(ok.exitCode, 0) << ok.err;
+  // A cycle through route's `in` still needs one.
+  const auto cycle =
+      dir.write("cycle.xml",
+                appXml(moduleXml("relay", "core/relay"), filterXml("w", "route"),
+                       connectXml("relay.out", "w.in") + connectXml("relay.endIt", "w.interest0") +
+                           connectXml("w.out0", "relay.in")));
+  const auto deadlock = runVrflow({"validate", cycle});
+  EXPECT_EQ(deadlock.exitCode, 1);
+  EXPECT_NE(deadlock.err.find("cycle without initial message (would deadlock): relay.out -> w.in, "
+                              "w.out0 -> relay.in"),
+            std::string::npos)
+      << deadlock.err;
 }
 
 // ---- greedy sampling -----------------------------------------------------------------------
@@ -442,13 +459,15 @@ TEST_F(Patterns, ValidateExplainsBadPatternParameters) {
 TEST_F(Patterns, GreedySamplingNeverBlocksTheWriterAndKeepsMemoryFlat) {
   const auto file = dir.write(
       "greedy.xml",
-      appXml(moduleXml("fast", "core/source", paramXml("size", "4096") + paramXml("count", "10000")) +
-                 moduleXml("slow", "testing/slow", paramXml("delay-ms", "10")) +
-                 moduleXml("rec", "core/recorder", paramXml("file", dir.file("sampled.csv"))),
-             filterXml("sample", "latest"),
-             connectXml("fast.out", "sample.in") + connectXml("sample.out", "slow.in") +
-                 connectXml("slow.endIt", "sample.sync") + connectXml("slow.out", "rec.in")));
-  const auto result = runVrflow({"run", file, "--report", dir.file("report.json"), "--timeout", "60"});
+      appXml(
+          moduleXml("fast", "core/source", paramXml("size", "4096") + paramXml("count", "10000")) +
+              moduleXml("slow", "testing/slow", paramXml("delay-ms", "10")) +
+              moduleXml("rec", "core/recorder", paramXml("file", dir.file("sampled.csv"))),
+          filterXml("sample", "latest"),
+          connectXml("fast.out", "sample.in") + connectXml("sample.out", "slow.in") +
+              connectXml("slow.endIt", "sample.sync") + connectXml("slow.out", "rec.in")));
+  const auto result =
+      runVrflow({"run", file, "--report", dir.file("report.json"), "--timeout", "60"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto json = report("report.json");
   std::map<std::string, long> iterations;

@@ -43,8 +43,8 @@ FilterType route() {
       "interest{k} (string user stamp `stamp`: \"minx miny minz maxx maxy maxz\", \"all\" or "
       "\"none\"); out{k} gets the chunks of objects whose bounds meet it, the full state of "
       "an object when it enters, and the resources those objects refer to, once.";
-  type.params.push_back(intParam("outputs", "1", 1, static_cast<double>(kMaxFilterPorts),
-                                 "number of receivers N"));
+  type.params.push_back(
+      intParam("outputs", "1", 1, static_cast<double>(kMaxFilterPorts), "number of receivers N"));
   type.params.push_back(
       stringParam("stamp", "interest", "name of the string user stamp holding the volume"));
   type.params.push_back(enumParam("initially", {"none", "all"},

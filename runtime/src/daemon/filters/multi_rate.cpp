@@ -55,7 +55,8 @@ class RepeatFilter final : public Filter {
 
 class DecimateFilter final : public Filter {
  public:
-  DecimateFilter(uint64_t count, bool restamp) : count_(count == 0 ? 1 : count), restamp_(restamp) {}
+  DecimateFilter(uint64_t count, bool restamp)
+      : count_(count == 0 ? 1 : count), restamp_(restamp) {}
 
   void process(FilterContext& context) override {
     auto& in = context.input(0);

@@ -46,10 +46,12 @@ std::optional<Box> boxOf(const msg::Aabb& aabb) {
 // The parameter holding the bounds of an object of a built-in type (a point: its position).
 std::optional<std::pair<uint32_t, bool>> boundsParamOf(uint32_t typeId) {
   if (typeId == msg::rigidType().id()) return std::pair{uint32_t{msg::RigidParam::kBounds}, true};
-  if (typeId == msg::massSpringType().id()) return std::pair{uint32_t{msg::MassSpringParam::kBounds}, true};
+  if (typeId == msg::massSpringType().id())
+    return std::pair{uint32_t{msg::MassSpringParam::kBounds}, true};
   if (typeId == msg::fluidType().id()) return std::pair{uint32_t{msg::FluidParam::kBounds}, true};
   if (typeId == msg::userType().id()) return std::pair{uint32_t{msg::UserParam::kBounds}, true};
-  if (typeId == msg::pointType().id()) return std::pair{uint32_t{msg::PointParam::kPosition}, false};
+  if (typeId == msg::pointType().id())
+    return std::pair{uint32_t{msg::PointParam::kPosition}, false};
   return std::nullopt;
 }
 
@@ -70,8 +72,8 @@ struct Action {
 };
 
 struct Receiver {
-  std::optional<Box> interest;  // nullopt: nothing
-  bool changed = false;         // interest changed since the last message of `in`
+  std::optional<Box> interest;             // nullopt: nothing
+  bool changed = false;                    // interest changed since the last message of `in`
   std::unordered_set<uint64_t> objects;    // objects whose state it holds (inside its volume)
   std::unordered_set<uint64_t> resources;  // resources it was sent
   std::unordered_set<uint64_t> wanted;     // resources its objects refer to, not seen yet
@@ -271,7 +273,8 @@ class RouteFilter final : public Filter {
           if (object->op() == msg::ObjectOp::Delete) {
             objects_.erase(id);
             for (auto& receiver : receivers_) {
-              if (receiver.objects.erase(id) != 0) receiver.actions.push_back({Action::Chunk, index});
+              if (receiver.objects.erase(id) != 0)
+                receiver.actions.push_back({Action::Chunk, index});
             }
             break;
           }
