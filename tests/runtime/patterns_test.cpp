@@ -397,6 +397,37 @@ TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
   EXPECT_EQ(byIteration(dir.file("v2.csv")).at(3).size(), 16u + 8u) << "all: 8 meshes, 16 bodies";
 }
 
+// core/points: a point's bounds are its position. Four points at rest at x = 0, 1, 2, 3; a
+// volume over x in [-0.5, 1.5] gets points 0 and 1 only (their full state first: the add's
+// mass with the latest position and velocity), every iteration.
+TEST_F(Patterns, RouteJudgesPointsByTheirPosition) {
+  const auto app =
+      dir.write("points.xml",
+                appXml(moduleXml("pts", "core/points",
+                                 paramXml("count", "4") +
+                                     "      <input port=\"beginIt\" initial-messages=\"1\"/>\n") +
+                           moduleXml("view", "routing/tile-viewer",
+                                     paramXml("box", "-0.5 -1 -1 1.5 1 1") +
+                                         paramXml("file", dir.file("view.csv"))),
+                       filterXml("w", "route"),
+                       connectXml("pts.objects", "w.in") + connectXml("w.out0", "view.objects") +
+                           connectXml("view.interest", "w.interest0") +
+                           connectXml("view.endIt", "pts.beginIt")));
+  const auto result = run(app, "--iterations 30");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::map<std::string, double> seen;
+  for (const auto& [it, chunks] : byIteration(dir.file("view.csv"))) {
+    for (const auto& c : chunks) {
+      EXPECT_EQ(c.kind, "object");
+      EXPECT_TRUE(c.x == 0.0 || c.x == 1.0) << "only the points inside, iteration " << it;
+      EXPECT_EQ(c.op, seen.count(c.id) ? "update" : "add");
+      EXPECT_EQ(c.mask, seen.count(c.id) ? "3" : "7") << "position, velocity (and mass)";
+      seen[c.id] = c.x;
+    }
+  }
+  EXPECT_EQ(seen.size(), 2u);
+}
+
 TEST_F(Patterns, RouteExampleCutsTheBytesToEachTile) {
   const auto result = run(example("dynamic_routing/dynamic_routing.xml"), "--report report.json");
   ASSERT_EQ(result.exitCode, 0) << result.err;
