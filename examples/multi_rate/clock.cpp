@@ -1,5 +1,7 @@
 // multirate/clock: the slow outer loop. Iteration i sends an empty message stamped with
 // simulation time i*dt and time step dt ("advance from i*dt to (i+1)*dt"); ends after `count`.
+// Its optional input `state` closes a loop (the fast module's decimated state back to the slow
+// one, as a fluid reads the net it is coupled with): each iteration then waits for one message.
 #include <cstdio>
 
 #include "vrflow/module/module.hpp"
@@ -7,6 +9,7 @@
 int main() {
   vrflow::Module module;
   auto& ticks = module.addOutput("ticks");
+  module.addInput("state");
   if (auto status = module.init(); !status) {
     std::fprintf(stderr, "multirate-clock: %s\n", status.error().message.c_str());
     return 2;

@@ -90,6 +90,40 @@ TEST_F(Patterns, MultiRateRunsTenInnerStepsOfDtOverTenPerOuterStep) {
   }
 }
 
+// The paper's coupling: the slow module reads the fast one's decimated state (a cycle through
+// repeat and decimate, started by one initial message on the slow side). Each outer iteration
+// waits for the 10 inner ones; the states are those of the open chain.
+TEST_F(Patterns, MultiRateLoopBackToTheSlowModuleRunsInLockstep) {
+  const auto app = dir.write(
+      "loop.xml",
+      appXml(moduleXml("outer", "multirate/clock",
+                       paramXml("dt", "0.2") + paramXml("count", "10") +
+                           "      <input port=\"state\" initial-messages=\"1\"/>\n") +
+                 moduleXml("net", "multirate/oscillator", paramXml("stiffness", "225")) +
+                 moduleXml("log", "core/recorder", paramXml("file", "loop.csv")),
+             filterXml("up", "repeat", paramXml("count", "10")) +
+                 filterXml("down", "decimate", paramXml("count", "10")),
+             connectXml("outer.ticks", "up.in") + connectXml("up.out", "net.clock") +
+                 connectXml("net.state", "down.in") + connectXml("down.out", "outer.state") +
+                 connectXml("down.out", "log.in")));
+  const auto result = run(app, "--report report.json");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto json = report("report.json");
+  std::map<std::string, long> iterations;
+  for (const auto& m : json["modules"]) iterations[m["id"]] = m["iterations"].get<long>();
+  EXPECT_EQ(iterations["outer"], 10);
+  EXPECT_EQ(iterations["net"], 100);
+  const auto loop = states(dir.file("loop.csv"));
+  ASSERT_EQ(loop.size(), 10u);
+  ASSERT_EQ(run(example("multi_rate/multi_rate.xml")).exitCode, 0);
+  const auto open = states(dir.file("outer.csv"));
+  ASSERT_EQ(open.size(), 10u);
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    EXPECT_EQ(loop[i].x, open[i].x);
+    EXPECT_EQ(loop[i].simTime, open[i].simTime);
+  }
+}
+
 TEST_F(Patterns, TheSameSpringStepRunAtTheOuterDtExplodes) {
   const auto app = dir.write(
       "single_rate.xml",
