@@ -97,7 +97,7 @@ Result<FrameWriter> FrameWriter::open(const FrameWriterSettings& settings) {
   const std::string command =
       shellQuote(ffmpeg) + " -y -loglevel error -f rawvideo -pixel_format rgb24 -video_size " +
       std::to_string(settings.width) + "x" + std::to_string(settings.height) + " -framerate " +
-      std::to_string(settings.fps) + " -i - -vf pad=ceil(iw/2)*2:ceil(ih/2)*2 " + codec +
+      std::to_string(settings.fps) + " -i - -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' " + codec +
       " -pix_fmt yuv420p " + shellQuote(video);
   writer.pipe_ = popen(command.c_str(), "w");
   if (!writer.pipe_) return makeError("cannot start ffmpeg: " + command);
