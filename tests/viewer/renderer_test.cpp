@@ -271,6 +271,36 @@ TEST(Renderer, ShadowDarkensTheGroundUnderAnObject) {
   EXPECT_LT(a[0] + 20, b[0]) << "shadowed " << int(a[0]) << ", plain " << int(b[0]);
 }
 
+TEST(Renderer, SupersamplingKeepsColoursAndBlendsEdges) {
+  SceneCache scene;
+  const msg::Vec3 centre{2.0, 1.0, 0.0};
+  ASSERT_TRUE(feed(scene, [&](msg::MessageBuilder& b) {
+    addShape(b, 100, msg::Shape::box({0.5, 0.5, 0.5}));
+    addRigid(b, 7, centre, 100);
+  }));
+  auto s = settings();
+  s.supersample = 3;
+  const Image image = render(scene, s);
+  ASSERT_EQ(image.width, kWidth);
+  const auto c = project({centre[0], centre[1], centre[2] + 0.5});
+  EXPECT_TRUE(pixelIs(image, static_cast<int>(c[0]), static_cast<int>(c[1]),
+                      bytesOf(objectColour(7), facingCameraIntensity()), 3));
+  // Along the row through the centre, the top edge of the front face is crossed somewhere: some
+  // pixel of the column above the centre is neither background nor face colour.
+  const auto background = bytesOf(s.background);
+  const auto face = bytesOf(objectColour(7), facingCameraIntensity());
+  int blended = 0;
+  for (int y = static_cast<int>(c[1]) - 30; y < c[1]; ++y) {
+    const auto p = image.at(static_cast<int>(c[0]), y);
+    const bool isBackground = pixelIs(image, static_cast<int>(c[0]), y, background, 1);
+    const bool isFace = pixelIs(image, static_cast<int>(c[0]), y, face, 3);
+    if (!isBackground && !isFace && p[2] <= std::max(background[2], face[2]) + 1) ++blended;
+  }
+  EXPECT_GE(blended, 1);
+  s.supersample = 5;
+  EXPECT_FALSE(Renderer::create(s).ok());
+}
+
 TEST(Renderer, RejectsAnImpossibleImageSize) {
   auto s = settings();
   s.width = 0;
@@ -279,12 +309,20 @@ TEST(Renderer, RejectsAnImpossibleImageSize) {
   EXPECT_NE(renderer.error().message.find("image size"), std::string::npos);
 }
 
-TEST(ObjectColour, IsStablePerIdAndDiffersBetweenNeighbours) {
+TEST(ObjectColour, IsStablePerIdAndFarApartForASendersConsecutiveIds) {
   EXPECT_EQ(objectColour(42), objectColour(42));
-  EXPECT_NE(objectColour(42), objectColour(43));
-  for (const float c : objectColour(42)) {
-    EXPECT_GE(c, 0.0f);
-    EXPECT_LE(c, 1.0f);
+  // Ids as Module::newId() hands them out on one host: consecutive counters.
+  const std::uint64_t first = (std::uint64_t{0x7F000001} << 32) | 5;
+  for (std::uint64_t a = first; a < first + 6; ++a) {
+    for (const float c : objectColour(a)) {
+      EXPECT_GE(c, 0.0f);
+      EXPECT_LE(c, 1.0f);
+    }
+    for (std::uint64_t b = a + 1; b < first + 6; ++b) {
+      const auto x = objectColour(a), y = objectColour(b);
+      const float distance = std::abs(x[0] - y[0]) + std::abs(x[1] - y[1]) + std::abs(x[2] - y[2]);
+      EXPECT_GT(distance, 0.15f) << "ids " << a << " and " << b;
+    }
   }
 }
 

@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   viewer::RenderSettings settings;
+  settings.supersample = 2;
   if (argc >= 4) {
     settings.width = std::atoi(argv[2]);
     settings.height = std::atoi(argv[3]);

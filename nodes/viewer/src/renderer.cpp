@@ -123,19 +123,25 @@ std::array<float, 3> hsvToRgb(double h, double s, double v) {
 }  // namespace
 
 std::array<float, 3> objectColour(std::uint64_t id) {
-  // splitmix64 finaliser: every bit of the id moves the hue.
-  std::uint64_t z = id + 0x9E3779B97F4A7C15ull;
+  // Ids are hostId << 32 | counter, and a sender's objects usually have consecutive counters:
+  // stepping the hue by the golden ratio per counter keeps neighbours far apart on the colour
+  // wheel; the host part (hashed, splitmix64) shifts the whole sequence.
+  std::uint64_t z = (id >> 32) + 0x9E3779B97F4A7C15ull;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   z ^= z >> 31;
-  const double hue = static_cast<double>(z >> 11) / 9007199254740992.0;  // [0, 1)
-  return hsvToRgb(hue, 0.65, 0.9);
+  const double offset = static_cast<double>(z >> 11) / 9007199254740992.0;  // [0, 1)
+  const double counter = static_cast<double>(id & 0xFFFFFFFFull);
+  const double hue = std::fmod(offset + counter * 0.6180339887498949, 1.0);
+  return hsvToRgb(hue, 0.62, 0.88);
 }
 
 struct Renderer::Impl {
   RenderSettings settings;
   OSMesaContext context = nullptr;
   std::vector<std::uint8_t> rgba;  // the OSMesa colour buffer, rows from the bottom
+  int bufferWidth = 0;             // settings' size times the supersampling factor
+  int bufferHeight = 0;
   DrawMesh unitSphere;             // point objects
 
   ~Impl() {
@@ -149,7 +155,7 @@ struct Renderer::Impl {
 
 void Renderer::Impl::setUpFrame(const Camera& camera) const {
   const auto& s = settings;
-  glViewport(0, 0, s.width, s.height);
+  glViewport(0, 0, bufferWidth, bufferHeight);
   glClearColor(s.background[0], s.background[1], s.background[2], 1.0f);
   glClearStencil(0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
@@ -247,12 +253,26 @@ void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass) const
       }
       case ObjectKind::MassSpring: {
         const DrawMesh mesh = netMesh(object);
-        if (!mesh.indices.empty()) {
+        if (!mesh.indices.empty() && (shadowPass || !settings.netLines)) {
           drawMesh(mesh);
+        } else if (!mesh.indices.empty()) {
+          // The surface pushed back a little in depth, then its edges, darker, on top.
+          glEnable(GL_POLYGON_OFFSET_FILL);
+          glPolygonOffset(1.0f, 1.0f);
+          drawMesh(mesh);
+          glDisable(GL_POLYGON_OFFSET_FILL);
+          const auto colour = objectColour(id);
+          glDisable(GL_LIGHTING);
+          glColor3f(colour[0] * 0.45f, colour[1] * 0.45f, colour[2] * 0.45f);
+          glLineWidth(static_cast<float>(settings.supersample));
+          glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+          drawMesh(mesh);
+          glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+          glEnable(GL_LIGHTING);
         } else if (!shadowPass && !mesh.xyz.empty()) {
           // No surface: the masses as dots.
           glDisable(GL_LIGHTING);
-          glPointSize(4.0f);
+          glPointSize(4.0f * static_cast<float>(settings.supersample));
           glEnableClientState(GL_VERTEX_ARRAY);
           glVertexPointer(3, GL_FLOAT, 0, mesh.xyz.data());
           glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(mesh.xyz.size() / 3));
@@ -267,7 +287,7 @@ void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass) const
         const auto& c = settings.particleColour;
         glDisable(GL_LIGHTING);
         glColor3f(c[0], c[1], c[2]);
-        glPointSize(settings.particleSize);
+        glPointSize(settings.particleSize * static_cast<float>(settings.supersample));
         glEnableClientState(GL_VERTEX_ARRAY);
         glVertexPointer(3, GL_FLOAT, 0, xyz->data());
         glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(xyz->size() / 3));
@@ -292,11 +312,19 @@ Result<Renderer> Renderer::create(const RenderSettings& settings) {
     return makeError("image size must be 1..8192 pixels each way, got " +
                      std::to_string(settings.width) + "x" + std::to_string(settings.height));
   }
+  if (settings.supersample < 1 || settings.supersample > 4 ||
+      settings.width * settings.supersample > 8192 ||
+      settings.height * settings.supersample > 8192) {
+    return makeError("supersample must be 1..4 and keep the drawn size within 8192 pixels, got " +
+                     std::to_string(settings.supersample));
+  }
   auto impl = std::make_unique<Impl>();
   impl->settings = settings;
   impl->context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
   if (!impl->context) return makeError("OSMesa could not create an RGBA context with 24-bit depth");
-  impl->rgba.resize(static_cast<std::size_t>(settings.width) * settings.height * 4);
+  impl->bufferWidth = settings.width * settings.supersample;
+  impl->bufferHeight = settings.height * settings.supersample;
+  impl->rgba.resize(static_cast<std::size_t>(impl->bufferWidth) * impl->bufferHeight * 4);
   const auto sphere = msg::renderMesh(msg::Shape::sphere(1.0), 16);
   impl->unitSphere = buildDrawMesh(sphere.xyz, sphere.indices);
   return Renderer(std::move(impl));
@@ -305,7 +333,8 @@ Result<Renderer> Renderer::create(const RenderSettings& settings) {
 Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera) {
   Impl& r = *impl_;
   const auto& s = r.settings;
-  if (!OSMesaMakeCurrent(r.context, r.rgba.data(), GL_UNSIGNED_BYTE, s.width, s.height)) {
+  if (!OSMesaMakeCurrent(r.context, r.rgba.data(), GL_UNSIGNED_BYTE, r.bufferWidth,
+                         r.bufferHeight)) {
     return makeError("OSMesa could not bind the frame buffer");
   }
   if (!finite(camera.eye) || !finite(camera.target) || camera.eye == camera.target) {
@@ -343,13 +372,21 @@ Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera) {
   image.width = s.width;
   image.height = s.height;
   image.rgb.resize(static_cast<std::size_t>(s.width) * s.height * 3);
+  // Rows from the top, each pixel the mean of its k x k drawn samples.
+  const int k = s.supersample;
+  const std::size_t rowBytes = static_cast<std::size_t>(r.bufferWidth) * 4;
   for (int y = 0; y < s.height; ++y) {
-    const std::uint8_t* from = r.rgba.data() + static_cast<std::size_t>(s.height - 1 - y) * s.width * 4;
     std::uint8_t* to = image.rgb.data() + static_cast<std::size_t>(y) * s.width * 3;
     for (int x = 0; x < s.width; ++x) {
-      to[3 * x] = from[4 * x];
-      to[3 * x + 1] = from[4 * x + 1];
-      to[3 * x + 2] = from[4 * x + 2];
+      for (int c = 0; c < 3; ++c) {
+        int sum = 0;
+        for (int dy = 0; dy < k; ++dy) {
+          const std::size_t row = static_cast<std::size_t>(r.bufferHeight - 1 - (y * k + dy));
+          const std::uint8_t* from = r.rgba.data() + row * rowBytes;
+          for (int dx = 0; dx < k; ++dx) sum += from[static_cast<std::size_t>(x * k + dx) * 4 + c];
+        }
+        to[3 * x + c] = static_cast<std::uint8_t>((sum + k * k / 2) / (k * k));
+      }
     }
   }
   return image;

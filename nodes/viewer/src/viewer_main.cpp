@@ -110,6 +110,8 @@ int main() {
   render.groundHalfSize = params.number("ground-size", 20.0, 0.01, 1e4);
   render.groundTile = params.number("ground-tile", 1.0, 0.001, 1e4);
   render.shadows = params.boolean("shadows", true);
+  render.netLines = params.boolean("net-lines", true);
+  render.supersample = params.integer("supersample", 2, 1, 4);
   render.pointRadius = params.number("point-radius", 0.08, 1e-6, 1e6);
   render.particleSize = static_cast<float>(params.number("particle-size", 3.0, 1.0, 64.0));
   const int segments = params.integer("segments", 24, 4, 256);

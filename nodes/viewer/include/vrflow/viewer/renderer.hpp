@@ -27,6 +27,8 @@ struct RenderSettings {
   std::array<float, 3> groundLight{0.78f, 0.78f, 0.76f};
   std::array<float, 3> groundDark{0.62f, 0.62f, 0.60f};
   bool shadows = true;                                   ///< dark footprints under objects
+  bool netLines = true;                                  ///< a net's triangle edges drawn darker
+  int supersample = 1;  ///< 1..4: draws at this many times the size, then averages (antialiasing)
   double pointRadius = 0.08;                             ///< spheres drawn for `point` objects
   float particleSize = 3.0f;                             ///< fluid particles, pixels
   std::array<float, 3> particleColour{0.15f, 0.40f, 0.85f};
