@@ -1,6 +1,7 @@
 // The viewer module in a `vrflow run`: frames on disk, bad parameters refused by name.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -37,6 +38,16 @@ std::string param(const std::string& name, const std::string& value) {
   return "<param name=\"" + name + "\" value=\"" + value + "\"/>";
 }
 
+// Pixels whose channels differ by more than 60: objects, not the grey ground or the pale sky.
+int colouredPixels(const Image& image) {
+  int coloured = 0;
+  for (std::size_t i = 0; i < image.rgb.size(); i += 3) {
+    const int r = image.rgb[i], g = image.rgb[i + 1], b = image.rgb[i + 2];
+    if (std::max({r, g, b}) - std::min({r, g, b}) > 60) ++coloured;
+  }
+  return coloured;
+}
+
 std::vector<std::string> filesIn(const std::string& dir) {
   std::vector<std::string> names;
   std::error_code ec;
@@ -70,13 +81,7 @@ TEST(ViewerModule, WritesOnePngPerIterationOfTheRun) {
   EXPECT_EQ(first->width, 160);
   EXPECT_EQ(first->height, 120);
   EXPECT_NE(first->rgb, last->rgb);  // the objects moved
-  // Something besides background and ground: count strongly coloured pixels.
-  int coloured = 0;
-  for (std::size_t i = 0; i < first->rgb.size(); i += 3) {
-    const int r = first->rgb[i], g = first->rgb[i + 1], b = first->rgb[i + 2];
-    if (std::max({r, g, b}) - std::min({r, g, b}) > 60) ++coloured;
-  }
-  EXPECT_GT(coloured, 500);
+  EXPECT_GT(colouredPixels(*first), 500);  // the objects are drawn
   EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
 }
 
@@ -99,7 +104,12 @@ TEST(ViewerModule, DeletedObjectDisappearsAndForgedShapeIsLoggedNotFatal) {
   ASSERT_EQ(result.exitCode, 0) << result.err;
   EXPECT_NE(result.err.find("rejected"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("module 'view'"), std::string::npos) << result.err;
-  EXPECT_EQ(filesIn(out).size(), 5u);
+  ASSERT_EQ(filesIn(out).size(), 5u);
+  // The sphere (about 0.5 m across at 7 m: hundreds of pixels) is gone after iteration 2.
+  const auto before = readPng(out + "/frame_000001.png");
+  const auto after = readPng(out + "/frame_000003.png");
+  ASSERT_TRUE(before.ok() && after.ok());
+  EXPECT_GT(colouredPixels(*before), colouredPixels(*after) + 150);
 }
 
 TEST(ViewerModule, ScriptedCameraMovesTheView) {
@@ -127,6 +137,19 @@ TEST(ViewerModule, BadParametersStopTheRunNamingModuleAndParameter) {
     EXPECT_NE(result.err.find("view"), std::string::npos) << result.err;
     EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
   }
+}
+
+TEST(ViewerExample, SnapshotWritesTheSampleScene) {
+  TempDir dir;
+  const auto png = dir.file("snapshot.png");
+  const auto result = vrflow::testing::runCommand(
+      {vrflow::testing::binDir() + "/vrflow-viewer-snapshot", png, "200", "100"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto image = readPng(png);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  EXPECT_EQ(image->width, 200);
+  EXPECT_EQ(image->height, 100);
+  EXPECT_GT(colouredPixels(*image), 300);
 }
 
 TEST(ViewerModule, WritesAnMp4WhenFfmpegIsPresent) {
