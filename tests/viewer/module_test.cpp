@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "../runtime/process_helpers.hpp"
@@ -137,6 +139,50 @@ TEST(ViewerModule, BadParametersStopTheRunNamingModuleAndParameter) {
     EXPECT_NE(result.err.find("view"), std::string::npos) << result.err;
     EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
   }
+}
+
+// The digests of every output port but the viewer's, from a run report.
+std::map<std::string, std::string> simulationDigests(const std::string& reportPath) {
+  std::map<std::string, std::string> digests;
+  const auto report = nlohmann::json::parse(vrflow::testing::readFile(reportPath));
+  for (const auto& output : report["outputs"]) {
+    if (output["module"] == "view") continue;
+    digests[output["module"].get<std::string>() + "." + output["port"].get<std::string>()] =
+        output["last_digest"].dump();
+  }
+  return digests;
+}
+
+TEST(ViewerExample, ChainWithAViewerComputesTheSameBitsAsWithout) {
+  TempDir dir;
+  const std::string source = vrflow::testing::readFile(
+      vrflow::testing::sourceDir() + "/nodes/viewer/examples/chain_viewer.xml");
+  // The same application without the viewer module and its connection.
+  std::string without = source;
+  const auto begin = without.find("    <module id=\"view\"");
+  const auto end = without.find("</module>", begin);
+  ASSERT_NE(begin, std::string::npos);
+  without.erase(begin, end + std::string("</module>\n").size() - begin);
+  const std::string connection = "    <connection from=\"chain.objects\" to=\"view.objects\"/>\n";
+  ASSERT_NE(without.find(connection), std::string::npos);
+  without.erase(without.find(connection), connection.size());
+  const auto withFile = dir.write("with.xml", source);
+  const auto withoutFile = dir.write("without.xml", without);
+  const auto run = [&](const std::string& app, const std::string& report) {
+    return vrflow::testing::runCommand(
+        {"/bin/sh", "-c",
+         "cd " + dir.path() + " && " + vrflow::testing::binDir() + "/vrflow run " + app +
+             " -n 60 --report " + report});
+  };
+  const auto a = run(withFile, dir.file("with.json"));
+  ASSERT_EQ(a.exitCode, 0) << a.err;
+  const auto b = run(withoutFile, dir.file("without.json"));
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  const auto withDigests = simulationDigests(dir.file("with.json"));
+  EXPECT_EQ(withDigests.size(), 3u);  // chain.objects, springs.forces, gravity.forces
+  for (const auto& [port, digest] : withDigests) EXPECT_NE(digest, "null") << port;
+  EXPECT_EQ(withDigests, simulationDigests(dir.file("without.json")));
+  EXPECT_EQ(filesIn(dir.file("out/chain-viewer")).size(), 6u);  // iterations 0, 10, ..., 50
 }
 
 TEST(ViewerExample, SnapshotWritesTheSampleScene) {
