@@ -53,7 +53,8 @@ int colouredPixels(const Image& image) {
 std::vector<std::string> filesIn(const std::string& dir) {
   std::vector<std::string> names;
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) names.push_back(entry.path().filename());
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    names.push_back(entry.path().filename());
   std::sort(names.begin(), names.end());
   return names;
 }
@@ -73,16 +74,16 @@ TEST(ViewerModule, WritesOnePngPerIterationOfTheRun) {
   const auto out = dir.file("frames");
   const auto result = run(dir, application(common(out)));
   ASSERT_EQ(result.exitCode, 0) << result.err;
-  EXPECT_EQ(filesIn(out), (std::vector<std::string>{"frame_000000.png", "frame_000001.png",
-                                                     "frame_000002.png", "frame_000003.png",
-                                                     "frame_000004.png"}));
+  EXPECT_EQ(filesIn(out),
+            (std::vector<std::string>{"frame_000000.png", "frame_000001.png", "frame_000002.png",
+                                      "frame_000003.png", "frame_000004.png"}));
   EXPECT_NE(result.err.find("PNG frames"), std::string::npos) << result.err;
   const auto first = readPng(out + "/frame_000000.png");
   const auto last = readPng(out + "/frame_000004.png");
   ASSERT_TRUE(first.ok() && last.ok());
   EXPECT_EQ(first->width, 160);
   EXPECT_EQ(first->height, 120);
-  EXPECT_NE(first->rgb, last->rgb);  // the objects moved
+  EXPECT_NE(first->rgb, last->rgb);        // the objects moved
   EXPECT_GT(colouredPixels(*first), 500);  // the objects are drawn
   EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
 }
@@ -118,8 +119,8 @@ TEST(ViewerModule, ScriptedCameraMovesTheView) {
   TempDir dir;
   const auto out = dir.file("frames");
   const auto path = dir.write("camera.txt", "0 0 2.5 7 0 1 0\n4 7 2.5 0 0 1 0 60\n");
-  const auto result = run(dir, application(common(out) + param("camera-path", path),
-                                           param("count", "5")));
+  const auto result =
+      run(dir, application(common(out) + param("camera-path", path), param("count", "5")));
   ASSERT_EQ(result.exitCode, 0) << result.err;
   ASSERT_EQ(filesIn(out).size(), 5u);
 }
@@ -128,10 +129,10 @@ TEST(ViewerModule, BadParametersStopTheRunNamingModuleAndParameter) {
   struct Case {
     std::string params, name;
   };
-  for (const Case& c : {Case{param("eye", "0 1 0") + param("target", "0 1 0"), "'eye'"},
-                        Case{param("camera-path", "/nonexistent/camera.txt"), "'camera-path'"},
-                        Case{param("width", "3"), "width"},
-                        Case{param("format", "gif"), "format"}}) {
+  for (const Case& c :
+       {Case{param("eye", "0 1 0") + param("target", "0 1 0"), "'eye'"},
+        Case{param("camera-path", "/nonexistent/camera.txt"), "'camera-path'"},
+        Case{param("width", "3"), "width"}, Case{param("format", "gif"), "format"}}) {
     TempDir dir;
     const auto result = run(dir, application(param("output-dir", dir.file("f")) + c.params));
     EXPECT_NE(result.exitCode, 0) << c.params;
@@ -155,8 +156,8 @@ std::map<std::string, std::string> simulationDigests(const std::string& reportPa
 
 TEST(ViewerExample, ChainWithAViewerComputesTheSameBitsAsWithout) {
   TempDir dir;
-  const std::string source = vrflow::testing::readFile(
-      vrflow::testing::sourceDir() + "/nodes/viewer/examples/chain_viewer.xml");
+  const std::string source = vrflow::testing::readFile(vrflow::testing::sourceDir() +
+                                                       "/nodes/viewer/examples/chain_viewer.xml");
   // The same application without the viewer module and its connection.
   std::string without = source;
   const auto begin = without.find("    <module id=\"view\"");
@@ -169,10 +170,9 @@ TEST(ViewerExample, ChainWithAViewerComputesTheSameBitsAsWithout) {
   const auto withFile = dir.write("with.xml", source);
   const auto withoutFile = dir.write("without.xml", without);
   const auto run = [&](const std::string& app, const std::string& report) {
-    return vrflow::testing::runCommand(
-        {"/bin/sh", "-c",
-         "cd " + dir.path() + " && " + vrflow::testing::binDir() + "/vrflow run " + app +
-             " -n 60 --report " + report});
+    return vrflow::testing::runCommand({"/bin/sh", "-c",
+                                        "cd " + dir.path() + " && " + vrflow::testing::binDir() +
+                                            "/vrflow run " + app + " -n 60 --report " + report});
   };
   const auto a = run(withFile, dir.file("with.json"));
   ASSERT_EQ(a.exitCode, 0) << a.err;

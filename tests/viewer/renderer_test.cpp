@@ -137,8 +137,9 @@ TEST(Renderer, BoxCoversItsProjectionLitByTheFixedLights) {
   // Every corner of the box projects inside this rectangle; 2 pixels outside it is background.
   double minX = 1e9, maxX = -1e9, minY = 1e9, maxY = -1e9;
   for (int corner = 0; corner < 8; ++corner) {
-    const auto p = project({centre[0] + ((corner & 1) ? h : -h), centre[1] + ((corner & 2) ? h : -h),
-                            centre[2] + ((corner & 4) ? h : -h)});
+    const auto p =
+        project({centre[0] + ((corner & 1) ? h : -h), centre[1] + ((corner & 2) ? h : -h),
+                 centre[2] + ((corner & 4) ? h : -h)});
     minX = std::min(minX, p[0]), maxX = std::max(maxX, p[0]);
     minY = std::min(minY, p[1]), maxY = std::max(maxY, p[1]);
   }

@@ -64,8 +64,8 @@ TEST(SceneCache, UpdateChangesOnlyTheParametersItCarries) {
   const CachedObject* o = s.scene.find(1);
   ASSERT_NE(o, nullptr);
   EXPECT_EQ(o->position, (msg::Vec3{4, 5, 6}));
-  EXPECT_EQ(o->orientation, q);      // kept
-  EXPECT_EQ(o->shapeId, 100u);       // kept
+  EXPECT_EQ(o->orientation, q);                                // kept
+  EXPECT_EQ(o->shapeId, 100u);                                 // kept
   EXPECT_EQ(s.scene.find(2)->position, (msg::Vec3{5, 5, 5}));  // untouched
   ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) {
     b.addObject(1, msg::rigidType(), msg::ObjectOp::Update)
@@ -108,11 +108,14 @@ TEST(SceneCache, DeleteRemovesTheObject) {
 
 TEST(SceneCache, StaticShapeIsDecodedOnce) {
   LoggedScene s;
-  ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) { addShape(b, 100, msg::Shape::sphere(1)); }));
+  ASSERT_TRUE(
+      feed(s.scene, [&](msg::MessageBuilder& b) { addShape(b, 100, msg::Shape::sphere(1)); }));
   const DrawMesh* first = s.scene.shapeMesh(100);
   ASSERT_NE(first, nullptr);
   // The same id again (another sender's copy) keeps the mesh already built.
-  ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) { addShape(b, 100, msg::Shape::box({1, 1, 1})); }));
+  ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) {
+    addShape(b, 100, msg::Shape::box({1, 1, 1}));
+  }));
   EXPECT_EQ(s.scene.shapeMesh(100), first);
 }
 
@@ -171,7 +174,8 @@ TEST(SceneCache, ShapeArrivingAfterItsObjectIsUsed) {
   LoggedScene s;
   ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) { addRigid(b, 1, {0, 1, 0}, 100); }));
   EXPECT_EQ(s.scene.shapeMesh(100), nullptr);
-  ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) { addShape(b, 100, msg::Shape::sphere(1)); }));
+  ASSERT_TRUE(
+      feed(s.scene, [&](msg::MessageBuilder& b) { addShape(b, 100, msg::Shape::sphere(1)); }));
   EXPECT_NE(s.scene.shapeMesh(100), nullptr);
   EXPECT_TRUE(s.lines.empty());
 }
@@ -215,18 +219,21 @@ TEST(DrawMesh, BoxHasFlatFacesAndSphereSmoothNormals) {
   const DrawMesh flat = buildDrawMesh(box.xyz, box.indices);
   EXPECT_EQ(flat.xyz.size(), 24u * 3u);  // four corners per face, none shared across faces
   for (std::size_t i = 0; i < flat.normals.size(); i += 3) {
-    const float big = std::max({std::abs(flat.normals[i]), std::abs(flat.normals[i + 1]),
-                                std::abs(flat.normals[i + 2])});
+    const float big = std::max(
+        {std::abs(flat.normals[i]), std::abs(flat.normals[i + 1]), std::abs(flat.normals[i + 2])});
     EXPECT_NEAR(big, 1.0f, 1e-6f);  // an axis direction
   }
   const auto sphere = msg::renderMesh(msg::Shape::sphere(2.0), 16);
   const DrawMesh smooth = buildDrawMesh(sphere.xyz, sphere.indices);
   for (std::size_t i = 0; i < smooth.xyz.size(); i += 3) {
     // On a sphere about the origin the normal points along the position.
-    const float r = std::sqrt(smooth.xyz[i] * smooth.xyz[i] + smooth.xyz[i + 1] * smooth.xyz[i + 1] +
-                              smooth.xyz[i + 2] * smooth.xyz[i + 2]);
-    const float cosine = (smooth.xyz[i] * smooth.normals[i] + smooth.xyz[i + 1] * smooth.normals[i + 1] +
-                          smooth.xyz[i + 2] * smooth.normals[i + 2]) / r;
+    const float r =
+        std::sqrt(smooth.xyz[i] * smooth.xyz[i] + smooth.xyz[i + 1] * smooth.xyz[i + 1] +
+                  smooth.xyz[i + 2] * smooth.xyz[i + 2]);
+    const float cosine =
+        (smooth.xyz[i] * smooth.normals[i] + smooth.xyz[i + 1] * smooth.normals[i + 1] +
+         smooth.xyz[i + 2] * smooth.normals[i + 2]) /
+        r;
     EXPECT_GT(cosine, 0.97f);
   }
 }

@@ -17,7 +17,9 @@ bool finite(const msg::Vec3& v) {
 
 }  // namespace
 
-CameraPath::CameraPath(const Camera& fixed) { keys_.push_back({0, fixed}); }
+CameraPath::CameraPath(const Camera& fixed) {
+  keys_.push_back({0, fixed});
+}
 
 Result<CameraPath> CameraPath::fromKeys(std::vector<CameraKey> keys) {
   if (keys.empty()) return makeError("a camera path needs at least one key");
@@ -66,8 +68,8 @@ Result<CameraPath> CameraPath::parse(const std::string& text, const Camera& base
     if (fields >> fov) key.camera.fovYDegrees = fov;
     std::string extra;
     if (!fields.eof() && (fields.clear(), fields >> extra)) {
-      return makeError("camera path line " + std::to_string(lineNumber) + ": unexpected '" +
-                       extra + "'");
+      return makeError("camera path line " + std::to_string(lineNumber) + ": unexpected '" + extra +
+                       "'");
     }
     key.iteration = static_cast<std::uint64_t>(iteration);
     keys.push_back(key);
@@ -92,8 +94,8 @@ Camera CameraPath::at(std::uint64_t iteration) const {
   while (keys_[next].iteration < iteration) ++next;
   const CameraKey& a = keys_[next - 1];
   const CameraKey& b = keys_[next];
-  const double t = static_cast<double>(iteration - a.iteration) /
-                   static_cast<double>(b.iteration - a.iteration);
+  const double t =
+      static_cast<double>(iteration - a.iteration) / static_cast<double>(b.iteration - a.iteration);
   Camera c = a.camera;
   c.eye = lerp(a.camera.eye, b.camera.eye, t);
   c.target = lerp(a.camera.target, b.camera.target, t);

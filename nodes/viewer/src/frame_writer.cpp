@@ -84,9 +84,9 @@ Result<FrameWriter> FrameWriter::open(const FrameWriterSettings& settings) {
     return makeError("format mp4 needs ffmpeg, which is not on PATH (use format png or auto)");
   }
   if (settings.format == FrameFormat::Png || ffmpeg.empty()) {
-    writer.description_ = "PNG frames " + settings.directory + "/" + settings.prefix +
-                          "_NNNNNN.png" +
-                          (settings.format == FrameFormat::Auto ? " (ffmpeg not found on PATH)" : "");
+    writer.description_ =
+        "PNG frames " + settings.directory + "/" + settings.prefix + "_NNNNNN.png" +
+        (settings.format == FrameFormat::Auto ? " (ffmpeg not found on PATH)" : "");
     return writer;
   }
   // Even sizes keep yuv420p happy; the filter pads an odd frame by one pixel.
@@ -125,7 +125,9 @@ FrameWriter& FrameWriter::operator=(FrameWriter&& other) noexcept {
   return *this;
 }
 
-FrameWriter::~FrameWriter() { (void)close(); }
+FrameWriter::~FrameWriter() {
+  (void)close();
+}
 
 Status FrameWriter::write(const Image& image) {
   if (image.width != settings_.width || image.height != settings_.height) {

@@ -29,7 +29,8 @@ void pngWarning(png_structp, png_const_charp) {}
 std::array<std::uint8_t, 3> Image::at(int x, int y) const {
   VRFLOW_ASSERT(x >= 0 && x < width && y >= 0 && y < height, "Image::at outside the image");
   const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                         static_cast<std::size_t>(x)) * 3;
+                         static_cast<std::size_t>(x)) *
+                        3;
   return {rgb[i], rgb[i + 1], rgb[i + 2]};
 }
 

@@ -16,11 +16,15 @@ constexpr double kPi = 3.14159265358979323846;
 // Column-major 4x4 for glMultMatrixd.
 using Matrix = std::array<double, 16>;
 
-msg::Vec3 sub(const msg::Vec3& a, const msg::Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+msg::Vec3 sub(const msg::Vec3& a, const msg::Vec3& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
 msg::Vec3 cross(const msg::Vec3& a, const msg::Vec3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
-double dot(const msg::Vec3& a, const msg::Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double dot(const msg::Vec3& a, const msg::Vec3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 msg::Vec3 unit(const msg::Vec3& v) {
   const double length = std::sqrt(dot(v, v));
   return length > 0.0 ? msg::Vec3{v[0] / length, v[1] / length, v[2] / length} : msg::Vec3{0, 0, 0};
@@ -31,10 +35,22 @@ Matrix lookAt(const Camera& camera) {
   msg::Vec3 s = unit(cross(f, camera.up));
   if (dot(s, s) == 0.0) s = unit(cross(f, {0.0, 0.0, 1.0}));  // up parallel to the view
   const msg::Vec3 u = cross(s, f);
-  return {s[0], u[0], -f[0], 0.0,
-          s[1], u[1], -f[1], 0.0,
-          s[2], u[2], -f[2], 0.0,
-          -dot(s, camera.eye), -dot(u, camera.eye), dot(f, camera.eye), 1.0};
+  return {s[0],
+          u[0],
+          -f[0],
+          0.0,
+          s[1],
+          u[1],
+          -f[1],
+          0.0,
+          s[2],
+          u[2],
+          -f[2],
+          0.0,
+          -dot(s, camera.eye),
+          -dot(u, camera.eye),
+          dot(f, camera.eye),
+          1.0};
 }
 
 Matrix rotation(const msg::Quat& q) {
@@ -42,10 +58,22 @@ Matrix rotation(const msg::Quat& q) {
   const double n = std::sqrt(x * x + y * y + z * z + w * w);
   if (!(n > 0.0) || !std::isfinite(n)) return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   x /= n, y /= n, z /= n, w /= n;
-  return {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),     0,
-          2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),     0,
-          2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y), 0,
-          0, 0, 0, 1};
+  return {1 - 2 * (y * y + z * z),
+          2 * (x * y + z * w),
+          2 * (x * z - y * w),
+          0,
+          2 * (x * y - z * w),
+          1 - 2 * (x * x + z * z),
+          2 * (y * z + x * w),
+          0,
+          2 * (x * z + y * w),
+          2 * (y * z - x * w),
+          1 - 2 * (x * x + y * y),
+          0,
+          0,
+          0,
+          0,
+          1};
 }
 
 // Projects onto the plane y = h along the direction towards a directional light.
@@ -110,12 +138,18 @@ std::array<float, 3> hsvToRgb(double h, double s, double v) {
   const double hp = h * 6.0;
   const double x = c * (1.0 - std::abs(std::fmod(hp, 2.0) - 1.0));
   double r = 0, g = 0, b = 0;
-  if (hp < 1) r = c, g = x;
-  else if (hp < 2) r = x, g = c;
-  else if (hp < 3) g = c, b = x;
-  else if (hp < 4) g = x, b = c;
-  else if (hp < 5) r = x, b = c;
-  else r = c, b = x;
+  if (hp < 1)
+    r = c, g = x;
+  else if (hp < 2)
+    r = x, g = c;
+  else if (hp < 3)
+    g = c, b = x;
+  else if (hp < 4)
+    g = x, b = c;
+  else if (hp < 5)
+    r = x, b = c;
+  else
+    r = c, b = x;
   const double m = v - c;
   return {static_cast<float>(r + m), static_cast<float>(g + m), static_cast<float>(b + m)};
 }
@@ -142,7 +176,7 @@ struct Renderer::Impl {
   std::vector<std::uint8_t> rgba;  // the OSMesa colour buffer, rows from the bottom
   int bufferWidth = 0;             // settings' size times the supersampling factor
   int bufferHeight = 0;
-  DrawMesh unitSphere;             // point objects
+  DrawMesh unitSphere;  // point objects
 
   ~Impl() {
     if (context) OSMesaDestroyContext(context);
@@ -181,13 +215,15 @@ void Renderer::Impl::setUpFrame(const Camera& camera) const {
   const float fill[4] = {kLighting.fill, kLighting.fill, kLighting.fill, 1.0f};
   const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
   glEnable(GL_LIGHT0);
-  const float keyPosition[4] = {kLighting.keyDirection[0], kLighting.keyDirection[1], kLighting.keyDirection[2], 0.0f};
+  const float keyPosition[4] = {kLighting.keyDirection[0], kLighting.keyDirection[1],
+                                kLighting.keyDirection[2], 0.0f};
   glLightfv(GL_LIGHT0, GL_POSITION, keyPosition);  // in world space: after the view
   glLightfv(GL_LIGHT0, GL_DIFFUSE, key);
   glLightfv(GL_LIGHT0, GL_AMBIENT, black);
   glLightfv(GL_LIGHT0, GL_SPECULAR, black);
   glEnable(GL_LIGHT1);
-  const float fillPosition[4] = {kLighting.fillDirection[0], kLighting.fillDirection[1], kLighting.fillDirection[2], 0.0f};
+  const float fillPosition[4] = {kLighting.fillDirection[0], kLighting.fillDirection[1],
+                                 kLighting.fillDirection[2], 0.0f};
   glLightfv(GL_LIGHT1, GL_POSITION, fillPosition);
   glLightfv(GL_LIGHT1, GL_DIFFUSE, fill);
   glLightfv(GL_LIGHT1, GL_AMBIENT, black);
@@ -304,7 +340,9 @@ Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 Renderer::~Renderer() = default;
 
-const RenderSettings& Renderer::settings() const { return impl_->settings; }
+const RenderSettings& Renderer::settings() const {
+  return impl_->settings;
+}
 
 Result<Renderer> Renderer::create(const RenderSettings& settings) {
   if (settings.width < 1 || settings.height < 1 || settings.width > 8192 ||

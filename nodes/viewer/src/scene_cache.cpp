@@ -77,7 +77,8 @@ DrawMesh buildDrawMesh(const std::vector<float>& xyz, const std::vector<std::uin
       }
       // The set of faces joined is identified by its smallest member (same set, same normal).
       const std::uint64_t key = (static_cast<std::uint64_t>(v) << 32) | smallest;
-      auto [it, inserted] = emitted.try_emplace(key, static_cast<std::uint32_t>(mesh.xyz.size() / 3));
+      auto [it, inserted] =
+          emitted.try_emplace(key, static_cast<std::uint32_t>(mesh.xyz.size() / 3));
       if (inserted) {
         const auto n = normalised(sum);
         for (int c = 0; c < 3; ++c) {

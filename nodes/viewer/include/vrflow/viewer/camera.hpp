@@ -5,6 +5,9 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+// Before values.hpp (sorted so): GCC's -Wshadow flags ParamKind's enumerators Vec3/Quat/Mat3 when
+// the msg::Vec3/Quat/Mat3 aliases were seen first.
+#include "vrflow/message/object_type.hpp"
 #include "vrflow/message/values.hpp"
 
 // Where the viewer looks from: a fixed camera, or keyframes over iterations.

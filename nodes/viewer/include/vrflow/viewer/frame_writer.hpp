@@ -21,13 +21,13 @@ std::string findOnPath(const std::string& program);
 
 /// What a FrameWriter was asked for.
 struct FrameWriterSettings {
-  std::string directory = ".";        ///< created if missing
-  std::string prefix = "frame";       ///< PNG files are PREFIX_000000.png; the video PREFIX.mp4
+  std::string directory = ".";   ///< created if missing
+  std::string prefix = "frame";  ///< PNG files are PREFIX_000000.png; the video PREFIX.mp4
   FrameFormat format = FrameFormat::Auto;
   int width = 0;
   int height = 0;
-  double fps = 30.0;                  ///< frame rate written into the MP4
-  std::string ffmpeg;                 ///< the ffmpeg to run; "" looks it up on PATH
+  double fps = 30.0;   ///< frame rate written into the MP4
+  std::string ffmpeg;  ///< the ffmpeg to run; "" looks it up on PATH
 };
 
 /// Writes frames one by one. For MP4 it pipes raw RGB into `ffmpeg -f rawvideo` encoding with

@@ -4,12 +4,10 @@
 #include <cstdint>
 #include <memory>
 
-// scene_cache.hpp first: GCC's -Wshadow flags ParamKind's enumerators (object_type.hpp) when the
-// msg::Vec3/Quat/Mat3 aliases (values.hpp) were seen before them.
-#include "vrflow/viewer/scene_cache.hpp"
 #include "vrflow/base/result.hpp"
 #include "vrflow/viewer/camera.hpp"
 #include "vrflow/viewer/image.hpp"
+#include "vrflow/viewer/scene_cache.hpp"
 
 // Draws a SceneCache with OpenGL 1.x through OSMesa (Mesa's software rasteriser, no display).
 
@@ -22,15 +20,15 @@ struct RenderSettings {
   std::array<float, 3> background{0.80f, 0.86f, 0.93f};  ///< where nothing is drawn
   bool ground = true;                                    ///< a checkered plane y = groundHeight
   double groundHeight = 0.0;
-  double groundHalfSize = 20.0;                          ///< the plane spans +-this along x and z
-  double groundTile = 1.0;                               ///< checker square size
+  double groundHalfSize = 20.0;  ///< the plane spans +-this along x and z
+  double groundTile = 1.0;       ///< checker square size
   std::array<float, 3> groundLight{0.78f, 0.78f, 0.76f};
   std::array<float, 3> groundDark{0.62f, 0.62f, 0.60f};
-  bool shadows = true;                                   ///< dark footprints under objects
-  bool netLines = true;                                  ///< a net's triangle edges drawn darker
-  int supersample = 1;  ///< 1..4: draws at this many times the size, then averages (antialiasing)
-  double pointRadius = 0.08;                             ///< spheres drawn for `point` objects
-  float particleSize = 3.0f;                             ///< fluid particles, pixels
+  bool shadows = true;   ///< dark footprints under objects
+  bool netLines = true;  ///< a net's triangle edges drawn darker
+  int supersample = 1;   ///< 1..4: draws at this many times the size, then averages (antialiasing)
+  double pointRadius = 0.08;  ///< spheres drawn for `point` objects
+  float particleSize = 3.0f;  ///< fluid particles, pixels
   std::array<float, 3> particleColour{0.15f, 0.40f, 0.85f};
 };
 
@@ -41,7 +39,7 @@ struct Lighting {
   float ambient = 0.30f;
   float key = 0.72f;
   float fill = 0.22f;
-  std::array<float, 3> keyDirection{0.45f, 1.0f, 0.55f};    ///< from above, front right
+  std::array<float, 3> keyDirection{0.45f, 1.0f, 0.55f};     ///< from above, front right
   std::array<float, 3> fillDirection{-0.6f, 0.35f, -0.45f};  ///< from behind left
 };
 /// The lighting every frame uses.

@@ -34,12 +34,12 @@ enum class ObjectKind { Rigid, MassSpring, Fluid, Point };
 struct CachedObject {
   std::uint64_t id = 0;
   ObjectKind kind = ObjectKind::Rigid;
-  msg::Vec3 position{};                   ///< rigid, point
-  msg::Quat orientation{0, 0, 0, 1};      ///< rigid
-  std::uint64_t shapeId = 0;              ///< rigid: the shape resource (0: none yet)
-  std::vector<double> positions;          ///< massspring: xyz per mass
-  std::vector<std::uint32_t> surface;     ///< massspring: three mass indices per triangle
-  std::uint64_t particlesId = 0;          ///< fluid: the particle resource
+  msg::Vec3 position{};                ///< rigid, point
+  msg::Quat orientation{0, 0, 0, 1};   ///< rigid
+  std::uint64_t shapeId = 0;           ///< rigid: the shape resource (0: none yet)
+  std::vector<double> positions;       ///< massspring: xyz per mass
+  std::vector<std::uint32_t> surface;  ///< massspring: three mass indices per triangle
+  std::uint64_t particlesId = 0;       ///< fluid: the particle resource
 };
 
 /// Counters a viewer reports (and tests check).
@@ -47,8 +47,8 @@ struct SceneStats {
   std::uint64_t messages = 0;
   std::uint64_t objectChunks = 0;
   std::uint64_t resourceChunks = 0;
-  std::uint64_t rejectedShapes = 0;   ///< shape resources that failed to decode
-  std::uint64_t ignoredChunks = 0;    ///< objects of types the viewer does not draw, events
+  std::uint64_t rejectedShapes = 0;  ///< shape resources that failed to decode
+  std::uint64_t ignoredChunks = 0;   ///< objects of types the viewer does not draw, events
 };
 
 /// Objects, shapes and particles, updated one message at a time. Not thread-safe.
