@@ -204,6 +204,26 @@ TEST(SceneCache, FluidParticlesFromARawFloatArray) {
   EXPECT_EQ(s.scene.find(50)->particlesId, 500u);
 }
 
+TEST(SceneCache, ResourcesNoObjectNamesAreNotKept) {
+  LoggedScene s;
+  const std::vector<float> xyz{1, 2, 3};
+  for (std::uint64_t id = 1000; id < 1100; ++id) {
+    ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) {
+      b.addRawResource(id, true, std::as_bytes(std::span(xyz)));
+      b.addMesh(id + 5000, true, xyz, {});
+    }));
+  }
+  EXPECT_EQ(s.scene.heldResources(), 0u);
+  ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) {
+    b.addMesh(7, true, xyz, {});
+    b.addObject(50, msg::fluidType(), msg::ObjectOp::Add)
+        .set(msg::FluidParam::kParticles, std::uint64_t{7});
+  }));
+  EXPECT_EQ(s.scene.heldResources(), 1u);
+  ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) { b.addDelete(50, msg::fluidType()); }));
+  EXPECT_EQ(s.scene.heldResources(), 0u);
+}
+
 TEST(SceneCache, EventsAndUnknownTypesAreIgnored) {
   LoggedScene s;
   ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <set>
 #include <unordered_map>
 
 #include "vrflow/message/builtin_types.hpp"
@@ -131,6 +132,7 @@ void SceneCache::apply(const msg::MessageView& message) {
     }
   }
   resolveShapes();
+  dropUnreferenced();
 }
 
 void SceneCache::applyObject(const msg::ObjectView& object) {
@@ -218,7 +220,7 @@ void SceneCache::applyResource(const msg::ResourceView& resource) {
   }
   // Not a shape: a raw array of xyz floats (fluid particles), or something a rigid object may
   // still name as its shape (then rejected in resolveShapes).
-  otherRaw_[id].assign(raw.begin(), raw.end());
+  otherRaw_[id] = raw.size();
   if (raw.size() % 12 == 0) {
     auto& xyz = particles_[id];
     xyz.resize(raw.size() / 4);
@@ -237,10 +239,20 @@ void SceneCache::resolveShapes() {
     if (raw == otherRaw_.end()) continue;  // not arrived yet
     ++stats_.rejectedShapes;
     log("shape resource " + std::to_string(object.shapeId) + " of rigid object " +
-        std::to_string(id) + " rejected: no shape magic 'SHP1' (" +
-        std::to_string(raw->second.size()) + " bytes); objects using it are not drawn");
+        std::to_string(id) + " rejected: no shape magic 'SHP1' (" + std::to_string(raw->second) +
+        " bytes); objects using it are not drawn");
     shapes_[object.shapeId] = nullptr;
   }
+}
+
+void SceneCache::dropUnreferenced() {
+  if (otherRaw_.empty() && particles_.empty()) return;
+  std::set<std::uint64_t> named;
+  for (const auto& [id, object] : objects_) {
+    if (object.kind == ObjectKind::Fluid) named.insert(object.particlesId);
+  }
+  std::erase_if(otherRaw_, [&](const auto& entry) { return !named.contains(entry.first); });
+  std::erase_if(particles_, [&](const auto& entry) { return !named.contains(entry.first); });
 }
 
 }  // namespace vrflow::viewer

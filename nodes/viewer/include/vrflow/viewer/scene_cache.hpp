@@ -73,6 +73,9 @@ class SceneCache {
   const DrawMesh* shapeMesh(std::uint64_t id) const;
   /// The latest particle positions (xyz floats) of resource `id`, or nullptr.
   const std::vector<float>* particles(std::uint64_t id) const;
+  /// Raw and particle resources held. After each message those no object names are dropped, so
+  /// a sender that makes a new resource id every iteration does not grow the cache.
+  std::size_t heldResources() const { return otherRaw_.size() + particles_.size(); }
   /// Counters so far.
   const SceneStats& stats() const { return stats_; }
 
@@ -80,13 +83,14 @@ class SceneCache {
   void applyObject(const msg::ObjectView& object);
   void applyResource(const msg::ResourceView& resource);
   void resolveShapes();
+  void dropUnreferenced();
   void log(const std::string& line);
 
   int segments_;
   LogFn log_;
   std::map<std::uint64_t, CachedObject> objects_;
-  // Raw resources without the shape magic, kept in case a rigid object names one as its shape.
-  std::map<std::uint64_t, std::vector<std::byte>> otherRaw_;
+  // Sizes of the Raw resources without the shape magic, to reject one a rigid object names.
+  std::map<std::uint64_t, std::size_t> otherRaw_;
   std::map<std::uint64_t, std::shared_ptr<const DrawMesh>> shapes_;  // nullptr: rejected
   std::map<std::uint64_t, std::vector<float>> particles_;
   SceneStats stats_;
