@@ -57,7 +57,7 @@ std::string findOnPath(const std::string& program) {
   while (start <= dirs.size()) {
     const std::size_t end = std::min(dirs.find(':', start), dirs.size());
     const std::string dir = end > start ? dirs.substr(start, end - start) : ".";
-    const std::string candidate = dir + "/" + program;
+    std::string candidate = dir + "/" + program;
     std::error_code ec;
     if (access(candidate.c_str(), X_OK) == 0 && std::filesystem::is_regular_file(candidate, ec)) {
       return candidate;

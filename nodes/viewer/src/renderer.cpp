@@ -83,9 +83,9 @@ Matrix shadowMatrix(double h) {
   const double p[4] = {0.0, 1.0, 0.0, -h};
   const double d = p[0] * l[0] + p[1] * l[1] + p[2] * l[2] + p[3] * l[3];
   Matrix m{};
-  for (int col = 0; col < 4; ++col) {
-    for (int row = 0; row < 4; ++row) {
-      m[static_cast<std::size_t>(col * 4 + row)] = (row == col ? d : 0.0) - l[row] * p[col];
+  for (std::size_t col = 0; col < 4; ++col) {
+    for (std::size_t row = 0; row < 4; ++row) {
+      m[col * 4 + row] = (row == col ? d : 0.0) - l[row] * p[col];
     }
   }
   return m;
@@ -122,11 +122,12 @@ DrawMesh netMesh(const CachedObject& net) {
     const std::uint32_t a = net.surface[t], b = net.surface[t + 1], c = net.surface[t + 2];
     if (a >= masses || b >= masses || c >= masses) continue;
     const auto p = [&](std::uint32_t i) {
-      return msg::Vec3{mesh.xyz[3 * i], mesh.xyz[3 * i + 1], mesh.xyz[3 * i + 2]};
+      const std::size_t at = std::size_t{3} * i;
+      return msg::Vec3{mesh.xyz[at], mesh.xyz[at + 1], mesh.xyz[at + 2]};
     };
     const msg::Vec3 n = cross(sub(p(b), p(a)), sub(p(c), p(a)));
     for (const std::uint32_t i : {a, b, c}) {
-      for (int k = 0; k < 3; ++k) mesh.normals[3 * i + k] += static_cast<float>(n[k]);
+      for (int k = 0; k < 3; ++k) mesh.normals[std::size_t{3} * i + k] += static_cast<float>(n[k]);
     }
     mesh.indices.insert(mesh.indices.end(), {a, b, c});
   }
