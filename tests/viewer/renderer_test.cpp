@@ -190,6 +190,27 @@ TEST(Renderer, SphereSilhouetteMatchesItsAngularRadius) {
   EXPECT_TRUE(pixelIs(image, cx, cy + static_cast<int>(extent) + 3, background, 1));
 }
 
+TEST(Renderer, OrientationQuaternionTurnsTheShape) {
+  // A rod along x, turned a quarter turn about z (x y z w order): it stands along y.
+  SceneCache scene;
+  const double s = std::sqrt(0.5);
+  ASSERT_TRUE(feed(scene, [&](msg::MessageBuilder& b) {
+    addShape(b, 100, msg::Shape::box({1.5, 0.2, 0.2}));
+    addRigid(b, 9, {0.0, 1.0, 0.0}, 100, {0.0, 0.0, s, s});
+  }));
+  const auto bg = settings();
+  const Image image = render(scene, bg);
+  const auto background = bytesOf(bg.background);
+  for (const double y : {-0.3, 2.3}) {  // along the rod's new axis: covered
+    const auto p = project({0.0, y, 0.2});
+    EXPECT_FALSE(pixelIs(image, static_cast<int>(p[0]), static_cast<int>(p[1]), background, 1));
+  }
+  for (const double x : {-1.2, 1.2}) {  // where the unturned rod would be: empty
+    const auto p = project({x, 1.0, 0.2});
+    EXPECT_TRUE(pixelIs(image, static_cast<int>(p[0]), static_cast<int>(p[1]), background, 1));
+  }
+}
+
 TEST(Renderer, NearObjectHidesFarObjectWhateverTheDrawingOrder) {
   for (const bool nearFirst : {true, false}) {
     SceneCache scene;
