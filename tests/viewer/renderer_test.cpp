@@ -51,6 +51,7 @@ RenderSettings settings(bool ground = false) {
 Image render(const SceneCache& scene, const RenderSettings& s) {
   auto renderer = Renderer::create(s);
   EXPECT_TRUE(renderer.ok()) << renderer.error().message;
+  EXPECT_NE(renderer->description().find("OpenGL"), std::string::npos);
   auto image = renderer->render(scene, testCamera());
   EXPECT_TRUE(image.ok()) << image.error().message;
   return *image;

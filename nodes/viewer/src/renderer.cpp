@@ -177,7 +177,8 @@ struct Renderer::Impl {
   std::vector<std::uint8_t> rgba;  // the OSMesa colour buffer, rows from the bottom
   int bufferWidth = 0;             // settings' size times the supersampling factor
   int bufferHeight = 0;
-  DrawMesh unitSphere;  // point objects
+  DrawMesh unitSphere;      // point objects
+  std::string description;  // GL_RENDERER and GL_VERSION
 
   ~Impl() {
     if (context) OSMesaDestroyContext(context);
@@ -345,6 +346,10 @@ const RenderSettings& Renderer::settings() const {
   return impl_->settings;
 }
 
+const std::string& Renderer::description() const {
+  return impl_->description;
+}
+
 Result<Renderer> Renderer::create(const RenderSettings& settings) {
   if (settings.width < 1 || settings.height < 1 || settings.width > 8192 ||
       settings.height > 8192) {
@@ -364,6 +369,16 @@ Result<Renderer> Renderer::create(const RenderSettings& settings) {
   impl->bufferWidth = settings.width * settings.supersample;
   impl->bufferHeight = settings.height * settings.supersample;
   impl->rgba.resize(static_cast<std::size_t>(impl->bufferWidth) * impl->bufferHeight * 4);
+  if (!OSMesaMakeCurrent(impl->context, impl->rgba.data(), GL_UNSIGNED_BYTE, impl->bufferWidth,
+                         impl->bufferHeight)) {
+    return makeError("OSMesa could not bind a " + std::to_string(impl->bufferWidth) + "x" +
+                     std::to_string(impl->bufferHeight) + " frame buffer");
+  }
+  const auto glString = [](GLenum name) {
+    const auto* text = reinterpret_cast<const char*>(glGetString(name));
+    return std::string(text ? text : "?");
+  };
+  impl->description = glString(GL_RENDERER) + ", OpenGL " + glString(GL_VERSION);
   const auto sphere = msg::renderMesh(msg::Shape::sphere(1.0), 16);
   impl->unitSphere = buildDrawMesh(sphere.xyz, sphere.indices);
   return Renderer(std::move(impl));

@@ -161,8 +161,9 @@ int main() {
     return 2;
   }
   const std::string prefix = "vrflow-viewer: module '" + module.id() + "': ";
-  std::fprintf(stderr, "%swriting %s, %dx%d, every %d iteration(s)\n", prefix.c_str(),
-               writer->description().c_str(), render.width, render.height, every);
+  std::fprintf(stderr, "%swriting %s, %dx%d, every %d iteration(s); drawing with %s\n",
+               prefix.c_str(), writer->description().c_str(), render.width, render.height, every,
+               renderer->description().c_str());
 
   viewer::SceneCache scene(segments, [&prefix](const std::string& line) {
     std::fprintf(stderr, "%s%s\n", prefix.c_str(), line.c_str());

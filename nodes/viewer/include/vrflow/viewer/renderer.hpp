@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "vrflow/base/result.hpp"
 #include "vrflow/viewer/camera.hpp"
@@ -61,6 +62,8 @@ class Renderer {
   /// Renders the scene seen by `camera`; the image is settings.width x settings.height.
   Result<Image> render(const SceneCache& scene, const Camera& camera);
   const RenderSettings& settings() const;
+  /// The OpenGL renderer and version strings ("llvmpipe (LLVM 15, 256 bits), 4.5 ..."), for logs.
+  const std::string& description() const;
 
  private:
   struct Impl;
