@@ -106,6 +106,17 @@ TEST(SceneCache, DeleteRemovesTheObject) {
   EXPECT_NE(s.scene.shapeMesh(100), nullptr);  // the resource outlives its users
 }
 
+TEST(SceneCache, AddOfAnExistingIdReplacesTheWholeObject) {
+  LoggedScene s;
+  const std::vector<double> xyz{0, 0, 0, 1, 0, 0, 0, 1, 0};
+  ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) { addNet(b, 9, xyz, {0, 1, 2}); }));
+  ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) {
+    b.addObject(9, msg::massSpringType(), msg::ObjectOp::Add)
+        .set(msg::MassSpringParam::kPositions, std::span<const double>(xyz));
+  }));
+  EXPECT_TRUE(s.scene.find(9)->surface.empty());  // the new add has no surface
+}
+
 TEST(SceneCache, StaticShapeIsDecodedOnce) {
   LoggedScene s;
   ASSERT_TRUE(

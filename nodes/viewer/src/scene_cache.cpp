@@ -160,6 +160,11 @@ void SceneCache::applyObject(const msg::ObjectView& object) {
     it->second = CachedObject{};
     it->second.id = object.id();
     it->second.kind = *kind;
+  } else if (object.op() == msg::ObjectOp::Add) {
+    // An add carries the whole object: nothing of an earlier incarnation survives.
+    it->second = CachedObject{};
+    it->second.id = object.id();
+    it->second.kind = *kind;
   }
   CachedObject& cached = it->second;
   switch (*kind) {
