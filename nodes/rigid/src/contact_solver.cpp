@@ -4,6 +4,7 @@
 
 #include <BulletCollision/CollisionShapes/btConvexHullShape.h>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -201,30 +202,32 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     gContactBreakingThreshold = saved;
   }
 
+  // Axis 0 is the normal (from b to a), 1 and 2 the friction tangents. For each axis the
+  // Jacobian's angular parts r x d and their images through the inverse inertia are precomputed.
   struct Constraint {
     std::size_t a, b;
-    Vec3 ra, rb, normal, t1, t2;
-    double massN, massT1, massT2, target;
-    double accN, accT1, accT2;
+    Vec3 ra, rb;
+    std::array<Vec3, 3> dir, raxd, rbxd, ia, ib;
+    std::array<double, 3> mass, acc;
+    double target;
     Vec3 accRoll;
     Mat3 rollMass;  // inverse of (Ia^-1 + Ib^-1)
+    bool rolls;     // a sphere or capsule is involved
     btManifoldPoint* point;
     std::uint64_t lo, hi;
-    int order;
   };
   std::vector<Constraint> constraints;
-  auto effectiveMass = [&](std::size_t a, std::size_t b, const Vec3& ra, const Vec3& rb, const Vec3& d) {
-    const Vec3 ca = cross(ra, d), cb = cross(rb, d);
-    const double k = invMass[a] + invMass[b] + dot(cross(mul(invInertia[a], ca), ra), d) +
-                     dot(cross(mul(invInertia[b], cb), rb), d);
-    return k > 0 ? 1.0 / k : 0.0;
+  auto velocityAlong = [&](const Constraint& c, int axis) {
+    return dot(v[c.a], c.dir[axis]) + dot(w[c.a], c.raxd[axis]) - dot(v[c.b], c.dir[axis]) - dot(w[c.b], c.rbxd[axis]);
   };
-  auto relativeVelocity = [&](const Constraint& c) {
-    return sub(add(v[c.a], cross(w[c.a], c.ra)), add(v[c.b], cross(w[c.b], c.rb)));
+  auto push = [&](const Constraint& c, int axis, double impulse) {
+    v[c.a] = add(v[c.a], scale(c.dir[axis], impulse * invMass[c.a]));
+    w[c.a] = add(w[c.a], scale(c.ia[axis], impulse));
+    v[c.b] = sub(v[c.b], scale(c.dir[axis], impulse * invMass[c.b]));
+    w[c.b] = sub(w[c.b], scale(c.ib[axis], impulse));
   };
 
   const int manifolds = impl_->dispatcher.getNumManifolds();
-  int order = 0;
   for (int m = 0; m < manifolds; ++m) {
     btPersistentManifold* manifold = impl_->dispatcher.getManifoldByIndexInternal(m);
     const auto* ea = static_cast<const Impl::Entry*>(manifold->getBody0()->getUserPointer());
@@ -237,12 +240,11 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       c.b = eb->dense;
       c.lo = std::min(ea->body.id, eb->body.id);
       c.hi = std::max(ea->body.id, eb->body.id);
-      c.order = order++;
       c.point = &pt;
-      c.normal = fromBt(pt.m_normalWorldOnB);
-      const double len = std::sqrt(dot(c.normal, c.normal));
+      Vec3 normal = fromBt(pt.m_normalWorldOnB);
+      const double len = std::sqrt(dot(normal, normal));
       if (!(len > 0)) continue;
-      c.normal = scale(c.normal, 1.0 / len);
+      normal = scale(normal, 1.0 / len);
       // One point for both bodies (the middle of the pair of closest points), so that the
       // contact's impulses are equal, opposite and collinear: momenta are conserved.
       const Vec3 pa = fromBt(pt.getPositionWorldOnA());
@@ -250,19 +252,30 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       const Vec3 middle = scale(add(pa, pb), 0.5);
       c.ra = sub(middle, ea->body.position);
       c.rb = sub(middle, eb->body.position);
-      tangents(c.normal, c.t1, c.t2);
-      {
+      c.dir[0] = normal;
+      tangents(normal, c.dir[1], c.dir[2]);
+      for (int axis = 0; axis < 3; ++axis) {
+        c.raxd[axis] = cross(c.ra, c.dir[axis]);
+        c.rbxd[axis] = cross(c.rb, c.dir[axis]);
+        c.ia[axis] = mul(invInertia[c.a], c.raxd[axis]);
+        c.ib[axis] = mul(invInertia[c.b], c.rbxd[axis]);
+        const double k = invMass[c.a] + invMass[c.b] + dot(c.ia[axis], c.raxd[axis]) + dot(c.ib[axis], c.rbxd[axis]);
+        c.mass[axis] = k > 0 ? 1.0 / k : 0.0;
+      }
+      auto round = [](const Impl::Entry* e) {
+        return e->body.shape.kind == msg::ShapeKind::Sphere || e->body.shape.kind == msg::ShapeKind::Capsule;
+      };
+      c.rolls = p.rollingFriction > 0 && (round(ea) || round(eb));
+      if (c.rolls) {
         Mat3 sum{};
         for (int k = 0; k < 9; ++k) sum[k] = invInertia[c.a][k] + invInertia[c.b][k];
         c.rollMass = inverse(sum);
       }
-      c.massN = effectiveMass(c.a, c.b, c.ra, c.rb, c.normal);
-      c.massT1 = effectiveMass(c.a, c.b, c.ra, c.rb, c.t1);
-      c.massT2 = effectiveMass(c.a, c.b, c.ra, c.rb, c.t2);
       const double distance = pt.getDistance();
-      const double vn = dot(relativeVelocity(c), c.normal);
+      const double vn = velocityAlong(c, 0);
       const bool bounce = vn < -p.restitutionThreshold;
       if (distance > 0) {
+        // Speculative: approach allowed up to the gap; a bounce when the gap closes this step.
         c.target = -distance / dt;
         if (bounce && vn * dt < -distance) c.target = std::max(c.target, -p.restitution * vn);
       } else {
@@ -270,12 +283,10 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
                             p.baumgarte / dt * std::max(-distance - p.slop, 0.0));
       }
       if (p.warmStart) {
-        c.accN = pt.m_appliedImpulse;
-        c.accT1 = pt.m_appliedImpulseLateral1;
-        c.accT2 = pt.m_appliedImpulseLateral2;
+        c.acc = {pt.m_appliedImpulse, pt.m_appliedImpulseLateral1, pt.m_appliedImpulseLateral2};
       }
       constraints.push_back(c);
-      contacts_.push_back({ea->body.id, eb->body.id, pb, c.normal, distance});
+      contacts_.push_back({ea->body.id, eb->body.id, pb, normal, distance});
     }
   }
   std::stable_sort(constraints.begin(), constraints.end(), [](const Constraint& x, const Constraint& y) {
@@ -286,40 +297,25 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     return xl != yl ? xl < yl : std::max(x.a, x.b) < std::max(y.a, y.b);
   });
 
-  auto applyImpulse = [&](const Constraint& c, const Vec3& impulse) {
-    v[c.a] = add(v[c.a], scale(impulse, invMass[c.a]));
-    w[c.a] = add(w[c.a], mul(invInertia[c.a], cross(c.ra, impulse)));
-    v[c.b] = sub(v[c.b], scale(impulse, invMass[c.b]));
-    w[c.b] = sub(w[c.b], mul(invInertia[c.b], cross(c.rb, impulse)));
-    linear[c.a] = add(linear[c.a], impulse);
-    angular[c.a] = add(angular[c.a], cross(c.ra, impulse));
-    linear[c.b] = sub(linear[c.b], impulse);
-    angular[c.b] = sub(angular[c.b], cross(c.rb, impulse));
-  };
-
   for (const Constraint& c : constraints)
-    if (c.accN != 0 || c.accT1 != 0 || c.accT2 != 0)
-      applyImpulse(c, add(scale(c.normal, c.accN), add(scale(c.t1, c.accT1), scale(c.t2, c.accT2))));
+    for (int axis = 0; axis < 3; ++axis)
+      if (c.acc[axis] != 0) push(c, axis, c.acc[axis]);
 
   for (int iteration = 0; iteration < p.iterations; ++iteration) {
     for (Constraint& c : constraints) {
       // Friction within the cone of the current normal impulse (box approximation).
-      const double limit = p.friction * c.accN;
-      for (int axis = 0; axis < 2; ++axis) {
-        const Vec3& t = axis == 0 ? c.t1 : c.t2;
-        double& acc = axis == 0 ? c.accT1 : c.accT2;
-        const double mass = axis == 0 ? c.massT1 : c.massT2;
-        const double vt = dot(relativeVelocity(c), t);
-        const double next = std::clamp(acc - mass * vt, -limit, limit);
-        const double delta = next - acc;
-        acc = next;
-        if (delta != 0) applyImpulse(c, scale(t, delta));
+      const double limit = p.friction * c.acc[0];
+      for (int axis = 1; axis < 3; ++axis) {
+        const double next = std::clamp(c.acc[axis] - c.mass[axis] * velocityAlong(c, axis), -limit, limit);
+        const double delta = next - c.acc[axis];
+        c.acc[axis] = next;
+        if (delta != 0) push(c, axis, delta);
       }
-      if (p.rollingFriction > 0) {
+      if (c.rolls && c.acc[0] > 0) {
         // Rolling and spinning resistance: an angular impulse against the relative rotation,
         // each component within rollingFriction * the normal impulse.
         const Vec3 wrel = sub(w[c.a], w[c.b]);
-        const double rollLimit = p.rollingFriction * c.accN;
+        const double rollLimit = p.rollingFriction * c.acc[0];
         const Vec3 wanted = sub(c.accRoll, mul(c.rollMass, wrel));
         const Vec3 next{std::clamp(wanted[0], -rollLimit, rollLimit), std::clamp(wanted[1], -rollLimit, rollLimit),
                         std::clamp(wanted[2], -rollLimit, rollLimit)};
@@ -328,22 +324,25 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
         if (delta != Vec3{}) {
           w[c.a] = add(w[c.a], mul(invInertia[c.a], delta));
           w[c.b] = sub(w[c.b], mul(invInertia[c.b], delta));
-          angular[c.a] = add(angular[c.a], delta);
-          angular[c.b] = sub(angular[c.b], delta);
         }
       }
-      const double vn = dot(relativeVelocity(c), c.normal);
-      const double next = std::max(c.accN + c.massN * (c.target - vn), 0.0);
-      const double delta = next - c.accN;
-      c.accN = next;
-      if (delta != 0) applyImpulse(c, scale(c.normal, delta));
+      const double next = std::max(c.acc[0] + c.mass[0] * (c.target - velocityAlong(c, 0)), 0.0);
+      const double delta = next - c.acc[0];
+      c.acc[0] = next;
+      if (delta != 0) push(c, 0, delta);
     }
   }
 
+  // The impulses each body received: the sums of the accumulated contact impulses.
   for (const Constraint& c : constraints) {
-    c.point->m_appliedImpulse = static_cast<btScalar>(c.accN);
-    c.point->m_appliedImpulseLateral1 = static_cast<btScalar>(c.accT1);
-    c.point->m_appliedImpulseLateral2 = static_cast<btScalar>(c.accT2);
+    c.point->m_appliedImpulse = static_cast<btScalar>(c.acc[0]);
+    c.point->m_appliedImpulseLateral1 = static_cast<btScalar>(c.acc[1]);
+    c.point->m_appliedImpulseLateral2 = static_cast<btScalar>(c.acc[2]);
+    const Vec3 impulse = add(scale(c.dir[0], c.acc[0]), add(scale(c.dir[1], c.acc[1]), scale(c.dir[2], c.acc[2])));
+    linear[c.a] = add(linear[c.a], impulse);
+    linear[c.b] = sub(linear[c.b], impulse);
+    angular[c.a] = add(angular[c.a], add(cross(c.ra, impulse), c.accRoll));
+    angular[c.b] = sub(angular[c.b], add(cross(c.rb, impulse), c.accRoll));
   }
 
   for (std::size_t k = 0; k < n; ++k) {

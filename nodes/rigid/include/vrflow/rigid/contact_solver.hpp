@@ -31,8 +31,9 @@ struct ContactParams {
   double baumgarte = 0.2;             ///< fraction of the penetration removed per step
   double slop = 0.005;                ///< penetration (m) left alone, keeps contacts alive
   double margin = 0.005;              ///< Bullet collision margin of hull shapes (m)
-  /// Rolling and spinning resistance (m): the contact resists relative rotation with a torque of
-  /// at most this times the normal force (rolling spheres and capsules come to rest).
+  /// Rolling and spinning resistance (m): a contact where a sphere or a capsule takes part resists
+  /// relative rotation with a torque of at most this times the normal force, so that they come to
+  /// rest (flat-faced shapes need none: their face contacts stop rolling).
   double rollingFriction = 0.01;
   /// Contacts are found up to this gap (m) and solved speculatively (approach allowed up to the
   /// gap): catches objects moving up to about this far per step against each other.
