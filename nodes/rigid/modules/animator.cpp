@@ -31,10 +31,11 @@ int main() {
     std::fprintf(stderr, "vrflow-rigid-animator: set the 'scene' or the 'generate' parameter\n");
     return 2;
   }
-  for (const auto& [what, loaded] : {std::pair{scenePath, scenePath.empty() ? Result<std::vector<rigid::Body>>(std::vector<rigid::Body>{})
-                                                                             : rigid::loadScene(scenePath)},
-                                     std::pair{generator, generator.empty() ? Result<std::vector<rigid::Body>>(std::vector<rigid::Body>{})
-                                                                            : rigid::generateScene(generator)}}) {
+  // The scene file's bodies first, then the generated ones.
+  for (const bool fromFile : {true, false}) {
+    const std::string& spec = fromFile ? scenePath : generator;
+    if (spec.empty()) continue;
+    auto loaded = fromFile ? rigid::loadScene(spec) : rigid::generateScene(spec);
     if (!loaded) {
       std::fprintf(stderr, "vrflow-rigid-animator: %s\n", loaded.error().message.c_str());
       return 2;
