@@ -34,10 +34,16 @@ Status RigidAnimatorState::addBody(Body body) {
   const auto at = std::lower_bound(bodies_.begin(), bodies_.end(), body.id,
                                    [](const Body& b, std::uint64_t id) { return b.id < id; });
   const auto offset = at - bodies_.begin();
+  const bool last = at == bodies_.end();
+  const std::uint64_t id = body.id;
   bodies_.insert(at, std::move(body));
   impulses_.insert(impulses_.begin() + offset, Accumulator{});
   stepForces_.insert(stepForces_.begin() + offset, Accumulator{});
-  reindex();
+  if (last) {
+    index_[id] = bodies_.size() - 1;  // ids in increasing order: no reindexing
+  } else {
+    reindex();
+  }
   return {};
 }
 

@@ -214,7 +214,6 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     Mat3 rollMass;  // inverse of (Ia^-1 + Ib^-1)
     bool rolls;     // a sphere or capsule is involved
     btManifoldPoint* point;
-    std::uint64_t lo, hi;
   };
   std::vector<Constraint> constraints;
   auto velocityAlong = [&](const Constraint& c, int axis) {
@@ -227,19 +226,32 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     w[c.b] = sub(w[c.b], scale(c.ib[axis], impulse));
   };
 
+  // Manifolds in the order of their pair of ids (then Bullet's order, deterministic too).
+  struct PairRef {
+    std::uint64_t lo, hi;
+    int index;
+  };
+  std::vector<PairRef> pairs;
   const int manifolds = impl_->dispatcher.getNumManifolds();
   for (int m = 0; m < manifolds; ++m) {
     btPersistentManifold* manifold = impl_->dispatcher.getManifoldByIndexInternal(m);
+    if (manifold->getNumContacts() == 0) continue;
     const auto* ea = static_cast<const Impl::Entry*>(manifold->getBody0()->getUserPointer());
     const auto* eb = static_cast<const Impl::Entry*>(manifold->getBody1()->getUserPointer());
     if (ea->body.kinematic && eb->body.kinematic) continue;
+    pairs.push_back({std::min(ea->body.id, eb->body.id), std::max(ea->body.id, eb->body.id), m});
+  }
+  std::stable_sort(pairs.begin(), pairs.end(),
+                   [](const PairRef& x, const PairRef& y) { return x.lo != y.lo ? x.lo < y.lo : x.hi < y.hi; });
+  for (const PairRef& pair : pairs) {
+    btPersistentManifold* manifold = impl_->dispatcher.getManifoldByIndexInternal(pair.index);
+    const auto* ea = static_cast<const Impl::Entry*>(manifold->getBody0()->getUserPointer());
+    const auto* eb = static_cast<const Impl::Entry*>(manifold->getBody1()->getUserPointer());
     for (int i = 0; i < manifold->getNumContacts(); ++i) {
       btManifoldPoint& pt = manifold->getContactPoint(i);
       Constraint c{};
       c.a = ea->dense;
       c.b = eb->dense;
-      c.lo = std::min(ea->body.id, eb->body.id);
-      c.hi = std::max(ea->body.id, eb->body.id);
       c.point = &pt;
       Vec3 normal = fromBt(pt.m_normalWorldOnB);
       const double len = std::sqrt(dot(normal, normal));
@@ -289,13 +301,6 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       contacts_.push_back({ea->body.id, eb->body.id, pb, normal, distance});
     }
   }
-  std::stable_sort(constraints.begin(), constraints.end(), [](const Constraint& x, const Constraint& y) {
-    return x.lo != y.lo ? x.lo < y.lo : x.hi < y.hi;
-  });
-  std::stable_sort(contacts_.begin(), contacts_.end(), [](const ContactInfo& x, const ContactInfo& y) {
-    const auto xl = std::min(x.a, x.b), yl = std::min(y.a, y.b);
-    return xl != yl ? xl < yl : std::max(x.a, x.b) < std::max(y.a, y.b);
-  });
 
   for (const Constraint& c : constraints)
     for (int axis = 0; axis < 3; ++axis)
