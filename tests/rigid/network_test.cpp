@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "process_helpers.hpp"
 #include "vrflow/rigid/scene.hpp"
@@ -97,6 +98,54 @@ TEST(RigidNetwork, BadSceneFailsTheRunNamingTheFile) {
   EXPECT_NE(result.exitCode, 0);
   EXPECT_NE((result.out + result.err).find("broken.json:2: body 0: 'radius' must be a number"), std::string::npos)
       << result.out << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+// The force field acts by type: on core point masses when asked to, here with gravity and drag.
+TEST(RigidNetwork, ForceFieldMovesPointMassesByType) {
+  TempDir dir;
+  const auto appFile = dir.write("points.xml", R"(<?xml version="1.0" encoding="UTF-8"?>
+<application name="field-points" version="1">
+  <hosts><host id="local" address="127.0.0.1"/></hosts>
+  <modules>
+    <module id="points" package="core" type="points" host="local">
+      <param name="count" value="2"/>
+      <param name="dt" value="0.01"/>
+      <input port="events" initial-messages="1"/>
+    </module>
+    <module id="field" package="rigid" type="forcefield" host="local">
+      <param name="field" value="gravity 0 -10 0; drag 0.5"/>
+      <param name="types" value="point"/>
+    </module>
+    <module id="recorder" package="core" type="recorder" host="local">
+      <param name="file" value=")" + dir.file("points.csv") + R"("/>
+    </module>
+  </modules>
+  <connections>
+    <connection from="points.objects" to="field.objects"/>
+    <connection from="field.forces" to="points.events"/>
+    <connection from="points.objects" to="recorder.in"/>
+  </connections>
+</application>
+)");
+  const int iterations = 101;
+  const auto result = runCommand({binDir() + "/vrflow", "run", appFile, "-n", std::to_string(iterations)}, 60);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto lines = readLines(dir.file("points.csv"));
+  ASSERT_EQ(lines.size(), 1u + 2u * iterations);
+  // The last line: iteration,source,source_iteration,sim_time,kind,id,x,y,z.
+  std::vector<std::string> f;
+  std::stringstream in(lines.back());
+  for (std::string field; std::getline(in, field, ',');) f.push_back(field);
+  ASSERT_GE(f.size(), 9u);
+  // The same recursion with m = 1: v += dt (-10 - 0.5 v), y += dt v, for 100 steps.
+  double v = 0, y = 0;
+  for (int i = 0; i < iterations - 1; ++i) {
+    v += 0.01 * (-10 - 0.5 * v);
+    y += 0.01 * v;
+  }
+  EXPECT_NEAR(std::stod(f[7]), y, 1e-4);
+  EXPECT_GT(std::stod(f[7]), -10 * 0.5);  // slower than free fall
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 
