@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <set>
 
 #include "vrflow/rigid/scene.hpp"
 #include "vrflow/rigid/world.hpp"
@@ -119,6 +120,7 @@ TEST(RigidPhysics, StackOfFiveBoxesStandsForTenSeconds) {
   auto bodies = generateScene("stack:5");
   ASSERT_TRUE(bodies);
   RigidWorld world(gravityField(), {});
+  world.state().setSleep({.enabled = false});  // the solver alone holds the stack
   ASSERT_TRUE(world.add(*bodies));
   const auto start = world.state().bodies();
   for (int i = 0; i < 1000; ++i) world.step(kDt);  // 10 s
@@ -166,6 +168,7 @@ RestResult settleMixed(RigidWorld& world, int steps) {
 
 TEST(RigidPhysics, TwentyMixedObjectsComeToRestInTheBox) {
   RigidWorld world(gravityField(), {});
+  world.state().setSleep({.enabled = false});  // measure the solver's own rest, without sleeping
   const auto r = settleMixed(world, 600);  // 6 s
   std::printf("[mixed] max speed in the last 0.5 s %.3g m/s, worst penetration %.3g m, lowest point %.3g m\n",
               r.maxSpeed, r.maxPenetration, r.lowest);
@@ -226,6 +229,27 @@ TEST(RigidPhysics, FastBodiesDoNotTunnelThroughTheWalls) {
       }
     }
   }
+}
+
+TEST(RigidPhysics, SettledBodiesSleepAndWakeWhenHit) {
+  RigidWorld world(gravityField(), {});
+  const auto r = settleMixed(world, 400);
+  EXPECT_EQ(r.maxSpeed, 0.0);
+  for (const Body& b : world.state().bodies())
+    if (!b.kinematic) {
+      EXPECT_TRUE(world.state().asleep(b.id)) << b.id;
+    }
+  EXPECT_TRUE(world.step(kDt).empty()) << "a settled scene reports no change";
+  // A heavy sphere dropped on the pile wakes what it hits.
+  ASSERT_TRUE(world.add({makeBody(1000, msg::Shape::sphere(0.2), 20.0, {0, 1.5, 0})}));
+  std::set<std::uint64_t> woken;
+  for (int i = 0; i < 200; ++i)
+    for (const Change& c : world.step(kDt))
+      if (c.id != 1000) woken.insert(c.id);
+  EXPECT_FALSE(woken.empty());
+  const Body& ball = *world.state().find(1000);
+  EXPECT_LT(ball.position[1], 1.0);  // it landed on the pile, not in the air
+  EXPECT_GT(msg::worldBounds(ball.shape, ball.position, ball.orientation).min[1], -0.01);
 }
 
 TEST(RigidPhysics, KinematicBodyNeverMoves) {

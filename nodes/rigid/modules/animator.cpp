@@ -43,6 +43,14 @@ int main() {
     bodies.insert(bodies.end(), loaded->begin(), loaded->end());
   }
   rigid::RigidAnimatorState state;
+  rigid::SleepParams sleep;
+  const std::string sleepText = module.param("sleep", "true");
+  if (sleepText != "true" && sleepText != "false" && sleepText != "1" && sleepText != "0") {
+    std::fprintf(stderr, "vrflow-rigid-animator: parameter 'sleep' must be true or false, not '%s'\n", sleepText.c_str());
+    return 2;
+  }
+  sleep.enabled = sleepText == "true" || sleepText == "1";
+  state.setSleep(sleep);
   std::map<std::uint64_t, std::uint64_t> shapeIds;
   for (auto& body : bodies) {
     body.id = module.newId();

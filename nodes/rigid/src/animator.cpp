@@ -39,6 +39,7 @@ Status RigidAnimatorState::addBody(Body body) {
   bodies_.insert(at, std::move(body));
   impulses_.insert(impulses_.begin() + offset, Accumulator{});
   stepForces_.insert(stepForces_.begin() + offset, Accumulator{});
+  rest_.insert(rest_.begin() + offset, Rest{});
   if (last) {
     index_[id] = bodies_.size() - 1;  // ids in increasing order: no reindexing
   } else {
@@ -54,6 +55,7 @@ Status RigidAnimatorState::removeBody(std::uint64_t id) {
   bodies_.erase(bodies_.begin() + offset);
   impulses_.erase(impulses_.begin() + offset);
   stepForces_.erase(stepForces_.begin() + offset);
+  rest_.erase(rest_.begin() + offset);
   reindex();
   return {};
 }
@@ -61,6 +63,11 @@ Status RigidAnimatorState::removeBody(std::uint64_t id) {
 void RigidAnimatorState::reindex() {
   index_.clear();
   for (std::size_t i = 0; i < bodies_.size(); ++i) index_[bodies_[i].id] = i;
+}
+
+bool RigidAnimatorState::asleep(std::uint64_t id) const {
+  const auto it = index_.find(id);
+  return it != index_.end() && rest_[it->second].asleep;
 }
 
 const Body* RigidAnimatorState::find(std::uint64_t id) const {
@@ -110,6 +117,19 @@ std::vector<Change> RigidAnimatorState::step(double dt) {
     } else {
       const Vec3 linear = add(impulses_[i].linear, scale(stepForces_[i].linear, dt));
       const Vec3 angular = add(impulses_[i].angular, scale(stepForces_[i].angular, dt));
+      Rest& rest = rest_[i];
+      if (rest.asleep) {
+        // A sleeping body stays put while the impulses it receives nearly cancel (its weight
+        // and its support); a blow or a lost support wakes it.
+        const Vec3 dv = scale(linear, 1.0 / b.mass);
+        const Vec3 dw = mul(rotateTensor(rotationMatrix(b.orientation), inverse(b.inertia)), angular);
+        if (std::sqrt(dot(dv, dv)) < sleep_.wakeLinear && std::sqrt(dot(dw, dw)) < sleep_.wakeAngular) {
+          impulses_[i] = Accumulator{};
+          stepForces_[i] = Accumulator{};
+          continue;
+        }
+        rest = Rest{};
+      }
       const Vec3 v0 = b.linearVelocity, w0 = b.angularVelocity;
       const Quat q0 = b.orientation;
       const Vec3 p0 = b.position;
@@ -122,6 +142,16 @@ std::vector<Change> RigidAnimatorState::step(double dt) {
         const Vec3 w = mul(rotateTensor(rotationMatrix(b.orientation), inertiaInverse), momentum);
         b.orientation = integrate(b.orientation, w, dt);
         b.angularVelocity = mul(rotateTensor(rotationMatrix(b.orientation), inertiaInverse), momentum);
+      }
+      if (sleep_.enabled) {
+        const bool slow = std::sqrt(dot(b.linearVelocity, b.linearVelocity)) < sleep_.linear &&
+                          std::sqrt(dot(b.angularVelocity, b.angularVelocity)) < sleep_.angular;
+        rest.still = slow ? rest.still + dt : 0.0;
+        if (slow && rest.still >= sleep_.time) {
+          rest.asleep = true;
+          b.linearVelocity = {0, 0, 0};
+          b.angularVelocity = {0, 0, 0};
+        }
       }
       change.pose = b.position != p0 || b.orientation != q0;
       change.velocity = b.linearVelocity != v0 || b.angularVelocity != w0;

@@ -19,8 +19,26 @@ struct Change {
   bool velocity = false;  ///< linear and/or angular velocity
 };
 
+/// Sleeping: a dynamic body slower than `linear` and `angular` for `time` seconds is put to sleep
+/// (velocities zeroed, one last change reported); it is then neither integrated nor reported
+/// while the velocity change its impulses would cause per step stays below `wakeLinear` and
+/// `wakeAngular` (its weight and its support cancel), and wakes otherwise (a blow, a lost
+/// support). Sleeping bodies are what keeps a settled scene from sending every body every step.
+struct SleepParams {
+  bool enabled = true;
+  double linear = 0.02;       ///< m/s
+  double angular = 0.05;      ///< rad/s
+  double time = 0.5;          ///< s
+  double wakeLinear = 0.02;   ///< m/s per step
+  double wakeAngular = 0.1;   ///< rad/s per step
+};
+
 class RigidAnimatorState {
  public:
+  void setSleep(const SleepParams& sleep) { sleep_ = sleep; }
+  const SleepParams& sleep() const { return sleep_; }
+  bool asleep(std::uint64_t id) const;
+
   /// Adds a body; its id must be new (bodies are kept ordered by id).
   Status addBody(Body body);
   Status removeBody(std::uint64_t id);
@@ -52,6 +70,12 @@ class RigidAnimatorState {
   std::vector<Body> bodies_;
   std::vector<Accumulator> impulses_;    // force * duration of timed events
   std::vector<Accumulator> stepForces_;  // forces of events lasting the whole step
+  struct Rest {
+    double still = 0.0;  // seconds below the sleep thresholds
+    bool asleep = false;
+  };
+  std::vector<Rest> rest_;
+  SleepParams sleep_;
   std::map<std::uint64_t, std::size_t> index_;
   double time_ = 0.0;
   void reindex();
