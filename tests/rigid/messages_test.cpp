@@ -1,11 +1,12 @@
 // Rigid bodies through messages: what the animator writes is what an interactor's copy reads.
+#include "vrflow/rigid/messages.hpp"
+
 #include <gtest/gtest.h>
 
 #include <vector>
 
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/message/byte_sink.hpp"
-#include "vrflow/rigid/messages.hpp"
 #include "vrflow/rigid/scene.hpp"
 
 namespace vrflow::rigid {
@@ -58,7 +59,8 @@ TEST(RigidMessages, AddThenUpdateRoundTripsThroughTheCopy) {
 TEST(RigidMessages, ObjectNamingAMissingShapeIsAnError) {
   msg::VectorSink sink;
   msg::MessageBuilder builder(sink);
-  builder.addObject(5, msg::rigidType(), msg::ObjectOp::Add).set(msg::RigidParam::kShape, std::uint64_t{77});
+  builder.addObject(5, msg::rigidType(), msg::ObjectOp::Add)
+      .set(msg::RigidParam::kShape, std::uint64_t{77});
   const auto size = builder.finish();
   auto view = msg::MessageView::parse(std::span(sink.buffer()).first(size));
   ASSERT_TRUE(view);

@@ -20,9 +20,11 @@ std::string app(const std::string& scene, const std::string& stateFile) {
   <hosts><host id="local" address="127.0.0.1"/></hosts>
   <modules>
     <module id="bodies" package="rigid" type="animator" host="local">
-      <param name="scene" value=")" + scene + R"("/>
+      <param name="scene" value=")" +
+         scene + R"("/>
       <param name="dt" value="0.01"/>
-      <param name="state-file" value=")" + stateFile + R"("/>
+      <param name="state-file" value=")" +
+         stateFile + R"("/>
       <input port="events" initial-messages="1"/>
     </module>
     <module id="contacts" package="rigid" type="interactor" host="local">
@@ -48,8 +50,8 @@ TEST(RigidNetwork, DropSceneComesToRestAndMatchesTheSingleProcessSolvers) {
   const auto appFile = dir.file("rigid.xml");
   std::ofstream(appFile) << app(scene, dir.file("state.json"));
   const int iterations = 300;
-  const auto result = runCommand({binDir() + "/vrflow", "run", appFile, "-n", std::to_string(iterations),
-                                  "--report", dir.file("report.json")},
+  const auto result = runCommand({binDir() + "/vrflow", "run", appFile, "-n",
+                                  std::to_string(iterations), "--report", dir.file("report.json")},
                                  60);
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto state = nlohmann::json::parse(readFile(dir.file("state.json")));
@@ -60,7 +62,8 @@ TEST(RigidNetwork, DropSceneComesToRestAndMatchesTheSingleProcessSolvers) {
   // The same scene, the same solvers, one process.
   auto loaded = rigid::loadScene(scene);
   ASSERT_TRUE(loaded);
-  rigid::RigidWorld world(rigid::ForceField({rigid::FieldTerm{rigid::FieldTerm::Kind::Gravity, {0, -9.81, 0}}}), {});
+  rigid::RigidWorld world(
+      rigid::ForceField({rigid::FieldTerm{rigid::FieldTerm::Kind::Gravity, {0, -9.81, 0}}}), {});
   ASSERT_TRUE(world.add(*loaded));
   for (int i = 0; i < iterations - 1; ++i) world.step(0.01);
 
@@ -91,12 +94,14 @@ TEST(RigidNetwork, DropSceneComesToRestAndMatchesTheSingleProcessSolvers) {
 TEST(RigidNetwork, BadSceneFailsTheRunNamingTheFile) {
   TempDir dir;
   const auto scene = dir.file("broken.json");
-  std::ofstream(scene) << "{\"bodies\": [\n  {\"shape\": {\"type\": \"sphere\"}, \"mass\": 1}\n]}\n";
+  std::ofstream(scene)
+      << "{\"bodies\": [\n  {\"shape\": {\"type\": \"sphere\"}, \"mass\": 1}\n]}\n";
   const auto appFile = dir.file("rigid.xml");
   std::ofstream(appFile) << app(scene, "");
   const auto result = runCommand({binDir() + "/vrflow", "run", appFile, "-n", "10"}, 60);
   EXPECT_NE(result.exitCode, 0);
-  EXPECT_NE((result.out + result.err).find("broken.json:2: body 0: 'radius' must be a number"), std::string::npos)
+  EXPECT_NE((result.out + result.err).find("broken.json:2: body 0: 'radius' must be a number"),
+            std::string::npos)
       << result.out << result.err;
   EXPECT_TRUE(leftoverProcesses().empty());
 }
@@ -118,7 +123,8 @@ TEST(RigidNetwork, ForceFieldMovesPointMassesByType) {
       <param name="types" value="point"/>
     </module>
     <module id="recorder" package="core" type="recorder" host="local">
-      <param name="file" value=")" + dir.file("points.csv") + R"("/>
+      <param name="file" value=")" + dir.file("points.csv") +
+                                                   R"("/>
     </module>
   </modules>
   <connections>
@@ -129,7 +135,8 @@ TEST(RigidNetwork, ForceFieldMovesPointMassesByType) {
 </application>
 )");
   const int iterations = 101;
-  const auto result = runCommand({binDir() + "/vrflow", "run", appFile, "-n", std::to_string(iterations)}, 60);
+  const auto result =
+      runCommand({binDir() + "/vrflow", "run", appFile, "-n", std::to_string(iterations)}, 60);
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto lines = readLines(dir.file("points.csv"));
   ASSERT_EQ(lines.size(), 1u + 2u * iterations);

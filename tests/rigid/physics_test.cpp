@@ -14,11 +14,17 @@ namespace {
 constexpr double kDt = 0.01;  // the demo's time step
 const Vec3 kG{0, -9.81, 0};
 
-ForceField gravityField() { return ForceField({FieldTerm{FieldTerm::Kind::Gravity, kG}}); }
+ForceField gravityField() {
+  return ForceField({FieldTerm{FieldTerm::Kind::Gravity, kG}});
+}
 
-Body ground(std::uint64_t id = 1) { return makeKinematic(id, msg::Shape::box({5, 0.5, 5}), {0, -0.5, 0}); }
+Body ground(std::uint64_t id = 1) {
+  return makeKinematic(id, msg::Shape::box({5, 0.5, 5}), {0, -0.5, 0});
+}
 
-double norm(const Vec3& v) { return std::sqrt(dot(v, v)); }
+double norm(const Vec3& v) {
+  return std::sqrt(dot(v, v));
+}
 
 TEST(RigidPhysics, FreeFallMatchesSemiImplicitEulerAndTheAnalyticCurve) {
   RigidWorld world(gravityField(), {});
@@ -67,14 +73,16 @@ TEST(RigidPhysics, BouncingSphereReboundsToRestitutionSquared) {
   const double travel = std::sqrt(2 * 9.81 * 1.0) * kDt;
   for (double e : {0.3, 0.5, 0.8}) {
     const double ratio = reboundHeight(e, 1.0, kDt) / 1.0;
-    std::printf("[bounce] e = %.1f, dt = %.3f: rebound ratio %.4f (e^2 = %.4f)\n", e, kDt, ratio, e * e);
+    std::printf("[bounce] e = %.1f, dt = %.3f: rebound ratio %.4f (e^2 = %.4f)\n", e, kDt, ratio,
+                e * e);
     EXPECT_GT(ratio, e * e - 0.005) << "e = " << e;
     EXPECT_LT(ratio, e * e + travel) << "e = " << e;
   }
   // A finer step is closer.
   for (double e : {0.3, 0.5, 0.8}) {
     const double ratio = reboundHeight(e, 1.0, 0.001);
-    std::printf("[bounce] e = %.1f, dt = 0.001: rebound ratio %.4f (e^2 = %.4f)\n", e, ratio, e * e);
+    std::printf("[bounce] e = %.1f, dt = 0.001: rebound ratio %.4f (e^2 = %.4f)\n", e, ratio,
+                e * e);
     EXPECT_NEAR(ratio, e * e, 0.006) << "e = " << e;
   }
 }
@@ -155,7 +163,8 @@ RestResult settleMixed(RigidWorld& world, int steps) {
         r.maxSpeed = std::max(r.maxSpeed, norm(b.linearVelocity) + 0.2 * norm(b.angularVelocity));
       }
     }
-    for (const auto& c : world.solver().contacts()) r.maxPenetration = std::max(r.maxPenetration, -c.distance);
+    for (const auto& c : world.solver().contacts())
+      r.maxPenetration = std::max(r.maxPenetration, -c.distance);
   }
   for (const Body& b : world.state().bodies()) {
     if (b.kinematic) continue;
@@ -169,9 +178,11 @@ RestResult settleMixed(RigidWorld& world, int steps) {
 TEST(RigidPhysics, TwentyMixedObjectsComeToRestInTheBox) {
   RigidWorld world(gravityField(), {});
   world.state().setSleep({.enabled = false});  // measure the solver's own rest, without sleeping
-  const auto r = settleMixed(world, 600);  // 6 s
-  std::printf("[mixed] max speed in the last 0.5 s %.3g m/s, worst penetration %.3g m, lowest point %.3g m\n",
-              r.maxSpeed, r.maxPenetration, r.lowest);
+  const auto r = settleMixed(world, 600);      // 6 s
+  std::printf(
+      "[mixed] max speed in the last 0.5 s %.3g m/s, worst penetration %.3g m, lowest point %.3g "
+      "m\n",
+      r.maxSpeed, r.maxPenetration, r.lowest);
   EXPECT_LT(r.maxSpeed, 0.05);
   EXPECT_LT(r.maxPenetration, 0.03);  // over the whole run, impacts included
   EXPECT_GT(r.lowest, -0.01);         // nothing sank through the ground
@@ -186,10 +197,12 @@ TEST(RigidPhysics, StaticTriangleMeshCatchesConvexAndMeshBodies) {
   std::vector<std::uint32_t> t{0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4};
   const auto trough = msg::Shape::triangleMesh(v, t);
   // A closed tetrahedron as a moving mesh.
-  const auto tetra = msg::Shape::triangleMesh({0.2, -0.1, 0, -0.1, -0.1, 0.17, -0.1, -0.1, -0.17, 0, 0.2, 0},
-                                              {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0});
+  const auto tetra =
+      msg::Shape::triangleMesh({0.2, -0.1, 0, -0.1, -0.1, 0.17, -0.1, -0.1, -0.17, 0, 0.2, 0},
+                               {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0});
   RigidWorld world(gravityField(), {});
-  ASSERT_TRUE(world.add({makeKinematic(1, trough, {0, 0, 0}), makeBody(2, msg::Shape::sphere(0.15), 1.0, {0.8, 1.5, 0}),
+  ASSERT_TRUE(world.add({makeKinematic(1, trough, {0, 0, 0}),
+                         makeBody(2, msg::Shape::sphere(0.15), 1.0, {0.8, 1.5, 0}),
                          makeBody(3, msg::Shape::box({0.1, 0.1, 0.1}), 1.0, {-0.6, 1.2, 0.5}),
                          makeBody(4, tetra, 1.0, {0.1, 1.0, -0.8})}));
   for (int i = 0; i < 500; ++i) world.step(kDt);
@@ -254,11 +267,14 @@ TEST(RigidPhysics, SettledBodiesSleepAndWakeWhenHit) {
 
 TEST(RigidPhysics, KinematicBodyNeverMoves) {
   RigidWorld world(gravityField(), {});
-  Body platform = makeKinematic(1, msg::Shape::box({1, 0.1, 1}), {0, 0.5, 0}, {0, std::sin(0.1), 0, std::cos(0.1)});
-  ASSERT_TRUE(world.add({platform, makeBody(2, msg::Shape::box({0.2, 0.2, 0.2}), 50.0, {0.3, 1.5, 0}),
-                         makeBody(3, msg::Shape::sphere(0.2), 5.0, {-0.3, 2.0, 0.1})}));
+  Body platform = makeKinematic(1, msg::Shape::box({1, 0.1, 1}), {0, 0.5, 0},
+                                {0, std::sin(0.1), 0, std::cos(0.1)});
+  ASSERT_TRUE(
+      world.add({platform, makeBody(2, msg::Shape::box({0.2, 0.2, 0.2}), 50.0, {0.3, 1.5, 0}),
+                 makeBody(3, msg::Shape::sphere(0.2), 5.0, {-0.3, 2.0, 0.1})}));
   // Forces sent to it are ignored too.
-  EXPECT_TRUE(world.state().applyForce(1, msg::ForceEvent{{0, 1e6, 0}, {1e6, 0, 0}, {1, 1, 1}, kDt}));
+  EXPECT_TRUE(
+      world.state().applyForce(1, msg::ForceEvent{{0, 1e6, 0}, {1e6, 0, 0}, {1, 1, 1}, kDt}));
   for (int i = 0; i < 300; ++i) world.step(kDt);
   const Body& p = *world.state().find(1);
   EXPECT_EQ(p.position, platform.position);
@@ -286,15 +302,21 @@ TEST(RigidPhysics, SameRunTwiceGivesIdenticalBits) {
     const Body& a = results[0][i];
     const Body& b = results[1][i];
     EXPECT_EQ(0, std::memcmp(a.position.data(), b.position.data(), sizeof(a.position))) << a.id;
-    EXPECT_EQ(0, std::memcmp(a.orientation.data(), b.orientation.data(), sizeof(a.orientation))) << a.id;
-    EXPECT_EQ(0, std::memcmp(a.linearVelocity.data(), b.linearVelocity.data(), sizeof(a.linearVelocity))) << a.id;
-    EXPECT_EQ(0, std::memcmp(a.angularVelocity.data(), b.angularVelocity.data(), sizeof(a.angularVelocity))) << a.id;
+    EXPECT_EQ(0, std::memcmp(a.orientation.data(), b.orientation.data(), sizeof(a.orientation)))
+        << a.id;
+    EXPECT_EQ(
+        0, std::memcmp(a.linearVelocity.data(), b.linearVelocity.data(), sizeof(a.linearVelocity)))
+        << a.id;
+    EXPECT_EQ(0, std::memcmp(a.angularVelocity.data(), b.angularVelocity.data(),
+                             sizeof(a.angularVelocity)))
+        << a.id;
   }
 }
 
 TEST(RigidPhysics, FreeAsymmetricBodyConservesAngularMomentum) {
   RigidAnimatorState state;
-  Body body = makeBody(1, msg::Shape::box({0.5, 0.2, 0.1}), 3.0, {0, 0, 0}, {0.1, 0.3, -0.2, 0.927});
+  Body body =
+      makeBody(1, msg::Shape::box({0.5, 0.2, 0.1}), 3.0, {0, 0, 0}, {0.1, 0.3, -0.2, 0.927});
   body.angularVelocity = {0.4, 2.0, 0.3};  // near the unstable middle axis: tumbles
   ASSERT_TRUE(state.addBody(body));
   const Vec3 l0 = angularMomentum(*state.find(1));
@@ -356,7 +378,8 @@ TEST(RigidPhysics, AnimatorReportsOnlyChangedBodies) {
 }
 
 TEST(RigidPhysics, ForceFieldTerms) {
-  auto field = ForceField::parse("gravity 0 -10 0; uniform 1 0 0; attractor 0 0 10 2 0.5; drag 0.5 0.25");
+  auto field =
+      ForceField::parse("gravity 0 -10 0; uniform 1 0 0; attractor 0 0 10 2 0.5; drag 0.5 0.25");
   ASSERT_TRUE(field) << field.error().message;
   FieldTarget t{2.0, {0, 0, 0}, {1, 0, 0}, {0, 4, 0}};
   const auto f = field->forceOn(t, 0.01);

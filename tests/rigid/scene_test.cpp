@@ -1,11 +1,12 @@
 // Scene files and generators.
+#include "vrflow/rigid/scene.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 
 #include "process_helpers.hpp"
-#include "vrflow/rigid/scene.hpp"
 
 namespace vrflow::rigid {
 namespace {
@@ -32,8 +33,10 @@ TEST(RigidScene, LoadsEveryShapeKindWithMassOrDensity) {
   EXPECT_GT(props.volume, 0);
   bool found = false;
   for (std::size_t i = 0; i < rock.shape.vertices.size(); i += 3) {
-    const Vec3 world = add(rock.position, {rock.shape.vertices[i], rock.shape.vertices[i + 1], rock.shape.vertices[i + 2]});
-    if (std::abs(world[0] - (-1.0 + 0.2)) < 1e-9 && std::abs(world[1] - 0.6) < 1e-9 && std::abs(world[2] + 0.5) < 1e-9)
+    const Vec3 world = add(rock.position, {rock.shape.vertices[i], rock.shape.vertices[i + 1],
+                                           rock.shape.vertices[i + 2]});
+    if (std::abs(world[0] - (-1.0 + 0.2)) < 1e-9 && std::abs(world[1] - 0.6) < 1e-9 &&
+        std::abs(world[2] + 0.5) < 1e-9)
       found = true;
   }
   EXPECT_TRUE(found) << "the point (0.2, 0, 0) of the file is not at position + (0.2, 0, 0)";
@@ -41,30 +44,38 @@ TEST(RigidScene, LoadsEveryShapeKindWithMassOrDensity) {
 
 TEST(RigidScene, BadFilesGiveErrorsNamingFileAndLine) {
   const std::string origin = "scenes/bad.json";
-  auto syntax = parseScene("{\n  \"bodies\": [\n    {\"shape\": {\"type\": \"sphere\", \"radius\": 1},}\n  ]\n}\n", origin);
+  auto syntax = parseScene(
+      "{\n  \"bodies\": [\n    {\"shape\": {\"type\": \"sphere\", \"radius\": 1},}\n  ]\n}\n",
+      origin);
   ASSERT_FALSE(syntax);
-  EXPECT_NE(syntax.error().message.find("scenes/bad.json:3:"), std::string::npos) << syntax.error().message;
+  EXPECT_NE(syntax.error().message.find("scenes/bad.json:3:"), std::string::npos)
+      << syntax.error().message;
 
-  auto unknown = parseScene("{\"bodies\": [\n  {\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"mass\": 1},\n"
-                            "  {\"name\": \"blob\", \"shape\": {\"type\": \"blob\"}, \"mass\": 1}\n]}\n",
-                            origin);
+  auto unknown = parseScene(
+      "{\"bodies\": [\n  {\"shape\": {\"type\": \"sphere\", \"radius\": 1}, \"mass\": 1},\n"
+      "  {\"name\": \"blob\", \"shape\": {\"type\": \"blob\"}, \"mass\": 1}\n]}\n",
+      origin);
   ASSERT_FALSE(unknown);
-  EXPECT_NE(unknown.error().message.find("scenes/bad.json:3: body 1 'blob': unknown shape type 'blob'"),
-            std::string::npos)
+  EXPECT_NE(
+      unknown.error().message.find("scenes/bad.json:3: body 1 'blob': unknown shape type 'blob'"),
+      std::string::npos)
       << unknown.error().message;
 
-  for (const char* body : {R"({"shape": {"type": "sphere", "radius": -1}, "mass": 1})",
-                           R"({"shape": {"type": "sphere", "radius": 1}})",
-                           R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "density": 2})",
-                           R"({"shape": {"type": "box", "halfExtents": [1, 1]}, "mass": 1})",
-                           R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "velocity": [1, 0, 0]})",
-                           R"({"shape": {"type": "sphere", "radius": 1}, "kinematic": true, "mass": 1})",
-                           R"({"shape": {"type": "convexHull", "points": [[0,0,0],[1,0,0],[0,1,0],[1,1,0]]}, "mass": 1})",
-                           R"({"shape": {"type": "triangleMesh", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,3]]}, "kinematic": true})",
-                           R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "orientation": [0, 0, 0, 0]})"}) {
+  for (
+      const char* body :
+      {R"({"shape": {"type": "sphere", "radius": -1}, "mass": 1})",
+       R"({"shape": {"type": "sphere", "radius": 1}})",
+       R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "density": 2})",
+       R"({"shape": {"type": "box", "halfExtents": [1, 1]}, "mass": 1})",
+       R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "velocity": [1, 0, 0]})",
+       R"({"shape": {"type": "sphere", "radius": 1}, "kinematic": true, "mass": 1})",
+       R"({"shape": {"type": "convexHull", "points": [[0,0,0],[1,0,0],[0,1,0],[1,1,0]]}, "mass": 1})",
+       R"({"shape": {"type": "triangleMesh", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,3]]}, "kinematic": true})",
+       R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "orientation": [0, 0, 0, 0]})"}) {
     auto result = parseScene(std::string("{\"bodies\": [") + body + "]}", origin);
     ASSERT_FALSE(result) << body;
-    EXPECT_EQ(result.error().message.rfind("scenes/bad.json:1: body 0: ", 0), 0u) << result.error().message;
+    EXPECT_EQ(result.error().message.rfind("scenes/bad.json:1: body 0: ", 0), 0u)
+        << result.error().message;
   }
   auto missing = loadScene("/nonexistent/scene.json");
   ASSERT_FALSE(missing);
@@ -84,7 +95,8 @@ TEST(RigidScene, GeneratorsAndTheirErrors) {
     if (!b.kinematic) ++kinds[static_cast<int>(b.shape.kind)];
   EXPECT_EQ(kinds[1] + kinds[2] + kinds[3] + kinds[4], 20);
   EXPECT_EQ(kinds[4], 5);
-  for (const char* bad : {"boxes", "boxes:0", "boxes:x", "pyramid:3", "boxes:3x"}) EXPECT_FALSE(generateScene(bad)) << bad;
+  for (const char* bad : {"boxes", "boxes:0", "boxes:x", "pyramid:3", "boxes:3x"})
+    EXPECT_FALSE(generateScene(bad)) << bad;
 }
 
 }  // namespace

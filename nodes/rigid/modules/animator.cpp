@@ -2,11 +2,12 @@
 // events it receives (semi-implicit Euler, world-frame torques with the rotated inertia) and
 // sends an add chunk and the shape resource of every body on the first iteration, then update
 // chunks only for the bodies, and the parameters, that changed.
+#include "vrflow/rigid/animator.hpp"
+
 #include <cstdio>
 #include <map>
 
 #include "vrflow/module/module.hpp"
-#include "vrflow/rigid/animator.hpp"
 #include "vrflow/rigid/messages.hpp"
 #include "vrflow/rigid/scene.hpp"
 
@@ -46,7 +47,9 @@ int main() {
   rigid::SleepParams sleep;
   const std::string sleepText = module.param("sleep", "true");
   if (sleepText != "true" && sleepText != "false" && sleepText != "1" && sleepText != "0") {
-    std::fprintf(stderr, "vrflow-rigid-animator: parameter 'sleep' must be true or false, not '%s'\n", sleepText.c_str());
+    std::fprintf(stderr,
+                 "vrflow-rigid-animator: parameter 'sleep' must be true or false, not '%s'\n",
+                 sleepText.c_str());
     return 2;
   }
   sleep.enabled = sleepText == "true" || sleepText == "1";
@@ -75,14 +78,16 @@ int main() {
       changes = state.step(dt);
       ++steps;
     }
-    auto out = module.newMessage(256 + (module.iteration() == 0 ? state.bodies().size() * 512 : changes.size() * 200));
+    auto out = module.newMessage(
+        256 + (module.iteration() == 0 ? state.bodies().size() * 512 : changes.size() * 200));
     auto& builder = out.builder();
     builder.setSimTime(state.time());
     builder.setTimeStep(dt);
     if (module.iteration() == 0) {
       for (const auto& body : state.bodies()) rigid::writeAdd(builder, body, shapeIds[body.id]);
     } else {
-      for (const auto& change : changes) rigid::writeUpdate(builder, *state.find(change.id), change);
+      for (const auto& change : changes)
+        rigid::writeUpdate(builder, *state.find(change.id), change);
     }
     if (!module.put(objects, std::move(out))) break;
   }
@@ -101,8 +106,8 @@ int main() {
                  static_cast<unsigned long long>(steps));
     for (std::size_t i = 0; i < state.bodies().size(); ++i) {
       const auto& b = state.bodies()[i];
-      std::fprintf(file, "%s\n  {\"id\": %llu, \"kinematic\": %s", i ? "," : "", static_cast<unsigned long long>(b.id),
-                   b.kinematic ? "true" : "false");
+      std::fprintf(file, "%s\n  {\"id\": %llu, \"kinematic\": %s", i ? "," : "",
+                   static_cast<unsigned long long>(b.id), b.kinematic ? "true" : "false");
       vec("position", b.position.data(), 3);
       vec("orientation", b.orientation.data(), 4);
       vec("linearVelocity", b.linearVelocity.data(), 3);

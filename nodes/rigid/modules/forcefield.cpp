@@ -21,16 +21,21 @@ int main() {
   }
   auto field = rigid::ForceField::parse(module.param("field", "gravity 0 -9.81 0"));
   if (!field) {
-    std::fprintf(stderr, "vrflow-rigid-forcefield: parameter 'field': %s\n", field.error().message.c_str());
+    std::fprintf(stderr, "vrflow-rigid-forcefield: parameter 'field': %s\n",
+                 field.error().message.c_str());
     return 2;
   }
   bool rigidBodies = false, points = false;
   std::istringstream types(module.param("types", "rigid"));
   for (std::string type; types >> type;) {
-    if (type == "rigid") rigidBodies = true;
-    else if (type == "point") points = true;
+    if (type == "rigid")
+      rigidBodies = true;
+    else if (type == "point")
+      points = true;
     else {
-      std::fprintf(stderr, "vrflow-rigid-forcefield: parameter 'types': unknown type '%s' (rigid, point)\n", type.c_str());
+      std::fprintf(stderr,
+                   "vrflow-rigid-forcefield: parameter 'types': unknown type '%s' (rigid, point)\n",
+                   type.c_str());
       return 2;
     }
   }
@@ -55,7 +60,8 @@ int main() {
           if (auto v = object->vec3(P::kPosition)) t.position = *v;
           if (auto v = object->vec3(P::kLinearVelocity)) t.linearVelocity = *v;
           if (auto v = object->vec3(P::kAngularVelocity)) t.angularVelocity = *v;
-          if (auto v = object->scalar(P::kMass)) t.mass = *v > 0 ? *v : rigid::kInfiniteMass;  // 0: kinematic
+          if (auto v = object->scalar(P::kMass))
+            t.mass = *v > 0 ? *v : rigid::kInfiniteMass;  // 0: kinematic
         } else {
           using P = msg::PointParam;
           if (auto v = object->vec3(P::kPosition)) t.position = *v;

@@ -28,7 +28,8 @@ int main() {
   params.iterations = static_cast<int>(module.paramInt("iterations", params.iterations));
   params.baumgarte = module.paramDouble("baumgarte", params.baumgarte);
   params.slop = module.paramDouble("slop", params.slop);
-  params.restitutionThreshold = module.paramDouble("restitution-threshold", params.restitutionThreshold);
+  params.restitutionThreshold =
+      module.paramDouble("restitution-threshold", params.restitutionThreshold);
   const double fallbackDt = module.paramDouble("dt", 0.01);
   rigid::RigidContactSolver solver(params);
   rigid::RigidObjectCopy copy;

@@ -21,14 +21,18 @@ Quat integrate(const Quat& q, const Vec3& w, double dt) {
   return normalized({q[0] + h * dq[0], q[1] + h * dq[1], q[2] + h * dq[2], q[3] + h * dq[3]});
 }
 
-bool isZero(const Vec3& v) { return v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0; }
+bool isZero(const Vec3& v) {
+  return v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0;
+}
 
 }  // namespace
 
 Status RigidAnimatorState::addBody(Body body) {
-  if (index_.contains(body.id)) return makeError("rigid body " + std::to_string(body.id) + " exists already");
+  if (index_.contains(body.id))
+    return makeError("rigid body " + std::to_string(body.id) + " exists already");
   if (!body.kinematic && !(body.mass > 0 && std::isfinite(body.mass)))
-    return makeError("rigid body " + std::to_string(body.id) + ": mass must be positive and finite");
+    return makeError("rigid body " + std::to_string(body.id) +
+                     ": mass must be positive and finite");
   if (body.kinematic) body.mass = kInfiniteMass;
   body.orientation = normalized(body.orientation);
   const auto at = std::lower_bound(bodies_.begin(), bodies_.end(), body.id,
@@ -122,8 +126,10 @@ std::vector<Change> RigidAnimatorState::step(double dt) {
         // A sleeping body stays put while the impulses it receives nearly cancel (its weight
         // and its support); a blow or a lost support wakes it.
         const Vec3 dv = scale(linear, 1.0 / b.mass);
-        const Vec3 dw = mul(rotateTensor(rotationMatrix(b.orientation), inverse(b.inertia)), angular);
-        if (std::sqrt(dot(dv, dv)) < sleep_.wakeLinear && std::sqrt(dot(dw, dw)) < sleep_.wakeAngular) {
+        const Vec3 dw =
+            mul(rotateTensor(rotationMatrix(b.orientation), inverse(b.inertia)), angular);
+        if (std::sqrt(dot(dv, dv)) < sleep_.wakeLinear &&
+            std::sqrt(dot(dw, dw)) < sleep_.wakeAngular) {
           impulses_[i] = Accumulator{};
           stepForces_[i] = Accumulator{};
           continue;
@@ -138,10 +144,13 @@ std::vector<Change> RigidAnimatorState::step(double dt) {
       if (!isZero(b.angularVelocity) || !isZero(angular)) {
         const Mat3 inertiaInverse = inverse(b.inertia);
         // Angular momentum in the world frame with the current orientation, plus the impulse.
-        const Vec3 momentum = add(mul(rotateTensor(rotationMatrix(b.orientation), b.inertia), b.angularVelocity), angular);
+        const Vec3 momentum =
+            add(mul(rotateTensor(rotationMatrix(b.orientation), b.inertia), b.angularVelocity),
+                angular);
         const Vec3 w = mul(rotateTensor(rotationMatrix(b.orientation), inertiaInverse), momentum);
         b.orientation = integrate(b.orientation, w, dt);
-        b.angularVelocity = mul(rotateTensor(rotationMatrix(b.orientation), inertiaInverse), momentum);
+        b.angularVelocity =
+            mul(rotateTensor(rotationMatrix(b.orientation), inertiaInverse), momentum);
       }
       if (sleep_.enabled) {
         const bool slow = std::sqrt(dot(b.linearVelocity, b.linearVelocity)) < sleep_.linear &&

@@ -1,8 +1,8 @@
 #include "vrflow/rigid/contact_solver.hpp"
 
+#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
 #include <btBulletCollisionCommon.h>
 
-#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,7 +14,9 @@ namespace {
 btVector3 toBt(const Vec3& v) {
   return {static_cast<btScalar>(v[0]), static_cast<btScalar>(v[1]), static_cast<btScalar>(v[2])};
 }
-Vec3 fromBt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+Vec3 fromBt(const btVector3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 btTransform transformOf(const Vec3& position, const Quat& q) {
   return btTransform(btQuaternion(static_cast<btScalar>(q[0]), static_cast<btScalar>(q[1]),
                                   static_cast<btScalar>(q[2]), static_cast<btScalar>(q[3])),
@@ -65,11 +67,13 @@ struct RigidContactSolver::Impl {
     const msg::Shape& s = e.body.shape;
     if (auto status = msg::validateShape(s); !status) return status;
     const bool concave = s.kind == msg::ShapeKind::TriangleMesh && e.body.kinematic;
-    if (s.kind == msg::ShapeKind::ConvexHull || (s.kind == msg::ShapeKind::TriangleMesh && !concave)) {
+    if (s.kind == msg::ShapeKind::ConvexHull ||
+        (s.kind == msg::ShapeKind::TriangleMesh && !concave)) {
       // Moving triangle meshes collide as their convex hull (documented approximation).
       auto hull = std::make_unique<btConvexHullShape>();
       for (std::size_t i = 0; i + 2 < s.vertices.size(); i += 3)
-        hull->addPoint(btVector3(static_cast<btScalar>(s.vertices[i]), static_cast<btScalar>(s.vertices[i + 1]),
+        hull->addPoint(btVector3(static_cast<btScalar>(s.vertices[i]),
+                                 static_cast<btScalar>(s.vertices[i + 1]),
                                  static_cast<btScalar>(s.vertices[i + 2])),
                        false);
       hull->recalcLocalAabb();
@@ -112,7 +116,8 @@ struct RigidContactSolver::Impl {
                                btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
     } else {
       e.object->setCollisionFlags(0);
-      world.addCollisionObject(e.object.get(), btBroadphaseProxy::DefaultFilter, btBroadphaseProxy::AllFilter);
+      world.addCollisionObject(e.object.get(), btBroadphaseProxy::DefaultFilter,
+                               btBroadphaseProxy::AllFilter);
     }
     return {};
   }
@@ -167,8 +172,12 @@ void RigidContactSolver::removeBody(std::uint64_t id) {
   impl_->entries.erase(it);
 }
 
-bool RigidContactSolver::contains(std::uint64_t id) const { return impl_->entries.contains(id); }
-std::size_t RigidContactSolver::size() const { return impl_->entries.size(); }
+bool RigidContactSolver::contains(std::uint64_t id) const {
+  return impl_->entries.contains(id);
+}
+std::size_t RigidContactSolver::size() const {
+  return impl_->entries.size();
+}
 
 std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve(double dt) {
   contacts_.clear();
@@ -217,7 +226,8 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   };
   std::vector<Constraint> constraints;
   auto velocityAlong = [&](const Constraint& c, int axis) {
-    return dot(v[c.a], c.dir[axis]) + dot(w[c.a], c.raxd[axis]) - dot(v[c.b], c.dir[axis]) - dot(w[c.b], c.rbxd[axis]);
+    return dot(v[c.a], c.dir[axis]) + dot(w[c.a], c.raxd[axis]) - dot(v[c.b], c.dir[axis]) -
+           dot(w[c.b], c.rbxd[axis]);
   };
   auto push = [&](const Constraint& c, int axis, double impulse) {
     v[c.a] = add(v[c.a], scale(c.dir[axis], impulse * invMass[c.a]));
@@ -241,8 +251,9 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     if (ea->body.kinematic && eb->body.kinematic) continue;
     pairs.push_back({std::min(ea->body.id, eb->body.id), std::max(ea->body.id, eb->body.id), m});
   }
-  std::stable_sort(pairs.begin(), pairs.end(),
-                   [](const PairRef& x, const PairRef& y) { return x.lo != y.lo ? x.lo < y.lo : x.hi < y.hi; });
+  std::stable_sort(pairs.begin(), pairs.end(), [](const PairRef& x, const PairRef& y) {
+    return x.lo != y.lo ? x.lo < y.lo : x.hi < y.hi;
+  });
   for (const PairRef& pair : pairs) {
     btPersistentManifold* manifold = impl_->dispatcher.getManifoldByIndexInternal(pair.index);
     const auto* ea = static_cast<const Impl::Entry*>(manifold->getBody0()->getUserPointer());
@@ -271,11 +282,13 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
         c.rbxd[axis] = cross(c.rb, c.dir[axis]);
         c.ia[axis] = mul(invInertia[c.a], c.raxd[axis]);
         c.ib[axis] = mul(invInertia[c.b], c.rbxd[axis]);
-        const double k = invMass[c.a] + invMass[c.b] + dot(c.ia[axis], c.raxd[axis]) + dot(c.ib[axis], c.rbxd[axis]);
+        const double k = invMass[c.a] + invMass[c.b] + dot(c.ia[axis], c.raxd[axis]) +
+                         dot(c.ib[axis], c.rbxd[axis]);
         c.mass[axis] = k > 0 ? 1.0 / k : 0.0;
       }
       auto round = [](const Impl::Entry* e) {
-        return e->body.shape.kind == msg::ShapeKind::Sphere || e->body.shape.kind == msg::ShapeKind::Capsule;
+        return e->body.shape.kind == msg::ShapeKind::Sphere ||
+               e->body.shape.kind == msg::ShapeKind::Capsule;
       };
       c.rolls = p.rollingFriction > 0 && (round(ea) || round(eb));
       if (c.rolls) {
@@ -311,7 +324,8 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       // Friction within the cone of the current normal impulse (box approximation).
       const double limit = p.friction * c.acc[0];
       for (int axis = 1; axis < 3; ++axis) {
-        const double next = std::clamp(c.acc[axis] - c.mass[axis] * velocityAlong(c, axis), -limit, limit);
+        const double next =
+            std::clamp(c.acc[axis] - c.mass[axis] * velocityAlong(c, axis), -limit, limit);
         const double delta = next - c.acc[axis];
         c.acc[axis] = next;
         if (delta != 0) push(c, axis, delta);
@@ -322,7 +336,8 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
         const Vec3 wrel = sub(w[c.a], w[c.b]);
         const double rollLimit = p.rollingFriction * c.acc[0];
         const Vec3 wanted = sub(c.accRoll, mul(c.rollMass, wrel));
-        const Vec3 next{std::clamp(wanted[0], -rollLimit, rollLimit), std::clamp(wanted[1], -rollLimit, rollLimit),
+        const Vec3 next{std::clamp(wanted[0], -rollLimit, rollLimit),
+                        std::clamp(wanted[1], -rollLimit, rollLimit),
                         std::clamp(wanted[2], -rollLimit, rollLimit)};
         const Vec3 delta = sub(next, c.accRoll);
         c.accRoll = next;
@@ -343,7 +358,8 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     c.point->m_appliedImpulse = static_cast<btScalar>(c.acc[0]);
     c.point->m_appliedImpulseLateral1 = static_cast<btScalar>(c.acc[1]);
     c.point->m_appliedImpulseLateral2 = static_cast<btScalar>(c.acc[2]);
-    const Vec3 impulse = add(scale(c.dir[0], c.acc[0]), add(scale(c.dir[1], c.acc[1]), scale(c.dir[2], c.acc[2])));
+    const Vec3 impulse =
+        add(scale(c.dir[0], c.acc[0]), add(scale(c.dir[1], c.acc[1]), scale(c.dir[2], c.acc[2])));
     linear[c.a] = add(linear[c.a], impulse);
     linear[c.b] = sub(linear[c.b], impulse);
     angular[c.a] = add(angular[c.a], add(cross(c.ra, impulse), c.accRoll));
@@ -354,7 +370,8 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     const Body& b = bodies[k]->body;
     if (b.kinematic) continue;
     if (linear[k] == Vec3{} && angular[k] == Vec3{}) continue;
-    result.emplace_back(b.id, msg::ForceEvent{scale(linear[k], 1.0 / dt), scale(angular[k], 1.0 / dt), b.position, dt});
+    result.emplace_back(b.id, msg::ForceEvent{scale(linear[k], 1.0 / dt),
+                                              scale(angular[k], 1.0 / dt), b.position, dt});
   }
   return result;
 }

@@ -16,13 +16,16 @@ Result<ForceField> ForceField::parse(std::string_view text) {
     FieldTerm term;
     std::vector<double> numbers;
     for (double x; in >> x;) numbers.push_back(x);
-    if (!in.eof()) return makeError("force field term '" + termText + "': not a number after '" + kind + "'");
+    if (!in.eof())
+      return makeError("force field term '" + termText + "': not a number after '" + kind + "'");
     auto need = [&](std::size_t lo, std::size_t hi) -> Status {
       if (numbers.size() < lo || numbers.size() > hi)
-        return makeError("force field term '" + termText + "': '" + kind + "' takes " + std::to_string(lo) +
-                         (lo == hi ? "" : " to " + std::to_string(hi)) + " numbers");
+        return makeError("force field term '" + termText + "': '" + kind + "' takes " +
+                         std::to_string(lo) + (lo == hi ? "" : " to " + std::to_string(hi)) +
+                         " numbers");
       for (double x : numbers)
-        if (!std::isfinite(x)) return makeError("force field term '" + termText + "': numbers must be finite");
+        if (!std::isfinite(x))
+          return makeError("force field term '" + termText + "': numbers must be finite");
       return {};
     };
     if (kind == "gravity" || kind == "uniform") {
@@ -35,7 +38,8 @@ Result<ForceField> ForceField::parse(std::string_view text) {
       term.vector = {numbers[0], numbers[1], numbers[2]};
       term.strength = numbers[3];
       if (numbers.size() == 5) {
-        if (!(numbers[4] > 0)) return makeError("force field term '" + termText + "': RMIN must be positive");
+        if (!(numbers[4] > 0))
+          return makeError("force field term '" + termText + "': RMIN must be positive");
         term.minRadius = numbers[4];
       }
     } else if (kind == "drag") {

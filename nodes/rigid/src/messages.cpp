@@ -31,10 +31,13 @@ void writeUpdate(msg::MessageBuilder& builder, const Body& body, const Change& c
         .set(P::kOrientation, body.orientation)
         .set(P::kBounds, msg::worldBounds(body.shape, body.position, body.orientation));
   }
-  if (change.velocity) object.set(P::kLinearVelocity, body.linearVelocity).set(P::kAngularVelocity, body.angularVelocity);
+  if (change.velocity)
+    object.set(P::kLinearVelocity, body.linearVelocity)
+        .set(P::kAngularVelocity, body.angularVelocity);
 }
 
-Status RigidObjectCopy::apply(const msg::MessageView& message, std::vector<std::uint64_t>* deleted) {
+Status RigidObjectCopy::apply(const msg::MessageView& message,
+                              std::vector<std::uint64_t>* deleted) {
   for (const auto chunk : message) {
     if (const auto resource = chunk.asResource()) {
       if (resource->kind() != msg::ResourceKind::Raw) continue;
@@ -81,7 +84,8 @@ Status RigidObjectCopy::apply(const msg::MessageView& message, std::vector<std::
   for (const auto& [id, entry] : entries_)
     if (!entry.hasShape && entry.shapeId != 0 && !shapes_.contains(entry.shapeId))
       return makeError("rigid object " + std::to_string(id) + " names shape resource " +
-                       std::to_string(entry.shapeId) + ", which did not arrive or does not decode as a shape");
+                       std::to_string(entry.shapeId) +
+                       ", which did not arrive or does not decode as a shape");
   return {};
 }
 

@@ -13,7 +13,8 @@ Status RigidWorld::add(const std::vector<Body>& bodies) {
 std::vector<Change> RigidWorld::step(double dt) {
   for (const Body& b : state_.bodies()) {
     if (b.kinematic) continue;
-    state_.applyForce(b.id, field_.forceOn({b.mass, b.position, b.linearVelocity, b.angularVelocity}, dt));
+    state_.applyForce(
+        b.id, field_.forceOn({b.mass, b.position, b.linearVelocity, b.angularVelocity}, dt));
   }
   for (const auto& [id, event] : solver_.solve(dt)) state_.applyForce(id, event);
   auto changes = state_.step(dt);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+#include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/rigid/body.hpp"
 
 // The rigid animator's state and integrator, without any messaging: the `rigid-animator` module
@@ -26,11 +27,11 @@ struct Change {
 /// support). Sleeping bodies are what keeps a settled scene from sending every body every step.
 struct SleepParams {
   bool enabled = true;
-  double linear = 0.02;       ///< m/s
-  double angular = 0.05;      ///< rad/s
-  double time = 0.5;          ///< s
-  double wakeLinear = 0.02;   ///< m/s per step
-  double wakeAngular = 0.1;   ///< rad/s per step
+  double linear = 0.02;      ///< m/s
+  double angular = 0.05;     ///< rad/s
+  double time = 0.5;         ///< s
+  double wakeLinear = 0.02;  ///< m/s per step
+  double wakeAngular = 0.1;  ///< rad/s per step
 };
 
 class RigidAnimatorState {

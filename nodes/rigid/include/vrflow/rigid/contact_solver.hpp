@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+#include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/message/values.hpp"
 #include "vrflow/rigid/body.hpp"
 
@@ -44,8 +45,8 @@ struct ContactParams {
 /// One contact point found in the last solve (for tests and diagnostics).
 struct ContactInfo {
   std::uint64_t a = 0, b = 0;
-  Vec3 point{};       ///< on b, world frame
-  Vec3 normal{};      ///< from b to a
+  Vec3 point{};         ///< on b, world frame
+  Vec3 normal{};        ///< from b to a
   double distance = 0;  ///< negative when penetrating
 };
 

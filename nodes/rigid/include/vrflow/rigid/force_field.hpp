@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+#include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/message/values.hpp"
 #include "vrflow/rigid/body.hpp"
 
@@ -17,10 +18,11 @@ namespace vrflow::rigid {
 struct FieldTerm {
   enum class Kind { Gravity, Uniform, Attractor, Drag };
   Kind kind = Kind::Gravity;
-  Vec3 vector{};          ///< Gravity: acceleration (m/s^2); Uniform: force (N); Attractor: centre
-  double strength = 0.0;  ///< Attractor: mu in a = mu / r^2 towards the centre; Drag: linear (N s/m)
-  double angular = 0.0;   ///< Drag: angular drag (N m s)
-  double minRadius = 0.1; ///< Attractor: r is clamped below to this (m)
+  Vec3 vector{};  ///< Gravity: acceleration (m/s^2); Uniform: force (N); Attractor: centre
+  double strength =
+      0.0;               ///< Attractor: mu in a = mu / r^2 towards the centre; Drag: linear (N s/m)
+  double angular = 0.0;  ///< Drag: angular drag (N m s)
+  double minRadius = 0.1;  ///< Attractor: r is clamped below to this (m)
 };
 
 /// What the field needs to know of an object (rigid bodies and point masses alike).

@@ -6,14 +6,16 @@
 
 #include "vrflow/base/result.hpp"
 #include "vrflow/message/builder.hpp"
+#include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/message/reader.hpp"
 #include "vrflow/rigid/animator.hpp"
 #include "vrflow/rigid/body.hpp"
 
 // How rigid bodies travel in messages (the `rigid` built-in object type): the animator writes
 // them, interactors keep a local copy. A kinematic (infinite-mass) body travels with mass = 0
-// and an all-zero inertia (messages carry no infinities): read mass 0 as inverse mass 0; its shape is a static Raw resource (encodeShape) sent
-// once, in the message with the body's add chunk, before it.
+// and an all-zero inertia (messages carry no infinities): read mass 0 as inverse mass 0; its shape
+// is a static Raw resource (encodeShape) sent once, in the message with the body's add chunk,
+// before it.
 
 namespace vrflow::rigid {
 

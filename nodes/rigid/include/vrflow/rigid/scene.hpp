@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+#include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/rigid/body.hpp"
 
 // Scenes: a JSON file of bodies (format in nodes/rigid/README.md) and generators for tests and

@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+#include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/rigid/animator.hpp"
 #include "vrflow/rigid/contact_solver.hpp"
 #include "vrflow/rigid/force_field.hpp"
