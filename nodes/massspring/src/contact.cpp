@@ -193,7 +193,7 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
         const msg::Vec3 normal = msg::rotate(body.orientation, sd.normal);
         const msg::Vec3 pointVelocity = add(body.linearVelocity, cross(body.angularVelocity, r));
         const double vn = dot(sub(net.velocity(i), pointVelocity), normal);
-        const double magnitude = contactMagnitude(sd.distance, vn, invNode + invRigid, p);
+        const double magnitude = contactMagnitude(sd.distance, vn, invNode / p.nodeMassScale + invRigid, p);
         if (magnitude <= 0) continue;
         ++out.contacts;
         const msg::Vec3 f = scale(normal, magnitude);

@@ -39,16 +39,20 @@ void addSpringForces(const Net& net, std::span<const Spring> springs, std::span<
 
 void addSpringForces(const Net& net, std::span<double> forces) { addSpringForces(net, net.springs, forces); }
 
-double enforceMaxStretch(Net& net, double h, int maxIterations) {
+double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible) {
   bool any = false;
   for (const auto& s : net.springs) any = any || s.maxStretch > 0;
   if (!any) return 0.0;
   double* x = net.positions.data();
   std::vector<double> before(net.positions);
   constexpr double kTolerance = 1e-9;
-  for (int iteration = 0; iteration < maxIterations; ++iteration) {
-    bool violated = false;
-    for (const auto& s : net.springs) {
+  const std::size_t count = net.springs.size();
+  bool violated = true;
+  for (int iteration = 0; iteration < maxIterations && violated; ++iteration) {
+    violated = false;
+    // Symmetric Gauss-Seidel: forward, then backward sweeps (corrections travel both ways).
+    for (std::size_t index = 0; index < count; ++index) {
+      const auto& s = net.springs[iteration % 2 == 0 ? index : count - 1 - index];
       if (s.maxStretch <= 0) continue;
       const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
       const double limit = s.maxStretch * s.restLength;
@@ -68,7 +72,34 @@ double enforceMaxStretch(Net& net, double h, int maxIterations) {
       x[b + 1] -= wb * excess * d1;
       x[b + 2] -= wb * excess * d2;
     }
-    if (!violated) break;
+  }
+  if (maxConstraintRatio(net) > 1.0 && feasible.size() == net.positions.size()) {
+    // Not converged: back off along the segment from the feasible positions to these, to the
+    // largest fraction t at which every limited spring holds (each spring's constraint holds on
+    // an interval of t that contains 0, so the smallest root over the springs is safe).
+    double t = 1.0;
+    for (const auto& s : net.springs) {
+      if (s.maxStretch <= 0) continue;
+      const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
+      const double limit = s.maxStretch * s.restLength * (1 - 0.5 * kTolerance);
+      double aa = 0, bb = 0, cc = -limit * limit, now = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double d = feasible[b + k] - feasible[a + k];
+        const double e = (x[b + k] - x[a + k]) - d;
+        aa += e * e;
+        bb += d * e;
+        cc += d * d;
+        now += (x[b + k] - x[a + k]) * (x[b + k] - x[a + k]);
+      }
+      if (now <= limit * limit || aa <= 0) continue;
+      if (cc >= 0) {
+        t = 0;  // the start was not inside this limit: stay there
+        continue;
+      }
+      t = std::min(t, (-bb + std::sqrt(std::max(0.0, bb * bb - aa * cc))) / aa);
+    }
+    t = std::max(0.0, t * (1 - 1e-12));
+    for (std::size_t i = 0; i < net.positions.size(); ++i) x[i] = feasible[i] + t * (x[i] - feasible[i]);
   }
   const double invH = 1.0 / h;
   for (std::size_t i = 0; i < net.positions.size(); ++i) net.velocities[i] += (x[i] - before[i]) * invH;
@@ -79,6 +110,7 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
   const std::size_t n = net.nodeCount();
   const double h = options.dt / options.substeps;
   std::vector<double> forces(3 * n);
+  std::vector<double> start;
   double worst = 0.0;
   for (int sub = 0; sub < options.substeps; ++sub) {
     for (std::size_t i = 0; i < n; ++i) {
@@ -87,6 +119,9 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
       }
     }
     if (options.internalSprings) addSpringForces(net, forces);
+    // The start of the sub-step, a fallback inside every limit when it was inside before.
+    if (maxConstraintRatio(net) <= 1.0) start = net.positions;
+    else start.clear();
     for (std::size_t i = 0; i < n; ++i) {
       if (net.pinned[i]) {
         for (int k = 0; k < 3; ++k) net.velocities[3 * i + k] = 0.0;
@@ -98,7 +133,7 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
         net.positions[3 * i + k] += h * net.velocities[3 * i + k];
       }
     }
-    worst = enforceMaxStretch(net, h, options.constraintIterations);
+    worst = enforceMaxStretch(net, h, options.constraintIterations, start);
   }
   return worst;
 }

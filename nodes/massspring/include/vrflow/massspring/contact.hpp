@@ -24,6 +24,7 @@ struct ContactParams {
   double thickness = 0.02;  ///< contact distance (m), > 0
   double beta = 0.2;        ///< fraction of the overlap removed per step, in [0, 1]
   double dt = 0.01;         ///< the outer step the forces are held for (s), > 0
+  double nodeMassScale = 1.0;  ///< nodes weigh this many times their mass in the response, >= 1
 };
 Status validateContactParams(const ContactParams& params);
 

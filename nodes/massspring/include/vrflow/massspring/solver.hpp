@@ -20,7 +20,7 @@ struct StepOptions {
   int substeps = 10;             ///< sub-steps per outer step (>= 1)
   bool internalSprings = true;   ///< evaluate the net's springs at every sub-step
   msg::Vec3 gravity{0, 0, 0};         ///< acceleration applied to every free node (m/s^2)
-  int constraintIterations = 200;  ///< most Gauss-Seidel sweeps of the max-stretch projection
+  int constraintIterations = 50;  ///< most Gauss-Seidel sweeps of the max-stretch projection
 };
 Status validateStepOptions(const StepOptions& options);
 
@@ -33,9 +33,12 @@ void addSpringForces(const Net& net, std::span<const Spring> springs, std::span<
 /// its free ends, inverse-mass weighted, pinned nodes immovable) in Gauss-Seidel sweeps until no
 /// spring exceeds its limit by more than 1e-9 relative or `maxIterations` sweeps ran. The
 /// position change of each node is added to its velocity divided by `h` (the separating speed
-/// the constraint removed). Returns the largest length / (maxStretch * restLength) left after
-/// the projection (<= 1 + 1e-9 when it converged).
-double enforceMaxStretch(Net& net, double h, int maxIterations);
+/// the constraint removed). If the sweeps did not converge and `feasible` (positions that met
+/// every limit, e.g. those at the start of the sub-step) is given, the positions are moved back
+/// along the straight path from `feasible` to the largest fraction at which every limit holds:
+/// the limit then holds exactly (the motion of that sub-step is cut short instead).
+/// Returns the largest length / (maxStretch * restLength) left (0 if no spring has a limit).
+double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible = {});
 
 /// Advances the net by one outer step. `externalForces` holds xyz per node (or is empty).
 /// Returns the largest constraint ratio left (see enforceMaxStretch), 0 if no spring has a limit.
