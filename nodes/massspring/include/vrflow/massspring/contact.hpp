@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <map>
+#include <tuple>
 #include <vector>
 
 #include "vrflow/massspring/net.hpp"
@@ -24,7 +25,11 @@ struct ContactParams {
   double thickness = 0.02;  ///< contact distance (m), > 0
   double beta = 0.2;        ///< fraction of the overlap removed per step, in [0, 1]
   double dt = 0.01;         ///< the outer step the forces are held for (s), > 0
-  double nodeMassScale = 1.0;  ///< nodes weigh this many times their mass in the response, >= 1
+  /// Rigid contacts only: a node weighs its mass plus springMassWeight * dt^2 * (stiffness of
+  /// its springs along the contact normal), since a node held by stiff springs does not give way
+  /// like a free particle within one outer step. 0: free particles (a heavy rigid then sinks deep
+  /// into a net); large values overshoot. 0.01 was tuned on the box-on-net test (README).
+  double springMassWeight = 0.01;
 };
 Status validateContactParams(const ContactParams& params);
 
@@ -49,12 +54,29 @@ struct ContactForces {
 
 /// Nodes of every net against the surface triangles of every other net (nets without a surface
 /// are seen as their nodes: node/node repulsion). Nets are visited in id order (deterministic).
+/// A node's side of a triangle is the side it was on one step before (x - v_rel dt), so a node
+/// that crossed a triangle within one step is pushed back, not through.
 ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& params);
 
-/// Nodes of every net against every rigid shape (signedDistance in the body frame).
+/// What rigidContacts remembers between steps: for each (rigid, net, node) in contact, the
+/// body-frame plane (outward normal, offset) of the surface where the contact began. While the
+/// contact lasts, the node is pushed out along that plane, so a node that went deep into a shape
+/// is never pushed out through the far side. Keep one per interactor; pass it every step.
+struct ContactMemory {
+  struct Plane {
+    msg::Vec3 normal{};
+    double offset = 0.0;
+  };
+  std::map<std::tuple<std::uint64_t, std::uint64_t, std::uint32_t>, Plane> planes;
+};
+
+/// Nodes of every net against every rigid shape (signed distance in the body frame), and the
+/// vertices of box, hull and mesh shapes against every net's surface triangles (so that a corner
+/// cannot slip between nodes), each side of a triangle as in netCollisions. All contacts of one
+/// rigid are gathered first and share its mass (each sees count / m_rigid as its inverse mass).
 ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
                             const std::map<std::uint64_t, RigidBody>& rigids,
-                            const ContactParams& params);
+                            const ContactParams& params, ContactMemory* memory = nullptr);
 
 /// Closest point of triangle abc to p, with its barycentric weights (Ericson's algorithm).
 struct TrianglePoint {
