@@ -47,11 +47,12 @@ struct PlaneHit {
   double gap = 0;        ///< 3-D distance to the closest point (to choose among triangles)
   msg::Vec3 normal{};    ///< unit, pointing to the side the point came from
   TrianglePoint closest;
+  int side = 0;          ///< that side along the triangle's own normal (+1 / -1)
 };
 
 /// A point x moving at `relative` (point minus surface) against triangle abc.
 PlaneHit pointTriangle(const msg::Vec3& x, const msg::Vec3& relative, const msg::Vec3& a, const msg::Vec3& b,
-                       const msg::Vec3& c, const ContactParams& p) {
+                       const msg::Vec3& c, const ContactParams& p, int knownSide = 0) {
   PlaneHit out;
   msg::Vec3 n = cross(sub(b, a), sub(c, a));
   const double length = std::sqrt(dot(n, n));
@@ -60,9 +61,10 @@ PlaneHit pointTriangle(const msg::Vec3& x, const msg::Vec3& relative, const msg:
   const double s = dot(sub(x, a), n);
   const double along = dot(relative, n);
   const double before = s - along * p.dt;
-  const double side = before > 0 ? 1.0 : before < 0 ? -1.0 : (s >= 0 ? 1.0 : -1.0);
+  const double side = knownSide != 0 ? knownSide : before > 0 ? 1.0 : before < 0 ? -1.0 : (s >= 0 ? 1.0 : -1.0);
   const double distance = s * side;
-  if (distance >= p.thickness || distance < -(std::abs(along) * p.dt + p.thickness)) return out;
+  const double deepest = std::abs(along) * p.dt + (knownSide != 0 ? 5.0 : 1.0) * p.thickness;
+  if (distance >= p.thickness || distance < -deepest) return out;
   const msg::Vec3 onPlane = sub(x, scale(n, s));
   const auto closest = closestPointOnTriangle(onPlane, a, b, c);
   const msg::Vec3 off = sub(onPlane, closest.point);
@@ -73,6 +75,7 @@ PlaneHit pointTriangle(const msg::Vec3& x, const msg::Vec3& relative, const msg:
   out.gap = std::sqrt(dot(gap, gap));
   out.normal = scale(n, side);
   out.closest = closest;
+  out.side = side > 0 ? 1 : -1;
   return out;
 }
 
@@ -161,10 +164,15 @@ TrianglePoint closestPointOnTriangle(const msg::Vec3& p, const msg::Vec3& a, con
   return {add(a, add(scale(ab, v), scale(ac, w))), 1 - v - w, v, w};
 }
 
-ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& p) {
+ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& p, ContactMemory* memory) {
   ContactForces out;
+  std::map<std::tuple<std::uint64_t, std::uint32_t, std::uint64_t>, int> sides;
   std::map<std::uint64_t, msg::Aabb> boxes;
-  for (const auto& [id, net] : nets) boxes[id] = bounds(net);
+  std::map<std::uint64_t, Adjacency> adjacent;
+  for (const auto& [id, net] : nets) {
+    boxes[id] = bounds(net);
+    adjacent[id] = adjacency(net);
+  }
   for (const auto& [idA, a] : nets) {
     for (const auto& [idB, b] : nets) {
       if (idA == idB || a.nodeCount() == 0 || b.nodeCount() == 0) continue;
@@ -189,6 +197,13 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
         std::size_t tri[3] = {0, 0, 0};
         double weights[3] = {0, 0, 0};
         int featureNodes = 0;
+        const auto key = std::tuple{idA, static_cast<std::uint32_t>(i), idB};
+        int knownSide = 0;
+        if (memory) {
+          const auto found = memory->sides.find(key);
+          if (found != memory->sides.end()) knownSide = found->second;
+        }
+        int side = 0;
         if (!b.surface.empty()) {
           double bestGap = 1e300;
           for (std::size_t t = 0; t + 2 < b.surface.size(); t += 3) {
@@ -205,9 +220,10 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
             const auto& w1 = b.velocity(ib);
             const auto& w2 = b.velocity(ic);
             const msg::Vec3 centre = scale(add(add(w0, w1), w2), 1.0 / 3.0);
-            const auto hit = pointTriangle(x, sub(a.velocity(i), centre), pa, pb, pc, p);
+            const auto hit = pointTriangle(x, sub(a.velocity(i), centre), pa, pb, pc, p, knownSide);
             if (!hit.hit || hit.gap >= bestGap) continue;
             bestGap = hit.gap;
+            side = hit.side;
             best = hit.distance;
             normal = hit.normal;
             tri[0] = ia, tri[1] = ib, tri[2] = ic;
@@ -227,17 +243,15 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
           }
         }
         if (featureNodes == 0) continue;
+        if (side != 0) sides[key] = knownSide != 0 ? knownSide : side;
         surfaceVelocity = {0, 0, 0};
-        double massB = 0;
-        bool pinnedB = false;
         for (int f = 0; f < featureNodes; ++f) {
           surfaceVelocity = add(surfaceVelocity, scale(b.velocity(tri[f]), weights[f]));
-          massB += weights[f] * b.masses[tri[f]];
-          pinnedB = pinnedB || (b.pinned[tri[f]] && weights[f] > 0.5);
+          invB += weights[f] * weights[f] * effectiveInvMass(b, adjacent[idB], tri[f], normal, p);
         }
-        invB = pinnedB || massB <= 0 ? 0.0 : 1.0 / massB;
+        const double invNode = effectiveInvMass(a, adjacent[idA], i, normal, p);
         const double vn = dot(sub(a.velocity(i), surfaceVelocity), normal);
-        const double magnitude = contactMagnitude(best, vn, invA + invB, p);
+        const double magnitude = contactMagnitude(best, vn, invNode + invB, p);
         if (magnitude <= 0) continue;
         ++out.contacts;
         const msg::Vec3 f = scale(normal, magnitude);
@@ -249,6 +263,7 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
       }
     }
   }
+  if (memory) memory->sides = std::move(sides);
   return out;
 }
 

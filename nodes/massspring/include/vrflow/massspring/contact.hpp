@@ -22,7 +22,7 @@
 namespace vrflow::massspring {
 
 struct ContactParams {
-  double thickness = 0.02;  ///< contact distance (m), > 0
+  double thickness = 0.03;  ///< contact distance (m), > 0
   double beta = 0.2;        ///< fraction of the overlap removed per step, in [0, 1]
   double dt = 0.01;         ///< the outer step the forces are held for (s), > 0
   /// Rigid contacts only: a node weighs its mass plus springMassWeight * dt^2 * (stiffness of
@@ -52,13 +52,9 @@ struct ContactForces {
   std::size_t contacts = 0;
 };
 
-/// Nodes of every net against the surface triangles of every other net (nets without a surface
-/// are seen as their nodes: node/node repulsion). Nets are visited in id order (deterministic).
-/// A node's side of a triangle is the side it was on one step before (x - v_rel dt), so a node
-/// that crossed a triangle within one step is pushed back, not through.
-ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& params);
-
-/// What rigidContacts remembers between steps: for each (rigid, net, node) in contact, the
+/// What the contact functions remember between steps. netCollisions: for each (net, node, other
+/// net) in contact, the side (+1/-1 along the other net's triangle normals) the node came from,
+/// kept while the contact lasts. rigidContacts: for each (rigid, net, node) in contact, the
 /// body-frame plane (outward normal, offset) of the surface where the contact began. While the
 /// contact lasts, the node is pushed out along that plane, so a node that went deep into a shape
 /// is never pushed out through the far side. Keep one per interactor; pass it every step.
@@ -68,7 +64,15 @@ struct ContactMemory {
     double offset = 0.0;
   };
   std::map<std::tuple<std::uint64_t, std::uint64_t, std::uint32_t>, Plane> planes;
+  std::map<std::tuple<std::uint64_t, std::uint32_t, std::uint64_t>, int> sides;
 };
+
+/// Nodes of every net against the surface triangles of every other net (nets without a surface
+/// are seen as their nodes: node/node repulsion). Nets are visited in id order (deterministic).
+/// A node's side of a triangle is the side it was on one step before (x - v_rel dt), so a node
+/// that crossed a triangle within one step is pushed back, not through.
+ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& params,
+                            ContactMemory* memory = nullptr);
 
 /// Nodes of every net against every rigid shape (signed distance in the body frame), and the
 /// vertices of box, hull and mesh shapes against every net's surface triangles (so that a corner
