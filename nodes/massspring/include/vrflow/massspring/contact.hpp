@@ -22,7 +22,7 @@
 namespace vrflow::massspring {
 
 struct ContactParams {
-  double thickness = 0.03;  ///< contact distance (m), > 0
+  double thickness = 0.02;  ///< contact distance (m), > 0
   double beta = 0.2;        ///< fraction of the overlap removed per step, in [0, 1]
   double dt = 0.01;         ///< the outer step the forces are held for (s), > 0
   /// Rigid contacts only: a node weighs its mass plus springMassWeight * dt^2 * (stiffness of
