@@ -11,6 +11,7 @@
 #include "vrflow/massspring/solver.hpp"
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/message/byte_sink.hpp"
+#include "vrflow/message/shape.hpp"
 
 namespace vrflow::massspring {
 namespace {
@@ -196,6 +197,57 @@ TEST(MassSpringFormats, NetsTravelAsObjectChunksIntoASceneCopy) {
   ASSERT_TRUE(updateView);
   ASSERT_TRUE(scene.apply(*updateView));
   EXPECT_TRUE(scene.nets().at(42) == moved);
+}
+
+TEST(MassSpringFormats, RigidsAndTheirShapeResourcesIntoASceneCopy) {
+  const auto shape = msg::Shape::box({0.2, 0.3, 0.4});
+  const auto shapeBytes = msg::encodeShape(shape);
+  msg::VectorSink sink;
+  msg::MessageBuilder builder(sink);
+  using P = msg::RigidParam;
+  builder.addObject(7, msg::rigidType(), msg::ObjectOp::Add)
+      .set(P::kPosition, msg::Vec3{1, 2, 3})
+      .set(P::kOrientation, msg::Quat{0, 0, 0, 1})
+      .set(P::kLinearVelocity, msg::Vec3{0, -1, 0})
+      .set(P::kAngularVelocity, msg::Vec3{0, 0, 0.5})
+      .set(P::kMass, 2.5)
+      .set(P::kShape, std::uint64_t{99});
+  builder.addRawResource(99, false, shapeBytes);
+  builder.addRawResource(100, false, std::vector<std::byte>(5, std::byte{1}));  // not a shape: ignored
+  builder.finish();
+  auto view = msg::MessageView::parse(builder.bytes());
+  ASSERT_TRUE(view) << view.error().message;
+  SceneCopy scene;
+  ASSERT_TRUE(scene.apply(*view));
+  const auto rigids = scene.rigids();
+  ASSERT_EQ(rigids.count(7), 1u);
+  const auto& body = rigids.at(7);
+  EXPECT_EQ(body.position, (msg::Vec3{1, 2, 3}));
+  EXPECT_EQ(body.linearVelocity, (msg::Vec3{0, -1, 0}));
+  EXPECT_EQ(body.angularVelocity, (msg::Vec3{0, 0, 0.5}));
+  EXPECT_EQ(body.mass, 2.5);
+  EXPECT_TRUE(body.shape == shape);
+  // A rigid whose shape has not arrived is left out until it does.
+  msg::VectorSink sink2;
+  msg::MessageBuilder second(sink2);
+  second.addObject(8, msg::rigidType(), msg::ObjectOp::Add).set(P::kMass, 1.0).set(P::kShape, std::uint64_t{101});
+  second.finish();
+  auto view2 = msg::MessageView::parse(second.bytes());
+  ASSERT_TRUE(view2);
+  ASSERT_TRUE(scene.apply(*view2));
+  EXPECT_EQ(scene.rigids().count(8), 0u);
+  // A net chunk with springs bytes of the wrong size is an error naming the net.
+  msg::VectorSink sink3;
+  msg::MessageBuilder third(sink3);
+  const std::vector<std::byte> badSprings(41);
+  third.addObject(9, msg::massSpringType(), msg::ObjectOp::Add)
+      .set(msg::MassSpringParam::kSprings, std::span<const std::byte>(badSprings));
+  third.finish();
+  auto view3 = msg::MessageView::parse(third.bytes());
+  ASSERT_TRUE(view3);
+  const auto status = scene.apply(*view3);
+  ASSERT_FALSE(status);
+  EXPECT_NE(status.error().message.find("net 9: springs: 41 bytes"), std::string::npos) << status.error().message;
 }
 
 }  // namespace
