@@ -273,8 +273,24 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
   ContactMemory next;
   std::map<std::uint64_t, Adjacency> adjacent;
   for (const auto& [netId, net] : nets) adjacent[netId] = adjacency(net);
+  std::map<std::uint64_t, msg::Aabb> netBoxes;
+  for (const auto& [netId, net] : nets) netBoxes[netId] = bounds(net);
   for (const auto& [rigidId, body] : rigids) {
     auto box = msg::worldBounds(body.shape, body.position, body.orientation);
+    // Nets whose box (grown by the thickness and one step of the rigid's motion) misses the
+    // rigid's box are skipped.
+    const double speed = std::abs(body.linearVelocity[0]) + std::abs(body.linearVelocity[1]) + std::abs(body.linearVelocity[2]);
+    const double spin = std::abs(body.angularVelocity[0]) + std::abs(body.angularVelocity[1]) + std::abs(body.angularVelocity[2]);
+    double radius = 0;
+    for (int k = 0; k < 3; ++k) radius = std::max(radius, 0.5 * (box.max[k] - box.min[k]));
+    const double margin = p.thickness + (speed + spin * radius) * p.dt;
+    auto netNear = [&](std::uint64_t netId) {
+      const auto& nb = netBoxes[netId];
+      for (int k = 0; k < 3; ++k) {
+        if (nb.min[k] > box.max[k] + margin || nb.max[k] < box.min[k] - margin) return false;
+      }
+      return true;
+    };
     const bool kinematic = !(body.mass > 0) || !std::isfinite(body.mass);
     const double invRigid = kinematic ? 0.0 : 1.0 / body.mass;
     msg::Vec3 totalForce{}, totalTorque{};
@@ -296,6 +312,7 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
     auto pointVelocity = [&](const msg::Vec3& r) { return add(body.linearVelocity, cross(body.angularVelocity, r)); };
     // Nodes against the shape.
     for (const auto& [netId, net] : nets) {
+      if (!netNear(netId)) continue;
       for (std::size_t i = 0; i < net.nodeCount(); ++i) {
         const msg::Vec3 x = net.position(i);
         if (!inBox(x, box, p.thickness)) continue;
@@ -339,7 +356,7 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
       }
     }
     for (const auto& [netId, net] : nets) {
-      if (corners.empty() || net.surface.empty()) continue;
+      if (corners.empty() || net.surface.empty() || !netNear(netId)) continue;
       for (const auto& corner : corners) {
         const msg::Vec3 r = msg::rotate(body.orientation, corner);
         const msg::Vec3 x = add(body.position, r);

@@ -44,8 +44,11 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
   for (const auto& s : net.springs) any = any || s.maxStretch > 0;
   if (!any) return 0.0;
   double* x = net.positions.data();
-  std::vector<double> before(net.positions);
+  double* v = net.velocities.data();
+  const double invH = 1.0 / h;
   constexpr double kTolerance = 1e-9;
+  constexpr double kSkip = (1 + 0.1 * kTolerance) * (1 + 0.1 * kTolerance);
+  constexpr double kViolated = (1 + kTolerance) * (1 + kTolerance);
   const std::size_t count = net.springs.size();
   bool violated = true;
   for (int iteration = 0; iteration < maxIterations && violated; ++iteration) {
@@ -57,20 +60,29 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
       const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
       const double limit = s.maxStretch * s.restLength;
       const double d0 = x[b] - x[a], d1 = x[b + 1] - x[a + 1], d2 = x[b + 2] - x[a + 2];
-      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
-      if (length <= limit * (1 + 0.1 * kTolerance)) continue;
-      if (length > limit * (1 + kTolerance)) violated = true;
+      const double squared = d0 * d0 + d1 * d1 + d2 * d2;
+      if (squared <= limit * limit * kSkip) continue;
+      if (squared > limit * limit * kViolated) violated = true;
+      const double length = std::sqrt(squared);
       const double wa = net.pinned[s.a] ? 0.0 : 1.0 / net.masses[s.a];
       const double wb = net.pinned[s.b] ? 0.0 : 1.0 / net.masses[s.b];
       if (wa + wb == 0) continue;
-      // Aim slightly inside the limit so rounding leaves the length at or below it.
+      // Aim slightly inside the limit so rounding leaves the length at or below it. The
+      // position change, divided by h, goes into the velocity.
       const double excess = (length - limit * (1 - 0.5 * kTolerance)) / (length * (wa + wb));
-      x[a] += wa * excess * d0;
-      x[a + 1] += wa * excess * d1;
-      x[a + 2] += wa * excess * d2;
-      x[b] -= wb * excess * d0;
-      x[b + 1] -= wb * excess * d1;
-      x[b + 2] -= wb * excess * d2;
+      const double ca = wa * excess, cb = wb * excess;
+      x[a] += ca * d0;
+      x[a + 1] += ca * d1;
+      x[a + 2] += ca * d2;
+      x[b] -= cb * d0;
+      x[b + 1] -= cb * d1;
+      x[b + 2] -= cb * d2;
+      v[a] += ca * d0 * invH;
+      v[a + 1] += ca * d1 * invH;
+      v[a + 2] += ca * d2 * invH;
+      v[b] -= cb * d0 * invH;
+      v[b + 1] -= cb * d1 * invH;
+      v[b + 2] -= cb * d2 * invH;
     }
   }
   if (maxConstraintRatio(net) > 1.0 && feasible.size() == net.positions.size()) {
@@ -99,10 +111,12 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
       t = std::min(t, (-bb + std::sqrt(std::max(0.0, bb * bb - aa * cc))) / aa);
     }
     t = std::max(0.0, t * (1 - 1e-12));
-    for (std::size_t i = 0; i < net.positions.size(); ++i) x[i] = feasible[i] + t * (x[i] - feasible[i]);
+    for (std::size_t i = 0; i < net.positions.size(); ++i) {
+      const double backed = feasible[i] + t * (x[i] - feasible[i]);
+      v[i] += (backed - x[i]) * invH;
+      x[i] = backed;
+    }
   }
-  const double invH = 1.0 / h;
-  for (std::size_t i = 0; i < net.positions.size(); ++i) net.velocities[i] += (x[i] - before[i]) * invH;
   return maxConstraintRatio(net);
 }
 
@@ -111,7 +125,7 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
   const double h = options.dt / options.substeps;
   std::vector<double> forces(3 * n);
   std::vector<double> start;
-  double worst = 0.0;
+  double worst = maxConstraintRatio(net);
   for (int sub = 0; sub < options.substeps; ++sub) {
     for (std::size_t i = 0; i < n; ++i) {
       for (int k = 0; k < 3; ++k) {
@@ -120,7 +134,7 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
     }
     if (options.internalSprings) addSpringForces(net, forces);
     // The start of the sub-step, a fallback inside every limit when it was inside before.
-    if (maxConstraintRatio(net) <= 1.0) start = net.positions;
+    if (worst <= 1.0) start = net.positions;
     else start.clear();
     for (std::size_t i = 0; i < n; ++i) {
       if (net.pinned[i]) {
