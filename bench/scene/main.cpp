@@ -1,0 +1,321 @@
+// vrflow-bench-scene: iterations per second of the demo scene without rendering, in three forms
+// run one after the other on the same machine:
+//   "network"      the vrflow network (examples/paper_scene without its viewer): every module its
+//                  own process, messages through the daemon, started by `vrflow run`;
+//   "monolithic"   the same solver classes called in one loop in one process;
+//   "bullet-world" Bullet's own btDiscreteDynamicsWorld stepping the same rigid bodies (no net:
+//                  Bullet's soft bodies are another solver, so only the rigid part compares).
+// The scene of 20 objects is the demo's (rigid objects and the 20 x 20 net); 200 and 2000 are
+// the rigid package's `boxes:N` scenes (rigid bodies only, in all three forms).
+// One JSON line per result: {"variant": V, "objects": N, "iterations_per_s": X, ...}.
+#include <btBulletDynamicsCommon.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <unistd.h>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "vrflow/app/loader.hpp"
+#include "vrflow/app/writer.hpp"
+#include "vrflow/massspring/contact.hpp"
+#include "vrflow/massspring/net.hpp"
+#include "vrflow/massspring/solver.hpp"
+#include "vrflow/rigid/scene.hpp"
+#include "vrflow/rigid/world.hpp"
+
+namespace fs = std::filesystem;
+using namespace vrflow;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kDt = 0.01;
+const msg::Vec3 kGravity{0, -9.81, 0};
+
+struct Context {
+  fs::path bin;      // build/bin
+  fs::path source;   // the repository
+  fs::path work;     // scratch folder
+};
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+// The parameters of the demo's net, as examples/paper_scene/paper_scene.xml sets them.
+massspring::GridParams demoGrid() {
+  massspring::GridParams grid;
+  grid.n = 20;
+  grid.m = 20;
+  grid.spacing = 0.1;
+  grid.mass = 8;
+  grid.stiffness = 300;
+  grid.damping = 0.2;
+  grid.origin = {1.25, 0.95, 0};
+  return grid;
+}
+
+Result<std::vector<rigid::Body>> bodiesFor(const Context& ctx, int objects) {
+  if (objects == 20) return rigid::loadScene((ctx.source / "examples/paper_scene/scene.json").string());
+  return rigid::generateScene("boxes:" + std::to_string(objects));
+}
+
+// The network's application: the demo scene without its viewer, or the rigid network of figure 4
+// (animator, force field, rigid interactor) for the boxes scenes.
+Result<std::string> networkApp(const Context& ctx, int objects) {
+  auto loaded = app::loadApplicationFile((ctx.source / "examples/paper_scene/paper_scene.xml").string());
+  if (!loaded) return loaded.error();
+  app::Application application = std::move(loaded).value();
+  const std::set<std::string> keep =
+      objects == 20 ? std::set<std::string>{"bodies", "contacts", "field", "net", "springs",
+                                            "net-collisions", "net-contacts"}
+                    : std::set<std::string>{"bodies", "contacts", "field"};
+  std::erase_if(application.modules, [&](const app::Module& m) { return !keep.contains(m.id); });
+  std::erase_if(application.connections, [&](const app::Connection& c) {
+    return !keep.contains(c.from.node) || !keep.contains(c.to.node);
+  });
+  for (auto& module : application.modules) {
+    std::erase_if(module.params, [](const app::Param& p) { return p.name == "state-file"; });
+    if (module.id != "bodies") continue;
+    for (auto& p : module.params) {
+      if (p.name == "scene" && objects != 20) p = {"generate", "boxes:" + std::to_string(objects), p.loc};
+      if (p.name == "scene" && objects == 20) p.value = (ctx.source / "examples/paper_scene/scene.json").string();
+    }
+  }
+  const fs::path file = ctx.work / ("scene-" + std::to_string(objects) + ".xml");
+  if (auto saved = app::saveApplicationFile(application, file.string()); !saved) return saved.error();
+  return file.string();
+}
+
+// Wall time of `vrflow run` for `iterations`, from its report (spawning included).
+Result<double> runNetwork(const Context& ctx, const std::string& appFile, int iterations) {
+  const fs::path report = ctx.work / "report.json";
+  fs::remove(report);
+  const std::string command = "cd " + quote(ctx.work.string()) + " && " +
+                              quote((ctx.bin / "vrflow").string()) + " run " + quote(appFile) +
+                              " -n " + std::to_string(iterations) +
+                              " --no-progress --report " + quote(report.string()) + " > run.log 2>&1";
+  if (const int status = std::system(command.c_str()); status != 0) {
+    return makeError("vrflow run failed (status " + std::to_string(status) + "); see " +
+                     (ctx.work / "run.log").string());
+  }
+  std::ifstream in(report);
+  const auto json = nlohmann::json::parse(in, nullptr, false);
+  if (json.is_discarded() || !json.contains("timing")) return makeError("unreadable report");
+  return json["timing"]["wall_s"].get<double>();
+}
+
+// Steady-state rate of the network: the difference of two runs of different lengths cancels the
+// start-up (spawning processes, loading the scene) and the shutdown.
+Result<double> networkRate(const Context& ctx, int objects, int warm, int measured) {
+  auto appFile = networkApp(ctx, objects);
+  if (!appFile) return appFile.error();
+  auto shorter = runNetwork(ctx, *appFile, warm);
+  if (!shorter) return shorter.error();
+  auto longer = runNetwork(ctx, *appFile, warm + measured);
+  if (!longer) return longer.error();
+  const double seconds = *longer - *shorter;
+  if (seconds <= 0) return makeError("the longer run was not longer; the machine is too noisy");
+  return measured / seconds;
+}
+
+// The same solvers in one loop: what one iteration of the network computes, in the network's
+// order (interactors see the state of the previous step, then the animators integrate).
+class Monolithic {
+ public:
+  Status init(std::vector<rigid::Body> bodies, bool withNet) {
+    rigid::ContactParams contact;
+    contact.gravity = kGravity;
+    world_ = std::make_unique<rigid::RigidWorld>(
+        rigid::ForceField({rigid::FieldTerm{rigid::FieldTerm::Kind::Gravity, kGravity}}), contact);
+    if (auto added = world_->add(bodies); !added) return added;
+    if (!withNet) return {};
+    auto net = massspring::generateGrid(demoGrid());
+    if (!net) return net.error();
+    nets_[kNetId] = std::move(net).value();
+    options_.dt = kDt;
+    options_.substeps = 1;
+    options_.internalSprings = false;
+    options_.gravity = kGravity;
+    collision_.thickness = 0.05;
+    collision_.dt = kDt;
+    touch_.dt = kDt;
+    return {};
+  }
+
+  void step() {
+    if (!nets_.empty()) {
+      std::map<std::uint64_t, massspring::RigidBody> rigids;
+      for (const rigid::Body& b : world_->state().bodies()) {
+        rigids[b.id] = {b.position, b.orientation, b.linearVelocity, b.angularVelocity,
+                        b.kinematic ? 0.0 : b.mass, b.shape};
+      }
+      massspring::Net& net = nets_[kNetId];
+      std::vector<double> forces(net.positions.size(), 0.0);
+      massspring::addSpringForces(net, forces);
+      const auto collisions = massspring::netCollisions(nets_, collision_, &collisionMemory_);
+      const auto touches = massspring::rigidContacts(nets_, rigids, touch_, &touchMemory_);
+      for (const auto* contact : {&collisions, &touches}) {
+        if (auto found = contact->nodeForces.find(kNetId); found != contact->nodeForces.end()) {
+          for (std::size_t i = 0; i < forces.size(); ++i) forces[i] += found->second[i];
+        }
+      }
+      for (const auto& [id, event] : touches.rigidForces) world_->state().applyForce(id, event);
+      world_->step(kDt);
+      massspring::step(net, forces, options_);
+    } else {
+      world_->step(kDt);
+    }
+  }
+
+ private:
+  static constexpr std::uint64_t kNetId = 1ull << 40;
+  std::unique_ptr<rigid::RigidWorld> world_;
+  std::map<std::uint64_t, massspring::Net> nets_;
+  massspring::StepOptions options_;
+  massspring::ContactParams collision_, touch_;
+  massspring::ContactMemory collisionMemory_, touchMemory_;
+};
+
+// Bullet's own world with the same rigid bodies, 20 solver iterations like our interactor.
+class BulletWorld {
+ public:
+  BulletWorld()
+      : dispatcher_(&configuration_),
+        world_(&dispatcher_, &broadphase_, &solver_, &configuration_) {
+    world_.setGravity(btVector3(btScalar(kGravity[0]), btScalar(kGravity[1]), btScalar(kGravity[2])));
+    world_.getSolverInfo().m_numIterations = 20;
+  }
+  ~BulletWorld() {
+    for (auto& body : bodies_) world_.removeRigidBody(body.get());
+  }
+
+  void add(const rigid::Body& b) {
+    std::unique_ptr<btCollisionShape> shape;
+    const msg::Shape& s = b.shape;
+    switch (s.kind) {
+      case msg::ShapeKind::Sphere:
+        shape = std::make_unique<btSphereShape>(btScalar(s.radius));
+        break;
+      case msg::ShapeKind::Box:
+        shape = std::make_unique<btBoxShape>(
+            btVector3(btScalar(s.halfExtents[0]), btScalar(s.halfExtents[1]), btScalar(s.halfExtents[2])));
+        break;
+      case msg::ShapeKind::Capsule:
+        shape = std::make_unique<btCapsuleShape>(btScalar(s.radius), btScalar(2 * s.halfHeight));
+        break;
+      default: {
+        auto hull = std::make_unique<btConvexHullShape>();
+        for (std::size_t i = 0; i + 2 < s.vertices.size(); i += 3) {
+          hull->addPoint(btVector3(btScalar(s.vertices[i]), btScalar(s.vertices[i + 1]),
+                                   btScalar(s.vertices[i + 2])),
+                         false);
+        }
+        hull->recalcLocalAabb();
+        shape = std::move(hull);
+      }
+    }
+    const btScalar mass = b.kinematic ? btScalar(0) : btScalar(b.mass);
+    btVector3 inertia(0, 0, 0);
+    if (mass > 0) inertia = btVector3(btScalar(b.inertia[0]), btScalar(b.inertia[4]), btScalar(b.inertia[8]));
+    btTransform pose;
+    pose.setOrigin(btVector3(btScalar(b.position[0]), btScalar(b.position[1]), btScalar(b.position[2])));
+    pose.setRotation(btQuaternion(btScalar(b.orientation[0]), btScalar(b.orientation[1]),
+                                  btScalar(b.orientation[2]), btScalar(b.orientation[3])));
+    motions_.push_back(std::make_unique<btDefaultMotionState>(pose));
+    btRigidBody::btRigidBodyConstructionInfo info(mass, motions_.back().get(), shape.get(), inertia);
+    info.m_friction = btScalar(0.6);
+    info.m_restitution = btScalar(0.3);
+    bodies_.push_back(std::make_unique<btRigidBody>(info));
+    world_.addRigidBody(bodies_.back().get());
+    shapes_.push_back(std::move(shape));
+  }
+
+  void step() { world_.stepSimulation(btScalar(kDt), 0); }
+
+ private:
+  btDefaultCollisionConfiguration configuration_;
+  btCollisionDispatcher dispatcher_;
+  btDbvtBroadphase broadphase_;
+  btSequentialImpulseConstraintSolver solver_;
+  btDiscreteDynamicsWorld world_;
+  std::vector<std::unique_ptr<btCollisionShape>> shapes_;
+  std::vector<std::unique_ptr<btDefaultMotionState>> motions_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+};
+
+// Steps `warm` times, then times `measured` steps.
+template <typename Step>
+double loopRate(Step&& step, int warm, int measured) {
+  for (int i = 0; i < warm; ++i) step();
+  const auto start = Clock::now();
+  for (int i = 0; i < measured; ++i) step();
+  return measured / std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void print(const std::string& variant, int objects, double rate, const std::string& extra = {}) {
+  std::printf("{\"variant\":\"%s\",\"objects\":%d,\"iterations_per_s\":%.1f%s}\n", variant.c_str(),
+              objects, rate, extra.c_str());
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"vrflow-bench-scene: the demo scene as a network, in one loop, and in Bullet"};
+  bool quick = false;
+  std::vector<int> sizes{20, 200, 2000};
+  cli.add_flag("--quick", quick, "Few iterations, 20 and 200 objects (checks the benchmark runs)");
+  cli.add_option("--objects", sizes, "Scene sizes: 20 (the demo scene), or N boxes");
+  CLI11_PARSE(cli, argc, argv);
+  if (quick) sizes = {20, 200};
+
+  Context ctx;
+  ctx.bin = fs::canonical("/proc/self/exe").parent_path();
+  ctx.source = VRFLOW_SOURCE_DIR;
+  ctx.work = fs::temp_directory_path() / ("vrflow-bench-scene-" + std::to_string(::getpid()));
+  fs::create_directories(ctx.work);
+
+  int failures = 0;
+  for (const int objects : sizes) {
+    // Steps before and during the measurement; the window covers falling, impacts and rest.
+    const int measured = quick ? 20 : objects <= 20 ? 600 : objects <= 200 ? 200 : 30;
+    const int warm = quick ? 5 : objects <= 200 ? 50 : 10;
+    auto bodies = bodiesFor(ctx, objects);
+    if (!bodies) {
+      std::fprintf(stderr, "vrflow-bench-scene: %s\n", bodies.error().message.c_str());
+      return 2;
+    }
+    auto network = networkRate(ctx, objects, warm, measured);
+    Monolithic mono;
+    if (auto ok = mono.init(*bodies, objects == 20); !ok) {
+      std::fprintf(stderr, "vrflow-bench-scene: %s\n", ok.error().message.c_str());
+      return 2;
+    }
+    const double monoRate = loopRate([&] { mono.step(); }, warm, measured);
+    if (network) {
+      char extra[96];
+      std::snprintf(extra, sizeof extra, ",\"of_monolithic\":%.3f", *network / monoRate);
+      print("network", objects, *network, extra);
+    } else {
+      std::fprintf(stderr, "vrflow-bench-scene: network, %d objects: %s\n", objects,
+                   network.error().message.c_str());
+      ++failures;
+    }
+    print("monolithic", objects, monoRate);
+    BulletWorld bullet;
+    for (const rigid::Body& b : *bodies) bullet.add(b);
+    print("bullet-world", objects, loopRate([&] { bullet.step(); }, warm, measured),
+          objects == 20 ? ",\"note\":\"rigid bodies only\"" : "");
+  }
+  std::error_code ignored;
+  fs::remove_all(ctx.work, ignored);
+  return failures == 0 ? 0 : 1;
+}
