@@ -1,6 +1,8 @@
 // vrflow-daemon: the daemon of one host of an application, with that host's modules. The
-// launcher starts one per host; `vrflow run` embeds the same daemon for all hosts at once.
-// Until the TCP transport between daemons exists, a connection crossing hosts is refused.
+// launcher starts one per host (`--control`: it talks to the launcher over stdin/stdout and to
+// the other hosts' daemons over TCP); `vrflow run` embeds the same daemon for all hosts at once.
+// Alone (without --control) it refuses connections that cross hosts.
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -14,6 +16,7 @@
 #include "vrflow/app/validate.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
+#include "control_link.hpp"
 
 int main(int argc, char** argv) {
   CLI::App cli{"vrflow-daemon: serve one host of an application"};
@@ -29,6 +32,16 @@ int main(int argc, char** argv) {
   cli.add_option("--iterations,-n", options.iterations, "Stop after N iterations of every module");
   cli.add_option("--report", options.reportPath, "Write a JSON run report to FILE");
   cli.add_option("--timeout", options.timeoutSeconds, "Fail if the run lasts longer (seconds)");
+  bool control = false;
+  std::string bindAddress;
+  double peerTimeout = 3.0;
+  cli.add_flag("--control", control,
+               "Run under `vrflow launch`: the run secret and commands come on stdin, events go "
+               "to stdout, connections crossing hosts go over TCP");
+  cli.add_option("--bind", bindAddress, "Address to listen on (default: the host's address)");
+  cli.add_option("--peer-timeout", peerTimeout,
+                 "A link to another host silent this long is declared lost (seconds)")
+      ->check(CLI::PositiveNumber);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -65,6 +78,26 @@ int main(int argc, char** argv) {
     return vrflow::run::kExitInvalid;
   }
 
+  // Under the launcher, the control channel is this process's stdin/stdout: keep them for it,
+  // and give modules (which inherit fds 0 and 1) /dev/null and stderr instead.
+  std::unique_ptr<vrflow::tools::ControlLink> link;
+  if (control) {
+    const int in = dup(STDIN_FILENO), out = dup(STDOUT_FILENO);
+    fcntl(in, F_SETFD, FD_CLOEXEC);
+    fcntl(out, F_SETFD, FD_CLOEXEC);
+    const int null = open("/dev/null", O_RDONLY | O_CLOEXEC);
+    dup2(null, STDIN_FILENO);
+    dup2(STDERR_FILENO, STDOUT_FILENO);
+    close(null);
+    auto made = vrflow::tools::ControlLink::create(*application, host, bindAddress, peerTimeout, in, out);
+    if (!made) {
+      std::fprintf(stderr, "vrflow-daemon: %s: %s\n", file.c_str(), made.error().message.c_str());
+      return vrflow::run::kExitInvalid;
+    }
+    link = std::move(*made);
+    options.hostLink = link.get();
+  }
+
   // Keep this host's share of the network.
   vrflow::app::Application local = *application;
   local.modules.clear();
@@ -86,10 +119,12 @@ int main(int argc, char** argv) {
   for (const auto& c : application->connections) {
     const bool from = here.count(c.from.node) != 0;
     const bool to = here.count(c.to.node) != 0;
+    if (from != to && link) continue;  // served by the transport (ControlLink::create)
     if (from != to) {
       std::fprintf(stderr,
-                   "%s:%d:%d: error: connection %s -> %s crosses hosts; daemons do not exchange "
-                   "messages over the network yet: map both ends to host '%s' or use `vrflow run`\n",
+                   "%s:%d:%d: error: connection %s -> %s crosses hosts; a daemon started alone "
+                   "serves one host only: map both ends to host '%s', or start the application "
+                   "with `vrflow launch` (or `vrflow run`)\n",
                    c.loc.file.c_str(), c.loc.line, c.loc.column,
                    vrflow::app::toString(c.from).c_str(), vrflow::app::toString(c.to).c_str(),
                    host.c_str());
@@ -98,6 +133,7 @@ int main(int argc, char** argv) {
     if (from) local.connections.push_back(c);
   }
   const auto outcome = vrflow::run::runApplication(local, *catalog, options);
+  if (link) return outcome.exitCode;  // the launcher reports
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow-daemon: %s\n", outcome.error.c_str());
   return outcome.exitCode;
 }

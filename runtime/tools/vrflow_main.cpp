@@ -15,6 +15,9 @@
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
+#ifdef VRFLOW_HAS_LAUNCHER
+#include "vrflow/launcher/launch.hpp"
+#endif
 
 namespace {
 
@@ -89,6 +92,22 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 262144.0));
   run->add_flag("--no-progress", noProgress, "Do not show live progress on a terminal");
 
+#ifdef VRFLOW_HAS_LAUNCHER
+  auto* launch = cli.add_subcommand("launch", "Run an application with one daemon per host (TCP between them)");
+  launch->fallthrough();
+  vrflow::launcher::LaunchOptions launchOptions;
+  launch->add_option("APP.xml", launchOptions.appFile, "Application file")->required();
+  launch->add_option("--hosts", launchOptions.hostfile, "Hostfile: where each host runs (docs/launcher.md)");
+  launch->add_option("--backend", launchOptions.backend, "How daemons are started: local")
+      ->check(CLI::IsMember({"local", "ssh", "mpirun"}));
+  launch->add_option("--iterations,-n", launchOptions.iterations, "Stop after N iterations of every module");
+  launch->add_option("--report", launchOptions.reportPath, "Write a JSON run report to FILE");
+  launch->add_option("--timeout", launchOptions.timeoutSeconds, "Fail if the run lasts longer (seconds)")
+      ->check(CLI::NonNegativeNumber);
+  launch->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,
+                     "A host silent this long (no heartbeat) is declared lost (seconds)")
+      ->check(CLI::PositiveNumber);
+#endif
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -110,6 +129,17 @@ int main(int argc, char** argv) {
   if (validate->parsed()) {
     return loadFlat(validateFile, compositeDirs, &*catalog) ? 0 : 1;
   }
+#ifdef VRFLOW_HAS_LAUNCHER
+  if (launch->parsed()) {
+    auto flat = loadFlat(launchOptions.appFile, compositeDirs, &*catalog);
+    if (!flat) return vrflow::run::kExitInvalid;
+    launchOptions.packageDirs = packageDirs;
+    launchOptions.compositeDirs = compositeDirs;
+    const auto outcome = vrflow::launcher::launch(*flat, launchOptions);
+    if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
+    return outcome.exitCode;
+  }
+#endif
   auto application = loadFlat(runFile, compositeDirs, &*catalog);
   if (!application) return vrflow::run::kExitInvalid;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);

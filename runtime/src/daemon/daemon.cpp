@@ -52,6 +52,12 @@ struct Daemon::Impl {
   // Per module and port index: the node fed by that port (output filter) or feeding it.
   std::map<std::pair<int, std::string>, Node*> portNodes;
   std::map<std::string, Node*> filterNodes;
+  struct RemoteInput {
+    uint32_t channel;
+    Queue* queue;
+    std::unique_ptr<QueueSink> sink;
+  };
+  std::vector<RemoteInput> remoteInputs;  ///< connections arriving from other hosts
   std::vector<std::pair<std::string, PortOutputFilter*>> outputFilters;  // "module.port"
   std::thread thread;
   std::atomic<bool> running{false};
@@ -85,6 +91,11 @@ Result<std::unique_ptr<Daemon>> Daemon::create(const app::Application& applicati
   if (!segment) return segment.error();
   d.segment = std::move(*segment);
   d.graph = std::make_unique<Graph>(d.segment);
+  if (options.transport != nullptr) {
+    options.transport->attachSegment(d.segment);
+    auto* bell = &d.segment.header().daemonBell;
+    options.transport->setArrivalCallback([bell] { bell->ring(); });
+  }
   if (auto status = d.build(application, catalog); !status) return status.error();
   return daemon;
 }
@@ -127,6 +138,13 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
   for (const auto& c : application.connections) {
     ++fanOut[{c.from.node, c.from.port}];
     ++fanIn[{c.to.node, c.to.port}];
+  }
+  for (const auto& r : options.remote) {
+    if (r.outgoing) {
+      ++fanOut[{r.connection.from.node, r.connection.from.port}];
+    } else {
+      ++fanIn[{r.connection.to.node, r.connection.to.port}];
+    }
   }
 
   for (std::size_t m = 0; m < application.modules.size(); ++m) {
@@ -236,7 +254,17 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     }
     return -1;
   };
-  for (const app::Connection& c : application.connections) {
+  // A module input fed by several connections concatenates them in file order, whichever
+  // host each comes from: attach them sorted by their index in the whole application.
+  struct VariadicInput {
+    uint32_t key;
+    Node* to;
+    Queue* queue;
+  };
+  std::vector<VariadicInput> variadicInputs;
+  for (std::size_t connectionIndex = 0; connectionIndex < application.connections.size();
+       ++connectionIndex) {
+    const app::Connection& c = application.connections[connectionIndex];
     Node* from = nullptr;
     std::size_t fromOutput = 0;
     if (const int m = moduleIndex(c.from.node); m >= 0) {
@@ -269,7 +297,10 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     queue.to = app::toString(c.to);
     queue.isConnection = true;
     if (toInput < 0) {
-      to->inputs.push_back(&queue);
+      const uint32_t key = connectionIndex < options.connectionChannels.size()
+                               ? options.connectionChannels[connectionIndex]
+                               : static_cast<uint32_t>(connectionIndex);
+      variadicInputs.push_back({key, to, &queue});
     } else {
       if (to->inputs[static_cast<std::size_t>(toInput)] != nullptr) {
         return makeError("filter input " + app::toString(c.to) + " has more than one connection");
@@ -278,6 +309,56 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     }
     from->outputs[fromOutput].push_back(std::make_unique<QueueSink>(queue));
   }
+  // Connections from or to another host: a sink that sends, or a queue fed by the transport.
+  for (const net::RemoteConnection& r : options.remote) {
+    const app::Connection& c = r.connection;
+    if (options.transport == nullptr) return makeError("connection crosses hosts without a transport");
+    if (r.outgoing) {
+      Node* from = nullptr;
+      std::size_t fromOutput = 0;
+      if (const int m = moduleIndex(c.from.node); m >= 0) {
+        from = portNodes[{m, c.from.port}];
+      } else if (filterNodes.count(c.from.node) != 0) {
+        from = filterNodes[c.from.node];
+        const auto& names = from->outputNames;
+        fromOutput = static_cast<std::size_t>(
+            std::find(names.begin(), names.end(), c.from.port) - names.begin());
+        if (fromOutput == names.size()) from = nullptr;
+      }
+      if (from == nullptr) return makeError("connection " + app::toString(c.from) + " names a missing port");
+      from->outputs[fromOutput].push_back(options.transport->makeSink(r.channel));
+      continue;
+    }
+    Node* to = nullptr;
+    int toInput = -1;
+    if (const int m = moduleIndex(c.to.node); m >= 0) {
+      to = portNodes[{m, c.to.port}];
+    } else if (filterNodes.count(c.to.node) != 0) {
+      to = filterNodes[c.to.node];
+      const auto& names = to->inputNames;
+      toInput = static_cast<int>(std::find(names.begin(), names.end(), c.to.port) - names.begin());
+      if (toInput == static_cast<int>(names.size())) to = nullptr;
+    }
+    if (to == nullptr) return makeError("connection " + app::toString(c.to) + " names a missing port");
+    Queue& queue = graph->newQueue();
+    queue.capacity = c.capacity > 0 ? static_cast<std::size_t>(c.capacity) : options.defaultCapacity;
+    queue.policy = c.policy;
+    queue.from = app::toString(c.from);
+    queue.to = app::toString(c.to);
+    queue.isConnection = true;
+    if (toInput < 0) {
+      variadicInputs.push_back({r.channel, to, &queue});
+    } else {
+      if (to->inputs[static_cast<std::size_t>(toInput)] != nullptr) {
+        return makeError("filter input " + app::toString(c.to) + " has more than one connection");
+      }
+      to->inputs[static_cast<std::size_t>(toInput)] = &queue;
+    }
+    remoteInputs.push_back({r.channel, &queue, std::make_unique<QueueSink>(queue)});
+  }
+  std::stable_sort(variadicInputs.begin(), variadicInputs.end(),
+                   [](const VariadicInput& a, const VariadicInput& b) { return a.key < b.key; });
+  for (const auto& v : variadicInputs) v.to->inputs.push_back(v.queue);
   // A filter input left unconnected never receives anything.
   for (auto& node : graph->nodes) {
     for (auto& input : node->inputs) {
@@ -417,6 +498,15 @@ bool Daemon::Impl::pass() {
     if (moduleDone && ring.empty()) {
       source.closed = true;
       source.queue->closed = true;
+      ++graph->operations;
+    }
+  }
+  for (auto& input : remoteInputs) {
+    if (input.queue->closed) continue;
+    bool closed = false;
+    if (options.transport->receive(input.channel, *input.sink, closed) > 0) ++graph->operations;
+    if (closed) {
+      input.queue->closed = true;
       ++graph->operations;
     }
   }

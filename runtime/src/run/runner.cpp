@@ -303,6 +303,12 @@ RunOutcome Supervisor::run() {
       outcome = {kExitTimeout, "timeout", text};
       break;
     }
+    if (options_.hostLink != nullptr) {
+      if (auto stop = options_.hostLink->poll()) {
+        outcome = *stop;
+        break;
+      }
+    }
     if (auto fatal = daemon_.fatalError(); !fatal.empty()) {
       outcome = {kExitRunFailed, "failed", fatal};
       break;
@@ -353,6 +359,7 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
       daemonOptions.hostId = *id;
     }
   }
+  if (options.hostLink != nullptr) options.hostLink->configure(daemonOptions);
   // The daemon thread must not take the signals meant for the supervisor: block them before
   // it is created (it inherits this mask).
   sigset_t signals, previous;
@@ -369,9 +376,20 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   }
   const auto start = Clock::now();
   Supervisor supervisor(application, options, **daemon);
-  RunOutcome outcome = supervisor.run();
+  RunOutcome outcome;
+  if (options.hostLink != nullptr) {
+    if (auto status = options.hostLink->ready(); !status) {
+      outcome = {kExitRunFailed, "failed", status.error().message};
+    }
+  }
+  if (outcome.exitCode == kExitOk) outcome = supervisor.run();
+  if (options.hostLink != nullptr) options.hostLink->drain(outcome);
   (*daemon)->shutdown();
   std::vector<std::string> warnings = (*daemon)->takeWarnings();
+  if (options.hostLink != nullptr) {
+    options.hostLink->report(reportJson(application, **daemon, supervisor.ends(), outcome, options,
+                                        secondsSince(start), warnings));
+  }
   if (!options.reportPath.empty()) {
     auto status = writeReport(options.reportPath, application, **daemon, supervisor.ends(), outcome,
                               options, secondsSince(start), warnings);

@@ -10,6 +10,7 @@
 #include "vrflow/base/result.hpp"
 #include "vrflow/ipc/control.hpp"
 #include "vrflow/ipc/segment.hpp"
+#include "vrflow/net/transport.hpp"
 
 namespace vrflow::daemon {
 
@@ -21,6 +22,14 @@ struct DaemonOptions {
   uint32_t hostId = 0x7f000001;                       ///< from the host's address
   /// Warn when a connection's buffer has stayed full this long (ns).
   uint64_t fullWarningNs = 2'000'000'000;
+  /// Links to the other hosts' daemons (vrflow-daemon under `vrflow launch`); null when every
+  /// connection stays on this daemon.
+  net::Transport* transport = nullptr;
+  /// The connections that cross this host's boundary, served through `transport`.
+  std::vector<net::RemoteConnection> remote;
+  /// Index in the whole application of each of `application.connections` (this host's share);
+  /// empty when the application given is the whole one.
+  std::vector<uint32_t> connectionChannels;
 };
 
 /// A module the daemon serves: what to start and where its shared state lives.

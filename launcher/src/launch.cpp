@@ -1,0 +1,388 @@
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/signalfd.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+#include "vrflow/launcher/launch.hpp"
+#include "vrflow/net/transport.hpp"
+
+namespace vrflow::launcher {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+std::string describeStatus(int status) {
+  if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) {
+    return "was killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
+           strsignal(WTERMSIG(status)) + ")";
+  }
+  return "ended";
+}
+
+// One host's daemon, as the launcher sees it.
+struct HostDaemon {
+  int index = 0;
+  std::string host, bind;
+  pid_t pid = -1;
+  int toDaemon = -1, fromDaemon = -1;
+  std::string buffer;
+  int port = -1;
+  bool connected = false, finished = false, exited = false;
+  int finishedCode = 0;
+  std::string finishedStatus, finishedError, report, exitText;
+
+  void send(const std::string& line) const {
+    if (toDaemon < 0) return;
+    const std::string text = line + "\n";
+    [[maybe_unused]] auto n = write(toDaemon, text.data(), text.size());
+  }
+  std::string name() const {
+    return "daemon of host '" + host + "' (" + bind + ", pid " + std::to_string(pid) + ")";
+  }
+};
+
+Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
+                          const std::vector<std::string>& environment, int& toChild,
+                          int& fromChild) {
+  int in[2], out[2];
+  if (pipe2(in, O_CLOEXEC) != 0 || pipe2(out, O_CLOEXEC) != 0) {
+    return makeError(std::string("pipe: ") + std::strerror(errno));
+  }
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) return makeError(std::string("fork: ") + std::strerror(errno));
+  if (pid == 0) {
+    setpgid(0, 0);
+    prctl(PR_SET_PDEATHSIG, SIGKILL);  // the daemon (and through it, its modules) dies with us
+    if (getppid() != parent) _exit(127);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    dup2(in[0], STDIN_FILENO);
+    dup2(out[1], STDOUT_FILENO);
+    for (const auto& e : environment) putenv(const_cast<char*>(e.c_str()));
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    std::fprintf(stderr, "vrflow: cannot start %s: %s\n", argv[0].c_str(), std::strerror(errno));
+    _exit(127);
+  }
+  close(in[0]);
+  close(out[1]);
+  toChild = in[1];
+  fromChild = out[0];
+  fcntl(fromChild, F_SETFL, fcntl(fromChild, F_GETFL) | O_NONBLOCK);
+  return pid;
+}
+
+class Launcher {
+ public:
+  Launcher(const app::Application& application, const LaunchOptions& options)
+      : application_(application), options_(options) {}
+  run::RunOutcome run();
+
+ private:
+  Status start();
+  void pump(int timeoutMs);
+  void onLine(HostDaemon& d, const std::string& line);
+  void failWith(run::RunOutcome outcome, bool rootCause);
+  void stopAll();
+  bool allExited() const {
+    for (const auto& d : daemons_) {
+      if (!d.exited) return false;
+    }
+    return true;
+  }
+
+  const app::Application& application_;
+  const LaunchOptions& options_;
+  std::vector<HostDaemon> daemons_;
+  int signalFd_ = -1;
+  std::optional<run::RunOutcome> failure_;
+  bool failureIsRoot_ = false;
+  Clock::time_point failureAt_;
+  bool interrupted_ = false;
+};
+
+void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
+  // A daemon's own death or a module's failure names the cause better than a peer's
+  // "lost the link": keep the first root cause.
+  if (failure_ && (failureIsRoot_ || !rootCause)) return;
+  if (!failure_) failureAt_ = Clock::now();
+  failure_ = std::move(outcome);
+  failureIsRoot_ = rootCause;
+}
+
+void Launcher::onLine(HostDaemon& d, const std::string& line) {
+  std::istringstream words(line);
+  std::string word;
+  words >> word;
+  if (word == "listening") {
+    words >> d.port;
+  } else if (word == "connected") {
+    d.connected = true;
+  } else if (word == "error") {
+    failWith({run::kExitRunFailed, "failed", "host '" + d.host + "': " + line.substr(6)}, true);
+  } else if (word == "finished") {
+    d.finished = true;
+    words >> d.finishedCode >> d.finishedStatus;
+    std::getline(words, d.finishedError);
+    if (!d.finishedError.empty() && d.finishedError[0] == ' ') d.finishedError.erase(0, 1);
+    if (d.finishedCode != 0 && d.finishedStatus != "stopped") {
+      const bool lostLink = d.finishedError.rfind("lost the link", 0) == 0;
+      failWith({d.finishedCode, d.finishedStatus, "host '" + d.host + "': " + d.finishedError},
+               !lostLink);
+    }
+  } else if (word == "report") {
+    d.report = line.substr(7);
+  }
+}
+
+void Launcher::pump(int timeoutMs) {
+  std::vector<pollfd> fds;
+  fds.push_back({signalFd_, POLLIN, 0});
+  for (const auto& d : daemons_) fds.push_back({d.fromDaemon, POLLIN, 0});
+  poll(fds.data(), fds.size(), timeoutMs);
+  if (fds[0].revents & POLLIN) {
+    signalfd_siginfo info{};
+    while (read(signalFd_, &info, sizeof info) == sizeof info) {
+      if ((info.ssi_signo == SIGINT || info.ssi_signo == SIGTERM) && !interrupted_) {
+        interrupted_ = true;
+        failWith({run::kExitInterrupted, "interrupted",
+                  std::string("interrupted by ") + (info.ssi_signo == SIGINT ? "SIGINT" : "SIGTERM")},
+                 true);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < daemons_.size(); ++i) {
+    HostDaemon& d = daemons_[i];
+    if (d.fromDaemon < 0) continue;
+    char chunk[65536];
+    while (true) {
+      const ssize_t n = read(d.fromDaemon, chunk, sizeof chunk);
+      if (n > 0) {
+        d.buffer.append(chunk, static_cast<std::size_t>(n));
+        continue;
+      }
+      if (n == 0) {
+        close(d.fromDaemon);
+        d.fromDaemon = -1;
+      }
+      break;
+    }
+    std::size_t eol = 0;
+    while ((eol = d.buffer.find('\n')) != std::string::npos) {
+      const std::string line = d.buffer.substr(0, eol);
+      d.buffer.erase(0, eol + 1);
+      onLine(d, line);
+    }
+  }
+  int status = 0;
+  pid_t pid = 0;
+  while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
+    for (auto& d : daemons_) {
+      if (d.pid != pid || d.exited) continue;
+      d.exited = true;
+      d.exitText = describeStatus(status);
+      // Read what it said last (its report, its finish line) before judging.
+      if (d.fromDaemon >= 0) {
+        char chunk[65536];
+        ssize_t n = 0;
+        while ((n = read(d.fromDaemon, chunk, sizeof chunk)) > 0) {
+          d.buffer.append(chunk, static_cast<std::size_t>(n));
+        }
+        std::size_t eol = 0;
+        while ((eol = d.buffer.find('\n')) != std::string::npos) {
+          const std::string line = d.buffer.substr(0, eol);
+          d.buffer.erase(0, eol + 1);
+          onLine(d, line);
+        }
+      }
+      if (!d.finished) {
+        failWith({run::kExitRunFailed, "failed", d.name() + " " + d.exitText}, true);
+      }
+      if (d.toDaemon >= 0) close(d.toDaemon);
+      d.toDaemon = -1;
+    }
+  }
+}
+
+Status Launcher::start() {
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const std::string daemonPath = (self.parent_path() / "vrflow-daemon").string();
+  std::vector<HostEntry> entries;
+  if (!options_.hostfile.empty()) {
+    auto read = readHostfile(options_.hostfile, application_);
+    if (!read) return read.error();
+    entries = *read;
+  }
+  const net::Secret secret = net::newSecret();
+  for (std::size_t i = 0; i < application_.hosts.size(); ++i) {
+    const app::Host& host = application_.hosts[i];
+    HostDaemon d;
+    d.index = static_cast<int>(i);
+    d.host = host.id;
+    // local: every host on its own loopback address, as a cluster would be.
+    d.bind = "127.0.0." + std::to_string(i + 1);
+    std::vector<std::string> environment;
+    for (const auto& e : entries) {
+      if (e.host != host.id) continue;
+      if (!e.address.empty()) d.bind = e.address;
+      environment = e.environment;
+    }
+    std::vector<std::string> argv{daemonPath, options_.appFile, "--host", host.id, "--control",
+                                  "--bind", d.bind};
+    char timeout[32];
+    std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
+    argv.insert(argv.end(), {"--peer-timeout", timeout});
+    if (options_.iterations > 0) argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
+    for (const auto& p : options_.packageDirs) argv.insert(argv.end(), {"--packages", p});
+    for (const auto& c : options_.compositeDirs) argv.insert(argv.end(), {"--composites", c});
+    auto pid = spawnDaemon(argv, environment, d.toDaemon, d.fromDaemon);
+    if (!pid) return makeError("host '" + host.id + "': " + pid.error().message);
+    d.pid = *pid;
+    // The secret travels on the daemon's stdin: never on a command line or in a file.
+    d.send("secret " + net::secretToHex(secret));
+    daemons_.push_back(std::move(d));
+  }
+  auto waitFor = [&](auto done, const char* what) -> Status {
+    const auto begin = Clock::now();
+    while (!failure_) {
+      bool all = true;
+      for (const auto& d : daemons_) all = all && done(d);
+      if (all) return {};
+      if (secondsSince(begin) > options_.startSeconds) {
+        std::string late;
+        for (const auto& d : daemons_) {
+          if (!done(d)) late += (late.empty() ? "" : ", ") + d.name();
+        }
+        char text[64];
+        std::snprintf(text, sizeof text, "%g s", options_.startSeconds);
+        return makeError(std::string("not ") + what + " within " + text + ": " + late);
+      }
+      pump(50);
+    }
+    return makeError(failure_->error);
+  };
+  if (auto s = waitFor([](const HostDaemon& d) { return d.port > 0; }, "listening"); !s) return s;
+  for (const auto& d : daemons_) {
+    for (const auto& peer : daemons_) {
+      d.send("peer " + std::to_string(peer.index) + " " + peer.bind + " " + std::to_string(peer.port));
+    }
+    d.send("connect");
+  }
+  if (auto s = waitFor([](const HostDaemon& d) { return d.connected; }, "linked"); !s) return s;
+  for (const auto& d : daemons_) d.send("go");
+  return {};
+}
+
+void Launcher::stopAll() {
+  for (const auto& d : daemons_) {
+    if (!d.exited) d.send("stop");
+  }
+  const auto begin = Clock::now();
+  while (!allExited() && secondsSince(begin) < 8) pump(20);
+  for (int round = 0; round < 2 && !allExited(); ++round) {
+    for (const auto& d : daemons_) {
+      if (!d.exited) kill(-d.pid, round == 0 ? SIGTERM : SIGKILL);
+    }
+    const auto t = Clock::now();
+    while (!allExited() && (round == 1 || secondsSince(t) < 2)) pump(20);
+  }
+}
+
+run::RunOutcome Launcher::run() {
+  sigset_t signals, previous;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGCHLD);
+  sigprocmask(SIG_BLOCK, &signals, &previous);
+  sigset_t wanted;
+  sigemptyset(&wanted);
+  sigaddset(&wanted, SIGINT);
+  sigaddset(&wanted, SIGTERM);
+  signalFd_ = signalfd(-1, &wanted, SFD_CLOEXEC | SFD_NONBLOCK);
+  const auto begin = Clock::now();
+
+  if (auto status = start(); !status) {
+    failWith({run::kExitRunFailed, "failed", status.error().message}, true);
+  }
+  bool quitSent = false;
+  while (!allExited()) {
+    pump(50);
+    if (failure_) {
+      // Give a root cause (a dead daemon, a failed module) a moment to show before stopping.
+      if (!failureIsRoot_ && secondsSince(failureAt_) < 0.5) continue;
+      break;
+    }
+    if (options_.timeoutSeconds > 0 && secondsSince(begin) > options_.timeoutSeconds) {
+      char text[96];
+      std::snprintf(text, sizeof text, "timed out after %g s (--timeout)", options_.timeoutSeconds);
+      failWith({run::kExitTimeout, "timeout", text}, true);
+      break;
+    }
+    bool allFinished = true;
+    for (const auto& d : daemons_) allFinished = allFinished && d.finished;
+    if (allFinished && !quitSent) {
+      for (const auto& d : daemons_) d.send("quit");
+      quitSent = true;
+    }
+  }
+  stopAll();
+  for (auto& d : daemons_) {
+    if (d.toDaemon >= 0) close(d.toDaemon);
+    if (d.fromDaemon >= 0) close(d.fromDaemon);
+  }
+  run::RunOutcome outcome = failure_.value_or(run::RunOutcome{});
+  if (!options_.reportPath.empty()) {
+    std::vector<std::string> parts;
+    for (const auto& d : daemons_) {
+      if (!d.report.empty()) parts.push_back(d.report);
+    }
+    std::ofstream out(options_.reportPath);
+    out << mergeReports(application_, parts, outcome, options_.iterations, secondsSince(begin)) << "\n";
+    if (!out && outcome.exitCode == run::kExitOk) {
+      outcome = {run::kExitRunFailed, "failed", "cannot write the report '" + options_.reportPath + "'"};
+    }
+  }
+  close(signalFd_);
+  timespec zero{0, 0};
+  while (sigtimedwait(&signals, nullptr, &zero) > 0) {
+  }
+  sigprocmask(SIG_SETMASK, &previous, nullptr);
+  return outcome;
+}
+
+}  // namespace
+
+run::RunOutcome launch(const app::Application& application, const LaunchOptions& options) {
+  if (options.backend != "local") {
+    return {run::kExitInvalid, "failed",
+            "--backend " + options.backend +
+                ": only the 'local' backend is available in this version (ssh and mpirun are "
+                "not implemented yet)"};
+  }
+  Launcher launcher(application, options);
+  return launcher.run();
+}
+
+}  // namespace vrflow::launcher

@@ -1,0 +1,205 @@
+#include "control_link.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+
+#include "vrflow/daemon/daemon.hpp"
+#include "vrflow/message/ids.hpp"
+
+namespace vrflow::tools {
+namespace {
+
+// One line from a descriptor, byte by byte (the secret must not be read ahead into a buffer
+// shared with anything else); false at end of input.
+bool readLine(int fd, std::string& line) {
+  line.clear();
+  char c = 0;
+  while (true) {
+    const ssize_t n = read(fd, &c, 1);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return !line.empty();
+    if (c == '\n') return true;
+    line += c;
+    if (line.size() > 1 << 20) return true;
+  }
+}
+
+int hostIndex(const app::Application& application, const std::string& host) {
+  for (std::size_t i = 0; i < application.hosts.size(); ++i) {
+    if (application.hosts[i].id == host) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application& application,
+                                                         const std::string& host,
+                                                         const std::string& bindAddress,
+                                                         double peerTimeoutSeconds, int in,
+                                                         int out) {
+  std::unique_ptr<ControlLink> link(new ControlLink(in, out));
+  std::string line;
+  if (!readLine(in, line) || line.rfind("secret ", 0) != 0) {
+    return makeError("--control: the first line on stdin must be the run secret");
+  }
+  auto secret = net::secretFromHex(line.substr(7));
+  std::fill(line.begin(), line.end(), '\0');
+  if (!secret) return secret.error();
+  link->selfIndex_ = hostIndex(application, host);
+  if (link->selfIndex_ < 0) return makeError("no host '" + host + "' in the application");
+  const app::Host& self = application.hosts[static_cast<std::size_t>(link->selfIndex_)];
+  auto id = msg::hostIdFromAddress(self.address);
+  if (!id) return makeError("host '" + host + "': " + id.error().message);
+  link->hostId_ = *id;
+
+  net::TransportOptions options;
+  options.selfIndex = link->selfIndex_;
+  for (const auto& h : application.hosts) options.hostNames.push_back(h.id);
+  options.bindAddress = bindAddress.empty() ? self.address : bindAddress;
+  options.secret = *secret;
+  options.peerTimeoutSeconds = peerTimeoutSeconds;
+  auto transport = net::Transport::listen(options);
+  secret->fill(0);
+  options.secret.fill(0);
+  if (!transport) return makeError("host '" + host + "': " + transport.error().message);
+  link->transport_ = std::move(*transport);
+
+  // Which host runs each node; connections crossing this host's boundary.
+  auto hostOf = [&](const std::string& node) {
+    for (const auto& m : application.modules) {
+      if (m.id == node) return hostIndex(application, app::effectiveHost(application, m.host));
+    }
+    for (const auto& f : application.filters) {
+      if (f.id == node) return hostIndex(application, app::effectiveHost(application, f.host));
+    }
+    return -1;
+  };
+  for (std::size_t i = 0; i < application.connections.size(); ++i) {
+    const auto& c = application.connections[i];
+    const int from = hostOf(c.from.node), to = hostOf(c.to.node);
+    const auto channel = static_cast<uint32_t>(i);
+    if (from == link->selfIndex_ && to == link->selfIndex_) {
+      link->localChannels_.push_back(channel);
+    } else if (from == link->selfIndex_ || to == link->selfIndex_) {
+      net::RemoteConnection r{channel, c, from == link->selfIndex_ ? to : from,
+                              from == link->selfIndex_};
+      link->remote_.push_back(r);
+      link->transport_->addConnection(r);
+    }
+  }
+  link->send("listening " + std::to_string(link->transport_->port()));
+  link->reader_ = std::thread([raw = link.get()] { raw->readLoop(); });
+  return link;
+}
+
+ControlLink::~ControlLink() {
+  if (transport_) transport_->stop();
+  // The reader ends at end of input: the launcher closes our stdin when the run is over.
+  if (reader_.joinable()) reader_.detach();
+}
+
+void ControlLink::readLoop() {
+  std::string line;
+  while (readLine(in_, line)) {
+    std::lock_guard lock(mutex_);
+    lines_.push_back(line);
+    changed_.notify_all();
+  }
+  std::lock_guard lock(mutex_);
+  lines_.push_back("eof");
+  changed_.notify_all();
+}
+
+std::string ControlLink::next(double seconds) {
+  std::unique_lock lock(mutex_);
+  if (seconds < 0) {
+    changed_.wait(lock, [&] { return !lines_.empty(); });
+  } else if (!changed_.wait_for(lock, std::chrono::duration<double>(seconds),
+                                [&] { return !lines_.empty(); })) {
+    return {};
+  }
+  std::string line = lines_.front();
+  if (line != "eof") lines_.pop_front();  // end of input stays visible
+  return line;
+}
+
+void ControlLink::send(const std::string& line) {
+  std::string text = line + "\n";
+  const char* p = text.data();
+  std::size_t left = text.size();
+  while (left > 0) {
+    const ssize_t n = write(out_, p, left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;  // the launcher is gone; poll() sees the end of input
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+}
+
+void ControlLink::configure(daemon::DaemonOptions& options) {
+  options.hostId = hostId_;
+  options.transport = transport_.get();
+  options.remote = remote_;
+  options.connectionChannels = localChannels_;
+}
+
+Status ControlLink::ready() {
+  std::vector<net::PeerAddress> peers;
+  while (true) {
+    const std::string line = next(-1);
+    if (line == "connect") break;
+    if (line == "eof" || line == "stop") return makeError("stopped by the launcher before the start");
+    std::istringstream words(line);
+    std::string word;
+    net::PeerAddress peer;
+    if (words >> word && word == "peer" && words >> peer.index >> peer.address >> peer.port) {
+      peers.push_back(peer);
+    }
+  }
+  if (auto status = transport_->connectPeers(peers); !status) {
+    send("error " + status.error().message);
+    return status;
+  }
+  send("connected");
+  const std::string go = next(-1);
+  if (go != "go") return makeError("stopped by the launcher before the start");
+  return {};
+}
+
+std::optional<run::RunOutcome> ControlLink::poll() {
+  if (auto fatal = transport_->fatalError(); !fatal.empty()) {
+    return run::RunOutcome{run::kExitRunFailed, "failed", fatal};
+  }
+  const std::string line = next(0);
+  if (line == "stop") return run::RunOutcome{run::kExitInterrupted, "stopped", "stopped by the launcher"};
+  if (line == "eof") return run::RunOutcome{run::kExitInterrupted, "stopped", "the launcher went away"};
+  return std::nullopt;
+}
+
+void ControlLink::drain(const run::RunOutcome& outcome) {
+  send("finished " + std::to_string(outcome.exitCode) + " " + outcome.status + " " + outcome.error);
+  // Keep routing (messages for the other hosts) until the launcher says every host is done.
+  while (true) {
+    const std::string line = next(0.05);
+    if (line == "quit") {
+      transport_->finish(2.0);
+      break;
+    }
+    if (line == "stop" || line == "eof") break;
+  }
+  transport_->stop();
+}
+
+void ControlLink::report(const std::string& json) {
+  std::string flat = json;
+  for (char& c : flat) {
+    if (c == '\n') c = ' ';  // JSON strings hold no raw newline: this keeps it one line
+  }
+  send("report " + flat);
+}
+
+}  // namespace vrflow::tools
