@@ -197,6 +197,7 @@ struct Transport::Impl {
   mutable std::mutex mutex;
   std::condition_variable changed;
   std::string fatal;
+  std::string setupFailure;  ///< a link this host opened failed before authentication
   std::thread thread;
   std::atomic<bool> running{false};
   std::atomic<bool> stopped{false};
@@ -411,6 +412,8 @@ void Transport::Impl::fail(Link& link, const std::string& why) {
       fatal = "lost the link to host '" + hostName(link.peer) + "' (" + link.address + "): " + why;
     }
     if (linkOfPeer.count(link.peer) != 0 && linkOfPeer[link.peer] == &link) linkOfPeer.erase(link.peer);
+  } else if (link.connector && setupFailure.empty()) {
+    setupFailure = "host '" + hostName(link.peer) + "' (" + link.address + "): " + why;
   }
   if (!link.byeReceived) {
     std::fprintf(stderr, "vrflow-daemon (host %s): closed the connection %s %s: %s\n",
@@ -421,6 +424,8 @@ void Transport::Impl::fail(Link& link, const std::string& why) {
                  why.c_str());
   }
   link.out.clear();
+  if (link.fd >= 0) close(link.fd);
+  link.fd = -1;
   changed.notify_all();
 }
 
@@ -732,6 +737,7 @@ Status Transport::connectPeers(const std::vector<PeerAddress>& peers) {
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration<double>(t.options.connectSeconds);
   while (t.fatal.empty()) {
+    if (!t.setupFailure.empty()) return makeError(t.setupFailure);
     bool all = true;
     for (const int p : t.neededPeers) all = all && t.linkOfPeer.count(p) != 0;
     if (all) return {};
