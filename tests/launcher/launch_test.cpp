@@ -1,0 +1,169 @@
+#include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "process_helpers.hpp"
+
+namespace vrflow::testing {
+namespace {
+
+std::string pipelineFile() { return sourceDir() + "/examples/pipeline/pipeline.xml"; }
+std::string threeHostsFile() { return sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml"; }
+
+// The report without timings and without what names the file or the hosts.
+nlohmann::json deterministicPart(const std::string& path) {
+  auto report = nlohmann::json::parse(readFile(path));
+  report.erase("timing");
+  report.erase("file");
+  for (auto& m : report["modules"]) {
+    m.erase("timing");
+    m.erase("host");
+  }
+  return report;
+}
+
+std::string cmdline(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (char& c : text) {
+    if (c == '\0') c = ' ';
+  }
+  return text;
+}
+
+pid_t parentOf(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = text.rfind(')');
+  if (close == std::string::npos) return -1;
+  char state = 0;
+  int ppid = -1;
+  std::sscanf(text.c_str() + close + 1, " %c %d", &state, &ppid);
+  return ppid;
+}
+
+// A descendant of `root` whose command line contains `needle`, or -1.
+pid_t findDescendant(pid_t root, const std::string& needle) {
+  DIR* dir = opendir("/proc");
+  pid_t found = -1;
+  while (dirent* e = readdir(dir)) {
+    const pid_t pid = std::atoi(e->d_name);
+    if (pid <= 0) continue;
+    bool below = false;
+    for (pid_t p = parentOf(pid), hops = 0; p > 1 && hops < 8; p = parentOf(p), ++hops) {
+      if (p == root) below = true;
+    }
+    if (below && cmdline(pid).find(needle) != std::string::npos) found = pid;
+  }
+  closedir(dir);
+  return found;
+}
+
+struct Launched {
+  int exitCode = -1;
+  std::string err;
+};
+
+// Runs `vrflow launch ... -n 0` (endless), kills -9 the process matching `victim` once it runs,
+// and returns how the launcher ended (killed after 60 s if it never does).
+Launched launchAndKill(const std::string& victim, const std::string& report) {
+  TempDir dir;
+  const std::string errFile = dir.file("err.txt");
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = open(errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    dup2(fd, 2);
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, 1);
+    const std::string vrflow = binDir() + "/vrflow";
+    execl(vrflow.c_str(), vrflow.c_str(), "launch", threeHostsFile().c_str(), "--report",
+          report.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  pid_t target = -1;
+  for (int i = 0; i < 200 && target < 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    target = findDescendant(pid, victim);
+  }
+  EXPECT_GT(target, 0) << "no process matching '" << victim << "'";
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the run get going
+  if (target > 0) kill(target, SIGKILL);
+  Launched result;
+  int status = 0;
+  for (int i = 0; i < 600; ++i) {
+    if (waitpid(pid, &status, WNOHANG) == pid) {
+      result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  if (result.exitCode < 0) {
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+  }
+  result.err = readFile(errFile);
+  return result;
+}
+
+TEST(Launch, ThreeHostsGiveTheSameDigestsAsOneHost) {
+  TempDir dir;
+  const auto one = runVrflow({"run", pipelineFile(), "-n", "150", "--no-progress", "--report",
+                              dir.file("one.json")},
+                             120);
+  ASSERT_EQ(one.exitCode, 0) << one.err;
+  const auto three = runVrflow({"launch", threeHostsFile(), "--backend", "local", "-n", "150",
+                                "--report", dir.file("three.json")},
+                               120);
+  ASSERT_EQ(three.exitCode, 0) << three.err;
+  const auto a = deterministicPart(dir.file("one.json"));
+  const auto b = deterministicPart(dir.file("three.json"));
+  EXPECT_EQ(a, b) << a.dump(1) << "\n---\n" << b.dump(1);
+  EXPECT_EQ(b["outputs"].size(), 4u);
+  EXPECT_EQ(b["outputs"][0]["last_iteration"], 149);
+  EXPECT_EQ(nlohmann::json::parse(readFile(dir.file("three.json")))["modules"][1]["host"], "b");
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+TEST(Launch, KillingADaemonStopsEveryHostAndNamesIt) {
+  TempDir dir;
+  const auto result = launchAndKill("--host b", dir.file("r.json"));
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("daemon of host 'b'"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("signal 9"), std::string::npos) << result.err;
+  EXPECT_EQ(nlohmann::json::parse(readFile(dir.file("r.json")))["status"], "failed");
+  // The killed daemon's modules die with it (PR_SET_PDEATHSIG) and, orphaned, come back to this
+  // test (a subreaper) as zombies to reap: none may still be running.
+  for (const auto& left : leftoverProcesses()) {
+    EXPECT_NE(left.find("(reaped)"), std::string::npos) << "still running: " << left;
+  }
+}
+
+TEST(Launch, KillingAModuleStopsEveryHostAndNamesItsHost) {
+  TempDir dir;
+  const auto result = launchAndKill("vrflow-core-gravity", dir.file("r.json"));
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("module 'gravity' (host c"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("signal 9"), std::string::npos) << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+TEST(Launch, AHostfileMistakeNamesTheFileAndLine) {
+  TempDir dir;
+  const auto hosts = dir.write("hosts", "a address=127.0.0.1\n# comment\nnowhere address=1.2.3.4\n");
+  const auto result = runVrflow({"launch", threeHostsFile(), "--hosts", hosts, "-n", "5"}, 60);
+  EXPECT_EQ(result.exitCode, 1);
+  EXPECT_NE(result.err.find(hosts + ":3: error: no host 'nowhere'"), std::string::npos) << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+}  // namespace
+}  // namespace vrflow::testing
