@@ -58,7 +58,7 @@ int run(int argc, char** argv) {
   int peerTimeoutS = 30;
   bool mpiRankMode = false;
   app.add_option("--transport", transport, "Which transport to measure")
-      ->check(CLI::IsMember({"all", "zeromq-ipc", "mpi-shm", "vrflow-shm"}))
+      ->check(CLI::IsMember({"all", "zeromq-ipc", "mpi-shm", "vrflow-shm", "zeromq-tcp", "raw-tcp", "vrflow-tcp"}))
       ->capture_default_str();
   app.add_option("--sizes", sizesText, "Message sizes, e.g. 64,4K,1M,16M (K, M: KiB, MiB)")
       ->capture_default_str();
@@ -91,6 +91,17 @@ int run(int argc, char** argv) {
   bool ok = true;
   if (selected("zeromq-ipc")) {
     ok = report(vrflow::bench::runZeromq(settings)) && ok;
+  }
+  // TCP on loopback: the floor (raw-tcp) and a messaging library (zeromq-tcp) beside vrflow
+  // between two daemons (vrflow-tcp). The forking ones run first, while single-threaded.
+  if (selected("zeromq-tcp")) {
+    ok = report(vrflow::bench::runZeromqTcp(settings)) && ok;
+  }
+  if (selected("raw-tcp")) {
+    ok = report(vrflow::bench::runRawTcp(settings)) && ok;
+  }
+  if (selected("vrflow-tcp")) {
+    ok = report(vrflow::bench::runVrflowTcp(settings)) && ok;
   }
   if (selected("mpi-shm")) {
     const std::string self = selfPath();
