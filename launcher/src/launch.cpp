@@ -16,11 +16,16 @@
 
 #include "vrflow/launcher/launch.hpp"
 #include "vrflow/net/transport.hpp"
+#include "vrflow/run/trace.hpp"
 
 namespace vrflow::launcher {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+int64_t steadyNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
 
 double secondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
@@ -45,7 +50,9 @@ struct HostDaemon {
   int port = -1;
   bool connected = false, finished = false, exited = false;
   int finishedCode = 0;
-  std::string finishedStatus, finishedError, report, exitText;
+  std::string finishedStatus, finishedError, report, exitText, trace;
+  bool clockKnown = false;
+  int64_t clockOffsetNs = 0;  ///< the daemon's steady clock minus ours
 
   void send(const std::string& line) const {
     if (toDaemon < 0) return;
@@ -152,6 +159,16 @@ void Launcher::onLine(HostDaemon& d, const std::string& line) {
     }
   } else if (word == "report") {
     d.report = line.substr(7);
+  } else if (word == "trace") {
+    d.trace = line.substr(6);
+  } else if (word == "clock") {
+    // "clock T0 Td": our send time echoed with the daemon's clock; the daemon read its clock
+    // about half-way through the round trip.
+    int64_t sent = 0, theirs = 0;
+    if (words >> sent >> theirs) {
+      d.clockOffsetNs = theirs - (sent + steadyNs()) / 2;
+      d.clockKnown = true;
+    }
   }
 }
 
@@ -250,6 +267,7 @@ Status Launcher::start() {
     }
     std::vector<std::string> argv{daemonPath, options_.appFile, "--host", host.id, "--control",
                                   "--bind", d.bind};
+    if (!options_.tracePath.empty()) argv.push_back("--trace");
     char timeout[32];
     std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
     argv.insert(argv.end(), {"--peer-timeout", timeout});
@@ -290,6 +308,12 @@ Status Launcher::start() {
     d.send("connect");
   }
   if (auto s = waitFor([](const HostDaemon& d) { return d.connected; }, "linked"); !s) return s;
+  if (!options_.tracePath.empty()) {
+    for (const auto& d : daemons_) d.send("clock " + std::to_string(steadyNs()));
+    if (auto s = waitFor([](const HostDaemon& d) { return d.clockKnown; }, "clock-aligned"); !s) {
+      return s;
+    }
+  }
   for (const auto& d : daemons_) d.send("go");
   return {};
 }
@@ -362,6 +386,22 @@ run::RunOutcome Launcher::run() {
     out << mergeReports(application_, parts, outcome, options_.iterations, secondsSince(begin)) << "\n";
     if (!out && outcome.exitCode == run::kExitOk) {
       outcome = {run::kExitRunFailed, "failed", "cannot write the report '" + options_.reportPath + "'"};
+    }
+  }
+  if (!options_.tracePath.empty()) {
+    std::vector<run::HostTrace> traces;
+    for (const auto& d : daemons_) {
+      if (d.trace.empty()) continue;
+      auto trace = run::hostTraceFromJson(d.trace);
+      if (!trace) continue;
+      trace->host = d.host;
+      trace->clockOffsetNs = d.clockOffsetNs;
+      traces.push_back(std::move(*trace));
+    }
+    std::ofstream out(options_.tracePath);
+    out << run::chromeTrace(application_, traces) << "\n";
+    if (!out && outcome.exitCode == run::kExitOk) {
+      outcome = {run::kExitRunFailed, "failed", "cannot write the trace '" + options_.tracePath + "'"};
     }
   }
   close(signalFd_);

@@ -25,6 +25,7 @@ vrflow_add_library(runtime
     src/net/transport.cpp
     src/run/spawn.cpp
     src/run/report.cpp
+    src/run/trace.cpp
     src/run/runner.cpp
   PUBLIC_DEPS vrflow::message vrflow::app vrflow::base Threads::Threads
   PRIVATE_DEPS nlohmann_json::nlohmann_json PkgConfig::SODIUM ${CMAKE_DL_LIBS})

@@ -165,9 +165,19 @@ Status ControlLink::ready() {
     return status;
   }
   send("connected");
-  const std::string go = next(-1);
-  if (go != "go") return makeError("stopped by the launcher before the start");
-  return {};
+  while (true) {
+    const std::string line = next(-1);
+    if (line == "go") return {};
+    // "clock T": the launcher aligns this host's clock with its own (--trace).
+    if (line.rfind("clock ", 0) == 0) {
+      const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                           std::chrono::steady_clock::now().time_since_epoch())
+                           .count();
+      send(line + " " + std::to_string(now));
+      continue;
+    }
+    return makeError("stopped by the launcher before the start");
+  }
 }
 
 std::optional<run::RunOutcome> ControlLink::poll() {
@@ -193,6 +203,8 @@ void ControlLink::drain(const run::RunOutcome& outcome) {
   }
   transport_->stop();
 }
+
+void ControlLink::trace(const std::string& json) { send("trace " + json); }
 
 void ControlLink::report(const std::string& json) {
   std::string flat = json;

@@ -31,6 +31,7 @@ class ControlLink final : public run::HostLink {
   std::optional<run::RunOutcome> poll() override;
   void drain(const run::RunOutcome& outcome) override;
   void report(const std::string& json) override;
+  void trace(const std::string& json) override;
 
  private:
   ControlLink(int in, int out) : in_(in), out_(out) {}

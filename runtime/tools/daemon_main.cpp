@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   cli.add_flag("--control", control,
                "Run under `vrflow launch`: the run secret and commands come on stdin, events go "
                "to stdout, connections crossing hosts go over TCP");
+  cli.add_flag("--trace", options.trace, "Record modules' spans and send them to the launcher");
   cli.add_option("--bind", bindAddress, "Address to listen on (default: the host's address)");
   cli.add_option("--peer-timeout", peerTimeout,
                  "A link to another host silent this long is declared lost (seconds)")

@@ -91,6 +91,8 @@ int main(int argc, char** argv) {
   run->add_option("--shm-size", shmMiB, "Shared-memory segment size in MiB (sparse)")
       ->check(CLI::Range(1.0, 262144.0));
   run->add_flag("--no-progress", noProgress, "Do not show live progress on a terminal");
+  run->add_option("--trace", options.tracePath,
+                  "Write a Chrome/Perfetto trace (modules' wait/compute spans, messages as flows)");
 
 #ifdef VRFLOW_HAS_LAUNCHER
   auto* launch = cli.add_subcommand("launch", "Run an application with one daemon per host (TCP between them)");
@@ -104,6 +106,8 @@ int main(int argc, char** argv) {
   launch->add_option("--report", launchOptions.reportPath, "Write a JSON run report to FILE");
   launch->add_option("--timeout", launchOptions.timeoutSeconds, "Fail if the run lasts longer (seconds)")
       ->check(CLI::NonNegativeNumber);
+  launch->add_option("--trace", launchOptions.tracePath,
+                     "Write a Chrome/Perfetto trace of every host, clocks aligned");
   launch->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,
                      "A host silent this long (no heartbeat) is declared lost (seconds)")
       ->check(CLI::PositiveNumber);

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -153,6 +154,41 @@ TEST(Launch, KillingAModuleStopsEveryHostAndNamesItsHost) {
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find("module 'gravity' (host c"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("signal 9"), std::string::npos) << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+TEST(Launch, TraceHoldsSpansOfEveryModuleAndFlowsAcrossHosts) {
+  TempDir dir;
+  const auto result = runVrflow({"launch", threeHostsFile(), "-n", "20", "--trace", dir.file("t.json")}, 120);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto trace = nlohmann::json::parse(readFile(dir.file("t.json")));
+  std::map<std::pair<int, int>, std::string> threads;
+  std::map<std::string, int> waits, computes;
+  int crossHostFlows = 0;
+  std::map<uint64_t, int> flowStart;
+  for (const auto& e : trace["traceEvents"]) {
+    const std::string ph = e["ph"];
+    if (ph == "M" && e["name"] == "thread_name") threads[{e["pid"], e["tid"]}] = e["args"]["name"];
+  }
+  for (const auto& e : trace["traceEvents"]) {
+    const std::string ph = e["ph"];
+    if (ph == "X") {
+      const std::string module = threads.at({e["pid"], e["tid"]});
+      ++(e["name"] == "wait" ? waits : computes)[module];
+      EXPECT_GE(e["dur"].get<double>(), 0.0);
+    } else if (ph == "s") {
+      flowStart[e["id"]] = e["pid"];
+    } else if (ph == "f") {
+      ASSERT_EQ(flowStart.count(e["id"]), 1u);
+      if (flowStart[e["id"]] != e["pid"].get<int>()) ++crossHostFlows;
+    }
+  }
+  for (const char* m : {"chain", "springs", "gravity", "relay", "recorder"}) {
+    EXPECT_EQ(waits[m], 20) << m;
+    EXPECT_EQ(computes[m], 20) << m;
+  }
+  EXPECT_GT(crossHostFlows, 0);
+  EXPECT_EQ(threads.size(), 5u);
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 

@@ -161,6 +161,11 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     const std::string host = app::effectiveHost(application, module.host);
     copyName(slot->host, host);
     slot->iterationLimit = options.iterationLimit;
+    if (options.trace) {
+      slot->traceOffset = segment.reserve(sizeof(ipc::TraceRing));
+      if (slot->traceOffset == 0) return makeError("shared-memory segment too small for tracing");
+      new (segment.at<void>(slot->traceOffset)) ipc::TraceRing();
+    }
     modules.push_back({module.id, host, type->executable, static_cast<int>(m)});
 
     // Parameters: manifest defaults, overridden by the file.

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <thread>
 
@@ -17,6 +18,7 @@
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/message/ids.hpp"
+#include "vrflow/run/trace.hpp"
 
 namespace vrflow::run {
 namespace {
@@ -77,6 +79,24 @@ class Supervisor {
   bool lingering(std::string& detail);
   Clock::time_point finishedSince_{};
   void showProgress(bool final);
+
+ public:
+  /// Moves what the modules traced into trace_ (no-op when the run is not traced).
+  void drainTraces() {
+    for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
+      const auto& slot = daemon_.slot(daemon_.modules()[i].slotIndex);
+      if (slot.traceOffset == 0) continue;
+      if (trace_.modules.size() != daemon_.modules().size()) {
+        trace_.modules.clear();
+        for (const auto& m : daemon_.modules()) trace_.modules.push_back(m.id);
+      }
+      auto& ring = *daemon_.segment().at<ipc::TraceRing>(slot.traceOffset);
+      drainTraceRing(ring, static_cast<uint32_t>(i), trace_);
+    }
+  }
+  HostTrace trace_;
+
+ private:
 
   const app::Application& application_;
   const RunOptions& options_;
@@ -297,6 +317,7 @@ RunOutcome Supervisor::run() {
     }
     reap(outcome, false);
     showProgress(false);
+    drainTraces();
     if (options_.timeoutSeconds > 0 && secondsSince(start_) > options_.timeoutSeconds) {
       char text[96];
       std::snprintf(text, sizeof text, "timed out after %g s (--timeout)", options_.timeoutSeconds);
@@ -354,6 +375,7 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   daemon::DaemonOptions daemonOptions;
   daemonOptions.segmentBytes = options.segmentBytes;
   daemonOptions.iterationLimit = options.iterations;
+  daemonOptions.trace = options.trace || !options.tracePath.empty();
   if (!application.hosts.empty()) {
     if (auto id = msg::hostIdFromAddress(application.hosts.front().address)) {
       daemonOptions.hostId = *id;
@@ -385,6 +407,29 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   if (outcome.exitCode == kExitOk) outcome = supervisor.run();
   if (options.hostLink != nullptr) options.hostLink->drain(outcome);
   (*daemon)->shutdown();
+  supervisor.drainTraces();
+  for (std::size_t i = 0; i < (*daemon)->modules().size(); ++i) {
+    const auto& slot = (*daemon)->slot((*daemon)->modules()[i].slotIndex);
+    if (slot.traceOffset != 0) {
+      supervisor.trace_.dropped +=
+          (*daemon)->segment().at<ipc::TraceRing>(slot.traceOffset)->dropped.load();
+    }
+  }
+  if (daemonOptions.trace) {
+    if (supervisor.trace_.modules.empty()) {
+      for (const auto& m : (*daemon)->modules()) supervisor.trace_.modules.push_back(m.id);
+    }
+    supervisor.trace_.host = application.hosts.empty() ? "localhost" : application.hosts.front().id;
+    if (options.hostLink != nullptr) {
+      options.hostLink->trace(hostTraceToJson(supervisor.trace_));
+    } else if (!options.tracePath.empty()) {
+      std::ofstream out(options.tracePath);
+      out << chromeTrace(application, {supervisor.trace_}) << "\n";
+      if (!out && outcome.exitCode == kExitOk) {
+        outcome = {kExitRunFailed, "failed", "cannot write the trace '" + options.tracePath + "'"};
+      }
+    }
+  }
   std::vector<std::string> warnings = (*daemon)->takeWarnings();
   if (options.hostLink != nullptr) {
     options.hostLink->report(reportJson(application, **daemon, supervisor.ends(), outcome, options,

@@ -32,6 +32,7 @@ struct LaunchOptions {
   std::string backend = "local";
   uint64_t iterations = 0;
   std::string reportPath;
+  std::string tracePath;          ///< Chrome trace of every host; empty = none
   double timeoutSeconds = 0;
   double peerTimeoutSeconds = 3;  ///< heartbeat timeout between daemons
   double startSeconds = 30;       ///< every daemon must be linked within this

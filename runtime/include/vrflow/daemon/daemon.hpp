@@ -22,6 +22,8 @@ struct DaemonOptions {
   uint32_t hostId = 0x7f000001;                       ///< from the host's address
   /// Warn when a connection's buffer has stayed full this long (ns).
   uint64_t fullWarningNs = 2'000'000'000;
+  /// Gives every module a trace ring (ipc::TraceRing) for `--trace`.
+  bool trace = false;
   /// Links to the other hosts' daemons (vrflow-daemon under `vrflow launch`); null when every
   /// connection stays on this daemon.
   net::Transport* transport = nullptr;

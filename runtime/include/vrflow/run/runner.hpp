@@ -37,6 +37,8 @@ struct RunOptions {
   double joinSeconds = 20;            ///< a module must call Module::init() within this
   double lingerSeconds = 5;           ///< a module that finished must exit within this
   HostLink* hostLink = nullptr;       ///< set by vrflow-daemon under the launcher
+  bool trace = false;                 ///< record modules' spans (also implied by tracePath)
+  std::string tracePath;              ///< Chrome trace-event JSON; empty = none
 };
 
 /// What happened, for the report and the exit code.
@@ -61,6 +63,8 @@ class HostLink {
   virtual void drain(const RunOutcome& outcome) = 0;
   /// This host's share of the run report (JSON text).
   virtual void report(const std::string& json) = 0;
+  /// This host's trace events (run::hostTraceToJson), when the run is traced.
+  virtual void trace(const std::string& json) = 0;
 };
 
 /// The node packages on the search path: `extraDirs` first, then $VRFLOW_PACKAGE_PATH, then
