@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "vrflow/launcher/launch.hpp"
@@ -51,6 +52,7 @@ struct HostDaemon {
   bool connected = false, finished = false, exited = false;
   int finishedCode = 0;
   std::string finishedStatus, finishedError, report, exitText, trace;
+  std::string stats, previousStats;  ///< the last two "stats" lines (vrflow monitor)
   bool clockKnown = false;
   int64_t clockOffsetNs = 0;  ///< the daemon's steady clock minus ours
 
@@ -99,6 +101,11 @@ Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
   return pid;
 }
 
+// Where running launches publish their live state for `vrflow monitor`.
+std::string monitorFile() {
+  return monitorDirectory() + "/monitor-" + std::to_string(getpid()) + ".json";
+}
+
 class Launcher {
  public:
   Launcher(const app::Application& application, const LaunchOptions& options)
@@ -111,6 +118,8 @@ class Launcher {
   void onLine(HostDaemon& d, const std::string& line);
   void failWith(run::RunOutcome outcome, bool rootCause);
   void stopAll();
+  void publish();
+  Clock::time_point lastPublish_{};
   bool allExited() const {
     for (const auto& d : daemons_) {
       if (!d.exited) return false;
@@ -159,6 +168,9 @@ void Launcher::onLine(HostDaemon& d, const std::string& line) {
     }
   } else if (word == "report") {
     d.report = line.substr(7);
+  } else if (word == "stats") {
+    d.previousStats = std::move(d.stats);
+    d.stats = line.substr(6);
   } else if (word == "trace") {
     d.trace = line.substr(6);
   } else if (word == "clock") {
@@ -318,6 +330,27 @@ Status Launcher::start() {
   return {};
 }
 
+// Rewrites this launch's monitor file (atomically: write, then rename).
+void Launcher::publish() {
+  std::string text = "{\"application\":" + nlohmann::json(application_.name).dump() +
+                     ",\"file\":" + nlohmann::json(application_.file).dump() +
+                     ",\"launcher_pid\":" + std::to_string(getpid()) + ",\"hosts\":[";
+  for (std::size_t i = 0; i < daemons_.size(); ++i) {
+    const auto& d = daemons_[i];
+    text += (i ? "," : "") + std::string("{\"host\":") + nlohmann::json(d.host).dump() +
+            ",\"address\":" + nlohmann::json(d.bind).dump() + ",\"daemon_pid\":" +
+            std::to_string(d.pid) + ",\"now\":" + (d.stats.empty() ? "null" : d.stats) +
+            ",\"before\":" + (d.previousStats.empty() ? "null" : d.previousStats) + "}";
+  }
+  text += "]}";
+  const std::string path = monitorFile(), temp = path + ".tmp";
+  const int fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (fd < 0) return;
+  const bool ok = write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+  close(fd);
+  if (ok) rename(temp.c_str(), path.c_str());
+}
+
 void Launcher::stopAll() {
   for (const auto& d : daemons_) {
     if (!d.exited) d.send("stop");
@@ -364,6 +397,10 @@ run::RunOutcome Launcher::run() {
       failWith({run::kExitTimeout, "timeout", text}, true);
       break;
     }
+    if (secondsSince(lastPublish_) >= 1.0) {
+      publish();
+      lastPublish_ = Clock::now();
+    }
     bool allFinished = true;
     for (const auto& d : daemons_) allFinished = allFinished && d.finished;
     if (allFinished && !quitSent) {
@@ -372,6 +409,7 @@ run::RunOutcome Launcher::run() {
     }
   }
   stopAll();
+  std::remove(monitorFile().c_str());
   for (auto& d : daemons_) {
     if (d.toDaemon >= 0) close(d.toDaemon);
     if (d.fromDaemon >= 0) close(d.fromDaemon);

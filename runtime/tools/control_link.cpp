@@ -185,6 +185,7 @@ std::optional<run::RunOutcome> ControlLink::poll() {
     return run::RunOutcome{run::kExitRunFailed, "failed", fatal};
   }
   const std::string line = next(0);
+  if (line == "stop" || line == "eof") stopped_ = true;
   if (line == "stop") return run::RunOutcome{run::kExitInterrupted, "stopped", "stopped by the launcher"};
   if (line == "eof") return run::RunOutcome{run::kExitInterrupted, "stopped", "the launcher went away"};
   return std::nullopt;
@@ -193,18 +194,34 @@ std::optional<run::RunOutcome> ControlLink::poll() {
 void ControlLink::drain(const run::RunOutcome& outcome) {
   send("finished " + std::to_string(outcome.exitCode) + " " + outcome.status + " " + outcome.error);
   // Keep routing (messages for the other hosts) until the launcher says every host is done.
-  while (true) {
+  while (!stopped_) {
     const std::string line = next(0.05);
     if (line == "quit") {
       transport_->finish(2.0);
       break;
     }
-    if (line == "stop" || line == "eof") break;
+    if (line == "stop" || line == "eof") stopped_ = true;
   }
+  if (stopped_) transport_->finish(0.5);  // say bye, so that peers do not log a lost link
   transport_->stop();
 }
 
 void ControlLink::trace(const std::string& json) { send("trace " + json); }
+
+void ControlLink::stats(const std::string& json) {
+  // The links' counters join the modules' and connections'.
+  std::string links = "[";
+  for (const auto& l : transport_->linkStats()) {
+    if (links.size() > 1) links += ",";
+    links += "{\"peer\":" + std::to_string(l.peer) + ",\"messages_sent\":" +
+             std::to_string(l.messagesSent) + ",\"bytes_sent\":" + std::to_string(l.bytesSent) +
+             ",\"messages_received\":" + std::to_string(l.messagesReceived) +
+             ",\"bytes_received\":" + std::to_string(l.bytesReceived) + "}";
+  }
+  links += "]";
+  if (json.empty() || json.back() != '}') return;
+  send("stats " + json.substr(0, json.size() - 1) + ",\"links\":" + links + "}");
+}
 
 void ControlLink::report(const std::string& json) {
   std::string flat = json;

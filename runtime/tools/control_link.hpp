@@ -32,6 +32,7 @@ class ControlLink final : public run::HostLink {
   void drain(const run::RunOutcome& outcome) override;
   void report(const std::string& json) override;
   void trace(const std::string& json) override;
+  void stats(const std::string& json) override;
 
  private:
   ControlLink(int in, int out) : in_(in), out_(out) {}
@@ -43,6 +44,7 @@ class ControlLink final : public run::HostLink {
 
   int in_, out_;
   int selfIndex_ = 0;
+  bool stopped_ = false;  ///< the launcher said stop (or went away)
   uint32_t hostId_ = 0;
   std::unique_ptr<net::Transport> transport_;
   std::vector<net::RemoteConnection> remote_;

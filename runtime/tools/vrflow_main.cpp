@@ -111,6 +111,10 @@ int main(int argc, char** argv) {
   launch->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,
                      "A host silent this long (no heartbeat) is declared lost (seconds)")
       ->check(CLI::PositiveNumber);
+  auto* monitorCommand = cli.add_subcommand("monitor", "Show live statistics of the running launches");
+  bool monitorOnce = false, monitorJson = false;
+  monitorCommand->add_flag("--once", monitorOnce, "Print one snapshot and exit");
+  monitorCommand->add_flag("--json", monitorJson, "Print the raw snapshots (JSON lines)");
 #endif
   try {
     cli.parse(argc, argv);
@@ -119,6 +123,9 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
+#ifdef VRFLOW_HAS_LAUNCHER
+  if (monitorCommand->parsed()) return vrflow::launcher::monitor(monitorOnce, monitorJson);
+#endif
   if (expand->parsed()) {
     const auto flat = loadFlat(expandFile, compositeDirs, nullptr);
     if (!flat) return 1;

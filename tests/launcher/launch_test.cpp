@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <csignal>
 #include <thread>
 
 #include "process_helpers.hpp"
@@ -189,6 +190,30 @@ TEST(Launch, TraceHoldsSpansOfEveryModuleAndFlowsAcrossHosts) {
   }
   EXPECT_GT(crossHostFlows, 0);
   EXPECT_EQ(threads.size(), 5u);
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+TEST(Launch, MonitorShowsEveryModuleHostConnectionAndLinkOfARunningLaunch) {
+  CommandResult launched;
+  std::thread launcher([&] {
+    launched = runVrflow({"launch", threeHostsFile(), "--timeout", "60"}, 90, 8, SIGINT);
+  });
+  std::string seen;
+  for (int i = 0; i < 60; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    const auto shown = runVrflow({"monitor", "--once"}, 30);
+    if (shown.exitCode == 0 && shown.out.find("LINKS") != std::string::npos &&
+        shown.out.find("recorder") != std::string::npos) {
+      seen = shown.out;
+      break;
+    }
+  }
+  launcher.join();
+  EXPECT_EQ(launched.exitCode, 130) << launched.err;
+  for (const char* text : {"chain", "springs", "gravity", "relay", "recorder", "relay.out -> recorder.in",
+                           "IT/S", "WAIT%", "CPU%", "RSS MiB", "msg/s out"}) {
+    EXPECT_NE(seen.find(text), std::string::npos) << text << " not in:\n" << seen;
+  }
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 

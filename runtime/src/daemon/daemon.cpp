@@ -66,6 +66,8 @@ struct Daemon::Impl {
   std::mutex warningsMutex;
   std::vector<std::string> warnings;
   std::string fatal;  ///< first protocol violation by a module (guarded by warningsMutex)
+  std::vector<QueueSnapshot> snapshot;  ///< guarded by warningsMutex
+  void publishSnapshot();
 
   Status build(const app::Application& application, const app::Catalog& catalog);
   Result<Node*> addNode(const std::string& id, const std::string& type,
@@ -431,6 +433,7 @@ void Daemon::shutdown() {
 void Daemon::Impl::loop() {
   auto& bell = segment.header().daemonBell;
   uint64_t lastFullCheck = 0;
+  uint64_t lastSnapshot = 0;
   while (running.load(std::memory_order_acquire)) {
     const uint32_t seen = bell.prepare();
     bool progressed = false;
@@ -439,6 +442,10 @@ void Daemon::Impl::loop() {
     if (now - lastFullCheck > 100'000'000) {
       checkFullQueues(now);
       lastFullCheck = now;
+    }
+    if (now - lastSnapshot > 500'000'000) {
+      publishSnapshot();
+      lastSnapshot = now;
     }
     publishWarnings();
     if (progressed) continue;
@@ -561,6 +568,22 @@ void Daemon::Impl::checkFullQueues(uint64_t now) {
                                 ")");
     }
   }
+}
+
+void Daemon::Impl::publishSnapshot() {
+  std::vector<QueueSnapshot> next;
+  for (const auto& queue : graph->queues) {
+    if (!queue.isConnection) continue;
+    next.push_back({queue.from, queue.to, queue.items.size(), queue.capacity, queue.messages,
+                    queue.bytes, queue.dropped});
+  }
+  std::lock_guard lock(warningsMutex);
+  snapshot = std::move(next);
+}
+
+std::vector<QueueSnapshot> Daemon::queueSnapshot() {
+  std::lock_guard lock(impl_->warningsMutex);
+  return impl_->snapshot;
 }
 
 void Daemon::Impl::publishWarnings() {

@@ -13,6 +13,8 @@
 #include <map>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "report.hpp"
 #include "spawn.hpp"
 #include "vrflow/daemon/daemon.hpp"
@@ -95,6 +97,61 @@ class Supervisor {
     }
   }
   HostTrace trace_;
+
+  /// Live counters for `vrflow monitor`: raw totals, so that the reader computes rates.
+  std::string statsJson() {
+    nlohmann::json j;
+    j["t_ns"] = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    Clock::now().time_since_epoch()).count();
+    auto modules = nlohmann::json::array();
+    const long ticks = sysconf(_SC_CLK_TCK);
+    const long page = sysconf(_SC_PAGESIZE);
+    for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
+      const auto& module = daemon_.modules()[i];
+      const auto& slot = daemon_.slot(module.slotIndex);
+      nlohmann::json m;
+      m["id"] = module.id;
+      m["iterations"] = slot.iterations.load();
+      m["state"] = children_[i].alive ? stateName(slot.state.load()) : "ended";
+      m["compute_ns"] = slot.computeNs.load();
+      m["wait_ns"] = slot.waitNs.load();
+      uint64_t cpuNs = 0, rss = 0;
+      if (children_[i].alive) {
+        std::FILE* stat = std::fopen(("/proc/" + std::to_string(children_[i].pid) + "/stat").c_str(), "r");
+        if (stat != nullptr) {
+          char text[1024] = {};
+          const std::size_t n = std::fread(text, 1, sizeof text - 1, stat);
+          std::fclose(stat);
+          const char* close = std::strrchr(text, ')');
+          unsigned long utime = 0, stime = 0;
+          if (n > 0 && close != nullptr &&
+              std::sscanf(close + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &utime,
+                          &stime) == 2 && ticks > 0) {
+            cpuNs = (utime + stime) * (1'000'000'000ull / static_cast<unsigned long>(ticks));
+          }
+        }
+        std::FILE* statm = std::fopen(("/proc/" + std::to_string(children_[i].pid) + "/statm").c_str(), "r");
+        if (statm != nullptr) {
+          unsigned long size = 0, resident = 0;
+          if (std::fscanf(statm, "%lu %lu", &size, &resident) == 2) rss = resident * static_cast<unsigned long>(page);
+          std::fclose(statm);
+        }
+      }
+      m["cpu_ns"] = cpuNs;
+      m["rss_bytes"] = rss;
+      modules.push_back(m);
+    }
+    j["modules"] = modules;
+    auto connections = nlohmann::json::array();
+    for (const auto& q : daemon_.queueSnapshot()) {
+      connections.push_back({{"from", q.from}, {"to", q.to}, {"length", q.length},
+                             {"capacity", q.capacity}, {"messages", q.messages},
+                             {"bytes", q.bytes}, {"dropped", q.dropped}});
+    }
+    j["connections"] = connections;
+    return j.dump();
+  }
+  Clock::time_point lastStats_{};
 
  private:
 
@@ -318,6 +375,10 @@ RunOutcome Supervisor::run() {
     reap(outcome, false);
     showProgress(false);
     drainTraces();
+    if (options_.hostLink != nullptr && secondsSince(lastStats_) >= 1.0) {
+      options_.hostLink->stats(statsJson());
+      lastStats_ = Clock::now();
+    }
     if (options_.timeoutSeconds > 0 && secondsSince(start_) > options_.timeoutSeconds) {
       char text[96];
       std::snprintf(text, sizeof text, "timed out after %g s (--timeout)", options_.timeoutSeconds);

@@ -45,6 +45,15 @@ struct LaunchOptions {
 std::string mergeReports(const app::Application& application, const std::vector<std::string>& parts,
                          const run::RunOutcome& outcome, uint64_t iterations, double wallSeconds);
 
+/// Folder (mode 0700) where running launches publish their live state:
+/// $XDG_RUNTIME_DIR/vrflow, or /tmp/vrflow-<uid>.
+std::string monitorDirectory();
+
+/// `vrflow monitor`: shows the live state of the launches running for this user, per host and
+/// module (iterations/s, wait vs compute, state, CPU, memory), per connection (queue, messages/s,
+/// bytes/s) and per link. Returns 0, or 1 when no launch is running.
+int monitor(bool once, bool json);
+
 /// Runs `application` (loaded, expanded and validated) with one daemon per host. Exit codes as
 /// `vrflow run`.
 run::RunOutcome launch(const app::Application& application, const LaunchOptions& options);

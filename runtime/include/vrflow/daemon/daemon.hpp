@@ -60,6 +60,13 @@ struct OutputStats {
   uint64_t lastIteration = 0;
 };
 
+/// A connection's live counters, published by the routing thread about twice a second.
+struct QueueSnapshot {
+  std::string from, to;
+  std::size_t length = 0, capacity = 0;
+  uint64_t messages = 0, bytes = 0, dropped = 0;
+};
+
 /// A host's daemon: owns the shared-memory segment, the control table of its modules, and the
 /// filter network between them, which it runs on its own thread. Routing goes through Sink
 /// objects, so destinations on other hosts slot in as another kind of sink.
@@ -90,6 +97,8 @@ class Daemon {
   std::string fatalError();
   /// Warnings raised while running (full queues, filter problems); thread-safe snapshot.
   std::vector<std::string> takeWarnings();
+  /// Live queue lengths and counters (thread-safe; at most about 0.5 s old).
+  std::vector<QueueSnapshot> queueSnapshot();
   /// Statistics; call after shutdown().
   std::vector<ConnectionStats> connectionStats() const;
   std::vector<OutputStats> outputStats() const;

@@ -65,6 +65,8 @@ class HostLink {
   virtual void report(const std::string& json) = 0;
   /// This host's trace events (run::hostTraceToJson), when the run is traced.
   virtual void trace(const std::string& json) = 0;
+  /// About once a second: live counters of this host's modules and connections (JSON).
+  virtual void stats(const std::string& json) = 0;
 };
 
 /// The node packages on the search path: `extraDirs` first, then $VRFLOW_PACKAGE_PATH, then
