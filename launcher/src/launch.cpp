@@ -49,6 +49,7 @@ struct HostDaemon {
   int toDaemon = -1, fromDaemon = -1;
   std::string buffer;
   int port = -1;
+  bool viaSsh = false;
   bool connected = false, finished = false, exited = false;
   int finishedCode = 0;
   std::string finishedStatus, finishedError, report, exitText, trace;
@@ -62,9 +63,23 @@ struct HostDaemon {
     [[maybe_unused]] auto n = write(toDaemon, text.data(), text.size());
   }
   std::string name() const {
-    return "daemon of host '" + host + "' (" + bind + ", pid " + std::to_string(pid) + ")";
+    return "daemon of host '" + host + "' (" + bind + (viaSsh ? ", ssh pid " : ", pid ") +
+           std::to_string(pid) + ")";
   }
 };
+
+// One word for a POSIX shell: single-quoted, with ' written as '\''.
+std::string shellQuote(const std::string& word) {
+  std::string quoted = "'";
+  for (const char c : word) {
+    if (c == '\'') {
+      quoted += "'\\''";
+    } else {
+      quoted += c;
+    }
+  }
+  return quoted + "'";
+}
 
 Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
                           const std::vector<std::string>& environment, int& toChild,
@@ -89,7 +104,7 @@ Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
-    execv(args[0], args.data());
+    execvp(args[0], args.data());
     std::fprintf(stderr, "vrflow: cannot start %s: %s\n", argv[0].c_str(), std::strerror(errno));
     _exit(127);
   }
@@ -257,7 +272,11 @@ Status Launcher::start() {
   std::error_code ec;
   const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
   const std::string daemonPath = (self.parent_path() / "vrflow-daemon").string();
+  const bool ssh = options_.backend == "ssh";
   std::vector<HostEntry> entries;
+  if (ssh && options_.hostfile.empty()) {
+    return makeError("--backend ssh needs --hosts HOSTFILE (where each host is and how to log in)");
+  }
   if (!options_.hostfile.empty()) {
     auto read = readHostfile(options_.hostfile, application_);
     if (!read) return read.error();
@@ -272,20 +291,56 @@ Status Launcher::start() {
     // local: every host on its own loopback address, as a cluster would be.
     d.bind = "127.0.0." + std::to_string(i + 1);
     std::vector<std::string> environment;
+    const HostEntry* entry = nullptr;
     for (const auto& e : entries) {
       if (e.host != host.id) continue;
+      entry = &e;
       if (!e.address.empty()) d.bind = e.address;
       environment = e.environment;
     }
-    std::vector<std::string> argv{daemonPath, options_.appFile, "--host", host.id, "--control",
-                                  "--bind", d.bind};
+    if (ssh) {
+      if (entry == nullptr) {
+        return makeError(options_.hostfile + ": error: no line for host '" + host.id +
+                         "' (--backend ssh needs one per host)");
+      }
+      if (entry->address.empty()) d.bind = host.address;
+    }
+    const std::string appFile = std::filesystem::absolute(options_.appFile, ec).string();
+    std::vector<std::string> argv{entry != nullptr && !entry->daemon.empty() ? entry->daemon : daemonPath,
+                                  appFile, "--host", host.id, "--control", "--bind", d.bind};
     if (!options_.tracePath.empty()) argv.push_back("--trace");
     char timeout[32];
     std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
     argv.insert(argv.end(), {"--peer-timeout", timeout});
     if (options_.iterations > 0) argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
-    for (const auto& p : options_.packageDirs) argv.insert(argv.end(), {"--packages", p});
-    for (const auto& c : options_.compositeDirs) argv.insert(argv.end(), {"--composites", c});
+    for (const auto& p : options_.packageDirs) {
+      argv.insert(argv.end(), {"--packages", std::filesystem::absolute(p, ec).string()});
+    }
+    for (const auto& c : options_.compositeDirs) {
+      argv.insert(argv.end(), {"--composites", std::filesystem::absolute(c, ec).string()});
+    }
+    if (ssh) {
+      // ssh carries nothing of our environment: the search paths and the hostfile's env go
+      // explicitly on the remote command line (the secret does not: it goes on stdin).
+      std::string remote = "cd " + shellQuote(entry->directory.empty()
+                                                  ? std::filesystem::current_path(ec).string()
+                                                  : entry->directory) +
+                           " && exec env";
+      for (const char* name : {"VRFLOW_PACKAGE_PATH", "VRFLOW_COMPOSITE_PATH", "VRFLOW_FILTER_PATH"}) {
+        if (const char* value = std::getenv(name)) remote += " " + shellQuote(std::string(name) + "=" + value);
+      }
+      for (const auto& e : environment) remote += " " + shellQuote(e);
+      for (const auto& a : argv) remote += " " + shellQuote(a);
+      std::vector<std::string> sshArgv{"ssh", "-T", "-o", "BatchMode=yes", "-p",
+                                       std::to_string(entry->sshPort)};
+      if (!entry->identity.empty()) sshArgv.insert(sshArgv.end(), {"-i", entry->identity});
+      for (const auto& o : entry->sshOptions) sshArgv.insert(sshArgv.end(), {"-o", o});
+      sshArgv.push_back(entry->user.empty() ? d.bind : entry->user + "@" + d.bind);
+      sshArgv.push_back(remote);
+      argv = std::move(sshArgv);
+      environment.clear();
+      d.viaSsh = true;
+    }
     auto pid = spawnDaemon(argv, environment, d.toDaemon, d.fromDaemon);
     if (!pid) return makeError("host '" + host.id + "': " + pid.error().message);
     d.pid = *pid;
@@ -453,11 +508,10 @@ run::RunOutcome Launcher::run() {
 }  // namespace
 
 run::RunOutcome launch(const app::Application& application, const LaunchOptions& options) {
-  if (options.backend != "local") {
+  if (options.backend != "local" && options.backend != "ssh") {
     return {run::kExitInvalid, "failed",
             "--backend " + options.backend +
-                ": only the 'local' backend is available in this version (ssh and mpirun are "
-                "not implemented yet)"};
+                ": not available in this version (use local or ssh; mpirun is not implemented yet)"};
   }
   Launcher launcher(application, options);
   return launcher.run();

@@ -16,12 +16,16 @@ struct HostEntry {
   std::string address;   ///< overrides the file's address (where the daemon binds)
   std::string user;      ///< ssh only
   int sshPort = 22;      ///< ssh only
+  std::string identity;  ///< ssh only: private key file (ssh -i)
+  std::vector<std::string> sshOptions;   ///< ssh only: -o KEY=VALUE
+  std::string directory; ///< ssh only: working folder there (default: the launcher's)
+  std::string daemon;    ///< ssh only: vrflow-daemon there (default: the one beside `vrflow`)
   std::vector<std::string> environment;  ///< NAME=VALUE given to the daemon and its modules
   int line = 0;
 };
 
-/// Reads a hostfile (docs/launcher.md): `HOST [address=A] [user=U] [ssh-port=P] [env=NAME=VALUE]...`
-/// per line, `#` comments. Errors name FILE:LINE.
+/// Reads a hostfile: `HOST [address=A] [user=U] [ssh-port=P] [identity=FILE] [ssh-option=K=V]...
+/// [dir=PATH] [daemon=PATH] [env=NAME=VALUE]...` per line, `#` comments. Errors name FILE:LINE.
 Result<std::vector<HostEntry>> readHostfile(const std::string& path,
                                             const app::Application& application);
 
