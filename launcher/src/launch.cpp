@@ -1,4 +1,7 @@
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -50,6 +53,7 @@ struct HostDaemon {
   std::string buffer;
   int port = -1;
   bool viaSsh = false;
+  bool viaMpirun = false;
   bool connected = false, finished = false, exited = false;
   int finishedCode = 0;
   std::string finishedStatus, finishedError, report, exitText, trace;
@@ -63,7 +67,8 @@ struct HostDaemon {
     [[maybe_unused]] auto n = write(toDaemon, text.data(), text.size());
   }
   std::string name() const {
-    return "daemon of host '" + host + "' (" + bind + (viaSsh ? ", ssh pid " : ", pid ") +
+    return "daemon of host '" + host + "' (" + bind +
+           (viaSsh ? ", ssh pid " : viaMpirun ? ", mpirun pid " : ", pid ") +
            std::to_string(pid) + ")";
   }
 };
@@ -83,7 +88,7 @@ std::string shellQuote(const std::string& word) {
 
 Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
                           const std::vector<std::string>& environment, int& toChild,
-                          int& fromChild) {
+                          int& fromChild, bool stdoutToStderr = false) {
   int in[2], out[2];
   if (pipe2(in, O_CLOEXEC) != 0 || pipe2(out, O_CLOEXEC) != 0) {
     return makeError(std::string("pipe: ") + std::strerror(errno));
@@ -100,6 +105,7 @@ Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
     sigprocmask(SIG_SETMASK, &none, nullptr);
     dup2(in[0], STDIN_FILENO);
     dup2(out[1], STDOUT_FILENO);
+    if (stdoutToStderr) dup2(STDERR_FILENO, STDOUT_FILENO);
     for (const auto& e : environment) putenv(const_cast<char*>(e.c_str()));
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
@@ -129,6 +135,7 @@ class Launcher {
 
  private:
   Status start();
+  Status startMpirun(const std::string& daemonPath, const net::Secret& secret);
   void pump(int timeoutMs);
   void onLine(HostDaemon& d, const std::string& line);
   void failWith(run::RunOutcome outcome, bool rootCause);
@@ -228,6 +235,11 @@ void Launcher::pump(int timeoutMs) {
       if (n == 0) {
         close(d.fromDaemon);
         d.fromDaemon = -1;
+        // Under mpirun every daemon has the same process (mpirun): the control channel's end
+        // is what names the host that died.
+        if (d.viaMpirun && !d.finished) {
+          failWith({run::kExitRunFailed, "failed", d.name() + " closed its control channel: it died"}, true);
+        }
       }
       break;
     }
@@ -268,6 +280,115 @@ void Launcher::pump(int timeoutMs) {
   }
 }
 
+// mpirun: one process starts every daemon (rank i serves host i); each connects back to a
+// control socket here and proves it holds the run secret, handed over in mpirun's environment.
+Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& secret) {
+  const int listenFd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  if (inet_pton(AF_INET, options_.controlAddress.c_str(), &addr.sin_addr) != 1 ||
+      bind(listenFd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 || listen(listenFd, 64) != 0) {
+    close(listenFd);
+    return makeError("cannot listen for the daemons on " + options_.controlAddress + ": " +
+                     std::strerror(errno));
+  }
+  socklen_t len = sizeof addr;
+  getsockname(listenFd, reinterpret_cast<sockaddr*>(&addr), &len);
+  const std::string control = options_.controlAddress + ":" + std::to_string(ntohs(addr.sin_port));
+  const std::size_t n = application_.hosts.size();
+  bool loopback = true;
+  std::string hostList;
+  for (const auto& h : application_.hosts) {
+    loopback = loopback && h.address.rfind("127.", 0) == 0;
+    hostList += (hostList.empty() ? "" : ",") + h.address;
+  }
+  std::error_code ec;
+  std::vector<std::string> argv{"mpirun", "-np", std::to_string(n), "-x", "VRFLOW_RUN_SECRET"};
+  for (const char* name : {"VRFLOW_PACKAGE_PATH", "VRFLOW_COMPOSITE_PATH", "VRFLOW_FILTER_PATH"}) {
+    if (std::getenv(name) != nullptr) argv.insert(argv.end(), {"-x", name});
+  }
+  // Rank i runs on host i: all on this machine when every host is a loopback address.
+  argv.insert(argv.end(), {"--host", loopback ? "localhost:" + std::to_string(n) : hostList});
+  argv.insert(argv.end(), {daemonPath, std::filesystem::absolute(options_.appFile, ec).string(),
+                           "--control-connect", control});
+  if (!options_.tracePath.empty()) argv.push_back("--trace");
+  char timeout[32];
+  std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
+  argv.insert(argv.end(), {"--peer-timeout", timeout});
+  if (options_.iterations > 0) argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
+  for (const auto& p : options_.packageDirs) {
+    argv.insert(argv.end(), {"--packages", std::filesystem::absolute(p, ec).string()});
+  }
+  for (const auto& c : options_.compositeDirs) {
+    argv.insert(argv.end(), {"--composites", std::filesystem::absolute(c, ec).string()});
+  }
+  int toMpirun = -1, fromMpirun = -1;
+  auto pid = spawnDaemon(argv, {"VRFLOW_RUN_SECRET=" + net::secretToHex(secret)}, toMpirun,
+                         fromMpirun, /*stdoutToStderr=*/true);
+  if (!pid) {
+    close(listenFd);
+    return makeError("mpirun: " + pid.error().message);
+  }
+  close(toMpirun);
+  close(fromMpirun);
+  for (std::size_t i = 0; i < n; ++i) {
+    HostDaemon d;
+    d.index = static_cast<int>(i);
+    d.host = application_.hosts[i].id;
+    d.bind = application_.hosts[i].address;
+    d.pid = *pid;
+    d.viaMpirun = true;
+    daemons_.push_back(std::move(d));
+  }
+  const auto begin = Clock::now();
+  std::size_t linked = 0;
+  while (linked < n && !failure_) {
+    if (secondsSince(begin) > options_.startSeconds) {
+      close(listenFd);
+      return makeError("not every daemon started by mpirun reached the launcher within " +
+                       std::to_string(static_cast<int>(options_.startSeconds)) + " s");
+    }
+    pollfd p{listenFd, POLLIN, 0};
+    if (poll(&p, 1, 50) == 1) {
+      const int fd = accept4(listenFd, nullptr, nullptr, SOCK_CLOEXEC);
+      if (fd < 0) continue;
+      const std::string nonce = net::newNonceHex();
+      const std::string hello = "nonce " + nonce + "\n";
+      [[maybe_unused]] auto w = write(fd, hello.data(), hello.size());
+      // Its answer, "hello INDEX PROOF", within 5 s.
+      std::string line;
+      const auto until = Clock::now() + std::chrono::seconds(5);
+      char c = 0;
+      while (Clock::now() < until && line.size() < 512) {
+        pollfd q{fd, POLLIN, 0};
+        if (poll(&q, 1, 100) != 1) continue;
+        if (read(fd, &c, 1) != 1 || c == '\n') break;
+        line += c;
+      }
+      std::istringstream words(line);
+      std::string word, proof;
+      int index = -1;
+      words >> word >> index >> proof;
+      if (word != "hello" || index < 0 || static_cast<std::size_t>(index) >= n ||
+          daemons_[static_cast<std::size_t>(index)].toDaemon >= 0 ||
+          proof != net::controlProof(secret, index, nonce)) {
+        std::fprintf(stderr, "vrflow: refused a control connection that did not prove the run secret\n");
+        close(fd);
+        continue;
+      }
+      HostDaemon& d = daemons_[static_cast<std::size_t>(index)];
+      d.toDaemon = fd;
+      d.fromDaemon = dup(fd);
+      fcntl(d.fromDaemon, F_SETFL, fcntl(d.fromDaemon, F_GETFL) | O_NONBLOCK);
+      ++linked;
+    }
+    pump(0);
+  }
+  close(listenFd);
+  if (failure_) return makeError(failure_->error);
+  return {};
+}
+
 Status Launcher::start() {
   std::error_code ec;
   const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
@@ -283,7 +404,10 @@ Status Launcher::start() {
     entries = *read;
   }
   const net::Secret secret = net::newSecret();
-  for (std::size_t i = 0; i < application_.hosts.size(); ++i) {
+  if (options_.backend == "mpirun") {
+    if (auto status = startMpirun(daemonPath, secret); !status) return status;
+  }
+  for (std::size_t i = 0; i < application_.hosts.size() && options_.backend != "mpirun"; ++i) {
     const app::Host& host = application_.hosts[i];
     HostDaemon d;
     d.index = static_cast<int>(i);
@@ -508,10 +632,8 @@ run::RunOutcome Launcher::run() {
 }  // namespace
 
 run::RunOutcome launch(const app::Application& application, const LaunchOptions& options) {
-  if (options.backend != "local" && options.backend != "ssh") {
-    return {run::kExitInvalid, "failed",
-            "--backend " + options.backend +
-                ": not available in this version (use local or ssh; mpirun is not implemented yet)"};
+  if (options.backend != "local" && options.backend != "ssh" && options.backend != "mpirun") {
+    return {run::kExitInvalid, "failed", "--backend " + options.backend + ": unknown backend"};
   }
   Launcher launcher(application, options);
   return launcher.run();

@@ -1,6 +1,11 @@
 #include "control_link.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
+
+#include <cstring>
 
 #include <chrono>
 #include <cstdio>
@@ -40,15 +45,20 @@ Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application&
                                                          const std::string& host,
                                                          const std::string& bindAddress,
                                                          double peerTimeoutSeconds, int in,
-                                                         int out) {
+                                                         int out, std::optional<net::Secret> given) {
   std::unique_ptr<ControlLink> link(new ControlLink(in, out));
-  std::string line;
-  if (!readLine(in, line) || line.rfind("secret ", 0) != 0) {
-    return makeError("--control: the first line on stdin must be the run secret");
+  Result<net::Secret> secret = net::Secret{};
+  if (given) {
+    secret = *given;
+  } else {
+    std::string line;
+    if (!readLine(in, line) || line.rfind("secret ", 0) != 0) {
+      return makeError("--control: the first line on stdin must be the run secret");
+    }
+    secret = net::secretFromHex(line.substr(7));
+    std::fill(line.begin(), line.end(), '\0');
+    if (!secret) return secret.error();
   }
-  auto secret = net::secretFromHex(line.substr(7));
-  std::fill(line.begin(), line.end(), '\0');
-  if (!secret) return secret.error();
   link->selfIndex_ = hostIndex(application, host);
   if (link->selfIndex_ < 0) return makeError("no host '" + host + "' in the application");
   const app::Host& self = application.hosts[static_cast<std::size_t>(link->selfIndex_)];
@@ -94,6 +104,36 @@ Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application&
   link->send("listening " + std::to_string(link->transport_->port()));
   link->reader_ = std::thread([raw = link.get()] { raw->readLoop(); });
   return link;
+}
+
+Result<int> ControlLink::connectBack(const std::string& address, const net::Secret& secret,
+                                     int hostIndex) {
+  const auto colon = address.rfind(':');
+  if (colon == std::string::npos) return makeError("--control-connect needs ADDRESS:PORT");
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(std::atoi(address.c_str() + colon + 1)));
+  if (inet_pton(AF_INET, address.substr(0, colon).c_str(), &addr.sin_addr) != 1) {
+    return makeError("--control-connect: '" + address + "' is not IPv4:PORT");
+  }
+  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0 || connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    const int err = errno;
+    if (fd >= 0) close(fd);
+    return makeError("cannot reach the launcher at " + address + ": " + std::strerror(err));
+  }
+  std::string line;
+  if (!readLine(fd, line) || line.rfind("nonce ", 0) != 0) {
+    close(fd);
+    return makeError("the launcher at " + address + " did not send its nonce");
+  }
+  const std::string hello =
+      "hello " + std::to_string(hostIndex) + " " + net::controlProof(secret, hostIndex, line.substr(6)) + "\n";
+  if (write(fd, hello.data(), hello.size()) != static_cast<ssize_t>(hello.size())) {
+    close(fd);
+    return makeError("the launcher at " + address + " closed the control channel");
+  }
+  return fd;
 }
 
 ControlLink::~ControlLink() {

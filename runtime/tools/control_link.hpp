@@ -4,6 +4,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -20,10 +21,15 @@ class ControlLink final : public run::HostLink {
  public:
   /// Reads the run secret (first line of `in`), binds the transport and tells the launcher its
   /// port. `bindAddress` empty: the host's address in the file.
+  /// `secret`: already known (mpirun: from the environment), else read from `in`.
   static Result<std::unique_ptr<ControlLink>> create(const app::Application& application,
                                                      const std::string& host,
                                                      const std::string& bindAddress,
-                                                     double peerTimeoutSeconds, int in, int out);
+                                                     double peerTimeoutSeconds, int in, int out,
+                                                     std::optional<net::Secret> secret = {});
+  /// mpirun: the daemon connects back to the launcher at `address` (HOST:PORT), proves it holds
+  /// the run secret, and returns the socket (the control channel both ways).
+  static Result<int> connectBack(const std::string& address, const net::Secret& secret, int hostIndex);
   ~ControlLink() override;
 
   void configure(daemon::DaemonOptions& options) override;

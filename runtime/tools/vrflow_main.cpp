@@ -100,12 +100,14 @@ int main(int argc, char** argv) {
   vrflow::launcher::LaunchOptions launchOptions;
   launch->add_option("APP.xml", launchOptions.appFile, "Application file")->required();
   launch->add_option("--hosts", launchOptions.hostfile, "Hostfile: where each host runs (docs/launcher.md)");
-  launch->add_option("--backend", launchOptions.backend, "How daemons are started: local")
+  launch->add_option("--backend", launchOptions.backend, "How daemons are started: local, ssh, mpirun")
       ->check(CLI::IsMember({"local", "ssh", "mpirun"}));
   launch->add_option("--iterations,-n", launchOptions.iterations, "Stop after N iterations of every module");
   launch->add_option("--report", launchOptions.reportPath, "Write a JSON run report to FILE");
   launch->add_option("--timeout", launchOptions.timeoutSeconds, "Fail if the run lasts longer (seconds)")
       ->check(CLI::NonNegativeNumber);
+  launch->add_option("--control-address", launchOptions.controlAddress,
+                     "mpirun: this machine's address as the daemons reach it (default 127.0.0.1)");
   launch->add_option("--trace", launchOptions.tracePath,
                      "Write a Chrome/Perfetto trace of every host, clocks aligned");
   launch->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,

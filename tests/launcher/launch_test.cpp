@@ -64,7 +64,16 @@ pid_t findDescendant(pid_t root, const std::string& needle) {
     for (pid_t p = parentOf(pid), hops = 0; p > 1 && hops < 8; p = parentOf(p), ++hops) {
       if (p == root) below = true;
     }
-    if (below && cmdline(pid).find(needle) != std::string::npos) found = pid;
+    if (!below) continue;
+    if (needle.rfind("comm:", 0) == 0) {
+      // By process name: mpirun's command line names the daemon too.
+      std::ifstream comm("/proc/" + std::to_string(pid) + "/comm");
+      std::string name;
+      std::getline(comm, name);
+      if (name == needle.substr(5)) found = pid;
+    } else if (cmdline(pid).find(needle) != std::string::npos) {
+      found = pid;
+    }
   }
   closedir(dir);
   return found;
@@ -77,7 +86,8 @@ struct Launched {
 
 // Runs `vrflow launch ... -n 0` (endless), kills -9 the process matching `victim` once it runs,
 // and returns how the launcher ended (killed after 60 s if it never does).
-Launched launchAndKill(const std::string& victim, const std::string& report) {
+Launched launchAndKill(const std::string& victim, const std::string& report,
+                       const std::vector<std::string>& extra = {}) {
   TempDir dir;
   const std::string errFile = dir.file("err.txt");
   const pid_t pid = fork();
@@ -86,9 +96,12 @@ Launched launchAndKill(const std::string& victim, const std::string& report) {
     dup2(fd, 2);
     const int null = open("/dev/null", O_WRONLY);
     dup2(null, 1);
-    const std::string vrflow = binDir() + "/vrflow";
-    execl(vrflow.c_str(), vrflow.c_str(), "launch", threeHostsFile().c_str(), "--report",
-          report.c_str(), static_cast<char*>(nullptr));
+    std::vector<std::string> args{binDir() + "/vrflow", "launch", threeHostsFile(), "--report", report};
+    args.insert(args.end(), extra.begin(), extra.end());
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
     _exit(127);
   }
   pid_t target = -1;
@@ -215,6 +228,40 @@ TEST(Launch, MonitorShowsEveryModuleHostConnectionAndLinkOfARunningLaunch) {
     EXPECT_NE(seen.find(text), std::string::npos) << text << " not in:\n" << seen;
   }
   EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+// mpirun refuses root unless told; the tests may run as root in a container.
+bool mpirunUsable() {
+  setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+  setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+  return runCommand({"/bin/sh", "-c", "command -v mpirun"}, 10).exitCode == 0;
+}
+
+TEST(LaunchMpirun, ThreeHostsThroughMpirunGiveTheSameDigestsAsOneHost) {
+  if (!mpirunUsable()) GTEST_SKIP() << "mpirun is not installed";
+  TempDir dir;
+  const auto one = runVrflow({"run", pipelineFile(), "-n", "100", "--no-progress", "--report",
+                              dir.file("one.json")},
+                             120);
+  ASSERT_EQ(one.exitCode, 0) << one.err;
+  const auto three = runVrflow({"launch", threeHostsFile(), "--backend", "mpirun", "-n", "100",
+                                "--report", dir.file("three.json")},
+                               120);
+  ASSERT_EQ(three.exitCode, 0) << three.err;
+  EXPECT_EQ(deterministicPart(dir.file("one.json")), deterministicPart(dir.file("three.json")));
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+TEST(LaunchMpirun, KillingADaemonStopsEveryHostAndNamesItsHost) {
+  if (!mpirunUsable()) GTEST_SKIP() << "mpirun is not installed";
+  TempDir dir;
+  const auto result = launchAndKill("comm:vrflow-daemon", dir.file("r.json"), {"--backend", "mpirun"});
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("closed its control channel"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("mpirun pid"), std::string::npos) << result.err;
+  for (const auto& left : leftoverProcesses()) {
+    EXPECT_NE(left.find("(reaped)"), std::string::npos) << "still running: " << left;
+  }
 }
 
 TEST(Launch, AHostfileMistakeNamesTheFileAndLine) {

@@ -147,6 +147,23 @@ Result<Secret> secretFromHex(const std::string& text) {
   return secret;
 }
 
+std::string controlProof(const Secret& secret, int hostIndex, const std::string& nonce) {
+  crypto_auth_hmacsha256_state state;
+  crypto_auth_hmacsha256_init(&state, secret.data(), secret.size());
+  const char label[] = "vrflow-control";
+  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(label), sizeof label);
+  std::byte index[4];
+  put32(index, static_cast<uint32_t>(hostIndex));
+  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(index), sizeof index);
+  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonce.data()),
+                                nonce.size());
+  Secret mac{};
+  crypto_auth_hmacsha256_final(&state, mac.data());
+  return secretToHex(mac);
+}
+
+std::string newNonceHex() { return secretToHex(newSecret()); }
+
 namespace {
 
 // One frame waiting to be written: its header (and a control payload), then a message's bytes.

@@ -37,6 +37,7 @@ struct LaunchOptions {
   uint64_t iterations = 0;
   std::string reportPath;
   std::string tracePath;          ///< Chrome trace of every host; empty = none
+  std::string controlAddress = "127.0.0.1";  ///< mpirun: where daemons reach the launcher
   double timeoutSeconds = 0;
   double peerTimeoutSeconds = 3;  ///< heartbeat timeout between daemons
   double startSeconds = 30;       ///< every daemon must be linked within this

@@ -31,6 +31,12 @@ std::string secretToHex(const Secret& secret);
 /// Parses secretToHex()'s form; an error for anything else.
 Result<Secret> secretFromHex(const std::string& text);
 
+/// What a daemon started through mpirun proves to the launcher when it connects back:
+/// hex HMAC-SHA256(secret, "vrflow-control\0" | u32 host index | nonce text).
+std::string controlProof(const Secret& secret, int hostIndex, const std::string& nonce);
+/// A fresh random nonce, as 64 hex digits.
+std::string newNonceHex();
+
 /// Where another host's daemon listens.
 struct PeerAddress {
   int index = -1;  ///< the host's position in the application file
