@@ -157,9 +157,11 @@ class Launcher {
   bool failureIsRoot_ = false;
   Clock::time_point failureAt_;
   bool interrupted_ = false;
+  bool stopping_ = false;
 };
 
 void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
+  if (stopping_) return;  // what dies while we stop everything is our doing, not a cause
   // A daemon's own death or a module's failure names the cause better than a peer's
   // "lost the link": keep the first root cause.
   if (failure_ && (failureIsRoot_ || !rootCause)) return;
@@ -531,6 +533,7 @@ void Launcher::publish() {
 }
 
 void Launcher::stopAll() {
+  stopping_ = true;
   for (const auto& d : daemons_) {
     if (!d.exited) d.send("stop");
   }

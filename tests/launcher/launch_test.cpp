@@ -87,7 +87,7 @@ struct Launched {
 // Runs `vrflow launch ... -n 0` (endless), kills -9 the process matching `victim` once it runs,
 // and returns how the launcher ended (killed after 60 s if it never does).
 Launched launchAndKill(const std::string& victim, const std::string& report,
-                       const std::vector<std::string>& extra = {}) {
+                       const std::vector<std::string>& extra = {}, int signal = SIGKILL) {
   TempDir dir;
   const std::string errFile = dir.file("err.txt");
   const pid_t pid = fork();
@@ -111,7 +111,7 @@ Launched launchAndKill(const std::string& victim, const std::string& report,
   }
   EXPECT_GT(target, 0) << "no process matching '" << victim << "'";
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the run get going
-  if (target > 0) kill(target, SIGKILL);
+  if (target > 0) kill(target, signal);
   Launched result;
   int status = 0;
   for (int i = 0; i < 600; ++i) {
@@ -169,6 +169,18 @@ TEST(Launch, KillingAModuleStopsEveryHostAndNamesItsHost) {
   EXPECT_NE(result.err.find("module 'gravity' (host c"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("signal 9"), std::string::npos) << result.err;
   EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+TEST(Launch, AFrozenDaemonIsDeclaredLostByHeartbeatTimeoutAndEverythingStops) {
+  // SIGSTOP: the daemon's sockets stay open but nothing comes out, as when a network is cut.
+  TempDir dir;
+  const auto result = launchAndKill("--host b", dir.file("r.json"), {"--peer-timeout", "1"}, SIGSTOP);
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("lost the link to host 'b'"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("heartbeat timeout"), std::string::npos) << result.err;
+  for (const auto& left : leftoverProcesses()) {
+    EXPECT_NE(left.find("(reaped)"), std::string::npos) << "still running: " << left;
+  }
 }
 
 TEST(Launch, TraceHoldsSpansOfEveryModuleAndFlowsAcrossHosts) {
