@@ -638,6 +638,16 @@ run::RunOutcome launch(const app::Application& application, const LaunchOptions&
   if (options.backend != "local" && options.backend != "ssh" && options.backend != "mpirun") {
     return {run::kExitInvalid, "failed", "--backend " + options.backend + ": unknown backend"};
   }
+  // Mistakes in what the user gave (exit 2, as an invalid application) before anything starts.
+  if (options.backend == "ssh" && options.hostfile.empty()) {
+    return {run::kExitInvalid, "failed",
+            "--backend ssh needs --hosts HOSTFILE (where each host is and how to log in)"};
+  }
+  if (!options.hostfile.empty()) {
+    if (auto read = readHostfile(options.hostfile, application); !read) {
+      return {run::kExitInvalid, "failed", read.error().message};
+    }
+  }
   Launcher launcher(application, options);
   return launcher.run();
 }

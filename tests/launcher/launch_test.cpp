@@ -280,7 +280,7 @@ TEST(Launch, AHostfileMistakeNamesTheFileAndLine) {
   TempDir dir;
   const auto hosts = dir.write("hosts", "a address=127.0.0.1\n# comment\nnowhere address=1.2.3.4\n");
   const auto result = runVrflow({"launch", threeHostsFile(), "--hosts", hosts, "-n", "5"}, 60);
-  EXPECT_EQ(result.exitCode, 1);
+  EXPECT_EQ(result.exitCode, 2);
   EXPECT_NE(result.err.find(hosts + ":3: error: no host 'nowhere'"), std::string::npos) << result.err;
   EXPECT_TRUE(leftoverProcesses().empty());
 }
