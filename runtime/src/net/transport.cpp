@@ -312,7 +312,10 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
           return makeError("host '" + hostName(static_cast<int>(from)) + "' is already linked");
         }
       }
-      link.peer = static_cast<int>(from);
+      {
+        std::lock_guard lock(mutex);  // linkStats() reads it
+        link.peer = static_cast<int>(from);
+      }
       std::memcpy(link.nonceC.data(), payload.data() + 16, kNonceBytes);
       randombytes_buf(link.nonceL.data(), kNonceBytes);
       const auto mac = proof(options.secret, "vrflow-listener", from, to, link.nonceC.data(),
@@ -410,10 +413,12 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       link.stats.clockOffsetNs = peerClock - static_cast<int64_t>(nowNs());
       return {};
     }
-    case FrameType::Bye:
+    case FrameType::Bye: {
+      std::lock_guard lock(mutex);  // finish() waits on it
       link.byeReceived = true;
       changed.notify_all();
       return {};
+    }
   }
   return makeError("unknown frame");
 }
