@@ -22,6 +22,7 @@ vrflow_add_library(runtime
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
     src/net/frame.cpp
+    src/net/secret.cpp
     src/net/transport.cpp
     src/run/spawn.cpp
     src/run/report.cpp

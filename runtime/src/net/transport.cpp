@@ -26,6 +26,7 @@
 #include "daemon/graph.hpp"
 #include "vrflow/ipc/segment.hpp"
 #include "vrflow/message/reader.hpp"
+#include "handshake.hpp"
 
 namespace vrflow::net {
 namespace {
@@ -60,30 +61,6 @@ uint64_t get64(const std::byte* in) {
   return v;
 }
 
-// HMAC-SHA256(secret, label | connector | listener | connector nonce | listener nonce).
-std::array<std::byte, kMacBytes> proof(const Secret& secret, const char* label, uint32_t connector,
-                                       uint32_t listener, const std::byte* nonceC,
-                                       const std::byte* nonceL) {
-  crypto_auth_hmacsha256_state state;
-  crypto_auth_hmacsha256_init(&state, secret.data(), secret.size());
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(label),
-                                std::strlen(label) + 1);
-  std::byte ids[8];
-  put32(ids, connector);
-  put32(ids + 4, listener);
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(ids), sizeof ids);
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonceC), kNonceBytes);
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonceL), kNonceBytes);
-  std::array<std::byte, kMacBytes> mac{};
-  crypto_auth_hmacsha256_final(&state, reinterpret_cast<unsigned char*>(mac.data()));
-  return mac;
-}
-
-bool sameMac(const std::byte* a, const std::byte* b) {
-  return crypto_verify_32(reinterpret_cast<const unsigned char*>(a),
-                          reinterpret_cast<const unsigned char*>(b)) == 0;
-}
-
 std::string peerName(int fd) {
   sockaddr_in addr{};
   socklen_t len = sizeof addr;
@@ -113,56 +90,6 @@ Result<sockaddr_in> resolve(const std::string& address, uint16_t port) {
 }
 
 }  // namespace
-
-Secret newSecret() {
-  if (sodium_init() < 0) std::abort();
-  Secret secret{};
-  randombytes_buf(secret.data(), secret.size());
-  return secret;
-}
-
-std::string secretToHex(const Secret& secret) {
-  static const char* digits = "0123456789abcdef";
-  std::string text;
-  for (const uint8_t b : secret) {
-    text += digits[b >> 4];
-    text += digits[b & 15];
-  }
-  return text;
-}
-
-Result<Secret> secretFromHex(const std::string& text) {
-  Secret secret{};
-  if (text.size() != 2 * secret.size()) return makeError("the run secret must be 64 hex digits");
-  auto digit = [](char c) -> int {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    return -1;
-  };
-  for (std::size_t i = 0; i < secret.size(); ++i) {
-    const int hi = digit(text[2 * i]), lo = digit(text[2 * i + 1]);
-    if (hi < 0 || lo < 0) return makeError("the run secret must be 64 hex digits");
-    secret[i] = static_cast<uint8_t>(hi * 16 + lo);
-  }
-  return secret;
-}
-
-std::string controlProof(const Secret& secret, int hostIndex, const std::string& nonce) {
-  crypto_auth_hmacsha256_state state;
-  crypto_auth_hmacsha256_init(&state, secret.data(), secret.size());
-  const char label[] = "vrflow-control";
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(label), sizeof label);
-  std::byte index[4];
-  put32(index, static_cast<uint32_t>(hostIndex));
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(index), sizeof index);
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonce.data()),
-                                nonce.size());
-  Secret mac{};
-  crypto_auth_hmacsha256_final(&state, mac.data());
-  return secretToHex(mac);
-}
-
-std::string newNonceHex() { return secretToHex(newSecret()); }
 
 namespace {
 
@@ -318,7 +245,7 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       }
       std::memcpy(link.nonceC.data(), payload.data() + 16, kNonceBytes);
       randombytes_buf(link.nonceL.data(), kNonceBytes);
-      const auto mac = proof(options.secret, "vrflow-listener", from, to, link.nonceC.data(),
+      const auto mac = detail::proof(options.secret, "vrflow-listener", from, to, link.nonceC.data(),
                              link.nonceL.data());
       std::byte reply[kNonceBytes + kMacBytes];
       std::memcpy(reply, link.nonceL.data(), kNonceBytes);
@@ -332,12 +259,12 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       std::memcpy(link.nonceL.data(), payload.data(), kNonceBytes);
       const auto self = static_cast<uint32_t>(options.selfIndex);
       const auto peer = static_cast<uint32_t>(link.peer);
-      const auto expected = proof(options.secret, "vrflow-listener", self, peer,
+      const auto expected = detail::proof(options.secret, "vrflow-listener", self, peer,
                                   link.nonceC.data(), link.nonceL.data());
-      if (!sameMac(expected.data(), payload.data() + kNonceBytes)) {
+      if (!detail::sameMac(expected.data(), payload.data() + kNonceBytes)) {
         return makeError("the peer failed the challenge-response (it does not hold this run's secret)");
       }
-      const auto mac = proof(options.secret, "vrflow-connector", self, peer, link.nonceC.data(),
+      const auto mac = detail::proof(options.secret, "vrflow-connector", self, peer, link.nonceC.data(),
                              link.nonceL.data());
       std::lock_guard lock(mutex);
       queueControl(link, FrameType::Auth, 0, reinterpret_cast<const std::byte*>(mac.data()),
@@ -351,9 +278,9 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
     case FrameType::Auth: {
       if (link.connector || link.peer < 0) return makeError("unexpected auth");
       const auto expected =
-          proof(options.secret, "vrflow-connector", static_cast<uint32_t>(link.peer),
+          detail::proof(options.secret, "vrflow-connector", static_cast<uint32_t>(link.peer),
                 static_cast<uint32_t>(options.selfIndex), link.nonceC.data(), link.nonceL.data());
-      if (!sameMac(expected.data(), payload.data())) {
+      if (!detail::sameMac(expected.data(), payload.data())) {
         return makeError("the peer failed the challenge-response (it does not hold this run's secret)");
       }
       std::lock_guard lock(mutex);
