@@ -192,7 +192,10 @@ Status ControlLink::ready() {
   while (true) {
     const std::string line = next(-1);
     if (line == "connect") break;
-    if (line == "eof" || line == "stop") return makeError("stopped by the launcher before the start");
+    if (line == "eof" || line == "stop") {
+      stopped_ = true;
+      return makeError("stopped by the launcher before the start");
+    }
     std::istringstream words(line);
     std::string word;
     net::PeerAddress peer;
@@ -216,6 +219,7 @@ Status ControlLink::ready() {
       send(line + " " + std::to_string(now));
       continue;
     }
+    stopped_ = true;  // "stop" or the end of input
     return makeError("stopped by the launcher before the start");
   }
 }

@@ -276,6 +276,17 @@ TEST(LaunchMpirun, KillingADaemonStopsEveryHostAndNamesItsHost) {
   }
 }
 
+TEST(Launch, ADaemonThatCannotBindItsAddressIsNamedAndNothingIsLeft) {
+  TempDir dir;
+  // 192.0.2.1 (TEST-NET-1) is no address of this machine: host b's daemon cannot bind it.
+  const auto hosts = dir.write("hosts", "b address=192.0.2.1\n");
+  const auto result = runVrflow({"launch", threeHostsFile(), "--hosts", hosts, "-n", "5"}, 60);
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("host 'b': cannot bind 192.0.2.1:0"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("daemon of host 'b' (192.0.2.1"), std::string::npos) << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
 TEST(Launch, AHostfileMistakeNamesTheFileAndLine) {
   TempDir dir;
   const auto hosts = dir.write("hosts", "a address=127.0.0.1\n# comment\nnowhere address=1.2.3.4\n");

@@ -12,6 +12,8 @@
 
 #include "daemon/graph.hpp"
 #include "vrflow/ipc/segment.hpp"
+#include "vrflow/message/builder.hpp"
+#include "vrflow/message/byte_sink.hpp"
 #include "vrflow/message/empty_message.hpp"
 #include "vrflow/net/transport.hpp"
 
@@ -114,6 +116,68 @@ TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
   received.messages.clear();
   (*a)->finish(2);
   (*b)->finish(2);
+  (*a)->stop();
+  (*b)->stop();
+}
+
+TEST(Transport, LargeMessagesArriveIntactAndInOrderUnderCreditFlowControl) {
+  const Secret secret = newSecret();
+  auto a = Transport::listen(optionsFor(0, secret));
+  auto b = Transport::listen(optionsFor(1, secret));
+  ASSERT_TRUE(a.ok() && b.ok());
+  auto segA = ipc::Segment::create(std::size_t{256} << 20, 0x7f000001);
+  auto segB = ipc::Segment::create(std::size_t{256} << 20, 0x7f000002);
+  ASSERT_TRUE(segA.ok() && segB.ok());
+  (*a)->attachSegment(*segA);
+  (*b)->attachSegment(*segB);
+  (*a)->addConnection(channel0(true));  // capacity 4: the sender must wait for credits
+  (*b)->addConnection(channel0(false));
+  const std::vector<PeerAddress> peers{{0, "127.0.0.1", (*a)->port()}, {1, "127.0.0.2", (*b)->port()}};
+  auto linkB = std::async(std::launch::async, [&] { return (*b)->connectPeers(peers); });
+  ASSERT_TRUE((*a)->connectPeers(peers).ok());
+  ASSERT_TRUE(linkB.get().ok());
+
+  // 12 messages of 6 MiB, each with its own fill byte: far more than the socket buffers hold.
+  constexpr int kCount = 12;
+  constexpr std::size_t kBytes = 6u << 20;
+  auto sink = (*a)->makeSink(0);
+  Collect received;
+  bool closed = false;
+  int sent = 0;
+  for (int round = 0; round < 20000 && !closed; ++round) {
+    while (sent < kCount && sink->hasSpace()) {
+      std::vector<std::byte> fill(kBytes, static_cast<std::byte>(sent + 1));
+      msg::VectorSink bytes(kBytes + 1024);
+      msg::MessageBuilder builder(bytes);
+      builder.setIteration(static_cast<uint64_t>(sent));
+      builder.addRawResource(1, true, fill);
+      const std::size_t used = builder.finish();
+      ASSERT_GT(used, kBytes);
+      const uint64_t handle = segA->allocate(used);
+      ASSERT_NE(handle, 0u);
+      std::memcpy(segA->payload(handle), bytes.buffer().data(), used);
+      segA->block(handle).used = used;
+      sink->push(daemon::MessageRef(&*segA, handle));
+      if (++sent == kCount) sink->close();
+    }
+    (*b)->receive(0, received, closed);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(closed);
+  ASSERT_EQ(received.messages.size(), static_cast<std::size_t>(kCount));
+  for (int i = 0; i < kCount; ++i) {
+    auto view = received.messages[static_cast<std::size_t>(i)].view();
+    ASSERT_TRUE(view.ok()) << view.error().message;
+    EXPECT_EQ(view->stamps().iteration, static_cast<uint64_t>(i));
+    const auto raw = received.messages[static_cast<std::size_t>(i)].bytes();
+    // The payload's last byte carries the message's fill.
+    EXPECT_EQ(raw[raw.size() - 1], static_cast<std::byte>(i + 1));
+  }
+  received.messages.clear();
+  EXPECT_EQ((*b)->fatalError(), "");
+  auto stopA = std::async(std::launch::async, [&] { (*a)->finish(2); });
+  (*b)->finish(2);
+  stopA.get();
   (*a)->stop();
   (*b)->stop();
 }
