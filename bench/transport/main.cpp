@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -57,8 +58,9 @@ int run(int argc, char** argv) {
   bool quick = false;
   int peerTimeoutS = 30;
   bool mpiRankMode = false;
-  app.add_option("--transport", transport, "Which transport to measure")
-      ->check(CLI::IsMember({"all", "zeromq-ipc", "mpi-shm", "vrflow-shm"}))
+  app.add_option("--transport", transport,
+                 "Which transports to measure: all, or a comma-separated list of zeromq-ipc, "
+                 "mpi-shm, vrflow-shm, zeromq-tcp, raw-tcp, vrflow-tcp")
       ->capture_default_str();
   app.add_option("--sizes", sizesText, "Message sizes, e.g. 64,4K,1M,16M (K, M: KiB, MiB)")
       ->capture_default_str();
@@ -84,13 +86,39 @@ int run(int argc, char** argv) {
     return vrflow::bench::runMpiRank(settings);
   }
 
+  std::vector<std::string> chosen;
+  for (std::size_t start = 0; start <= transport.size();) {
+    const std::size_t comma = std::min(transport.find(',', start), transport.size());
+    chosen.push_back(transport.substr(start, comma - start));
+    start = comma + 1;
+  }
+  for (const auto& name : chosen) {
+    static const std::vector<std::string> known{"all", "zeromq-ipc", "mpi-shm", "vrflow-shm",
+                                                "zeromq-tcp", "raw-tcp", "vrflow-tcp"};
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      std::cerr << "--transport: unknown transport '" << name << "'\n";
+      return 2;
+    }
+  }
   warnIfBusy();
-  const auto selected = [&transport](const char* name) {
-    return transport == "all" || transport == name;
+  const auto selected = [&chosen](const char* name) {
+    return std::find(chosen.begin(), chosen.end(), "all") != chosen.end() ||
+           std::find(chosen.begin(), chosen.end(), name) != chosen.end();
   };
   bool ok = true;
   if (selected("zeromq-ipc")) {
     ok = report(vrflow::bench::runZeromq(settings)) && ok;
+  }
+  // TCP on loopback: the floor (raw-tcp) and a messaging library (zeromq-tcp) beside vrflow
+  // between two daemons (vrflow-tcp). The forking ones run first, while single-threaded.
+  if (selected("zeromq-tcp")) {
+    ok = report(vrflow::bench::runZeromqTcp(settings)) && ok;
+  }
+  if (selected("raw-tcp")) {
+    ok = report(vrflow::bench::runRawTcp(settings)) && ok;
+  }
+  if (selected("vrflow-tcp")) {
+    ok = report(vrflow::bench::runVrflowTcp(settings)) && ok;
   }
   if (selected("mpi-shm")) {
     const std::string self = selfPath();
@@ -107,7 +135,7 @@ int run(int argc, char** argv) {
     if (results && results->empty()) {
       // The hook is still a stub: an explicit request for it fails, "all" only says so.
       std::cerr << "vrflow-shm: not implemented yet (runVrflow returned no results)\n";
-      ok = ok && transport == "all";
+      ok = ok && selected("all");
     }
   }
   return ok ? 0 : 1;

@@ -94,6 +94,15 @@ Result<std::vector<BenchResult>> runMpi(const char* selfPath, const BenchSetting
 /// The body of one MPI rank (the `--mpi-rank-mode` entry point); returns the exit code.
 int runMpiRank(const BenchSettings& settings);
 
+/// ZeroMQ over tcp://127.0.0.1 (TCP_NODELAY is libzmq's default), otherwise as runZeromq.
+Result<std::vector<BenchResult>> runZeromqTcp(const BenchSettings& settings);
+
+/// A plain TCP socket pair on loopback between this process and a forked child.
+Result<std::vector<BenchResult>> runRawTcp(const BenchSettings& settings);
+
+/// vrflow across two daemons on loopback (`vrflow launch --backend local`, hosts 127.0.0.1/.2).
+Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings);
+
 /// HOOK for the vrflow side (vrflow_peer.cpp): vrflow's shared-memory transport through the
 /// per-host daemon, run on the same plan and reported the same way. main treats an empty result
 /// as "not implemented yet".

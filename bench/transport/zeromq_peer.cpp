@@ -11,7 +11,10 @@
 // two copies through the socket, one malloc per received message over 33 bytes (libzmq reads a
 // large body straight into it), and the hand-off between each process's I/O thread and its
 // application thread.
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <unistd.h>
 #include <zmq.h>
 
@@ -35,7 +38,7 @@ namespace vrflow::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr const char* kTransport = "zeromq-ipc";
+const char* kTransport = "zeromq-ipc";  // or zeromq-tcp, set by the entry point
 // Blocking calls wake up this often to check that the peer process is still alive.
 constexpr int kLivenessSliceMs = 200;
 constexpr int kReconnectMs = 10;
@@ -376,9 +379,21 @@ std::string describeSetup(std::size_t bytes) {
          "; zero-copy send (zmq_msg_init_data, constant message), receive into zmq_msg_t";
 }
 
-}  // namespace
+// A free port on 127.0.0.1 for a tcp:// endpoint (found by binding port 0, then released).
+std::string freeTcpAddress() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
+  socklen_t len = sizeof addr;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  close(fd);
+  return "tcp://127.0.0.1:" + std::to_string(ntohs(addr.sin_port));
+}
 
-Result<std::vector<BenchResult>> runZeromq(const BenchSettings& settings) {
+Result<std::vector<BenchResult>> runZeromqOn(const BenchSettings& settings, bool tcp) {
+  kTransport = tcp ? "zeromq-tcp" : "zeromq-ipc";
   if (const int threads = threadCount(); threads != 1) {
     return makeError(std::string(kTransport) + ": runZeromq forks its peer and must be called " +
                      "while the process has one thread (it has " + std::to_string(threads) + ")");
@@ -393,17 +408,30 @@ Result<std::vector<BenchResult>> runZeromq(const BenchSettings& settings) {
     std::vector<unsigned char> payload = makePayload(bytes);
     const IterationPlan plan = iterationPlan(bytes, settings.quick);
     auto roundTrips =
-        measureRoundTrips(payload, plan, dir->address("pingpong"), settings.peerTimeout);
+        measureRoundTrips(payload, plan, tcp ? freeTcpAddress() : dir->address("pingpong"),
+                          settings.peerTimeout);
     if (!roundTrips) {
       return makeError(where + roundTrips.error().message);
     }
-    auto rate = measureStream(payload, plan, dir->address("stream"), settings.peerTimeout);
+    auto rate = measureStream(payload, plan, tcp ? freeTcpAddress() : dir->address("stream"),
+                              settings.peerTimeout);
     if (!rate) {
       return makeError(where + rate.error().message);
     }
-    results.push_back(makeResult(kTransport, bytes, *roundTrips, *rate, describeSetup(bytes)));
+    results.push_back(makeResult(kTransport, bytes, *roundTrips, *rate,
+                                 (tcp ? "tcp://127.0.0.1 (TCP_NODELAY), " : "") + describeSetup(bytes)));
   }
   return results;
+}
+
+}  // namespace
+
+Result<std::vector<BenchResult>> runZeromq(const BenchSettings& settings) {
+  return runZeromqOn(settings, false);
+}
+
+Result<std::vector<BenchResult>> runZeromqTcp(const BenchSettings& settings) {
+  return runZeromqOn(settings, true);
 }
 
 }  // namespace vrflow::bench

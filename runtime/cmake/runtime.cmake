@@ -1,3 +1,5 @@
+pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)
+
 # The runtime proper: shared memory, module API, daemon and filters, the run supervisor.
 vrflow_add_library(runtime
   SOURCES
@@ -21,12 +23,17 @@ vrflow_add_library(runtime
     src/daemon/plugin_loader.cpp
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
+    src/net/frame.cpp
+    src/net/secret.cpp
+    src/net/transport.cpp
     src/run/spawn.cpp
     src/run/report.cpp
+    src/run/trace.cpp
     src/run/runner.cpp
   PUBLIC_DEPS vrflow::message vrflow::app vrflow::base Threads::Threads
-  PRIVATE_DEPS nlohmann_json::nlohmann_json ${CMAKE_DL_LIBS})
+  PRIVATE_DEPS nlohmann_json::nlohmann_json PkgConfig::SODIUM ${CMAKE_DL_LIBS})
 
 # The programs that load filter plugins export the whole runtime (docs/filters.md, "Plugins").
 vrflow_add_plugin_host(vrflow SOURCES tools/vrflow_main.cpp DEPS CLI11::CLI11)
-vrflow_add_plugin_host(vrflow-daemon SOURCES tools/daemon_main.cpp DEPS CLI11::CLI11)
+vrflow_add_plugin_host(vrflow-daemon SOURCES tools/daemon_main.cpp tools/control_link.cpp
+  DEPS CLI11::CLI11)

@@ -1,10 +1,15 @@
 // vrflow-daemon: the daemon of one host of an application, with that host's modules. The
-// launcher starts one per host; `vrflow run` embeds the same daemon for all hosts at once.
-// Until the TCP transport between daemons exists, a connection crossing hosts is refused.
+// launcher starts one per host (`--control`: it talks to the launcher over stdin/stdout and to
+// the other hosts' daemons over TCP); `vrflow run` embeds the same daemon for all hosts at once.
+// Alone (without --control) it refuses connections that cross hosts.
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
 #include <set>
 
 #include "vrflow/app/catalog.hpp"
@@ -14,6 +19,7 @@
 #include "vrflow/app/validate.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
+#include "control_link.hpp"
 
 int main(int argc, char** argv) {
   CLI::App cli{"vrflow-daemon: serve one host of an application"};
@@ -21,7 +27,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> packageDirs;
   vrflow::run::RunOptions options;
   cli.add_option("APP.xml", file, "Application file")->required();
-  cli.add_option("--host", host, "Host id (as in the application file) this daemon serves")->required();
+  cli.add_option("--host", host,
+                 "Host id (as in the application file) this daemon serves (required, except "
+                 "under mpirun with --control-connect: the host of the rank's index)");
   cli.add_option("--packages", packageDirs, "Extra folder of node packages (repeatable)");
   std::vector<std::string> compositeDirs;
   cli.add_option("--composites", compositeDirs,
@@ -29,6 +37,21 @@ int main(int argc, char** argv) {
   cli.add_option("--iterations,-n", options.iterations, "Stop after N iterations of every module");
   cli.add_option("--report", options.reportPath, "Write a JSON run report to FILE");
   cli.add_option("--timeout", options.timeoutSeconds, "Fail if the run lasts longer (seconds)");
+  bool control = false;
+  std::string bindAddress;
+  double peerTimeout = 3.0;
+  cli.add_flag("--control", control,
+               "Run under `vrflow launch`: the run secret and commands come on stdin, events go "
+               "to stdout, connections crossing hosts go over TCP");
+  std::string controlConnect;
+  cli.add_option("--control-connect", controlConnect,
+                 "Run under `vrflow launch --backend mpirun`: reach the launcher at ADDRESS:PORT; "
+                 "the run secret is read from $VRFLOW_RUN_SECRET, which is cleared at once");
+  cli.add_flag("--trace", options.trace, "Record modules' spans and send them to the launcher");
+  cli.add_option("--bind", bindAddress, "Address to listen on (default: the host's address)");
+  cli.add_option("--peer-timeout", peerTimeout,
+                 "A link to another host silent this long is declared lost (seconds)")
+      ->check(CLI::PositiveNumber);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -59,10 +82,77 @@ int main(int argc, char** argv) {
   vrflow::app::sortAndDeduplicate(problems);
   for (const auto& d : problems) std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
   if (vrflow::app::hasErrors(problems)) return vrflow::run::kExitInvalid;
+  std::optional<vrflow::net::Secret> secret;
+  if (!controlConnect.empty()) {
+    const char* text = std::getenv("VRFLOW_RUN_SECRET");
+    if (text == nullptr) {
+      std::fprintf(stderr, "vrflow-daemon: --control-connect needs $VRFLOW_RUN_SECRET\n");
+      return vrflow::run::kExitInvalid;
+    }
+    auto parsed = vrflow::net::secretFromHex(text);
+    std::memset(const_cast<char*>(text), 0, std::strlen(text));
+    unsetenv("VRFLOW_RUN_SECRET");  // modules must not inherit it
+    if (!parsed) {
+      std::fprintf(stderr, "vrflow-daemon: $VRFLOW_RUN_SECRET: %s\n", parsed.error().message.c_str());
+      return vrflow::run::kExitInvalid;
+    }
+    secret = *parsed;
+    if (host.empty()) {
+      const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
+      const long index = rank != nullptr ? std::atol(rank) : -1;
+      if (index < 0 || static_cast<std::size_t>(index) >= application->hosts.size()) {
+        std::fprintf(stderr, "vrflow-daemon: %s: no --host, and MPI rank %s names no host of the file\n",
+                     file.c_str(), rank != nullptr ? rank : "(none)");
+        return vrflow::run::kExitInvalid;
+      }
+      host = application->hosts[static_cast<std::size_t>(index)].id;
+    }
+  }
+  if (host.empty()) {
+    std::fprintf(stderr, "vrflow-daemon: --host is required\n");
+    return vrflow::run::kExitInvalid;
+  }
   if (vrflow::app::findHost(*application, host) == nullptr && host != "localhost") {
     std::fprintf(stderr, "vrflow-daemon: %s: no host '%s' in the application\n", file.c_str(),
                  host.c_str());
     return vrflow::run::kExitInvalid;
+  }
+
+  // Under the launcher, the control channel is this process's stdin/stdout: keep them for it,
+  // and give modules (which inherit fds 0 and 1) /dev/null and stderr instead.
+  std::unique_ptr<vrflow::tools::ControlLink> link;
+  if (control || !controlConnect.empty()) {
+    int in = -1, out = -1;
+    if (control) {
+      in = dup(STDIN_FILENO);
+      out = dup(STDOUT_FILENO);
+    } else {
+      int index = 0;
+      for (std::size_t i = 0; i < application->hosts.size(); ++i) {
+        if (application->hosts[i].id == host) index = static_cast<int>(i);
+      }
+      auto fd = vrflow::tools::ControlLink::connectBack(controlConnect, *secret, index);
+      if (!fd) {
+        std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", host.c_str(), fd.error().message.c_str());
+        return vrflow::run::kExitRunFailed;
+      }
+      in = *fd;
+      out = dup(*fd);
+    }
+    fcntl(in, F_SETFD, FD_CLOEXEC);
+    fcntl(out, F_SETFD, FD_CLOEXEC);
+    const int null = open("/dev/null", O_RDONLY | O_CLOEXEC);
+    dup2(null, STDIN_FILENO);
+    dup2(STDERR_FILENO, STDOUT_FILENO);
+    close(null);
+    auto made = vrflow::tools::ControlLink::create(*application, host, bindAddress, peerTimeout, in,
+                                                   out, secret);
+    if (!made) {
+      std::fprintf(stderr, "vrflow-daemon: %s: %s\n", file.c_str(), made.error().message.c_str());
+      return vrflow::run::kExitInvalid;
+    }
+    link = std::move(*made);
+    options.hostLink = link.get();
   }
 
   // Keep this host's share of the network.
@@ -86,10 +176,12 @@ int main(int argc, char** argv) {
   for (const auto& c : application->connections) {
     const bool from = here.count(c.from.node) != 0;
     const bool to = here.count(c.to.node) != 0;
+    if (from != to && link) continue;  // served by the transport (ControlLink::create)
     if (from != to) {
       std::fprintf(stderr,
-                   "%s:%d:%d: error: connection %s -> %s crosses hosts; daemons do not exchange "
-                   "messages over the network yet: map both ends to host '%s' or use `vrflow run`\n",
+                   "%s:%d:%d: error: connection %s -> %s crosses hosts; a daemon started alone "
+                   "serves one host only: map both ends to host '%s', or start the application "
+                   "with `vrflow launch` (or `vrflow run`)\n",
                    c.loc.file.c_str(), c.loc.line, c.loc.column,
                    vrflow::app::toString(c.from).c_str(), vrflow::app::toString(c.to).c_str(),
                    host.c_str());
@@ -98,6 +190,7 @@ int main(int argc, char** argv) {
     if (from) local.connections.push_back(c);
   }
   const auto outcome = vrflow::run::runApplication(local, *catalog, options);
+  if (link) return outcome.exitCode;  // the launcher reports
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow-daemon: %s\n", outcome.error.c_str());
   return outcome.exitCode;
 }

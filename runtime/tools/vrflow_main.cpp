@@ -15,6 +15,9 @@
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
+#ifdef VRFLOW_HAS_LAUNCHER
+#include "vrflow/launcher/launch.hpp"
+#endif
 
 namespace {
 
@@ -88,7 +91,33 @@ int main(int argc, char** argv) {
   run->add_option("--shm-size", shmMiB, "Shared-memory segment size in MiB (sparse)")
       ->check(CLI::Range(1.0, 262144.0));
   run->add_flag("--no-progress", noProgress, "Do not show live progress on a terminal");
+  run->add_option("--trace", options.tracePath,
+                  "Write a Chrome/Perfetto trace (modules' wait/compute spans, messages as flows)");
 
+#ifdef VRFLOW_HAS_LAUNCHER
+  auto* launch = cli.add_subcommand("launch", "Run an application with one daemon per host (TCP between them)");
+  launch->fallthrough();
+  vrflow::launcher::LaunchOptions launchOptions;
+  launch->add_option("APP.xml", launchOptions.appFile, "Application file")->required();
+  launch->add_option("--hosts", launchOptions.hostfile, "Hostfile: where each host runs (docs/launcher.md)");
+  launch->add_option("--backend", launchOptions.backend, "How daemons are started: local, ssh, mpirun")
+      ->check(CLI::IsMember({"local", "ssh", "mpirun"}));
+  launch->add_option("--iterations,-n", launchOptions.iterations, "Stop after N iterations of every module");
+  launch->add_option("--report", launchOptions.reportPath, "Write a JSON run report to FILE");
+  launch->add_option("--timeout", launchOptions.timeoutSeconds, "Fail if the run lasts longer (seconds)")
+      ->check(CLI::NonNegativeNumber);
+  launch->add_option("--control-address", launchOptions.controlAddress,
+                     "mpirun: this machine's address as the daemons reach it (default 127.0.0.1)");
+  launch->add_option("--trace", launchOptions.tracePath,
+                     "Write a Chrome/Perfetto trace of every host, clocks aligned");
+  launch->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,
+                     "A host silent this long (no heartbeat) is declared lost (seconds)")
+      ->check(CLI::PositiveNumber);
+  auto* monitorCommand = cli.add_subcommand("monitor", "Show live statistics of the running launches");
+  bool monitorOnce = false, monitorJson = false;
+  monitorCommand->add_flag("--once", monitorOnce, "Print one snapshot and exit");
+  monitorCommand->add_flag("--json", monitorJson, "Print the raw snapshots (JSON lines)");
+#endif
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -96,6 +125,9 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
+#ifdef VRFLOW_HAS_LAUNCHER
+  if (monitorCommand->parsed()) return vrflow::launcher::monitor(monitorOnce, monitorJson);
+#endif
   if (expand->parsed()) {
     const auto flat = loadFlat(expandFile, compositeDirs, nullptr);
     if (!flat) return 1;
@@ -110,6 +142,17 @@ int main(int argc, char** argv) {
   if (validate->parsed()) {
     return loadFlat(validateFile, compositeDirs, &*catalog) ? 0 : 1;
   }
+#ifdef VRFLOW_HAS_LAUNCHER
+  if (launch->parsed()) {
+    auto flat = loadFlat(launchOptions.appFile, compositeDirs, &*catalog);
+    if (!flat) return vrflow::run::kExitInvalid;
+    launchOptions.packageDirs = packageDirs;
+    launchOptions.compositeDirs = compositeDirs;
+    const auto outcome = vrflow::launcher::launch(*flat, launchOptions);
+    if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
+    return outcome.exitCode;
+  }
+#endif
   auto application = loadFlat(runFile, compositeDirs, &*catalog);
   if (!application) return vrflow::run::kExitInvalid;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);

@@ -10,7 +10,7 @@ fi
 cmake -S "$src/tests/fuzz/standalone" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build "$build" >/dev/null
-for target in message_reader app_loader; do
+for target in message_reader app_loader frame_reader; do
   corpus=$(mktemp -d)
   cp "$src"/tests/fuzz/corpus/${target%%_*}/* "$corpus"/ 2>/dev/null || true
   echo "fuzzing $target for ${seconds}s"

@@ -53,6 +53,12 @@ struct Daemon::Impl {
   // Per module and port index: the node fed by that port (output filter) or feeding it.
   std::map<std::pair<int, std::string>, Node*> portNodes;
   std::map<std::string, Node*> filterNodes;
+  struct RemoteInput {
+    uint32_t channel;
+    Queue* queue;
+    std::unique_ptr<QueueSink> sink;
+  };
+  std::vector<RemoteInput> remoteInputs;  ///< connections arriving from other hosts
   std::vector<std::pair<std::string, PortOutputFilter*>> outputFilters;  // "module.port"
   std::thread thread;
   std::atomic<bool> running{false};
@@ -61,6 +67,8 @@ struct Daemon::Impl {
   std::mutex warningsMutex;
   std::vector<std::string> warnings;
   std::string fatal;  ///< first protocol violation by a module (guarded by warningsMutex)
+  std::vector<QueueSnapshot> snapshot;  ///< guarded by warningsMutex
+  void publishSnapshot();
 
   Status build(const app::Application& application, const app::Catalog& catalog);
   Result<Node*> addNode(const std::string& id, const std::string& type,
@@ -86,6 +94,11 @@ Result<std::unique_ptr<Daemon>> Daemon::create(const app::Application& applicati
   if (!segment) return segment.error();
   d.segment = std::move(*segment);
   d.graph = std::make_unique<Graph>(d.segment);
+  if (options.transport != nullptr) {
+    options.transport->attachSegment(d.segment);
+    auto* bell = &d.segment.header().daemonBell;
+    options.transport->setArrivalCallback([bell] { bell->ring(); });
+  }
   if (auto status = d.build(application, catalog); !status) return status.error();
   return daemon;
 }
@@ -129,6 +142,13 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     ++fanOut[{c.from.node, c.from.port}];
     ++fanIn[{c.to.node, c.to.port}];
   }
+  for (const auto& r : options.remote) {
+    if (r.outgoing) {
+      ++fanOut[{r.connection.from.node, r.connection.from.port}];
+    } else {
+      ++fanIn[{r.connection.to.node, r.connection.to.port}];
+    }
+  }
 
   for (std::size_t m = 0; m < application.modules.size(); ++m) {
     const app::Module& module = application.modules[m];
@@ -144,6 +164,11 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     const std::string host = app::effectiveHost(application, module.host);
     copyName(slot->host, host);
     slot->iterationLimit = options.iterationLimit;
+    if (options.trace) {
+      slot->traceOffset = segment.reserve(sizeof(ipc::TraceRing));
+      if (slot->traceOffset == 0) return makeError("shared-memory segment too small for tracing");
+      new (segment.at<void>(slot->traceOffset)) ipc::TraceRing();
+    }
     modules.push_back({module.id, host, type->executable, static_cast<int>(m)});
 
     // Parameters: manifest defaults, overridden by the file.
@@ -252,7 +277,17 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     }
     return -1;
   };
-  for (const app::Connection& c : application.connections) {
+  // A module input fed by several connections concatenates them in file order, whichever
+  // host each comes from: attach them sorted by their index in the whole application.
+  struct VariadicInput {
+    uint32_t key;
+    Node* to;
+    Queue* queue;
+  };
+  std::vector<VariadicInput> variadicInputs;
+  for (std::size_t connectionIndex = 0; connectionIndex < application.connections.size();
+       ++connectionIndex) {
+    const app::Connection& c = application.connections[connectionIndex];
     Node* from = nullptr;
     std::size_t fromOutput = 0;
     if (const int m = moduleIndex(c.from.node); m >= 0) {
@@ -285,7 +320,10 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     queue.to = app::toString(c.to);
     queue.isConnection = true;
     if (toInput < 0) {
-      to->inputs.push_back(&queue);
+      const uint32_t key = connectionIndex < options.connectionChannels.size()
+                               ? options.connectionChannels[connectionIndex]
+                               : static_cast<uint32_t>(connectionIndex);
+      variadicInputs.push_back({key, to, &queue});
     } else {
       if (to->inputs[static_cast<std::size_t>(toInput)] != nullptr) {
         return makeError("filter input " + app::toString(c.to) + " has more than one connection");
@@ -294,6 +332,56 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     }
     from->outputs[fromOutput].push_back(std::make_unique<QueueSink>(queue));
   }
+  // Connections from or to another host: a sink that sends, or a queue fed by the transport.
+  for (const net::RemoteConnection& r : options.remote) {
+    const app::Connection& c = r.connection;
+    if (options.transport == nullptr) return makeError("connection crosses hosts without a transport");
+    if (r.outgoing) {
+      Node* from = nullptr;
+      std::size_t fromOutput = 0;
+      if (const int m = moduleIndex(c.from.node); m >= 0) {
+        from = portNodes[{m, c.from.port}];
+      } else if (filterNodes.count(c.from.node) != 0) {
+        from = filterNodes[c.from.node];
+        const auto& names = from->outputNames;
+        fromOutput = static_cast<std::size_t>(
+            std::find(names.begin(), names.end(), c.from.port) - names.begin());
+        if (fromOutput == names.size()) from = nullptr;
+      }
+      if (from == nullptr) return makeError("connection " + app::toString(c.from) + " names a missing port");
+      from->outputs[fromOutput].push_back(options.transport->makeSink(r.channel));
+      continue;
+    }
+    Node* to = nullptr;
+    int toInput = -1;
+    if (const int m = moduleIndex(c.to.node); m >= 0) {
+      to = portNodes[{m, c.to.port}];
+    } else if (filterNodes.count(c.to.node) != 0) {
+      to = filterNodes[c.to.node];
+      const auto& names = to->inputNames;
+      toInput = static_cast<int>(std::find(names.begin(), names.end(), c.to.port) - names.begin());
+      if (toInput == static_cast<int>(names.size())) to = nullptr;
+    }
+    if (to == nullptr) return makeError("connection " + app::toString(c.to) + " names a missing port");
+    Queue& queue = graph->newQueue();
+    queue.capacity = c.capacity > 0 ? static_cast<std::size_t>(c.capacity) : options.defaultCapacity;
+    queue.policy = c.policy;
+    queue.from = app::toString(c.from);
+    queue.to = app::toString(c.to);
+    queue.isConnection = true;
+    if (toInput < 0) {
+      variadicInputs.push_back({r.channel, to, &queue});
+    } else {
+      if (to->inputs[static_cast<std::size_t>(toInput)] != nullptr) {
+        return makeError("filter input " + app::toString(c.to) + " has more than one connection");
+      }
+      to->inputs[static_cast<std::size_t>(toInput)] = &queue;
+    }
+    remoteInputs.push_back({r.channel, &queue, std::make_unique<QueueSink>(queue)});
+  }
+  std::stable_sort(variadicInputs.begin(), variadicInputs.end(),
+                   [](const VariadicInput& a, const VariadicInput& b) { return a.key < b.key; });
+  for (const auto& v : variadicInputs) v.to->inputs.push_back(v.queue);
   // A filter input left unconnected never receives anything.
   for (auto& node : graph->nodes) {
     for (auto& input : node->inputs) {
@@ -361,6 +449,7 @@ void Daemon::shutdown() {
 void Daemon::Impl::loop() {
   auto& bell = segment.header().daemonBell;
   uint64_t lastFullCheck = 0;
+  uint64_t lastSnapshot = 0;
   while (running.load(std::memory_order_acquire)) {
     const uint32_t seen = bell.prepare();
     bool progressed = false;
@@ -369,6 +458,10 @@ void Daemon::Impl::loop() {
     if (now - lastFullCheck > 100'000'000) {
       checkFullQueues(now);
       lastFullCheck = now;
+    }
+    if (now - lastSnapshot > 500'000'000) {
+      publishSnapshot();
+      lastSnapshot = now;
     }
     publishWarnings();
     if (progressed) continue;
@@ -436,6 +529,15 @@ bool Daemon::Impl::pass() {
       ++graph->operations;
     }
   }
+  for (auto& input : remoteInputs) {
+    if (input.queue->closed) continue;
+    bool closed = false;
+    if (options.transport->receive(input.channel, *input.sink, closed) > 0) ++graph->operations;
+    if (closed) {
+      input.queue->closed = true;
+      ++graph->operations;
+    }
+  }
   for (auto& node : graph->nodes) {
     if (node->closed) {
       // Nothing will ever consume these: drop them so that producers are not held back.
@@ -482,6 +584,22 @@ void Daemon::Impl::checkFullQueues(uint64_t now) {
                                 ")");
     }
   }
+}
+
+void Daemon::Impl::publishSnapshot() {
+  std::vector<QueueSnapshot> next;
+  for (const auto& queue : graph->queues) {
+    if (!queue.isConnection) continue;
+    next.push_back({queue.from, queue.to, queue.items.size(), queue.capacity, queue.messages,
+                    queue.bytes, queue.dropped});
+  }
+  std::lock_guard lock(warningsMutex);
+  snapshot = std::move(next);
+}
+
+std::vector<QueueSnapshot> Daemon::queueSnapshot() {
+  std::lock_guard lock(impl_->warningsMutex);
+  return impl_->snapshot;
 }
 
 void Daemon::Impl::publishWarnings() {

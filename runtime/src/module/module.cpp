@@ -18,6 +18,7 @@
 #include "vrflow/base/assert.hpp"
 #include "vrflow/ipc/control.hpp"
 #include "vrflow/ipc/ring.hpp"
+#include "vrflow/message/ids.hpp"
 
 namespace vrflow {
 namespace {
@@ -65,6 +66,13 @@ struct Module::Impl {
   bool failed = false;
   uint64_t iteration = 0;
   uint64_t iterationStartNs = 0;
+  ipc::TraceRing* trace = nullptr;  ///< set when the run is traced
+  void traceEvent(ipc::TraceKind kind, uint64_t begin, uint64_t end, uint64_t sourceHash = 0,
+                  uint64_t sourceIteration = 0) {
+    if (trace == nullptr) return;
+    trace->record({begin, end, iteration, sourceIteration, static_cast<uint32_t>(kind),
+                   static_cast<uint32_t>(sourceHash)});
+  }
   double simTime = 0.0;
   double timeStep = 0.0;
   std::map<std::string, std::string, std::less<>> params;
@@ -102,6 +110,10 @@ struct Module::Impl {
     port.messages.fetch_add(1, std::memory_order_relaxed);
     port.bytes.fetch_add(segment.block(handle).used, std::memory_order_relaxed);
     segment.header().daemonBell.ring();
+    if (trace != nullptr) {
+      const uint64_t now = nowNs();
+      traceEvent(ipc::TraceKind::Sent, now, now);
+    }
     setState(ipc::ModuleState::Computing);
     return true;
   }
@@ -110,6 +122,7 @@ struct Module::Impl {
     const uint64_t took = now - iterationStartNs;
     slot->computeNs.fetch_add(took, std::memory_order_relaxed);
     slot->histogram[ipc::histogramBucket(took)].fetch_add(1, std::memory_order_relaxed);
+    traceEvent(ipc::TraceKind::Compute, iterationStartNs, now);
     if (endItSlot >= 0 && slot->ports[endItSlot].connected) {
       detail::ShmSink sink(segment, 64);
       msg::MessageBuilder builder(sink);
@@ -202,6 +215,9 @@ Status Module::init() {
   m.id = m.slot->id;
   m.slot->pid.store(static_cast<int32_t>(getpid()));
   m.current.resize(m.slot->portCount);
+  if (m.slot->traceOffset != 0 && m.segment.contains(m.slot->traceOffset, sizeof(ipc::TraceRing))) {
+    m.trace = m.segment.at<ipc::TraceRing>(m.slot->traceOffset);
+  }
 
   // Parameters: "name=value" lines.
   std::string_view text(m.segment.at<char>(m.slot->paramsOffset), m.slot->paramsBytes);
@@ -292,6 +308,13 @@ bool Module::wait() {
   }
   const uint64_t now = nowNs();
   m.slot->waitNs.fetch_add(now - waitStart, std::memory_order_relaxed);
+  if (m.trace != nullptr) {
+    m.traceEvent(ipc::TraceKind::Wait, waitStart, now);
+    for (const int portSlot : m.waitOrder) {
+      const auto stamps = m.current[static_cast<std::size_t>(portSlot)]->stamps();
+      m.traceEvent(ipc::TraceKind::Received, now, now, msg::fnv1a32(stamps.source), stamps.iteration);
+    }
+  }
   m.iterationStartNs = now;
   if (!m.waitOrder.empty()) {
     const auto stamps = m.current[static_cast<std::size_t>(m.waitOrder.front())]->stamps();

@@ -28,10 +28,10 @@ std::string hex(uint64_t value) {
 
 }  // namespace
 
-Status writeReport(const std::string& path, const app::Application& application,
-                   daemon::Daemon& daemon, const std::vector<ModuleEnd>& ends,
-                   const RunOutcome& outcome, const RunOptions& options, double wallSeconds,
-                   const std::vector<std::string>& warnings) {
+std::string reportJson(const app::Application& application, daemon::Daemon& daemon,
+                       const std::vector<ModuleEnd>& ends, const RunOutcome& outcome,
+                       const RunOptions& options, double wallSeconds,
+                       const std::vector<std::string>& warnings) {
   using nlohmann::ordered_json;
   ordered_json report;
   report["format"] = "vrflow-run-report/1";
@@ -96,10 +96,18 @@ Status writeReport(const std::string& path, const app::Application& application,
   timing["wall_s"] = wallSeconds;
   timing["segment_peak_bytes"] = daemon.segment().header().peakInUseBytes.load();
   report["timing"] = timing;
+  return report.dump(2);
+}
 
+Status writeReport(const std::string& path, const app::Application& application,
+                   daemon::Daemon& daemon, const std::vector<ModuleEnd>& ends,
+                   const RunOutcome& outcome, const RunOptions& options, double wallSeconds,
+                   const std::vector<std::string>& warnings) {
+  const std::string text =
+      reportJson(application, daemon, ends, outcome, options, wallSeconds, warnings);
   std::ofstream out(path);
   if (!out) return makeError("cannot write the report '" + path + "'");
-  out << report.dump(2) << "\n";
+  out << text << "\n";
   if (!out) return makeError("cannot write the report '" + path + "'");
   return {};
 }

@@ -13,6 +13,12 @@ struct ModuleEnd {
   std::string exit;  ///< "status 0", "signal 9", "running" (killed at stop)
 };
 
+/// The run report as JSON text (what writeReport() writes).
+std::string reportJson(const app::Application& application, daemon::Daemon& daemon,
+                       const std::vector<ModuleEnd>& ends, const RunOutcome& outcome,
+                       const RunOptions& options, double wallSeconds,
+                       const std::vector<std::string>& warnings);
+
 /// Writes the run report (JSON) described in the README. Deterministic fields first; timings
 /// are grouped under "timing" objects so that two runs can be diffed without them.
 Status writeReport(const std::string& path, const app::Application& application,

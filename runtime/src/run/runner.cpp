@@ -9,14 +9,18 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "report.hpp"
 #include "spawn.hpp"
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/message/ids.hpp"
+#include "vrflow/run/trace.hpp"
 
 namespace vrflow::run {
 namespace {
@@ -77,6 +81,79 @@ class Supervisor {
   bool lingering(std::string& detail);
   Clock::time_point finishedSince_{};
   void showProgress(bool final);
+
+ public:
+  /// Moves what the modules traced into trace_ (no-op when the run is not traced).
+  void drainTraces() {
+    for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
+      const auto& slot = daemon_.slot(daemon_.modules()[i].slotIndex);
+      if (slot.traceOffset == 0) continue;
+      if (trace_.modules.size() != daemon_.modules().size()) {
+        trace_.modules.clear();
+        for (const auto& m : daemon_.modules()) trace_.modules.push_back(m.id);
+      }
+      auto& ring = *daemon_.segment().at<ipc::TraceRing>(slot.traceOffset);
+      drainTraceRing(ring, static_cast<uint32_t>(i), trace_);
+    }
+  }
+  HostTrace trace_;
+
+  /// Live counters for `vrflow monitor`: raw totals, so that the reader computes rates.
+  std::string statsJson() {
+    nlohmann::json j;
+    j["t_ns"] = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    Clock::now().time_since_epoch()).count();
+    auto modules = nlohmann::json::array();
+    const long ticks = sysconf(_SC_CLK_TCK);
+    const long page = sysconf(_SC_PAGESIZE);
+    for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
+      const auto& module = daemon_.modules()[i];
+      const auto& slot = daemon_.slot(module.slotIndex);
+      nlohmann::json m;
+      m["id"] = module.id;
+      m["iterations"] = slot.iterations.load();
+      m["state"] = children_[i].alive ? stateName(slot.state.load()) : "ended";
+      m["compute_ns"] = slot.computeNs.load();
+      m["wait_ns"] = slot.waitNs.load();
+      uint64_t cpuNs = 0, rss = 0;
+      if (children_[i].alive) {
+        std::FILE* stat = std::fopen(("/proc/" + std::to_string(children_[i].pid) + "/stat").c_str(), "r");
+        if (stat != nullptr) {
+          char text[1024] = {};
+          const std::size_t n = std::fread(text, 1, sizeof text - 1, stat);
+          std::fclose(stat);
+          const char* close = std::strrchr(text, ')');
+          unsigned long utime = 0, stime = 0;
+          if (n > 0 && close != nullptr &&
+              std::sscanf(close + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &utime,
+                          &stime) == 2 && ticks > 0) {
+            cpuNs = (utime + stime) * (1'000'000'000ull / static_cast<unsigned long>(ticks));
+          }
+        }
+        std::FILE* statm = std::fopen(("/proc/" + std::to_string(children_[i].pid) + "/statm").c_str(), "r");
+        if (statm != nullptr) {
+          unsigned long size = 0, resident = 0;
+          if (std::fscanf(statm, "%lu %lu", &size, &resident) == 2) rss = resident * static_cast<unsigned long>(page);
+          std::fclose(statm);
+        }
+      }
+      m["cpu_ns"] = cpuNs;
+      m["rss_bytes"] = rss;
+      modules.push_back(m);
+    }
+    j["modules"] = modules;
+    auto connections = nlohmann::json::array();
+    for (const auto& q : daemon_.queueSnapshot()) {
+      connections.push_back({{"from", q.from}, {"to", q.to}, {"length", q.length},
+                             {"capacity", q.capacity}, {"messages", q.messages},
+                             {"bytes", q.bytes}, {"dropped", q.dropped}});
+    }
+    j["connections"] = connections;
+    return j.dump();
+  }
+  Clock::time_point lastStats_{};
+
+ private:
 
   const app::Application& application_;
   const RunOptions& options_;
@@ -297,11 +374,22 @@ RunOutcome Supervisor::run() {
     }
     reap(outcome, false);
     showProgress(false);
+    drainTraces();
+    if (options_.hostLink != nullptr && secondsSince(lastStats_) >= 1.0) {
+      options_.hostLink->stats(statsJson());
+      lastStats_ = Clock::now();
+    }
     if (options_.timeoutSeconds > 0 && secondsSince(start_) > options_.timeoutSeconds) {
       char text[96];
       std::snprintf(text, sizeof text, "timed out after %g s (--timeout)", options_.timeoutSeconds);
       outcome = {kExitTimeout, "timeout", text};
       break;
+    }
+    if (options_.hostLink != nullptr) {
+      if (auto stop = options_.hostLink->poll()) {
+        outcome = *stop;
+        break;
+      }
     }
     if (auto fatal = daemon_.fatalError(); !fatal.empty()) {
       outcome = {kExitRunFailed, "failed", fatal};
@@ -348,11 +436,13 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   daemon::DaemonOptions daemonOptions;
   daemonOptions.segmentBytes = options.segmentBytes;
   daemonOptions.iterationLimit = options.iterations;
+  daemonOptions.trace = options.trace || !options.tracePath.empty();
   if (!application.hosts.empty()) {
     if (auto id = msg::hostIdFromAddress(application.hosts.front().address)) {
       daemonOptions.hostId = *id;
     }
   }
+  if (options.hostLink != nullptr) options.hostLink->configure(daemonOptions);
   // The daemon thread must not take the signals meant for the supervisor: block them before
   // it is created (it inherits this mask).
   sigset_t signals, previous;
@@ -369,9 +459,43 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   }
   const auto start = Clock::now();
   Supervisor supervisor(application, options, **daemon);
-  RunOutcome outcome = supervisor.run();
+  RunOutcome outcome;
+  if (options.hostLink != nullptr) {
+    if (auto status = options.hostLink->ready(); !status) {
+      outcome = {kExitRunFailed, "failed", status.error().message};
+    }
+  }
+  if (outcome.exitCode == kExitOk) outcome = supervisor.run();
+  if (options.hostLink != nullptr) options.hostLink->drain(outcome);
   (*daemon)->shutdown();
+  supervisor.drainTraces();
+  for (std::size_t i = 0; i < (*daemon)->modules().size(); ++i) {
+    const auto& slot = (*daemon)->slot((*daemon)->modules()[i].slotIndex);
+    if (slot.traceOffset != 0) {
+      supervisor.trace_.dropped +=
+          (*daemon)->segment().at<ipc::TraceRing>(slot.traceOffset)->dropped.load();
+    }
+  }
+  if (daemonOptions.trace) {
+    if (supervisor.trace_.modules.empty()) {
+      for (const auto& m : (*daemon)->modules()) supervisor.trace_.modules.push_back(m.id);
+    }
+    supervisor.trace_.host = application.hosts.empty() ? "localhost" : application.hosts.front().id;
+    if (options.hostLink != nullptr) {
+      options.hostLink->trace(hostTraceToJson(supervisor.trace_));
+    } else if (!options.tracePath.empty()) {
+      std::ofstream out(options.tracePath);
+      out << chromeTrace(application, {supervisor.trace_}) << "\n";
+      if (!out && outcome.exitCode == kExitOk) {
+        outcome = {kExitRunFailed, "failed", "cannot write the trace '" + options.tracePath + "'"};
+      }
+    }
+  }
   std::vector<std::string> warnings = (*daemon)->takeWarnings();
+  if (options.hostLink != nullptr) {
+    options.hostLink->report(reportJson(application, **daemon, supervisor.ends(), outcome, options,
+                                        secondsSince(start), warnings));
+  }
   if (!options.reportPath.empty()) {
     auto status = writeReport(options.reportPath, application, **daemon, supervisor.ends(), outcome,
                               options, secondsSince(start), warnings);

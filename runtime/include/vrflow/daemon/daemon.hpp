@@ -10,6 +10,7 @@
 #include "vrflow/base/result.hpp"
 #include "vrflow/ipc/control.hpp"
 #include "vrflow/ipc/segment.hpp"
+#include "vrflow/net/transport.hpp"
 
 namespace vrflow::daemon {
 
@@ -21,6 +22,16 @@ struct DaemonOptions {
   uint32_t hostId = 0x7f000001;                       ///< from the host's address
   /// Warn when a connection's buffer has stayed full this long (ns).
   uint64_t fullWarningNs = 2'000'000'000;
+  /// Gives every module a trace ring (ipc::TraceRing) for `--trace`.
+  bool trace = false;
+  /// Links to the other hosts' daemons (vrflow-daemon under `vrflow launch`); null when every
+  /// connection stays on this daemon.
+  net::Transport* transport = nullptr;
+  /// The connections that cross this host's boundary, served through `transport`.
+  std::vector<net::RemoteConnection> remote;
+  /// Index in the whole application of each of `application.connections` (this host's share);
+  /// empty when the application given is the whole one.
+  std::vector<uint32_t> connectionChannels;
 };
 
 /// A module the daemon serves: what to start and where its shared state lives.
@@ -47,6 +58,13 @@ struct OutputStats {
   bool hasLast = false;
   uint64_t lastDigest = 0;
   uint64_t lastIteration = 0;
+};
+
+/// A connection's live counters, published by the routing thread about twice a second.
+struct QueueSnapshot {
+  std::string from, to;
+  std::size_t length = 0, capacity = 0;
+  uint64_t messages = 0, bytes = 0, dropped = 0;
 };
 
 /// A host's daemon: owns the shared-memory segment, the control table of its modules, and the
@@ -79,6 +97,8 @@ class Daemon {
   std::string fatalError();
   /// Warnings raised while running (full queues, filter problems); thread-safe snapshot.
   std::vector<std::string> takeWarnings();
+  /// Live queue lengths and counters (thread-safe; at most about 0.5 s old).
+  std::vector<QueueSnapshot> queueSnapshot();
   /// Statistics; call after shutdown().
   std::vector<ConnectionStats> connectionStats() const;
   std::vector<OutputStats> outputStats() const;

@@ -46,6 +46,37 @@ struct ModuleSlot {
   std::atomic<uint64_t> computeNs{0};         ///< total time between wait() returning and the next wait()
   std::atomic<uint64_t> waitNs{0};            ///< total time spent in wait()
   std::atomic<uint64_t> histogram[kHistogramBuckets];  ///< iteration durations, log-linear buckets
+  uint64_t traceOffset = 0;                   ///< a TraceRing when the run is traced; 0: not traced
+};
+
+/// What a module records when the run is traced (`--trace`), in steady-clock ns.
+enum class TraceKind : uint32_t { Wait = 0, Compute = 1, Received = 2, Sent = 3 };
+
+/// One traced event: a span (wait, compute) or an instant (a message received or sent).
+struct TraceEvent {
+  uint64_t beginNs = 0, endNs = 0;
+  uint64_t iteration = 0;        ///< the module's iteration
+  uint64_t sourceIteration = 0;  ///< Received: the message's iteration stamp
+  uint32_t kind = 0;             ///< a TraceKind
+  uint32_t sourceHash = 0;       ///< Received: FNV-1a 32 of the message's source module id
+};
+
+inline constexpr uint64_t kTraceCapacity = 8192;
+
+/// Single-producer (the module), single-consumer (the supervisor) ring of trace events; a
+/// module that finds it full drops the event and counts it.
+struct TraceRing {
+  std::atomic<uint64_t> head{0}, tail{0}, dropped{0};
+  TraceEvent events[kTraceCapacity];
+  void record(const TraceEvent& event) {
+    const uint64_t h = head.load(std::memory_order_relaxed);
+    if (h - tail.load(std::memory_order_acquire) >= kTraceCapacity) {
+      dropped.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    events[h % kTraceCapacity] = event;
+    head.store(h + 1, std::memory_order_release);
+  }
 };
 
 /// The run's table of modules, at SegmentHeader::controlOffset.

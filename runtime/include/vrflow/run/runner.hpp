@@ -8,6 +8,10 @@
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/model.hpp"
 
+namespace vrflow::daemon {
+struct DaemonOptions;
+}
+
 namespace vrflow::run {
 
 /// Exit codes of `vrflow run`, stable for scripts and CI.
@@ -18,6 +22,8 @@ enum ExitCode : int {
   kExitTimeout = 3,       ///< --timeout exceeded
   kExitInterrupted = 130  ///< Ctrl-C or SIGTERM
 };
+
+class HostLink;
 
 /// How to run an application on this machine.
 struct RunOptions {
@@ -30,6 +36,9 @@ struct RunOptions {
   double stopGraceSeconds = 2;        ///< after a stop request, before SIGTERM then SIGKILL
   double joinSeconds = 20;            ///< a module must call Module::init() within this
   double lingerSeconds = 5;           ///< a module that finished must exit within this
+  HostLink* hostLink = nullptr;       ///< set by vrflow-daemon under the launcher
+  bool trace = false;                 ///< record modules' spans (also implied by tracePath)
+  std::string tracePath;              ///< Chrome trace-event JSON; empty = none
 };
 
 /// What happened, for the report and the exit code.
@@ -37,6 +46,27 @@ struct RunOutcome {
   int exitCode = kExitOk;
   std::string status = "ok";  ///< ok, failed, deadlock, timeout, interrupted
   std::string error;          ///< one line a person can act on; empty on success
+};
+
+/// What a daemon started by `vrflow launch` adds to a run: links to the other hosts' daemons
+/// and the launcher's control channel (tools/daemon_main.cpp implements it).
+class HostLink {
+ public:
+  virtual ~HostLink() = default;
+  /// Adds the host id, the transport and the connections crossing hosts before the daemon is built.
+  virtual void configure(daemon::DaemonOptions& options) = 0;
+  /// Once the daemon is built, before modules start: links to peers, waits for the launcher.
+  virtual Status ready() = 0;
+  /// Every supervisor tick: an outcome ends the run (a peer lost, a stop from the launcher).
+  virtual std::optional<RunOutcome> poll() = 0;
+  /// After this host's modules ended: keeps routing until every host is done.
+  virtual void drain(const RunOutcome& outcome) = 0;
+  /// This host's share of the run report (JSON text).
+  virtual void report(const std::string& json) = 0;
+  /// This host's trace events (run::hostTraceToJson), when the run is traced.
+  virtual void trace(const std::string& json) = 0;
+  /// About once a second: live counters of this host's modules and connections (JSON).
+  virtual void stats(const std::string& json) = 0;
 };
 
 /// The node packages on the search path: `extraDirs` first, then $VRFLOW_PACKAGE_PATH, then

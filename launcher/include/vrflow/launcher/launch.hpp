@@ -1,0 +1,66 @@
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "vrflow/app/model.hpp"
+#include "vrflow/base/result.hpp"
+#include "vrflow/run/runner.hpp"
+
+namespace vrflow::launcher {
+
+/// One line of a hostfile: where a host of the application really runs.
+struct HostEntry {
+  std::string host;      ///< host id, as in the application file
+  std::string address;   ///< overrides the file's address (where the daemon binds)
+  std::string user;      ///< ssh only
+  int sshPort = 22;      ///< ssh only
+  std::string identity;  ///< ssh only: private key file (ssh -i)
+  std::vector<std::string> sshOptions;   ///< ssh only: -o KEY=VALUE
+  std::string directory; ///< ssh only: working folder there (default: the launcher's)
+  std::string daemon;    ///< ssh only: vrflow-daemon there (default: the one beside `vrflow`)
+  std::vector<std::string> environment;  ///< NAME=VALUE given to the daemon and its modules
+  int line = 0;
+};
+
+/// Reads a hostfile: `HOST [address=A] [user=U] [ssh-port=P] [identity=FILE] [ssh-option=K=V]...
+/// [dir=PATH] [daemon=PATH] [env=NAME=VALUE]...` per line, `#` comments. Errors name FILE:LINE.
+Result<std::vector<HostEntry>> readHostfile(const std::string& path,
+                                            const app::Application& application);
+
+/// Settings of `vrflow launch`.
+struct LaunchOptions {
+  std::string appFile;
+  std::string hostfile;
+  std::string backend = "local";
+  uint64_t iterations = 0;
+  std::string reportPath;
+  std::string tracePath;          ///< Chrome trace of every host; empty = none
+  std::string controlAddress = "127.0.0.1";  ///< mpirun: where daemons reach the launcher
+  double timeoutSeconds = 0;
+  double peerTimeoutSeconds = 3;  ///< heartbeat timeout between daemons
+  double startSeconds = 30;       ///< every daemon must be linked within this
+  std::vector<std::string> packageDirs, compositeDirs;
+  bool progress = false;
+};
+
+/// Merges the hosts' report shares into one report in the shape `vrflow run` writes (modules,
+/// connections and outputs in file order).
+std::string mergeReports(const app::Application& application, const std::vector<std::string>& parts,
+                         const run::RunOutcome& outcome, uint64_t iterations, double wallSeconds);
+
+/// Folder (mode 0700) where running launches publish their live state:
+/// $XDG_RUNTIME_DIR/vrflow, or /tmp/vrflow-<uid>.
+std::string monitorDirectory();
+
+/// `vrflow monitor`: shows the live state of the launches running for this user, per host and
+/// module (iterations/s, wait vs compute, state, CPU, memory), per connection (queue, messages/s,
+/// bytes/s) and per link. Returns 0, or 1 when no launch is running.
+int monitor(bool once, bool json);
+
+/// Runs `application` (loaded, expanded and validated) with one daemon per host. Exit codes as
+/// `vrflow run`.
+run::RunOutcome launch(const app::Application& application, const LaunchOptions& options);
+
+}  // namespace vrflow::launcher

@@ -1,0 +1,278 @@
+#include "control_link.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstring>
+
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+
+#include "vrflow/daemon/daemon.hpp"
+#include "vrflow/message/ids.hpp"
+
+namespace vrflow::tools {
+namespace {
+
+// One line from a descriptor, byte by byte (the secret must not be read ahead into a buffer
+// shared with anything else); false at end of input.
+bool readLine(int fd, std::string& line) {
+  line.clear();
+  char c = 0;
+  while (true) {
+    const ssize_t n = read(fd, &c, 1);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return !line.empty();
+    if (c == '\n') return true;
+    line += c;
+    if (line.size() > 1 << 20) return true;
+  }
+}
+
+int hostIndex(const app::Application& application, const std::string& host) {
+  for (std::size_t i = 0; i < application.hosts.size(); ++i) {
+    if (application.hosts[i].id == host) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application& application,
+                                                         const std::string& host,
+                                                         const std::string& bindAddress,
+                                                         double peerTimeoutSeconds, int in,
+                                                         int out, std::optional<net::Secret> given) {
+  std::unique_ptr<ControlLink> link(new ControlLink(in, out));
+  Result<net::Secret> secret = net::Secret{};
+  if (given) {
+    secret = *given;
+  } else {
+    std::string line;
+    if (!readLine(in, line) || line.rfind("secret ", 0) != 0) {
+      return makeError("--control: the first line on stdin must be the run secret");
+    }
+    secret = net::secretFromHex(line.substr(7));
+    std::fill(line.begin(), line.end(), '\0');
+    if (!secret) return secret.error();
+  }
+  link->selfIndex_ = hostIndex(application, host);
+  if (link->selfIndex_ < 0) return makeError("no host '" + host + "' in the application");
+  const app::Host& self = application.hosts[static_cast<std::size_t>(link->selfIndex_)];
+  auto id = msg::hostIdFromAddress(self.address);
+  if (!id) return makeError("host '" + host + "': " + id.error().message);
+  link->hostId_ = *id;
+
+  net::TransportOptions options;
+  options.selfIndex = link->selfIndex_;
+  for (const auto& h : application.hosts) options.hostNames.push_back(h.id);
+  options.bindAddress = bindAddress.empty() ? self.address : bindAddress;
+  options.secret = *secret;
+  options.peerTimeoutSeconds = peerTimeoutSeconds;
+  auto transport = net::Transport::listen(options);
+  secret->fill(0);
+  options.secret.fill(0);
+  if (!transport) return makeError("host '" + host + "': " + transport.error().message);
+  link->transport_ = std::move(*transport);
+
+  // Which host runs each node; connections crossing this host's boundary.
+  auto hostOf = [&](const std::string& node) {
+    for (const auto& m : application.modules) {
+      if (m.id == node) return hostIndex(application, app::effectiveHost(application, m.host));
+    }
+    for (const auto& f : application.filters) {
+      if (f.id == node) return hostIndex(application, app::effectiveHost(application, f.host));
+    }
+    return -1;
+  };
+  for (std::size_t i = 0; i < application.connections.size(); ++i) {
+    const auto& c = application.connections[i];
+    const int from = hostOf(c.from.node), to = hostOf(c.to.node);
+    const auto channel = static_cast<uint32_t>(i);
+    if (from == link->selfIndex_ && to == link->selfIndex_) {
+      link->localChannels_.push_back(channel);
+    } else if (from == link->selfIndex_ || to == link->selfIndex_) {
+      net::RemoteConnection r{channel, c, from == link->selfIndex_ ? to : from,
+                              from == link->selfIndex_};
+      link->remote_.push_back(r);
+      link->transport_->addConnection(r);
+    }
+  }
+  link->send("listening " + std::to_string(link->transport_->port()));
+  link->reader_ = std::thread([raw = link.get()] { raw->readLoop(); });
+  return link;
+}
+
+Result<int> ControlLink::connectBack(const std::string& address, const net::Secret& secret,
+                                     int hostIndex) {
+  const auto colon = address.rfind(':');
+  if (colon == std::string::npos) return makeError("--control-connect needs ADDRESS:PORT");
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(std::atoi(address.c_str() + colon + 1)));
+  if (inet_pton(AF_INET, address.substr(0, colon).c_str(), &addr.sin_addr) != 1) {
+    return makeError("--control-connect: '" + address + "' is not IPv4:PORT");
+  }
+  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0 || connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    const int err = errno;
+    if (fd >= 0) close(fd);
+    return makeError("cannot reach the launcher at " + address + ": " + std::strerror(err));
+  }
+  std::string line;
+  if (!readLine(fd, line) || line.rfind("nonce ", 0) != 0) {
+    close(fd);
+    return makeError("the launcher at " + address + " did not send its nonce");
+  }
+  const std::string hello =
+      "hello " + std::to_string(hostIndex) + " " + net::controlProof(secret, hostIndex, line.substr(6)) + "\n";
+  if (write(fd, hello.data(), hello.size()) != static_cast<ssize_t>(hello.size())) {
+    close(fd);
+    return makeError("the launcher at " + address + " closed the control channel");
+  }
+  return fd;
+}
+
+ControlLink::~ControlLink() {
+  if (transport_) transport_->stop();
+  // The reader ends at end of input: the launcher closes our stdin when the run is over.
+  if (reader_.joinable()) reader_.detach();
+}
+
+void ControlLink::readLoop() {
+  std::string line;
+  while (readLine(in_, line)) {
+    std::lock_guard lock(mutex_);
+    lines_.push_back(line);
+    changed_.notify_all();
+  }
+  std::lock_guard lock(mutex_);
+  lines_.push_back("eof");
+  changed_.notify_all();
+}
+
+std::string ControlLink::next(double seconds) {
+  std::unique_lock lock(mutex_);
+  if (seconds < 0) {
+    changed_.wait(lock, [&] { return !lines_.empty(); });
+  } else if (!changed_.wait_for(lock, std::chrono::duration<double>(seconds),
+                                [&] { return !lines_.empty(); })) {
+    return {};
+  }
+  std::string line = lines_.front();
+  if (line != "eof") lines_.pop_front();  // end of input stays visible
+  return line;
+}
+
+void ControlLink::send(const std::string& line) {
+  std::string text = line + "\n";
+  const char* p = text.data();
+  std::size_t left = text.size();
+  while (left > 0) {
+    const ssize_t n = write(out_, p, left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;  // the launcher is gone; poll() sees the end of input
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+}
+
+void ControlLink::configure(daemon::DaemonOptions& options) {
+  options.hostId = hostId_;
+  options.transport = transport_.get();
+  options.remote = remote_;
+  options.connectionChannels = localChannels_;
+}
+
+Status ControlLink::ready() {
+  std::vector<net::PeerAddress> peers;
+  while (true) {
+    const std::string line = next(-1);
+    if (line == "connect") break;
+    if (line == "eof" || line == "stop") {
+      stopped_ = true;
+      return makeError("stopped by the launcher before the start");
+    }
+    std::istringstream words(line);
+    std::string word;
+    net::PeerAddress peer;
+    if (words >> word && word == "peer" && words >> peer.index >> peer.address >> peer.port) {
+      peers.push_back(peer);
+    }
+  }
+  if (auto status = transport_->connectPeers(peers); !status) {
+    send("error " + status.error().message);
+    return status;
+  }
+  send("connected");
+  while (true) {
+    const std::string line = next(-1);
+    if (line == "go") return {};
+    // "clock T": the launcher aligns this host's clock with its own (--trace).
+    if (line.rfind("clock ", 0) == 0) {
+      const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                           std::chrono::steady_clock::now().time_since_epoch())
+                           .count();
+      send(line + " " + std::to_string(now));
+      continue;
+    }
+    stopped_ = true;  // "stop" or the end of input
+    return makeError("stopped by the launcher before the start");
+  }
+}
+
+std::optional<run::RunOutcome> ControlLink::poll() {
+  if (auto fatal = transport_->fatalError(); !fatal.empty()) {
+    return run::RunOutcome{run::kExitRunFailed, "failed", fatal};
+  }
+  const std::string line = next(0);
+  if (line == "stop" || line == "eof") stopped_ = true;
+  if (line == "stop") return run::RunOutcome{run::kExitInterrupted, "stopped", "stopped by the launcher"};
+  if (line == "eof") return run::RunOutcome{run::kExitInterrupted, "stopped", "the launcher went away"};
+  return std::nullopt;
+}
+
+void ControlLink::drain(const run::RunOutcome& outcome) {
+  send("finished " + std::to_string(outcome.exitCode) + " " + outcome.status + " " + outcome.error);
+  // Keep routing (messages for the other hosts) until the launcher says every host is done.
+  while (!stopped_) {
+    const std::string line = next(0.05);
+    if (line == "quit") {
+      transport_->finish(2.0);
+      break;
+    }
+    if (line == "stop" || line == "eof") stopped_ = true;
+  }
+  if (stopped_) transport_->finish(0.5);  // say bye, so that peers do not log a lost link
+  transport_->stop();
+}
+
+void ControlLink::trace(const std::string& json) { send("trace " + json); }
+
+void ControlLink::stats(const std::string& json) {
+  // The links' counters join the modules' and connections'.
+  std::string links = "[";
+  for (const auto& l : transport_->linkStats()) {
+    if (links.size() > 1) links += ",";
+    links += "{\"peer\":" + std::to_string(l.peer) + ",\"messages_sent\":" +
+             std::to_string(l.messagesSent) + ",\"bytes_sent\":" + std::to_string(l.bytesSent) +
+             ",\"messages_received\":" + std::to_string(l.messagesReceived) +
+             ",\"bytes_received\":" + std::to_string(l.bytesReceived) + "}";
+  }
+  links += "]";
+  if (json.empty() || json.back() != '}') return;
+  send("stats " + json.substr(0, json.size() - 1) + ",\"links\":" + links + "}");
+}
+
+void ControlLink::report(const std::string& json) {
+  std::string flat = json;
+  for (char& c : flat) {
+    if (c == '\n') c = ' ';  // JSON strings hold no raw newline: this keeps it one line
+  }
+  send("report " + flat);
+}
+
+}  // namespace vrflow::tools

@@ -1,0 +1,169 @@
+// The ssh backend against a real sshd that this test starts on loopback, with keys it makes.
+#include <dirent.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "process_helpers.hpp"
+
+namespace vrflow::testing {
+namespace {
+
+// A private sshd on 127.0.0.1-3 at a free port, accepting one generated key.
+bool hasChildren(pid_t parent) {
+  DIR* dir = opendir("/proc");
+  bool any = false;
+  while (dirent* e = readdir(dir)) {
+    const int pid = std::atoi(e->d_name);
+    if (pid <= 0) continue;
+    std::ifstream in("/proc/" + std::string(e->d_name) + "/stat");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto close = text.rfind(')');
+    if (close == std::string::npos) continue;
+    char state = 0;
+    int ppid = 0;
+    if (std::sscanf(text.c_str() + close + 1, " %c %d", &state, &ppid) == 2 && ppid == parent) any = true;
+  }
+  closedir(dir);
+  return any;
+}
+
+class Sshd {
+ public:
+  explicit Sshd(const TempDir& dir) : dir_(dir) {}
+  ~Sshd() { stop(); }
+  // Empty on success, else why sshd cannot run here.
+  std::string start() {
+    if (access("/usr/sbin/sshd", X_OK) != 0) return "/usr/sbin/sshd is not installed";
+    // sshd insists on its privilege-separation folder; as root we may make it (it is what the
+    // openssh-server service would do), otherwise sshd cannot run as this user.
+    if (access("/run/sshd", F_OK) != 0) {
+      if (geteuid() != 0) return "/run/sshd is missing and only root may create it";
+      mkdir("/run/sshd", 0755);
+    }
+    for (const char* key : {"host_key", "user_key"}) {
+      const auto made = runCommand({"/usr/bin/ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f",
+                                    dir_.file(key)},
+                                   30);
+      if (made.exitCode != 0) return "ssh-keygen failed: " + made.err;
+    }
+    dir_.write("authorized_keys", readFile(dir_.file("user_key.pub")));
+    chmod(dir_.file("authorized_keys").c_str(), 0600);
+    port_ = 20000 + static_cast<int>(getpid() % 20000);
+    dir_.write("sshd_config", "Port " + std::to_string(port_) +
+                                  "\nListenAddress 127.0.0.1\nListenAddress 127.0.0.2\n"
+                                  "ListenAddress 127.0.0.3\nHostKey " + dir_.file("host_key") +
+                                  "\nAuthorizedKeysFile " + dir_.file("authorized_keys") +
+                                  "\nPidFile " + dir_.file("sshd.pid") +
+                                  "\nUsePAM no\nStrictModes no\nPasswordAuthentication no\n"
+                                  "KbdInteractiveAuthentication no\nPubkeyAuthentication yes\n"
+                                  "PermitRootLogin prohibit-password\nLogLevel ERROR\n");
+    pid_ = fork();
+    if (pid_ == 0) {
+      execl("/usr/sbin/sshd", "/usr/sbin/sshd", "-D", "-f", dir_.file("sshd_config").c_str(), "-E",
+            dir_.file("sshd.log").c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    // Ready when a login works.
+    for (int i = 0; i < 50; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const auto probe = runCommand({"/usr/bin/ssh", "-T", "-o", "BatchMode=yes", "-o",
+                                     "StrictHostKeyChecking=no", "-o", "UserKnownHostsFile=/dev/null",
+                                     "-o", "LogLevel=ERROR", "-i", dir_.file("user_key"), "-p",
+                                     std::to_string(port_), "127.0.0.2", "true"},
+                                    20);
+      if (probe.exitCode == 0) return {};
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return "sshd did not start: " + readFile(dir_.file("sshd.log"));
+      }
+    }
+    return "no login through sshd within 5 s: " + readFile(dir_.file("sshd.log"));
+  }
+  void stop() {
+    if (pid_ > 0) {
+      // Let sshd's per-session processes finish their tear-down first (they end once the
+      // session's processes, our daemons, have ended); what outlives this shows up as leftover.
+      for (int i = 0; i < 50 && hasChildren(pid_); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+      kill(pid_, SIGTERM);
+      int status = 0;
+      waitpid(pid_, &status, 0);
+      pid_ = -1;
+    }
+  }
+  std::string hostLine(const std::string& host, const std::string& address) const {
+    return host + " address=" + address + " ssh-port=" + std::to_string(port_) + " identity=" +
+           dir_.file("user_key") +
+           " ssh-option=StrictHostKeyChecking=no ssh-option=UserKnownHostsFile=/dev/null"
+           " ssh-option=LogLevel=ERROR\n";
+  }
+
+ private:
+  const TempDir& dir_;
+  pid_t pid_ = -1;
+  int port_ = 0;
+};
+
+nlohmann::json deterministicPart(const std::string& path) {
+  auto report = nlohmann::json::parse(readFile(path));
+  report.erase("timing");
+  report.erase("file");
+  for (auto& m : report["modules"]) {
+    m.erase("timing");
+    m.erase("host");
+  }
+  return report;
+}
+
+TEST(LaunchSsh, ThreeHostsThroughSshdGiveTheSameDigestsAsOneHost) {
+  TempDir dir;
+  Sshd sshd(dir);
+  if (const std::string why = sshd.start(); !why.empty()) GTEST_SKIP() << why;
+  const auto hosts = dir.write("hosts", sshd.hostLine("a", "127.0.0.1") +
+                                            sshd.hostLine("b", "127.0.0.2") +
+                                            sshd.hostLine("c", "127.0.0.3"));
+  const std::string app = sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml";
+  const auto three = runVrflow({"launch", app, "--backend", "ssh", "--hosts", hosts, "-n", "100",
+                                "--report", dir.file("three.json")},
+                               120);
+  const auto one = runVrflow({"run", sourceDir() + "/examples/pipeline/pipeline.xml", "-n", "100",
+                              "--no-progress", "--report", dir.file("one.json")},
+                             120);
+  sshd.stop();
+  ASSERT_EQ(three.exitCode, 0) << three.err;
+  ASSERT_EQ(one.exitCode, 0) << one.err;
+  EXPECT_EQ(deterministicPart(dir.file("one.json")), deterministicPart(dir.file("three.json")));
+  const auto left = leftoverProcesses();
+  EXPECT_TRUE(left.empty()) << ::testing::PrintToString(left);
+}
+
+TEST(LaunchSsh, AnUnreachableHostIsNamed) {
+  TempDir dir;
+  // Nothing listens on port 1: ssh fails, and the launcher names the host's daemon.
+  const auto hosts = dir.write("hosts", "a address=127.0.0.1 ssh-port=1\nb address=127.0.0.2 ssh-port=1\n"
+                                        "c address=127.0.0.3 ssh-port=1\n");
+  const auto result = runVrflow({"launch", sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml",
+                                 "--backend", "ssh", "--hosts", hosts, "-n", "5"},
+                                60);
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("daemon of host '"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("ssh pid"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("exited with status 255"), std::string::npos) << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+}  // namespace
+}  // namespace vrflow::testing
