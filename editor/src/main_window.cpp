@@ -240,6 +240,11 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
 }
 
 MainWindow::~MainWindow() {
+  // The panels outlive this object's members (Qt deletes children last): no more signals here.
+  for (QObject* child : std::initializer_list<QObject*>{canvas_, palette_, properties_, hosts_, problemList_, undo_}) {
+    child->disconnect(this);
+    disconnect(child, nullptr, this, nullptr);
+  }
   if (process_ != nullptr && process_->state() != QProcess::NotRunning) {
     process_->disconnect(this);
     process_->terminate();
@@ -342,10 +347,14 @@ bool MainWindow::openFile(const QString& path) {
   std::vector<app::Diagnostic> problems;
   const std::string absolute = s(QFileInfo(path).absoluteFilePath());
   auto loaded = app::loadApplicationString(text, absolute, &problems);
-  if (!loaded) {
+  // Not well-formed, or not an application at all (a manifest, a composite): nothing to edit.
+  const bool notAnApplication = std::any_of(problems.begin(), problems.end(), [](const app::Diagnostic& d) {
+    return d.message.rfind("root element must be", 0) == 0;
+  });
+  if (!loaded || notAnApplication) {
     reporter().error(this, "Cannot open file",
                      QFileInfo(path).fileName() + " is not a valid vrflow application file:\n\n" +
-                         q(loaded.error().message));
+                         (loaded ? q(app::formatDiagnostics(problems)) : q(loaded.error().message)));
     return false;
   }
   OpenedText opened{text, app::saveApplication(*loaded)};
