@@ -34,6 +34,14 @@ double snap(double v) { return std::round(v / kGrid) * kGrid; }
 
 QPainterPath curve(QPointF from, QPointF to) {
   QPainterPath path(from);
+  if (to.x() < from.x() + 30) {
+    // A connection going back (a feedback loop): around, below both ends, not through nodes.
+    const double below = std::max(from.y(), to.y()) + 60;
+    const double midX = (from.x() + to.x()) / 2;
+    path.cubicTo(from + QPointF(70, 0), QPointF(from.x() + 70, below), QPointF(midX, below));
+    path.cubicTo(QPointF(to.x() - 70, below), to - QPointF(70, 0), to);
+    return path;
+  }
   const double dx = std::max(40.0, std::abs(to.x() - from.x()) * 0.5);
   path.cubicTo(from + QPointF(dx, 0), to - QPointF(dx, 0), to);
   return path;
@@ -244,7 +252,8 @@ void NodeItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
 
   if (!badge_.isEmpty()) {
     painter->setFont(smallFont);
-    const QRectF r(w - 70, -12, 70, 14);
+    const double textWidth = QFontMetricsF(smallFont).horizontalAdvance(badge_) + 10;
+    const QRectF r(w - textWidth, -12, textWidth, 14);
     painter->setPen(Qt::NoPen);
     painter->setBrush(QColor(255, 255, 255, 230));
     painter->drawRoundedRect(r, 4, 4);
@@ -409,7 +418,7 @@ void Canvas::rebuild() {
     if (auto it = spread.find(i.id); it != spread.end()) {
       QStringList hosts;
       for (const auto& h : it->second.second) hosts << q(h);
-      item->setBadge(QString("%1 modules").arg(it->second.first));
+      item->setBadge(QString("%1 modules on %2").arg(it->second.first).arg(hosts.size() <= 2 ? hosts.join(", ") : QString("%1 hosts").arg(hosts.size())));
       item->setToolTip(QString("%1 modules on %2").arg(it->second.first).arg(hosts.join(", ")));
     }
     place(item);
@@ -577,9 +586,11 @@ void Canvas::fitAll() {
     return;
   }
   fitInView(bounds.adjusted(-30, -30, 30, 30), Qt::KeepAspectRatio);
-  // Do not blow small networks up beyond their natural size.
-  if (transform().m11() > 1.0) {
-    resetTransform();
+  // Do not blow small networks up beyond their natural size, nor shrink big ones until their
+  // text cannot be read (scroll instead).
+  if (transform().m11() > 1.0 || transform().m11() < 0.5) {
+    const double scale = transform().m11() > 1.0 ? 1.0 : 0.5;
+    setTransform(QTransform::fromScale(scale, scale));
     centerOn(bounds.center());
   }
 }
@@ -588,7 +599,7 @@ Positions Canvas::nodeSizes() const {
   Positions sizes;
   for (const auto& [id, item] : nodes_) {
     // Room for the labels around rhombi and the run text under nodes.
-    const double extra = item->kind() == NodeKind::Filter ? 120 : 0;
+    const double extra = item->kind() == NodeKind::Filter ? 70 : 0;
     sizes[id] = {item->size().width() + extra, item->size().height() + 30};
   }
   return sizes;

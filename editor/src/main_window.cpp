@@ -143,7 +143,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
     addDockWidget(area, d);
     return d;
   };
-  dock("Palette", palette_, Qt::LeftDockWidgetArea);
+  auto* paletteDock = dock("Palette", palette_, Qt::LeftDockWidgetArea);
   auto* propertiesDock = dock("Properties", properties_, Qt::RightDockWidgetArea);
   auto* hostsDock = dock("Hosts", hosts_, Qt::RightDockWidgetArea);
   splitDockWidget(propertiesDock, hostsDock, Qt::Vertical);
@@ -151,7 +151,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   auto* logDock = dock("Run log", log_, Qt::BottomDockWidgetArea);
   tabifyDockWidget(problemsDock, logDock);
   problemsDock->raise();
-  resizeDocks({propertiesDock}, {330}, Qt::Horizontal);
+  resizeDocks({paletteDock, propertiesDock}, {190, 320}, Qt::Horizontal);
   resizeDocks({problemsDock}, {150}, Qt::Vertical);
   log_->setReadOnly(true);
   log_->setMaximumBlockCount(20000);

@@ -126,8 +126,8 @@ std::map<std::string, std::pair<double, double>> autoLayout(
   GVC_t* gvc = gvContext();
   Agraph_t* g = agopen(const_cast<char*>("app"), Agdirected, nullptr);
   agattr(g, AGRAPH, const_cast<char*>("rankdir"), const_cast<char*>("LR"));
-  agattr(g, AGRAPH, const_cast<char*>("nodesep"), const_cast<char*>("0.5"));
-  agattr(g, AGRAPH, const_cast<char*>("ranksep"), const_cast<char*>("1.0"));
+  agattr(g, AGRAPH, const_cast<char*>("nodesep"), const_cast<char*>("0.35"));
+  agattr(g, AGRAPH, const_cast<char*>("ranksep"), const_cast<char*>("0.6"));
   agattr(g, AGNODE, const_cast<char*>("shape"), const_cast<char*>("box"));
   agattr(g, AGNODE, const_cast<char*>("fixedsize"), const_cast<char*>("true"));
   agattr(g, AGNODE, const_cast<char*>("width"), const_cast<char*>("2"));
