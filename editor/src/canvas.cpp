@@ -2,6 +2,8 @@
 
 #include <QContextMenuEvent>
 #include <QGraphicsPathItem>
+#include <QGraphicsRectItem>
+#include <QGraphicsSimpleTextItem>
 #include <QGraphicsScene>
 #include <QGraphicsSceneHoverEvent>
 #include <QKeyEvent>
@@ -323,8 +325,8 @@ void ConnectionItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, Q
   QPolygonF head;
   head << end << end + QPointF(-9, -4.5) << end + QPointF(-9, 4.5);
   painter->drawPolygon(head);
-  QString text = label_;
-  if (problem_ == 3) text = text.isEmpty() ? QString("deadlock") : "deadlock\n" + text;
+  // The run's figures are drawn by the canvas above the nodes; here only the deadlock mark.
+  const QString text = problem_ == 3 ? QString("deadlock") : QString();
   if (!text.isEmpty()) {
     QFont font = painter->font();
     font.setPointSizeF(7.5);
@@ -492,17 +494,37 @@ void Canvas::rebuild() {
       for (auto* item : connections_) {
         const auto& conn = app.connections[item->index()];
         if (app::toString(conn.from) != stats.from || app::toString(conn.to) != stats.to) continue;
-        QString text = QString("%1 msg, %2").arg(stats.messages).arg(humanBytes(static_cast<double>(stats.bytes)));
+        QString total = QString("%1 msg, %2").arg(stats.messages).arg(humanBytes(static_cast<double>(stats.bytes)));
+        if (stats.dropped > 0) total += QString(", %1 dropped").arg(stats.dropped);
+        // On the canvas: the averages over the run; the totals in the tooltip.
+        QString shown = total;
         if (wall > 0) {
-          text += QString("\n%1 msg/s, %2/s")
-                      .arg(static_cast<double>(stats.messages) / wall, 0, 'f', 1)
+          shown = QString("%1 msg/s \u00b7 %2/s")
+                      .arg(static_cast<double>(stats.messages) / wall, 0, 'f', 0)
                       .arg(humanBytes(static_cast<double>(stats.bytes) / wall));
         }
-        if (stats.dropped > 0) text += QString(", %1 dropped").arg(stats.dropped);
-        item->setLabel(text);
+        item->setLabel(total);
+        item->setToolTip(item->toolTip() + "\nlast run: " + total + (wall > 0 ? "\naverage: " + shown : QString()));
+        auto* text = new QGraphicsSimpleTextItem(shown);
+        QFont font = text->font();
+        font.setPointSizeF(7);
+        text->setFont(font);
+        text->setBrush(QColor(30, 60, 120));
+        const QRectF box = text->boundingRect().adjusted(-3, -1, 3, 1);
+        auto* back = new QGraphicsRectItem(box);
+        back->setBrush(QColor(255, 255, 255, 225));
+        back->setPen(QPen(item->color(), 1));
+        text->setParentItem(back);
+        back->setPos(item->midPoint() - box.center());
+        back->setZValue(3);
+        back->setToolTip(item->toolTip());
+        scene_->addItem(back);
+        decorations_.push_back(back);
       }
     }
   }
+
+  if (!state_.run && !state_.live.empty()) setLiveRates(state_.live);
 
   const QSignalBlocker block(scene_);
   for (const auto& id : selected) {
@@ -510,6 +532,14 @@ void Canvas::rebuild() {
   }
   for (std::size_t c : selectedEdges) {
     if (auto* item = connectionItem(c)) item->setSelected(true);
+  }
+}
+
+void Canvas::setLiveRates(const std::map<std::string, double>& rates) {
+  state_.live = rates;
+  for (auto& [id, item] : nodes_) {
+    auto it = rates.find(id);
+    if (it != rates.end()) item->setRunInfo(QString("running \u00b7 %1 it/s").arg(it->second, 0, 'f', 0), false);
   }
 }
 

@@ -43,6 +43,8 @@ struct CanvasState {
   std::optional<RunReport> run;
   /// Positions for nodes the file places nowhere (shown there, not saved until moved).
   Positions fallback;
+  /// Live iterations/s per module while a run goes on (from the runtime's progress line).
+  std::map<std::string, double> live;
 };
 
 class NodeItem;
@@ -73,6 +75,8 @@ class Canvas : public QGraphicsView {
   ConnectionItem* connectionItem(std::size_t index) const;
   /// Scene position of a port's connection point.
   QPointF portScenePos(const std::string& node, const std::string& port) const;
+  /// Shows live iterations/s on the nodes, in place (no rebuild: a drag in progress goes on).
+  void setLiveRates(const std::map<std::string, double>& rates);
   /// Shows every node.
   void fitAll();
   /// Sizes of the node items (for the automatic layout).
@@ -198,6 +202,7 @@ class ConnectionItem : public QGraphicsItem {
   int problem() const { return problem_; }
   void setLabel(const QString& text) { label_ = text; }
   const QString& label() const { return label_; }
+  QPointF midPoint() const { return mid_; }
 
  private:
   std::size_t index_;

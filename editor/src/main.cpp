@@ -1,7 +1,7 @@
-// vrflow-editor [APP.xml] [--screenshot OUT.png] [--packages DIR]...
+// vrflow-editor [APP.xml] [--screenshot OUT.png [--run N]] [--packages DIR]...
 #include <QApplication>
 #include <QCommandLineParser>
-#include <QTimer>
+#include <QEventLoop>
 #include <cstdio>
 
 #include "main_window.hpp"
@@ -16,7 +16,9 @@ int main(int argc, char** argv) {
   parser.addPositionalArgument("APP.xml", "Application file to open");
   QCommandLineOption screenshot("screenshot", "Render the window to OUT.png and exit", "OUT.png");
   QCommandLineOption packages("packages", "Extra folder of node packages (repeatable)", "DIR");
+  QCommandLineOption runFirst("run", "With --screenshot: run the application N iterations first", "N");
   parser.addOption(screenshot);
+  parser.addOption(runFirst);
   parser.addOption(packages);
   parser.process(application);
 
@@ -42,6 +44,12 @@ int main(int argc, char** argv) {
   if (!files.isEmpty()) opened = window.openFile(files.front());
   if (!shooting) return application.exec();
   if (!opened) return 1;
+  if (parser.isSet(runFirst)) {
+    QEventLoop loop;
+    QObject::connect(&window, &vrflow::editor::gui::MainWindow::runFinished, &loop, &QEventLoop::quit);
+    window.runApplication(parser.value(runFirst).toInt());
+    if (window.running()) loop.exec();
+  }
   QApplication::processEvents();
   window.canvas()->fitAll();
   if (!window.screenshot(parser.value(screenshot))) {

@@ -5,6 +5,7 @@
 #include <QProcess>
 #include <QSettings>
 #include <QStringList>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -23,6 +24,7 @@ class QPlainTextEdit;
 class QMenu;
 class QAction;
 class QTemporaryDir;
+class QSocketNotifier;
 
 namespace vrflow::editor::gui {
 
@@ -97,6 +99,8 @@ class MainWindow : public QMainWindow {
   QPlainTextEdit* log() const { return log_; }
   QUndoStack* undoStack() const { return undo_; }
   const std::optional<RunReport>& lastRun() const { return lastRun_; }
+  /// Iterations/s per module from the running `vrflow`'s progress line (empty when none).
+  const std::map<std::string, double>& liveRates() const { return liveRates_; }
 
   /// Applies an edit through the undo stack; reports why when it cannot be made.
   bool apply(Result<Edit> edit, bool quietWhenUnchanged = true);
@@ -106,6 +110,8 @@ class MainWindow : public QMainWindow {
 
  Q_SIGNALS:
   void runFinished(int exitCode);
+  /// The runtime's live progress line was read: liveRates() changed.
+  void liveRatesUpdated();
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -119,6 +125,9 @@ class MainWindow : public QMainWindow {
   void showSelection();
   void problemActivated(int row);
   void finishRun(int exitCode);
+  void readTerminal();
+  void closeTerminal();
+  void handleRunOutput(const QString& text);
   void setDocument(app::Application app, OpenedText opened, const QString& path);
   void computeFallbackLayout();
   Reporter& reporter() { return *reporter_; }
@@ -150,6 +159,11 @@ class MainWindow : public QMainWindow {
   QElapsedTimer runClock_;
   std::optional<RunReport> lastRun_;
   QString runError_;
+  // The run's stderr is a pseudo-terminal, so that `vrflow` shows its live progress line.
+  int terminal_ = -1;
+  QSocketNotifier* terminalNotifier_ = nullptr;
+  QString terminalPending_;
+  std::map<std::string, double> liveRates_;
 };
 
 }  // namespace vrflow::editor::gui

@@ -465,6 +465,50 @@ TEST_F(EditorWindow, RunsAnApplicationAndShowsWhatTheRunReported) {
   EXPECT_TRUE(window_->log()->toPlainText().contains("Run finished"));
 }
 
+TEST_F(EditorWindow, ShowsLiveIterationRatesWhileARunGoesOn) {
+  QDir::setCurrent(dir_.path());
+  // 60 iterations of a relay that waits 25 ms each: the run lasts at least 1.5 s, and the
+  // runtime prints its progress line every second.
+  dropFromPalette("module core source", {0, 0});
+  dropFromPalette("module core relay", {300, 0});
+  dropFromPalette("module core recorder", {600, 0});
+  dragConnect("source.out", "relay.in");
+  dragConnect("relay.out", "recorder.in");
+  window_->apply(setParameter(app(), "relay", "delay-ms", "25"));
+  reporter_.nextFile = dir_.filePath("live.xml");
+  QSignalSpy live(window_.get(), &MainWindow::liveRatesUpdated);
+  QSignalSpy finished(window_.get(), &MainWindow::runFinished);
+  window_->runApplication(60);
+  ASSERT_TRUE(finished.wait(60000)) << window_->log()->toPlainText().toStdString();
+  EXPECT_EQ(finished.at(0).at(0).toInt(), 0) << window_->log()->toPlainText().toStdString();
+  ASSERT_GE(live.count(), 1) << window_->log()->toPlainText().toStdString();
+  EXPECT_EQ(window_->liveRates().count("relay"), 1u);
+  EXPECT_EQ(window_->liveRates().count("source"), 1u);
+  EXPECT_FALSE(window_->log()->toPlainText().contains("[vrflow "));  // not in the log
+  EXPECT_EQ(window_->lastRun()->modules.at("relay").iterations, 60);
+}
+
+TEST_F(EditorWindow, StopsARunThatWouldNotEnd) {
+  QDir::setCurrent(dir_.path());
+  dropFromPalette("module core source", {0, 0});  // count 0: until the run stops
+  dropFromPalette("module core relay", {300, 0});
+  dropFromPalette("module core recorder", {600, 0});
+  dragConnect("source.out", "relay.in");
+  dragConnect("relay.out", "recorder.in");
+  window_->apply(setParameter(app(), "relay", "delay-ms", "20"));
+  reporter_.nextFile = dir_.filePath("endless.xml");
+  QSignalSpy live(window_.get(), &MainWindow::liveRatesUpdated);
+  QSignalSpy finished(window_.get(), &MainWindow::runFinished);
+  window_->runApplication();
+  ASSERT_TRUE(window_->running());
+  ASSERT_TRUE(live.wait(30000)) << window_->log()->toPlainText().toStdString();  // it is going
+  window_->stopRun();
+  ASSERT_TRUE(finished.count() > 0 || finished.wait(30000));
+  EXPECT_EQ(finished.at(0).at(0).toInt(), 130) << window_->log()->toPlainText().toStdString();
+  EXPECT_FALSE(window_->running());
+  EXPECT_TRUE(window_->log()->toPlainText().contains("Run stopped"));
+}
+
 TEST_F(EditorWindow, AFailedRunShowsTheFailingModule) {
   QDir::setCurrent(dir_.path());
   dropFromPalette("module core source", {0, 0});
