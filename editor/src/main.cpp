@@ -1,4 +1,4 @@
-// vrflow-editor [APP.xml] [--screenshot OUT.png [--run N]] [--packages DIR]...
+// vrflow-editor [APP.xml] [--screenshot OUT.png [--run N] [--select ID]] [--packages DIR]...
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QEventLoop>
@@ -18,7 +18,9 @@ int main(int argc, char** argv) {
   QCommandLineOption packages("packages", "Extra folder of node packages (repeatable)", "DIR");
   QCommandLineOption runFirst("run", "With --screenshot: run the application N iterations first", "N");
   parser.addOption(screenshot);
+  QCommandLineOption select("select", "With --screenshot: select this node first (its properties show)", "ID");
   parser.addOption(runFirst);
+  parser.addOption(select);
   parser.addOption(packages);
   parser.process(application);
 
@@ -50,6 +52,7 @@ int main(int argc, char** argv) {
     window.runApplication(parser.value(runFirst).toInt());
     if (window.running()) loop.exec();
   }
+  if (parser.isSet(select)) window.canvas()->selectOnly({parser.value(select).toStdString()});
   QApplication::processEvents();
   window.canvas()->fitAll();
   if (!window.screenshot(parser.value(screenshot))) {

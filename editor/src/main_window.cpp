@@ -152,15 +152,14 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
     addDockWidget(area, d);
     return d;
   };
-  auto* paletteDock = dock("Palette", palette_, Qt::LeftDockWidgetArea);
-  auto* propertiesDock = dock("Properties", properties_, Qt::RightDockWidgetArea);
-  auto* hostsDock = dock("Hosts", hosts_, Qt::RightDockWidgetArea);
-  splitDockWidget(propertiesDock, hostsDock, Qt::Vertical);
+  paletteDock_ = dock("Palette", palette_, Qt::LeftDockWidgetArea);
+  propertiesDock_ = dock("Properties", properties_, Qt::RightDockWidgetArea);
+  hostsDock_ = dock("Hosts", hosts_, Qt::RightDockWidgetArea);
+  splitDockWidget(propertiesDock_, hostsDock_, Qt::Vertical);
   auto* problemsDock = dock("Problems", problemList_, Qt::BottomDockWidgetArea);
   auto* logDock = dock("Run log", log_, Qt::BottomDockWidgetArea);
   tabifyDockWidget(problemsDock, logDock);
   problemsDock->raise();
-  resizeDocks({paletteDock, propertiesDock}, {190, 320}, Qt::Horizontal);
   resizeDocks({problemsDock}, {150}, Qt::Vertical);
   log_->setReadOnly(true);
   log_->setMaximumBlockCount(20000);
@@ -444,6 +443,15 @@ void MainWindow::updateTitle() {
   const QString name = path_.isEmpty() ? QString("untitled") : QFileInfo(path_).fileName();
   setWindowTitle(name + "[*] \u2014 " + q(app_.name) + " \u2014 vrflow editor");
   setWindowModified(modified());
+}
+
+void MainWindow::showEvent(QShowEvent* event) {
+  QMainWindow::showEvent(event);
+  if (shown_) return;
+  shown_ = true;
+  // Dock sizes apply once the window has its size.
+  resizeDocks({paletteDock_, propertiesDock_}, {190, 330}, Qt::Horizontal);
+  resizeDocks({propertiesDock_, hostsDock_}, {height() * 2 / 5, height() / 5}, Qt::Vertical);
 }
 
 void MainWindow::closeEvent(QCloseEvent* event) {

@@ -22,6 +22,7 @@ class QUndoStack;
 class QListWidget;
 class QPlainTextEdit;
 class QMenu;
+class QDockWidget;
 class QAction;
 class QTemporaryDir;
 class QSocketNotifier;
@@ -115,6 +116,7 @@ class MainWindow : public QMainWindow {
 
  protected:
   void closeEvent(QCloseEvent* event) override;
+  void showEvent(QShowEvent* event) override;
 
  private:
   void buildMenus();
@@ -151,6 +153,10 @@ class MainWindow : public QMainWindow {
   QListWidget* problemList_;
   QPlainTextEdit* log_;
   QMenu* recentMenu_ = nullptr;
+  QDockWidget* paletteDock_ = nullptr;
+  QDockWidget* propertiesDock_ = nullptr;
+  QDockWidget* hostsDock_ = nullptr;
+  bool shown_ = false;
   QAction* runAction_ = nullptr;
   QAction* stopAction_ = nullptr;
 

@@ -17,6 +17,7 @@
 #include <QToolButton>
 #include <QVBoxLayout>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -185,7 +186,24 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
   const std::string node = node_;
   const std::string name = spec.name;
   const std::string shown = set ? value : spec.defaultValue;
-  auto emitValue = [this, node, name](const std::string& v) { Q_EMIT parameterEdited(node, name, v); };
+  const bool numeric = spec.type == app::ParamType::Int || spec.type == app::ParamType::Float ||
+                       spec.type == app::ParamType::Vec3;
+  // A widget left without a change (focus passing through) must not write the value it shows:
+  // an unset parameter would become set to its default, "1e-3" would become "0.001".
+  auto emitValue = [this, node, name, shown, numeric](const std::string& v) {
+    if (v == shown) return;
+    if (numeric) {
+      std::istringstream a(v), b(shown);
+      double x = 0, y = 0;
+      bool same = true, any = false;
+      while (a >> x) {
+        if (!(b >> y) || x != y) same = false;
+        any = true;
+      }
+      if (any && same && !(b >> y)) return;
+    }
+    Q_EMIT parameterEdited(node, name, v);
+  };
   QWidget* widget = nullptr;
   switch (spec.type) {
     case app::ParamType::Int: {
@@ -206,7 +224,7 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
       box->setKeyboardTracking(false);
       connect(box, &QDoubleSpinBox::editingFinished, this, [box, emitValue] {
         std::ostringstream text;
-        text << box->value();
+        text << std::setprecision(12) << box->value();
         emitValue(text.str());
       });
       widget = box;
@@ -248,7 +266,7 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
       for (auto* box : boxes) {
         connect(box, &QDoubleSpinBox::editingFinished, this, [boxes, emitValue] {
           std::ostringstream text;
-          text << boxes[0]->value() << ' ' << boxes[1]->value() << ' ' << boxes[2]->value();
+          text << std::setprecision(12) << boxes[0]->value() << ' ' << boxes[1]->value() << ' ' << boxes[2]->value();
           emitValue(text.str());
         });
       }
@@ -285,6 +303,10 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
     }
   }
   widget->setObjectName("param:" + q(name));
+  // Spin boxes with wide ranges ask for much width: let them shrink to the panel.
+  for (auto* box : widget->findChildren<QAbstractSpinBox*>()) box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+  if (auto* box = qobject_cast<QAbstractSpinBox*>(widget)) box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+  widget->setMinimumWidth(60);
   QString tip = q(spec.doc);
   tip += (tip.isEmpty() ? "" : "\n") + QString("type: ") + q(app::toString(spec.type));
   tip += "\ndefault: " + (spec.defaultValue.empty() ? QString("(empty)") : q(spec.defaultValue));
@@ -307,6 +329,7 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
   outer->setContentsMargins(0, 0, 0, 0);
   auto* scroll = new QScrollArea;
   scroll->setWidgetResizable(true);
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
   auto* content = new QWidget;
   auto* form = new QFormLayout(content);
   form->setFieldGrowthPolicy(QFormLayout::AllNonFixedFieldsGrow);

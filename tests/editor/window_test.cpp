@@ -260,12 +260,32 @@ TEST_F(EditorWindow, EditsAParameterAndInitialMessagesInThePropertiesPanel) {
   EXPECT_EQ(app::findParam(app::findModule(app(), "spring")->params, "stiffness"), nullptr);
   window_->undoStack()->redo();
   EXPECT_EQ(app::paramString(app::findModule(app(), "spring")->params, "stiffness", ""), "123.5");
+  // Leaving a field unchanged writes nothing (an unset parameter stays unset).
+  auto* damping = qobject_cast<QDoubleSpinBox*>(window_->properties()->parameterWidget("damping"));
+  ASSERT_NE(damping, nullptr);
+  const int edits = window_->undoStack()->count();
+  Q_EMIT damping->editingFinished();
+  EXPECT_EQ(window_->undoStack()->count(), edits);
+  EXPECT_EQ(app::findParam(app::findModule(app(), "spring")->params, "damping"), nullptr);
   // Other widget types: a vec3 for gravity's g, an int with range for points' count.
   canvas()->selectOnly({"points"});
   auto* count = qobject_cast<QSpinBox*>(window_->properties()->parameterWidget("count"));
   ASSERT_NE(count, nullptr);
   EXPECT_EQ(count->minimum(), 1);
   EXPECT_EQ(count->maximum(), 100000);
+  // The vec3 of gravity: three numbers, written as the manifest writes them.
+  dropFromPalette("module core gravity", {0, 300});
+  canvas()->selectOnly({"gravity"});
+  QWidget* g = window_->properties()->parameterWidget("g");
+  ASSERT_NE(g, nullptr);
+  auto* gy = g->findChild<QDoubleSpinBox*>("component1");
+  ASSERT_NE(gy, nullptr);
+  EXPECT_DOUBLE_EQ(gy->value(), -9.81);
+  gy->selectAll();
+  QTest::keyClicks(gy, "-3.5");
+  QTest::keyClick(gy, Qt::Key_Return);
+  EXPECT_EQ(app::paramString(app::findModule(app(), "gravity")->params, "g", ""), "0 -3.5 0");
+  canvas()->selectOnly({"points"});
   auto* initial = qobject_cast<QSpinBox*>(window_->properties()->initialMessagesWidget("events"));
   ASSERT_NE(initial, nullptr);
   initial->selectAll();
