@@ -507,7 +507,7 @@ void MainWindow::refresh() {
   const std::size_t filterTypes = catalog_->filterTypes().size();
   problems_ = findProblems(app_, *catalog_, [this](const app::Application& loaded) {
     return daemon::loadApplicationPlugins(loaded, *catalog_);
-  });
+  }, &opened_);
   if (catalog_->filterTypes().size() != filterTypes) palette_->setCatalog(*catalog_);  // a plugin added some
   CanvasState& state = canvas_->state();
   state.app = &app_;

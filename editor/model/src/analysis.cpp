@@ -57,9 +57,9 @@ std::vector<std::size_t> cycleConnections(const app::Application& app, const std
 }  // namespace
 
 std::vector<Problem> findProblems(const app::Application& app, const app::Catalog& catalog,
-                                  const ExtraCheck& extra) {
+                                  const ExtraCheck& extra, const OpenedText* opened) {
   const std::string fileName = app.file.empty() ? std::string("untitled.xml") : app.file;
-  const std::string xml = app::saveApplication(app);
+  const std::string xml = opened != nullptr ? textToSave(app, *opened) : app::saveApplication(app);
   std::vector<app::Diagnostic> diagnostics;
   auto loaded = app::loadApplicationString(xml, fileName, &diagnostics);
   std::vector<Problem> problems;

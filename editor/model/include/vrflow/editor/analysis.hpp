@@ -16,6 +16,7 @@
 #include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/model.hpp"
 #include "vrflow/base/result.hpp"
+#include "vrflow/editor/edit.hpp"
 
 namespace vrflow::editor {
 
@@ -34,9 +35,10 @@ using ExtraCheck = std::function<std::vector<app::Diagnostic>(const app::Applica
 
 /// Every problem `vrflow validate` would print for `app` saved as it is now (same loader, same
 /// rules: the application is saved to text and checked as the command checks a file), each
-/// tied to its node or connection.
+/// tied to its node or connection. When `opened` is given and `app` is still what was loaded
+/// from it, its own text is checked, so that lines are those of the file on disk.
 std::vector<Problem> findProblems(const app::Application& app, const app::Catalog& catalog,
-                                  const ExtraCheck& extra = {});
+                                  const ExtraCheck& extra = {}, const OpenedText* opened = nullptr);
 
 /// Positions (x, y of the top-left corner, y down) for every node, from Graphviz `dot`, left to
 /// right. `sizes` gives each node's width and height (missing: 160 x 80).
