@@ -354,6 +354,11 @@ Canvas::Canvas(QWidget* parent) : QGraphicsView(parent), scene_(new QGraphicsSce
   connect(scene_, &QGraphicsScene::selectionChanged, this, &Canvas::selectionChangedIds);
 }
 
+Canvas::~Canvas() {
+  // The scene (a child) is deleted after this object: its last signals must not reach it.
+  disconnect(scene_, nullptr, this, nullptr);
+}
+
 void Canvas::rebuild() {
   const std::vector<std::string> selected = selectedNodes();
   const std::vector<std::size_t> selectedEdges = selectedConnections();

@@ -56,6 +56,7 @@ class Canvas : public QGraphicsView {
 
  public:
   explicit Canvas(QWidget* parent = nullptr);
+  ~Canvas() override;
 
   CanvasState& state() { return state_; }
   /// Recreates every item from state(); keeps the selection (by id) and the view.

@@ -14,6 +14,7 @@
 #include <QScrollArea>
 #include <QSpinBox>
 #include <QTableWidget>
+#include <QTimer>
 #include <QToolButton>
 #include <QVBoxLayout>
 #include <cmath>
@@ -162,8 +163,18 @@ PropertiesPanel::PropertiesPanel(QWidget* parent) : QWidget(parent), layout_(new
   clear();
 }
 
+// The old body goes later: show() runs from the signals of its own widgets (an edit is applied,
+// the window refreshes), and a widget must not be deleted inside its own signal.
+static void dropLater(QWidget*& body) {
+  if (body == nullptr) return;
+  body->hide();
+  body->setParent(nullptr);
+  body->deleteLater();
+  body = nullptr;
+}
+
 void PropertiesPanel::clear() {
-  delete body_;
+  dropLater(body_);
   body_ = new QWidget;
   auto* scroll = new QScrollArea;
   scroll->setWidgetResizable(true);
@@ -318,8 +329,7 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
 
 void PropertiesPanel::show(const app::Application& app, const app::Catalog& catalog, const std::string& node) {
   node_ = node;
-  delete body_;
-  body_ = nullptr;
+  dropLater(body_);
   if (node.empty() || nodeKind(app, node) == NodeKind::None) {
     clear();
     return;
@@ -487,8 +497,13 @@ HostsPanel::HostsPanel(QWidget* parent) : QWidget(parent) {
   connect(table_, &QTableWidget::itemChanged, this, [this](QTableWidgetItem* item) {
     if (filling_ || item->row() < 0 || static_cast<std::size_t>(item->row()) >= ids_.size()) return;
     const std::string host = ids_[static_cast<std::size_t>(item->row())];
-    if (item->column() == 1) Q_EMIT renameRequested(host, s(item->text()));
-    if (item->column() == 2) Q_EMIT addressChanged(host, s(item->text()));
+    const std::string text = s(item->text());
+    const int column = item->column();
+    // Applied after the table is done with its item (the refresh replaces the rows).
+    QTimer::singleShot(0, this, [this, host, text, column] {
+      if (column == 1) Q_EMIT renameRequested(host, text);
+      if (column == 2) Q_EMIT addressChanged(host, text);
+    });
   });
 }
 

@@ -330,6 +330,19 @@ TEST_F(EditorWindow, AssignsHostsFromThePanelTheContextOfANodeAndByDrop) {
   EXPECT_EQ(app::findModule(app(), "points")->host, "localhost");
   // The saved file says it.
   EXPECT_NE(app::saveApplication(app()).find("type=\"spring\" host=\"far\""), std::string::npos);
+  // Renaming a host and changing its address in the table; the nodes follow.
+  window_->hosts()->table()->item(1, 1)->setText("gpu");
+  QApplication::processEvents();
+  ASSERT_EQ(app().hosts[1].id, "gpu");
+  EXPECT_EQ(app::findModule(app(), "spring")->host, "gpu");
+  window_->hosts()->table()->item(1, 2)->setText("10.0.0.10");
+  QApplication::processEvents();
+  EXPECT_EQ(app().hosts[1].address, "10.0.0.10");
+  // A name already taken is refused and the table shows the real name again.
+  window_->hosts()->table()->item(1, 1)->setText("localhost");
+  QApplication::processEvents();
+  EXPECT_EQ(app().hosts[1].id, "gpu");
+  EXPECT_EQ(window_->hosts()->table()->item(1, 1)->text(), "gpu");
 }
 
 TEST_F(EditorWindow, DeletesDuplicatesCopiesAndPastes) {

@@ -123,12 +123,15 @@ std::map<std::string, std::pair<double, double>> autoLayout(
   std::map<std::string, std::pair<double, double>> result;
   const auto ids = nodeIds(app);
   if (ids.empty()) return result;
-  GVC_t* gvc = gvContext();
+  // One Graphviz context for the process: contexts made and freed one after the other leave
+  // its text-measuring plugin with dangling font caches (seen under AddressSanitizer).
+  static GVC_t* const gvc = gvContext();
   Agraph_t* g = agopen(const_cast<char*>("app"), Agdirected, nullptr);
   agattr(g, AGRAPH, const_cast<char*>("rankdir"), const_cast<char*>("LR"));
   agattr(g, AGRAPH, const_cast<char*>("nodesep"), const_cast<char*>("0.35"));
   agattr(g, AGRAPH, const_cast<char*>("ranksep"), const_cast<char*>("0.6"));
   agattr(g, AGNODE, const_cast<char*>("shape"), const_cast<char*>("box"));
+  agattr(g, AGNODE, const_cast<char*>("label"), const_cast<char*>(""));  // sizes are given: no text
   agattr(g, AGNODE, const_cast<char*>("fixedsize"), const_cast<char*>("true"));
   agattr(g, AGNODE, const_cast<char*>("width"), const_cast<char*>("2"));
   agattr(g, AGNODE, const_cast<char*>("height"), const_cast<char*>("1"));
@@ -162,7 +165,6 @@ std::map<std::string, std::pair<double, double>> autoLayout(
     gvFreeLayout(gvc, g);
   }
   agclose(g);
-  gvFreeContext(gvc);
   return result;
 }
 
