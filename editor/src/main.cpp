@@ -37,7 +37,10 @@ int main(int argc, char** argv) {
     Choice askToSave(QWidget*, const QString&) override { return Choice::Discard; }
   } stderrReporter;
   const bool shooting = parser.isSet(screenshot);
-  if (shooting) options.reporter = &stderrReporter;
+  if (shooting) {
+    options.reporter = &stderrReporter;
+    options.rememberRecent = false;  // a picture is not a use of the file
+  }
 
   vrflow::editor::gui::MainWindow window(options);
   window.show();

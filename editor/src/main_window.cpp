@@ -420,6 +420,7 @@ bool MainWindow::maybeSave() {
 QStringList MainWindow::recentFiles() const { return settings_->value("recentFiles").toStringList(); }
 
 void MainWindow::addRecent(const QString& path) {
+  if (!options_.rememberRecent) return;
   QStringList files = recentFiles();
   files.removeAll(path);
   files.prepend(path);

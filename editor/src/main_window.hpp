@@ -49,6 +49,7 @@ struct EditorOptions {
   QString settingsFile;                  ///< recent files; empty: the user's settings
   Reporter* reporter = nullptr;          ///< not owned; null: dialogs
   QString vrflowProgram;                 ///< empty: `vrflow` beside this program
+  bool rememberRecent = true;            ///< false: opening and saving leave the settings alone
 };
 
 class MainWindow : public QMainWindow {

@@ -377,7 +377,7 @@ TEST_F(EditorWindow, SavesAndReloadsAnEqualModel) {
   const std::string saved = app::saveApplication(app());
   EXPECT_EQ(readFile(file), saved);
 
-  MainWindow other(EditorOptions{{}, dir_.filePath("other.ini"), &reporter_, {}});
+  MainWindow other(EditorOptions{{}, dir_.filePath("other.ini"), &reporter_, {}, true});
   ASSERT_TRUE(other.openFile(file));
   EXPECT_EQ(app::saveApplication(other.application()), saved);
   EXPECT_EQ(other.application().connections.size(), 2u);
