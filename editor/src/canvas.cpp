@@ -809,18 +809,26 @@ void Canvas::contextMenuEvent(QContextMenuEvent* event) {
   Q_EMIT contextMenuForNodes(selectedNodes(), event->globalPos());
 }
 
+namespace {
+// Drops are always copies: a move would make the palette or the hosts table drop the row.
+void acceptAsCopy(QDropEvent* event) {
+  event->setDropAction(Qt::CopyAction);
+  event->accept();
+}
+}  // namespace
+
 void Canvas::dragEnterEvent(QDragEnterEvent* event) {
   if (event->mimeData()->hasFormat(kNodeMime) || event->mimeData()->hasFormat(kHostMime)) {
-    event->acceptProposedAction();
+    acceptAsCopy(event);
   }
 }
 
 void Canvas::dragMoveEvent(QDragMoveEvent* event) {
   if (event->mimeData()->hasFormat(kNodeMime)) {
-    event->acceptProposedAction();
+    acceptAsCopy(event);
   } else if (event->mimeData()->hasFormat(kHostMime)) {
     if (nodeAt(event->position().toPoint()) != nullptr) {
-      event->acceptProposedAction();
+      acceptAsCopy(event);
     } else {
       event->ignore();
     }
@@ -832,11 +840,11 @@ void Canvas::dropEvent(QDropEvent* event) {
   if (mime->hasFormat(kNodeMime)) {
     const QPointF at = mapToScene(event->position().toPoint());
     Q_EMIT addRequested(QString::fromUtf8(mime->data(kNodeMime)), QPointF(snap(at.x()), snap(at.y())));
-    event->acceptProposedAction();
+    acceptAsCopy(event);
   } else if (mime->hasFormat(kHostMime)) {
     if (NodeItem* node = nodeAt(event->position().toPoint())) {
       Q_EMIT hostDropped(QString::fromUtf8(mime->data(kHostMime)), node->id());
-      event->acceptProposedAction();
+      acceptAsCopy(event);
     }
   }
 }

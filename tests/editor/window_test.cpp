@@ -105,8 +105,12 @@ class EditorWindow : public ::testing::Test {
     QApplication::sendEvent(viewport, &enter);
     QDragMoveEvent move(at, Qt::CopyAction, mime, Qt::LeftButton, Qt::NoModifier);
     QApplication::sendEvent(viewport, &move);
-    QDropEvent dropped(QPointF(at), Qt::CopyAction, mime, Qt::LeftButton, Qt::NoModifier);
+    // Offered as a move too: the canvas must take a copy, or the panel would lose the row.
+    QDropEvent dropped(QPointF(at), Qt::CopyAction | Qt::MoveAction, mime, Qt::LeftButton, Qt::NoModifier);
+    dropped.setDropAction(Qt::MoveAction);
     QApplication::sendEvent(viewport, &dropped);
+    EXPECT_TRUE(dropped.isAccepted());
+    EXPECT_EQ(dropped.dropAction(), Qt::CopyAction);
     QApplication::processEvents();
   }
 
