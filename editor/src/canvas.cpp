@@ -325,19 +325,7 @@ void ConnectionItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, Q
   QPolygonF head;
   head << end << end + QPointF(-9, -4.5) << end + QPointF(-9, 4.5);
   painter->drawPolygon(head);
-  // The run's figures are drawn by the canvas above the nodes; here only the deadlock mark.
-  const QString text = problem_ == 3 ? QString("deadlock") : QString();
-  if (!text.isEmpty()) {
-    QFont font = painter->font();
-    font.setPointSizeF(7.5);
-    painter->setFont(font);
-    const QRectF r = painter->boundingRect(QRectF(mid_ - QPointF(90, 20), QSizeF(180, 40)), Qt::AlignCenter, text);
-    painter->setPen(Qt::NoPen);
-    painter->setBrush(QColor(255, 255, 255, 220));
-    painter->drawRoundedRect(r.adjusted(-3, -1, 3, 1), 3, 3);
-    painter->setPen(problem_ >= 2 ? QColor(200, 20, 20) : QColor(40, 44, 52));
-    painter->drawText(r, Qt::AlignCenter, text);
-  }
+  // Labels (run figures, "deadlock") are items of their own, above the nodes.
 }
 
 // ---- Canvas ------------------------------------------------------------------------------
@@ -358,6 +346,25 @@ Canvas::~Canvas() {
   // The scene (a child) is deleted after this object: its last signals must not reach it.
   disconnect(scene_, nullptr, this, nullptr);
 }
+
+namespace {
+// A small boxed text at `centre`, above the nodes.
+QGraphicsRectItem* makeLabel(const QString& text, QPointF centre, QColor border, QColor ink) {
+  auto* item = new QGraphicsSimpleTextItem(text);
+  QFont font = item->font();
+  font.setPointSizeF(7);
+  item->setFont(font);
+  item->setBrush(ink);
+  const QRectF box = item->boundingRect().adjusted(-3, -1, 3, 1);
+  auto* back = new QGraphicsRectItem(box);
+  back->setBrush(QColor(255, 255, 255, 225));
+  back->setPen(QPen(border, 1));
+  item->setParentItem(back);
+  back->setPos(centre - box.center());
+  back->setZValue(3);
+  return back;
+}
+}  // namespace
 
 void Canvas::rebuild() {
   const std::vector<std::string> selected = selectedNodes();
@@ -454,6 +461,10 @@ void Canvas::rebuild() {
         if (auto* item = connectionItem(c)) {
           item->setProblem(3);
           item->setToolTip(item->toolTip() + "\n" + q(p.message));
+          auto* label = makeLabel("deadlock", item->midPoint(), QColor(220, 30, 30), QColor(200, 20, 20));
+          label->setToolTip(q(p.message));
+          scene_->addItem(label);
+          decorations_.push_back(label);
         }
       }
       continue;
@@ -510,18 +521,7 @@ void Canvas::rebuild() {
         }
         item->setLabel(total);
         item->setToolTip(item->toolTip() + "\nlast run: " + total + (wall > 0 ? "\naverage: " + shown : QString()));
-        auto* text = new QGraphicsSimpleTextItem(shown);
-        QFont font = text->font();
-        font.setPointSizeF(7);
-        text->setFont(font);
-        text->setBrush(QColor(30, 60, 120));
-        const QRectF box = text->boundingRect().adjusted(-3, -1, 3, 1);
-        auto* back = new QGraphicsRectItem(box);
-        back->setBrush(QColor(255, 255, 255, 225));
-        back->setPen(QPen(item->color(), 1));
-        text->setParentItem(back);
-        back->setPos(item->midPoint() - box.center());
-        back->setZValue(3);
+        auto* back = makeLabel(shown, item->midPoint(), item->color(), QColor(30, 60, 120));
         back->setToolTip(item->toolTip());
         scene_->addItem(back);
         decorations_.push_back(back);
