@@ -481,11 +481,22 @@ void Canvas::rebuild() {
       entry.second << (level == 2 ? "error: " : "warning: ") + q(p.message);
     }
   }
+  // Tooltips: the problems first, then what the node is.
   for (auto& [id, item] : nodes_) {
+    QString about = item->toolTip();  // instances: how many modules, where
+    if (const auto* m = app::findModule(app, id)) {
+      const auto* type = catalog.findModule(m->package, m->type);
+      about = q(m->id + ": module " + m->package + "/" + m->type + " on " + app::effectiveHost(app, m->host)) +
+              (type != nullptr && !type->doc.empty() ? "\n" + q(type->doc) : QString());
+    } else if (const auto* f = app::findFilter(app, id)) {
+      const auto* type = catalog.findFilter(f->type);
+      about = q(f->id + ": filter " + f->type + " on " + app::effectiveHost(app, f->host)) +
+              (type != nullptr && !type->doc.empty() ? "\n" + q(type->doc) : QString());
+    }
     if (auto it = nodeProblems.find(id); it != nodeProblems.end()) {
-      item->setProblems(it->second.first, it->second.second.join("\n"));
-    } else if (item->toolTip().isEmpty()) {
-      item->setToolTip(item->kind() == NodeKind::Module ? "" : "");
+      item->setProblems(it->second.first, it->second.second.join("\n") + "\n\n" + about);
+    } else {
+      item->setToolTip(about);
     }
   }
 
