@@ -20,6 +20,7 @@
 #include <QTemporaryDir>
 #include <QTest>
 #include <QUndoStack>
+#include <QWheelEvent>
 #include <filesystem>
 #include <memory>
 
@@ -247,6 +248,33 @@ TEST_F(EditorWindow, MovesNodesByDragAndUndoes) {
   window_->undoStack()->undo();
   EXPECT_NEAR(app::findEditorNode(app(), "spring")->x, 300, 10);
   EXPECT_NEAR(canvas()->nodeItem("spring")->pos().x(), 300, 10);
+}
+
+TEST_F(EditorWindow, ZoomsPansAndSelectsWithARubberBand) {
+  pointsAndSpring();
+  canvas()->resetTransform();
+  canvas()->centerOn(200, 50);
+  QApplication::processEvents();
+  const QPoint centre = canvas()->viewport()->rect().center();
+  QWheelEvent wheel(QPointF(centre), canvas()->viewport()->mapToGlobal(QPointF(centre)), QPoint(), QPoint(0, 240),
+                    Qt::NoButton, Qt::NoModifier, Qt::NoScrollPhase, false);
+  QApplication::sendEvent(canvas()->viewport(), &wheel);
+  EXPECT_GT(canvas()->transform().m11(), 1.2);
+  // Middle button drag pans.
+  const QPointF before = canvas()->mapToScene(centre);
+  mouse(QEvent::MouseButtonPress, centre, Qt::MiddleButton, Qt::MiddleButton);
+  mouse(QEvent::MouseMove, centre + QPoint(80, 40), Qt::NoButton, Qt::MiddleButton);
+  mouse(QEvent::MouseButtonRelease, centre + QPoint(80, 40), Qt::MiddleButton, Qt::NoButton);
+  EXPECT_GT(QLineF(before, canvas()->mapToScene(centre)).length(), 20);
+  // A rubber band from empty space around both nodes selects both.
+  canvas()->resetTransform();
+  canvas()->centerOn(200, 50);
+  QApplication::processEvents();
+  canvas()->selectOnly({});
+  drag(QPointF(-40, -60), QPointF(560, 200));
+  EXPECT_EQ(canvas()->selectedNodes(), (std::vector<std::string>{"points", "spring"}));
+  // Nothing moved: a rubber band is not an edit.
+  EXPECT_EQ(window_->undoStack()->count(), 2);
 }
 
 TEST_F(EditorWindow, EditsAParameterAndInitialMessagesInThePropertiesPanel) {
