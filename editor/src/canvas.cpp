@@ -401,15 +401,37 @@ void Canvas::rebuild() {
     scene_->addItem(item);
     nodes_[item->id()] = item;
   };
+  // A node whose type no installed package declares still shows the ports its connections
+  // name, so that the network keeps its shape (validation reports the unknown type).
+  auto portsFromConnections = [&](const std::string& id) {
+    std::vector<app::PortSpec> ports;
+    auto add = [&](const std::string& name, bool input) {
+      for (const auto& p : ports) {
+        if (p.name == name && p.isInput == input) return;
+      }
+      app::PortSpec spec;
+      spec.name = name;
+      spec.isInput = input;
+      spec.doc = "declared by no installed package";
+      ports.push_back(spec);
+    };
+    for (const auto& c : app.connections) {
+      if (c.to.node == id) add(c.to.port, true);
+      if (c.from.node == id) add(c.from.port, false);
+    }
+    return ports;
+  };
   for (const auto& m : app.modules) {
     const auto* type = catalog.findModule(m.package, m.type);
-    const QString sub = q(m.package + "/" + m.type) + (type == nullptr ? "  (unknown)" : "");
-    place(new NodeItem(m.id, NodeKind::Module, q(m.id), sub, colorFor(m.host),
-                       q(app::effectiveHost(app, m.host)), catalog.portsOf(m)));
+    const QString sub = q(m.package + "/" + m.type) + (type == nullptr ? " (unknown)" : "");
+    place(new NodeItem(m.id, NodeKind::Module, q(m.id), sub, colorFor(m.host), q(app::effectiveHost(app, m.host)),
+                       type == nullptr ? portsFromConnections(m.id) : catalog.portsOf(m)));
   }
   for (const auto& f : app.filters) {
-    place(new NodeItem(f.id, NodeKind::Filter, q(f.id), q(f.type), colorFor(f.host),
-                       q(app::effectiveHost(app, f.host)), catalog.portsOf(f)));
+    const auto* type = catalog.findFilter(f.type);
+    place(new NodeItem(f.id, NodeKind::Filter, q(f.id), q(f.type) + (type == nullptr ? " (unknown)" : ""),
+                       colorFor(f.host), q(app::effectiveHost(app, f.host)),
+                       type == nullptr ? portsFromConnections(f.id) : catalog.portsOf(f)));
   }
   // Instances: how many modules they expand to, and on which hosts.
   std::map<std::string, std::pair<int, std::set<std::string>>> spread;

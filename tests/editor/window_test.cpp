@@ -461,6 +461,23 @@ TEST_F(EditorWindow, ShowsADeadlockCycleAsAnErrorOnCanvasAndInTheProblems) {
   EXPECT_TRUE(canvas()->nodeItem("spring")->toolTip().contains("stiffness"));
 }
 
+TEST_F(EditorWindow, NodesOfUnknownTypesKeepThePortsTheirConnectionsName) {
+  const QString file = dir_.filePath("unknown.xml");
+  {
+    QFile out(file);
+    ASSERT_TRUE(out.open(QIODevice::WriteOnly));
+    out.write("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"u\" version=\"1\">\n"
+              "  <modules>\n    <module id=\"a\" package=\"nowhere\" type=\"thing\"/>\n"
+              "    <module id=\"r\" package=\"core\" type=\"recorder\"/>\n  </modules>\n"
+              "  <connections>\n    <connection from=\"a.out\" to=\"r.in\"/>\n  </connections>\n"
+              "</application>\n");
+  }
+  ASSERT_TRUE(window_->openFile(file));
+  EXPECT_NE(canvas()->portItem("a", "out"), nullptr);
+  EXPECT_NE(canvas()->connectionItem(0), nullptr);
+  EXPECT_EQ(canvas()->nodeItem("a")->problemLevel(), 2);  // unknown package
+}
+
 TEST_F(EditorWindow, AMalformedFileGivesAClearMessageAndKeepsTheDocument) {
   pointsAndSpring();
   const QString bad = dir_.filePath("bad.xml");
