@@ -227,7 +227,10 @@ void NodeItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
     painter->setFont(titleFont);
     painter->drawText(QRectF(8, 3, w - 16, 20), Qt::AlignLeft | Qt::AlignVCenter, title_);
     painter->setFont(smallFont);
-    painter->drawText(QRectF(8, 22, w - 16, 16), Qt::AlignLeft | Qt::AlignVCenter, subtitle_);
+    const QFontMetricsF metrics(smallFont);
+    const double hostWidth = metrics.horizontalAdvance(hostName_) + 8;
+    painter->drawText(QRectF(8, 22, w - 16 - hostWidth, 16), Qt::AlignLeft | Qt::AlignVCenter,
+                      metrics.elidedText(subtitle_, Qt::ElideRight, w - 16 - hostWidth));
     painter->drawText(QRectF(8, 22, w - 16, 16), Qt::AlignRight | Qt::AlignVCenter, hostName_);
   }
   // Port names.
