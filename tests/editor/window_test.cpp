@@ -326,7 +326,7 @@ TEST_F(EditorWindow, EditsAParameterAndInitialMessagesInThePropertiesPanel) {
   EXPECT_EQ(app::inputConfigOrDefault(*app::findModule(app(), "points"), "events").initialMessages, 1);
 }
 
-TEST_F(EditorWindow, AssignsHostsFromThePanelTheContextOfANodeAndByDrop) {
+TEST_F(EditorWindow, AssignsHostsFromThePanelThePropertiesAndByDrop) {
   pointsAndSpring();
   auto buttons = window_->hosts()->findChildren<QPushButton*>();
   auto button = [&](const QString& text) {
