@@ -1,0 +1,66 @@
+// vrflow-editor [APP.xml] [--screenshot OUT.png [--run N] [--select ID]] [--packages DIR]...
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QEventLoop>
+#include <cstdio>
+
+#include "main_window.hpp"
+
+int main(int argc, char** argv) {
+  QApplication application(argc, argv);
+  QApplication::setApplicationName("vrflow-editor");
+  QApplication::setOrganizationName("vrflow");
+  QCommandLineParser parser;
+  parser.setApplicationDescription("vrflow node editor: lay out, validate, save and run applications");
+  parser.addHelpOption();
+  parser.addPositionalArgument("APP.xml", "Application file to open");
+  QCommandLineOption screenshot("screenshot", "Render the window to OUT.png and exit", "OUT.png");
+  QCommandLineOption packages("packages", "Extra folder of node packages (repeatable)", "DIR");
+  QCommandLineOption runFirst("run", "With --screenshot: run the application N iterations first", "N");
+  parser.addOption(screenshot);
+  QCommandLineOption select("select", "With --screenshot: select this node first (its properties show)", "ID");
+  parser.addOption(runFirst);
+  parser.addOption(select);
+  parser.addOption(packages);
+  parser.process(application);
+
+  vrflow::editor::gui::EditorOptions options;
+  for (const QString& dir : parser.values(packages)) options.packageDirs.push_back(dir.toStdString());
+  // A screenshot must never wait on a dialog: messages go to stderr.
+  struct StderrReporter : vrflow::editor::gui::Reporter {
+    void error(QWidget*, const QString& title, const QString& text) override {
+      std::fprintf(stderr, "vrflow-editor: %s: %s\n", qPrintable(title), qPrintable(text));
+    }
+    void warning(QWidget*, const QString& title, const QString& text) override {
+      std::fprintf(stderr, "vrflow-editor: warning: %s: %s\n", qPrintable(title), qPrintable(text));
+    }
+    Choice askToSave(QWidget*, const QString&) override { return Choice::Discard; }
+  } stderrReporter;
+  const bool shooting = parser.isSet(screenshot);
+  if (shooting) {
+    options.reporter = &stderrReporter;
+    options.rememberRecent = false;  // a picture is not a use of the file
+  }
+
+  vrflow::editor::gui::MainWindow window(options);
+  window.show();
+  const QStringList files = parser.positionalArguments();
+  bool opened = true;
+  if (!files.isEmpty()) opened = window.openFile(files.front());
+  if (!shooting) return application.exec();
+  if (!opened) return 1;
+  if (parser.isSet(runFirst)) {
+    QEventLoop loop;
+    QObject::connect(&window, &vrflow::editor::gui::MainWindow::runFinished, &loop, &QEventLoop::quit);
+    window.runApplication(parser.value(runFirst).toInt());
+    if (window.running()) loop.exec();
+  }
+  if (parser.isSet(select)) window.canvas()->selectOnly({parser.value(select).toStdString()});
+  QApplication::processEvents();
+  window.canvas()->fitAll();
+  if (!window.screenshot(parser.value(screenshot))) {
+    std::fprintf(stderr, "vrflow-editor: cannot write %s\n", qPrintable(parser.value(screenshot)));
+    return 1;
+  }
+  return 0;
+}

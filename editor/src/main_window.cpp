@@ -1,0 +1,835 @@
+#include "main_window.hpp"
+
+#include <QAction>
+#include <QApplication>
+#include <QClipboard>
+#include <QCloseEvent>
+#include <QDialog>
+#include <QDialogButtonBox>
+#include <QDir>
+#include <QDockWidget>
+#include <QFile>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QLabel>
+#include <QLineEdit>
+#include <QListWidget>
+#include <QMenu>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QPlainTextEdit>
+#include <QRegularExpression>
+#include <QSaveFile>
+#include <QSocketNotifier>
+#include <QStatusBar>
+#include <QTemporaryDir>
+#include <QTimer>
+#include <QToolBar>
+#include <QUndoCommand>
+#include <QUndoStack>
+#include <fcntl.h>
+#include <sys/ioctl.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <set>
+
+#include "vrflow/app/loader.hpp"
+#include "vrflow/app/writer.hpp"
+#include "vrflow/daemon/plugin.hpp"
+#include "vrflow/run/runner.hpp"
+
+namespace vrflow::editor::gui {
+
+namespace {
+
+QString q(const std::string& text) { return QString::fromStdString(text); }
+std::string s(const QString& text) { return text.toStdString(); }
+
+constexpr int kMaxRecent = 8;
+constexpr const char* kFileFilter = "vrflow applications (*.xml);;All files (*)";
+
+// One edit on the undo stack.
+class EditCommand : public QUndoCommand {
+ public:
+  EditCommand(MainWindow* window, Edit edit)
+      : QUndoCommand(q(edit.label)), window_(window), edit_(std::move(edit)) {}
+  void redo() override {
+    edit_.redo(window_->mutableApplication());
+    window_->applicationChanged();
+  }
+  void undo() override {
+    edit_.undo(window_->mutableApplication());
+    window_->applicationChanged();
+  }
+
+ private:
+  MainWindow* window_;
+  Edit edit_;
+};
+
+}  // namespace
+
+// ---- Reporter ----------------------------------------------------------------------------
+
+void Reporter::error(QWidget* parent, const QString& title, const QString& text) {
+  QMessageBox::critical(parent, title, text);
+}
+
+void Reporter::warning(QWidget* parent, const QString& title, const QString& text) {
+  QMessageBox::warning(parent, title, text);
+}
+
+Reporter::Choice Reporter::askToSave(QWidget* parent, const QString& text) {
+  const auto answer = QMessageBox::warning(parent, "Unsaved changes", text,
+                                           QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel,
+                                           QMessageBox::Save);
+  if (answer == QMessageBox::Save) return Choice::Save;
+  if (answer == QMessageBox::Discard) return Choice::Discard;
+  return Choice::Cancel;
+}
+
+QString Reporter::fileName(QWidget* parent, bool forSaving, const QString& suggestion) {
+  return forSaving ? QFileDialog::getSaveFileName(parent, "Save application", suggestion, kFileFilter)
+                   : QFileDialog::getOpenFileName(parent, "Open", suggestion, kFileFilter);
+}
+
+bool Reporter::newHost(QWidget* parent, QString& id, QString& address) {
+  QDialog dialog(parent);
+  dialog.setWindowTitle("Add host");
+  auto* form = new QFormLayout(&dialog);
+  auto* idEdit = new QLineEdit(id);
+  auto* addressEdit = new QLineEdit(address);
+  form->addRow("Id", idEdit);
+  form->addRow("Address", addressEdit);
+  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
+  form->addRow(buttons);
+  QObject::connect(buttons, &QDialogButtonBox::accepted, &dialog, &QDialog::accept);
+  QObject::connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
+  if (dialog.exec() != QDialog::Accepted) return false;
+  id = idEdit->text().trimmed();
+  address = addressEdit->text().trimmed();
+  return true;
+}
+
+// ---- MainWindow --------------------------------------------------------------------------
+
+MainWindow::MainWindow(EditorOptions options, QWidget* parent)
+    : QMainWindow(parent),
+      options_(std::move(options)),
+      reporter_(options_.reporter),
+      undo_(new QUndoStack(this)),
+      canvas_(new Canvas),
+      palette_(new Palette),
+      properties_(new PropertiesPanel),
+      hosts_(new HostsPanel),
+      problemList_(new QListWidget),
+      log_(new QPlainTextEdit) {
+  if (reporter_ == nullptr) {
+    ownReporter_ = std::make_unique<Reporter>();
+    reporter_ = ownReporter_.get();
+  }
+  settings_ = options_.settingsFile.isEmpty()
+                  ? std::make_unique<QSettings>("vrflow", "editor")
+                  : std::make_unique<QSettings>(options_.settingsFile, QSettings::IniFormat);
+  auto catalog = run::loadCatalog(options_.packageDirs);
+  if (catalog) {
+    catalog_ = std::make_unique<app::Catalog>(std::move(*catalog));
+  } else {
+    catalog_ = std::make_unique<app::Catalog>();
+    catalogProblems_ = q(catalog.error().message);
+  }
+
+  setCentralWidget(canvas_);
+  auto dock = [this](const QString& title, QWidget* widget, Qt::DockWidgetArea area) {
+    auto* d = new QDockWidget(title, this);
+    d->setObjectName(title);
+    d->setWidget(widget);
+    addDockWidget(area, d);
+    return d;
+  };
+  paletteDock_ = dock("Palette", palette_, Qt::LeftDockWidgetArea);
+  propertiesDock_ = dock("Properties", properties_, Qt::RightDockWidgetArea);
+  hostsDock_ = dock("Hosts", hosts_, Qt::RightDockWidgetArea);
+  splitDockWidget(propertiesDock_, hostsDock_, Qt::Vertical);
+  auto* problemsDock = dock("Problems", problemList_, Qt::BottomDockWidgetArea);
+  auto* logDock = dock("Run log", log_, Qt::BottomDockWidgetArea);
+  tabifyDockWidget(problemsDock, logDock);
+  problemsDock->raise();
+  resizeDocks({problemsDock}, {150}, Qt::Vertical);
+  log_->setReadOnly(true);
+  log_->setMaximumBlockCount(20000);
+  QFont mono("monospace");
+  mono.setStyleHint(QFont::Monospace);
+  log_->setFont(mono);
+  palette_->setCatalog(*catalog_);
+
+  connect(canvas_, &Canvas::connectRequested, this,
+          [this](const app::Endpoint& from, const app::Endpoint& to) { connectPorts(from, to); });
+  connect(canvas_, &Canvas::nodesMoved, this, [this](const Positions& positions) {
+    if (!apply(moveNodes(app_, positions))) refresh();
+  });
+  connect(canvas_, &Canvas::addRequested, this, [this](const QString& spec, QPointF at) { addNode(spec, at); });
+  connect(canvas_, &Canvas::hostDropped, this,
+          [this](const QString& host, const std::string& node) { apply(assignHost(app_, {node}, s(host))); });
+  connect(canvas_, &Canvas::deleteRequested, this, &MainWindow::deleteSelection);
+  connect(canvas_, &Canvas::selectionChangedIds, this, &MainWindow::showSelection);
+  connect(canvas_, &Canvas::contextMenuForNodes, this, [this](const std::vector<std::string>& ids, QPoint at) {
+    QMenu menu;
+    QMenu* hostsMenu = menu.addMenu("Run on host");
+    for (const auto& h : app_.hosts) {
+      const std::string id = h.id;
+      hostsMenu->addAction(q(id), this, [this, ids, id] { apply(assignHost(app_, ids, id)); });
+    }
+    menu.addAction("Duplicate", this, &MainWindow::duplicateSelection);
+    menu.addAction("Copy", this, &MainWindow::copySelection);
+    menu.addAction("Delete", this, &MainWindow::deleteSelection);
+    menu.exec(at);
+  });
+  connect(palette_, &Palette::addRequested, this,
+          [this](const QString& spec) { addNode(spec, canvas_->dropPoint()); });
+  connect(properties_, &PropertiesPanel::parameterEdited, this,
+          [this](const std::string& node, const std::string& name, const std::string& value) {
+            apply(setParameter(app_, node, name, value));
+          });
+  connect(properties_, &PropertiesPanel::initialMessagesEdited, this,
+          [this](const std::string& node, const std::string& port, int count) {
+            apply(setInitialMessages(app_, node, port, count));
+          });
+  connect(properties_, &PropertiesPanel::hostChosen, this,
+          [this](const std::string& node, const std::string& host) { apply(assignHost(app_, {node}, host)); });
+  connect(properties_, &PropertiesPanel::renameRequested, this,
+          [this](const std::string& node, const std::string& newId) {
+            if (apply(renameNode(app_, node, newId), false)) canvas_->selectOnly({newId});
+          });
+  connect(hosts_, &HostsPanel::addRequested, this, [this] {
+    QString id = QString("host%1").arg(app_.hosts.size() + 1);
+    QString address = "127.0.0.1";
+    if (reporter().newHost(this, id, address)) apply(addHost(app_, s(id), s(address)), false);
+  });
+  connect(hosts_, &HostsPanel::removeRequested, this,
+          [this](const std::string& host) { apply(removeHost(app_, host), false); });
+  connect(hosts_, &HostsPanel::renameRequested, this, [this](const std::string& host, const std::string& newId) {
+    if (!apply(renameHost(app_, host, newId), false)) hosts_->show(app_);
+  });
+  connect(hosts_, &HostsPanel::addressChanged, this, [this](const std::string& host, const std::string& address) {
+    if (!apply(setHostAddress(app_, host, address), false)) hosts_->show(app_);
+  });
+  connect(hosts_, &HostsPanel::importRequested, this, [this] {
+    const QString file = reporter().fileName(this, false, QDir::homePath());
+    if (file.isEmpty()) return;
+    QFile in(file);
+    if (!in.open(QIODevice::ReadOnly)) {
+      reporter().error(this, "Import hosts", "Cannot read " + file + ": " + in.errorString());
+      return;
+    }
+    apply(importHostfile(app_, in.readAll().toStdString()), false);
+  });
+  connect(hosts_, &HostsPanel::assignSelectionRequested, this, &MainWindow::assignSelectionToHost);
+  connect(problemList_, &QListWidget::itemActivated, this,
+          [this](QListWidgetItem* item) { problemActivated(problemList_->row(item)); });
+  connect(undo_, &QUndoStack::cleanChanged, this, &MainWindow::updateTitle);
+
+  buildMenus();
+  resize(1400, 860);
+  newFile();
+  if (!catalogProblems_.isEmpty()) log_->appendPlainText("Node packages: " + catalogProblems_);
+  log_->appendPlainText(QString("%1 module types and %2 filter types from: %3")
+                            .arg(catalog_->moduleTypes().size())
+                            .arg(catalog_->filterTypes().size())
+                            .arg(catalog_->manifestFiles().empty()
+                                     ? QString("(no package found)")
+                                     : q(catalog_->manifestFiles().front()) +
+                                           (catalog_->manifestFiles().size() > 1 ? ", ..." : "")));
+}
+
+MainWindow::~MainWindow() {
+  closeTerminal();
+  // The panels outlive this object's members (Qt deletes children last): no more signals here.
+  for (QObject* child : std::initializer_list<QObject*>{canvas_, palette_, properties_, hosts_, problemList_, undo_}) {
+    child->disconnect(this);
+    disconnect(child, nullptr, this, nullptr);
+  }
+  if (process_ != nullptr && process_->state() != QProcess::NotRunning) {
+    process_->disconnect(this);
+    process_->terminate();
+    if (!process_->waitForFinished(5000)) process_->kill();
+    process_->waitForFinished(2000);
+  }
+}
+
+void MainWindow::buildMenus() {
+  QMenu* file = menuBar()->addMenu("&File");
+  file->addAction("&New", QKeySequence::New, this, [this] {
+    if (maybeSave()) newFile();
+  });
+  file->addAction("&Open\u2026", QKeySequence::Open, this, [this] {
+    if (!maybeSave()) return;
+    const QString path = reporter().fileName(this, false, path_.isEmpty() ? QDir::currentPath() : QFileInfo(path_).path());
+    if (!path.isEmpty()) openFile(path);
+  });
+  recentMenu_ = file->addMenu("Open &recent");
+  file->addAction("&Save", QKeySequence::Save, this, [this] { save(); });
+  file->addAction("Save &as\u2026", QKeySequence::SaveAs, this, [this] {
+    const QString path = reporter().fileName(this, true, path_);
+    if (!path.isEmpty()) saveAs(path);
+  });
+  file->addSeparator();
+  file->addAction("&Quit", QKeySequence::Quit, this, &QWidget::close);
+  rebuildRecentMenu();
+
+  QMenu* edit = menuBar()->addMenu("&Edit");
+  QAction* undo = undo_->createUndoAction(this, "&Undo");
+  undo->setShortcut(QKeySequence::Undo);
+  QAction* redo = undo_->createRedoAction(this, "&Redo");
+  redo->setShortcut(QKeySequence::Redo);
+  edit->addAction(undo);
+  edit->addAction(redo);
+  edit->addSeparator();
+  edit->addAction("&Copy", QKeySequence::Copy, this, &MainWindow::copySelection);
+  edit->addAction("&Paste", QKeySequence::Paste, this, &MainWindow::paste);
+  edit->addAction("&Duplicate", QKeySequence(Qt::CTRL | Qt::Key_D), this, &MainWindow::duplicateSelection);
+  edit->addAction("De&lete", QKeySequence::Delete, this, &MainWindow::deleteSelection);
+  edit->addAction("Select &all", QKeySequence::SelectAll, this, [this] {
+    canvas_->selectOnly(nodeIds(app_));
+  });
+
+  QMenu* view = menuBar()->addMenu("&View");
+  view->addAction("&Automatic layout", QKeySequence(Qt::CTRL | Qt::Key_L), this, &MainWindow::autoLayout);
+  view->addAction("&Fit all", QKeySequence(Qt::CTRL | Qt::Key_0), canvas_, &Canvas::fitAll);
+  view->addAction("Zoom &in", QKeySequence::ZoomIn, this, [this] { canvas_->scale(1.2, 1.2); });
+  view->addAction("Zoom &out", QKeySequence::ZoomOut, this, [this] { canvas_->scale(1 / 1.2, 1 / 1.2); });
+
+  QMenu* runMenu = menuBar()->addMenu("&Run");
+  runAction_ = runMenu->addAction("&Run on this machine", QKeySequence(Qt::Key_F5), this, [this] { runApplication(); });
+  stopAction_ = runMenu->addAction("&Stop", QKeySequence(Qt::SHIFT | Qt::Key_F5), this, &MainWindow::stopRun);
+  stopAction_->setEnabled(false);
+
+  QToolBar* tools = addToolBar("Main");
+  tools->setObjectName("Main");
+  tools->addAction(undo);
+  tools->addAction(redo);
+  tools->addSeparator();
+  tools->addAction("Layout", this, &MainWindow::autoLayout);
+  tools->addAction("Fit", canvas_, &Canvas::fitAll);
+  tools->addSeparator();
+  tools->addAction(runAction_);
+  tools->addAction(stopAction_);
+}
+
+// ---- File --------------------------------------------------------------------------------
+
+void MainWindow::setDocument(app::Application app, OpenedText opened, const QString& path) {
+  app_ = std::move(app);
+  opened_ = std::move(opened);
+  path_ = path;
+  lastRun_.reset();
+  {
+    const QSignalBlocker block(undo_);
+    undo_->clear();
+  }
+  undo_->setClean();
+  computeFallbackLayout();
+  refresh();
+  canvas_->fitAll();
+  updateTitle();
+}
+
+void MainWindow::newFile() {
+  app::Application app;
+  app.name = "untitled";
+  app.hosts.push_back({std::string(app::kDefaultHostId), std::string(app::kDefaultHostAddress), {}});
+  setDocument(std::move(app), OpenedText{}, QString());
+}
+
+bool MainWindow::openFile(const QString& path) {
+  QFile in(path);
+  if (!in.open(QIODevice::ReadOnly)) {
+    reporter().error(this, "Cannot open file", "Cannot read " + path + ": " + in.errorString());
+    return false;
+  }
+  const std::string text = in.readAll().toStdString();
+  std::vector<app::Diagnostic> problems;
+  const std::string absolute = s(QFileInfo(path).absoluteFilePath());
+  auto loaded = app::loadApplicationString(text, absolute, &problems);
+  // Not well-formed, or not an application at all (a manifest, a composite): nothing to edit.
+  const bool notAnApplication = std::any_of(problems.begin(), problems.end(), [](const app::Diagnostic& d) {
+    return d.message.rfind("root element must be", 0) == 0;
+  });
+  if (!loaded || notAnApplication) {
+    reporter().error(this, "Cannot open file",
+                     QFileInfo(path).fileName() + " is not a valid vrflow application file:\n\n" +
+                         (loaded ? q(app::formatDiagnostics(problems)) : q(loaded.error().message)));
+    return false;
+  }
+  OpenedText opened{text, app::saveApplication(*loaded)};
+  setDocument(std::move(*loaded), std::move(opened), QFileInfo(path).absoluteFilePath());
+  addRecent(path_);
+  log_->appendPlainText("Opened " + path_);
+  if (!problems.empty()) {
+    reporter().warning(this, "Problems in " + QFileInfo(path).fileName(),
+                       "What could be read was loaded; saving writes it without these:\n\n" +
+                           q(app::formatDiagnostics(problems)));
+  }
+  return true;
+}
+
+bool MainWindow::save() {
+  if (path_.isEmpty()) {
+    const QString path = reporter().fileName(this, true, QDir::currentPath() + "/" + q(app_.name) + ".xml");
+    if (path.isEmpty()) return false;
+    return saveAs(path);
+  }
+  return saveAs(path_);
+}
+
+bool MainWindow::saveAs(const QString& path) {
+  const std::string text = textToSave(app_, opened_);
+  QSaveFile out(path);
+  if (!out.open(QIODevice::WriteOnly) || out.write(text.data(), static_cast<qint64>(text.size())) < 0 ||
+      !out.commit()) {
+    reporter().error(this, "Cannot save", "Cannot write " + path + ": " + out.errorString());
+    return false;
+  }
+  opened_ = OpenedText{text, app::saveApplication(app_)};
+  path_ = QFileInfo(path).absoluteFilePath();
+  app_.file = s(path_);
+  undo_->setClean();
+  addRecent(path_);
+  statusBar()->showMessage("Saved " + path_, 5000);
+  refresh();
+  return true;
+}
+
+bool MainWindow::modified() const { return !undo_->isClean(); }
+
+bool MainWindow::maybeSave() {
+  if (!modified()) return true;
+  switch (reporter().askToSave(this, "The application \"" + q(app_.name) + "\" has unsaved changes. Save them?")) {
+    case Reporter::Choice::Save: return save();
+    case Reporter::Choice::Discard: return true;
+    case Reporter::Choice::Cancel: break;
+  }
+  return false;
+}
+
+QStringList MainWindow::recentFiles() const { return settings_->value("recentFiles").toStringList(); }
+
+void MainWindow::addRecent(const QString& path) {
+  if (!options_.rememberRecent) return;
+  QStringList files = recentFiles();
+  files.removeAll(path);
+  files.prepend(path);
+  while (files.size() > kMaxRecent) files.removeLast();
+  settings_->setValue("recentFiles", files);
+  rebuildRecentMenu();
+}
+
+void MainWindow::rebuildRecentMenu() {
+  if (recentMenu_ == nullptr) return;
+  recentMenu_->clear();
+  for (const QString& file : recentFiles()) {
+    recentMenu_->addAction(file, this, [this, file] {
+      if (maybeSave()) openFile(file);
+    });
+  }
+  recentMenu_->setEnabled(!recentMenu_->isEmpty());
+}
+
+void MainWindow::updateTitle() {
+  const QString name = path_.isEmpty() ? QString("untitled") : QFileInfo(path_).fileName();
+  setWindowTitle(name + "[*] \u2014 " + q(app_.name) + " \u2014 vrflow editor");
+  setWindowModified(modified());
+}
+
+void MainWindow::showEvent(QShowEvent* event) {
+  QMainWindow::showEvent(event);
+  if (shown_) return;
+  shown_ = true;
+  // Dock sizes apply once the window has its size.
+  resizeDocks({paletteDock_, propertiesDock_}, {190, 330}, Qt::Horizontal);
+  resizeDocks({propertiesDock_, hostsDock_}, {height() * 2 / 5, height() / 5}, Qt::Vertical);
+}
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+  if (!maybeSave()) {
+    event->ignore();
+    return;
+  }
+  stopRun();
+  event->accept();
+}
+
+// ---- State -------------------------------------------------------------------------------
+
+void MainWindow::computeFallbackLayout() {
+  canvas_->state().fallback.clear();
+  std::vector<std::string> missing;
+  for (const auto& id : nodeIds(app_)) {
+    if (app::findEditorNode(app_, id) == nullptr) missing.push_back(id);
+  }
+  if (missing.empty()) return;
+  canvas_->state().app = &app_;
+  canvas_->state().catalog = catalog_.get();
+  canvas_->rebuild();
+  auto layout = editor::autoLayout(app_, canvas_->nodeSizes());
+  // Below the nodes the file places, when there are some.
+  double shift = 0;
+  bool placed = false;
+  double bottom = 0;
+  for (const auto& n : app_.editor) {
+    bottom = placed ? std::max(bottom, n.y) : n.y;
+    placed = true;
+  }
+  if (placed) {
+    double top = 0;
+    bool first = true;
+    for (const auto& id : missing) {
+      top = first ? layout[id].second : std::min(top, layout[id].second);
+      first = false;
+    }
+    shift = bottom + 200 - top;
+  }
+  for (const auto& id : missing) {
+    canvas_->state().fallback[id] = {layout[id].first, layout[id].second + shift};
+  }
+}
+
+void MainWindow::applicationChanged() {
+  if (!path_.isEmpty()) app_.file = s(path_);
+  refresh();
+}
+
+void MainWindow::refresh() {
+  const std::size_t filterTypes = catalog_->filterTypes().size();
+  problems_ = findProblems(app_, *catalog_, [this](const app::Application& loaded) {
+    return daemon::loadApplicationPlugins(loaded, *catalog_);
+  }, &opened_);
+  if (catalog_->filterTypes().size() != filterTypes) palette_->setCatalog(*catalog_);  // a plugin added some
+  CanvasState& state = canvas_->state();
+  state.app = &app_;
+  state.catalog = catalog_.get();
+  state.problems = problems_;
+  state.run = lastRun_;
+  canvas_->rebuild();
+  hosts_->show(app_);
+
+  problemList_->clear();
+  int errors = 0, warnings = 0;
+  for (const auto& p : problems_) {
+    const bool error = p.severity == app::Diagnostic::Error;
+    (error ? errors : warnings) += 1;
+    QString where = q(p.node);
+    if (p.connection && *p.connection < app_.connections.size()) {
+      const auto& c = app_.connections[*p.connection];
+      where = q(app::toString(c.from) + " \u2192 " + app::toString(c.to));
+    }
+    if (!p.cycle.empty()) where = "deadlock";
+    auto* item = new QListWidgetItem(style()->standardIcon(error ? QStyle::SP_MessageBoxCritical
+                                                                 : QStyle::SP_MessageBoxWarning),
+                                     (where.isEmpty() ? QString() : where + ": ") + q(p.message));
+    item->setToolTip(q(p.text));
+    problemList_->addItem(item);
+  }
+  statusBar()->showMessage(errors + warnings == 0
+                               ? QString("Valid: %1 modules, %2 filters, %3 connections")
+                                     .arg(app_.modules.size())
+                                     .arg(app_.filters.size())
+                                     .arg(app_.connections.size())
+                               : QString("%1 errors, %2 warnings").arg(errors).arg(warnings));
+  showSelection();
+  updateTitle();
+}
+
+void MainWindow::showSelection() {
+  const auto selected = canvas_->selectedNodes();
+  properties_->show(app_, *catalog_, selected.size() == 1 ? selected.front() : std::string());
+}
+
+void MainWindow::problemActivated(int row) {
+  if (row < 0 || static_cast<std::size_t>(row) >= problems_.size()) return;
+  const Problem& p = problems_[static_cast<std::size_t>(row)];
+  std::vector<std::string> nodes;
+  if (!p.node.empty()) nodes.push_back(p.node);
+  for (std::size_t c : p.cycle) {
+    if (c < app_.connections.size()) nodes.push_back(app_.connections[c].from.node);
+  }
+  std::optional<std::size_t> connection = p.connection;
+  if (!p.cycle.empty()) connection = p.cycle.front();
+  canvas_->selectOnly(nodes, connection);
+}
+
+// ---- Edits -------------------------------------------------------------------------------
+
+bool MainWindow::apply(Result<Edit> edit, bool quietWhenUnchanged) {
+  if (!edit) {
+    const QString why = q(edit.error().message);
+    if (!(quietWhenUnchanged && why == "unchanged")) statusBar()->showMessage(why, 8000);
+    return false;
+  }
+  undo_->push(new EditCommand(this, std::move(*edit)));
+  return true;
+}
+
+bool MainWindow::addNode(const QString& spec, QPointF at) {
+  const QStringList parts = spec.split(' ', Qt::SkipEmptyParts);
+  std::string id;
+  bool ok = false;
+  if (parts.size() == 3 && parts[0] == "module") {
+    ok = apply(addModule(app_, *catalog_, s(parts[1]), s(parts[2]), at.x(), at.y(), &id), false);
+  } else if (parts.size() == 2 && parts[0] == "filter") {
+    ok = apply(addFilter(app_, *catalog_, s(parts[1]), at.x(), at.y(), &id), false);
+  }
+  if (ok) canvas_->selectOnly({id});
+  return ok;
+}
+
+bool MainWindow::connectPorts(const app::Endpoint& from, const app::Endpoint& to) {
+  return apply(editor::connect(app_, *catalog_, from, to), false);
+}
+
+void MainWindow::deleteSelection() {
+  const auto nodes = canvas_->selectedNodes();
+  const auto connections = canvas_->selectedConnections();
+  if (nodes.empty() && connections.empty()) return;
+  Edit edit{"", app_, app_};
+  if (!connections.empty()) {
+    auto step = editor::disconnect(edit.after, connections);
+    if (step) {
+      edit.after = step->after;
+      edit.label = step->label;
+    }
+  }
+  if (!nodes.empty()) {
+    auto step = removeNodes(edit.after, nodes);
+    if (step) {
+      edit.after = step->after;
+      edit.label = step->label;
+    }
+  }
+  if (!nodes.empty() && !connections.empty()) edit.label = "Delete selection";
+  apply(std::move(edit));
+}
+
+void MainWindow::copySelection() {
+  const auto nodes = canvas_->selectedNodes();
+  if (nodes.empty()) return;
+  QApplication::clipboard()->setText(q(copyAsXml(app_, nodes)));
+  statusBar()->showMessage(QString("Copied %1 nodes as XML").arg(nodes.size()), 4000);
+}
+
+void MainWindow::paste() {
+  std::vector<std::string> ids;
+  if (apply(pasteXml(app_, s(QApplication::clipboard()->text()), 40, 40, &ids), false)) canvas_->selectOnly(ids);
+}
+
+void MainWindow::duplicateSelection() {
+  const auto nodes = canvas_->selectedNodes();
+  if (nodes.empty()) return;
+  std::vector<std::string> ids;
+  auto edit = pasteXml(app_, copyAsXml(app_, nodes), 40, 40, &ids);
+  if (edit) edit->label = "Duplicate";
+  if (apply(std::move(edit), false)) canvas_->selectOnly(ids);
+}
+
+void MainWindow::autoLayout() {
+  auto edit = moveNodes(app_, editor::autoLayout(app_, canvas_->nodeSizes()));
+  if (edit) edit->label = "Automatic layout";
+  apply(std::move(edit));
+  canvas_->fitAll();
+}
+
+void MainWindow::assignSelectionToHost(const std::string& host) {
+  const auto nodes = canvas_->selectedNodes();
+  if (nodes.empty()) {
+    statusBar()->showMessage("Select nodes first", 4000);
+    return;
+  }
+  apply(assignHost(app_, nodes, host));
+}
+
+// ---- Run ---------------------------------------------------------------------------------
+
+bool MainWindow::running() const { return process_ != nullptr && process_->state() != QProcess::NotRunning; }
+
+void MainWindow::runApplication(int iterations) {
+  if (running()) return;
+  if (app::hasErrors([this] {
+        std::vector<app::Diagnostic> d;
+        for (const auto& p : problems_) d.push_back({{}, p.severity, p.message});
+        return d;
+      }())) {
+    reporter().error(this, "Cannot run", "The application has errors; see the Problems list.");
+    return;
+  }
+  if ((path_.isEmpty() || modified()) && !save()) return;
+  runDir_ = std::make_unique<QTemporaryDir>();
+  const QString report = runDir_->filePath("report.json");
+  QString program = options_.vrflowProgram;
+  if (program.isEmpty()) program = QCoreApplication::applicationDirPath() + "/vrflow";
+  QStringList args{"run", path_, "--report", report};
+  if (iterations > 0) args << "--iterations" << QString::number(iterations);
+  for (const auto& dir : options_.packageDirs) args << "--packages" << q(dir);
+  delete process_;
+  process_ = new QProcess(this);
+  process_->setProcessChannelMode(QProcess::MergedChannels);
+  process_->setWorkingDirectory(QDir::currentPath());
+  // stderr goes to a pseudo-terminal: `vrflow` then prints its live per-module iterations/s
+  // (it does only on a terminal); its log comes through there too.
+  closeTerminal();
+  int slave = -1;
+  terminal_ = posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
+  if (terminal_ >= 0 && grantpt(terminal_) == 0 && unlockpt(terminal_) == 0) {
+    const char* name = ptsname(terminal_);
+    slave = name == nullptr ? -1 : ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC);
+  }
+  if (slave >= 0) {
+    termios mode{};
+    if (tcgetattr(slave, &mode) == 0) {
+      cfmakeraw(&mode);
+      tcsetattr(slave, TCSANOW, &mode);
+    }
+    winsize size{};
+    size.ws_col = 4000;  // wide enough that the progress line is never cut
+    size.ws_row = 50;
+    ioctl(slave, TIOCSWINSZ, &size);
+    process_->setChildProcessModifier([slave] { ::dup2(slave, STDERR_FILENO); });
+    terminalNotifier_ = new QSocketNotifier(terminal_, QSocketNotifier::Read, this);
+    connect(terminalNotifier_, &QSocketNotifier::activated, this, &MainWindow::readTerminal);
+  } else {
+    closeTerminal();
+    args << "--no-progress";
+    log_->appendPlainText("(no pseudo-terminal: live rates unavailable for this run)");
+  }
+  connect(process_, &QProcess::readyRead, this, [this] { handleRunOutput(QString::fromUtf8(process_->readAll())); });
+  connect(process_, &QProcess::finished, this, [this](int code, QProcess::ExitStatus) { finishRun(code); });
+  connect(process_, &QProcess::errorOccurred, this, [this, program](QProcess::ProcessError error) {
+    if (error == QProcess::FailedToStart) {
+      log_->appendPlainText("Cannot start " + program + ": " + process_->errorString());
+      finishRun(-1);
+    }
+  });
+  lastRun_.reset();
+  liveRates_.clear();
+  canvas_->state().live.clear();
+  runError_.clear();
+  log_->appendPlainText("$ " + program + " " + args.join(' '));
+  runAction_->setEnabled(false);
+  stopAction_->setEnabled(true);
+  runClock_.start();
+  refresh();
+  process_->start(program, args);
+  if (slave >= 0) ::close(slave);  // the child has its copy
+  auto* ticker = new QTimer(process_);
+  connect(ticker, &QTimer::timeout, this, [this] {
+    statusBar()->showMessage(QString("Running\u2026 %1 s").arg(runClock_.elapsed() / 1000));
+  });
+  ticker->start(1000);
+}
+
+void MainWindow::stopRun() {
+  if (!running()) return;
+  log_->appendPlainText("Stopping the run (SIGTERM)");
+  process_->terminate();
+}
+
+void MainWindow::handleRunOutput(const QString& text) {
+  terminalPending_ += text;
+  // Lines end with '\n'; the progress line is rewritten in place with '\r'.
+  for (;;) {
+    const auto end = terminalPending_.indexOf(QRegularExpression("[\r\n]"));
+    if (end < 0) break;
+    QString line = terminalPending_.left(end);
+    terminalPending_.remove(0, end + 1);
+    line.remove("\x1b[K");
+    if (line.trimmed().isEmpty()) continue;
+    if (!line.startsWith("[vrflow ")) {
+      log_->appendPlainText(line);
+      continue;
+    }
+    // "[vrflow 3s]  chain 1234 it/s  springs 1200 it/s"
+    const QStringList words = line.mid(line.indexOf(']') + 1).split(' ', Qt::SkipEmptyParts);
+    std::map<std::string, double> rates;
+    for (qsizetype i = 0; i + 2 < words.size(); i += 3) {
+      bool ok = false;
+      const double rate = words[i + 1].toDouble(&ok);
+      if (!ok || words[i + 2] != "it/s") break;
+      rates[s(words[i])] = rate;
+    }
+    if (rates.empty()) continue;
+    liveRates_ = rates;
+    canvas_->setLiveRates(liveRates_);
+    Q_EMIT liveRatesUpdated();
+  }
+}
+
+void MainWindow::readTerminal() {
+  char buffer[4096];
+  const ssize_t n = ::read(terminal_, buffer, sizeof buffer);
+  if (n <= 0) {
+    if (n < 0 && errno == EAGAIN) return;
+    closeTerminal();  // EIO: every writer is gone
+    return;
+  }
+  handleRunOutput(QString::fromUtf8(buffer, static_cast<qsizetype>(n)));
+}
+
+void MainWindow::closeTerminal() {
+  delete terminalNotifier_;
+  terminalNotifier_ = nullptr;
+  if (terminal_ >= 0) ::close(terminal_);
+  terminal_ = -1;
+}
+
+void MainWindow::finishRun(int exitCode) {
+  runAction_->setEnabled(true);
+  stopAction_->setEnabled(false);
+  // What is left in the terminal and the pipe.
+  if (terminal_ >= 0) {
+    const int flags = fcntl(terminal_, F_GETFL);
+    fcntl(terminal_, F_SETFL, flags | O_NONBLOCK);
+    while (terminal_ >= 0) {
+      char buffer[4096];
+      const ssize_t n = ::read(terminal_, buffer, sizeof buffer);
+      if (n <= 0) break;
+      handleRunOutput(QString::fromUtf8(buffer, static_cast<qsizetype>(n)));
+    }
+    closeTerminal();
+  }
+  if (process_ != nullptr) handleRunOutput(QString::fromUtf8(process_->readAll()));
+  if (!terminalPending_.isEmpty()) handleRunOutput("\n");
+  QFile reportFile(runDir_ ? runDir_->filePath("report.json") : QString());
+  if (runDir_ && reportFile.open(QIODevice::ReadOnly)) {
+    auto report = parseRunReport(reportFile.readAll().toStdString());
+    if (report) lastRun_ = std::move(*report);
+  }
+  canvas_->state().live.clear();  // the report's figures replace the live ones
+  QString summary;
+  if (exitCode == 0) {
+    summary = "Run finished";
+  } else if (exitCode == run::kExitInterrupted) {
+    summary = "Run stopped";
+  } else {
+    summary = QString("Run failed (exit %1)").arg(exitCode);
+    if (lastRun_ && !lastRun_->error.empty()) summary += ": " + q(lastRun_->error);
+  }
+  if (lastRun_ && lastRun_->wallSeconds > 0) summary += QString(" after %1 s").arg(lastRun_->wallSeconds, 0, 'f', 2);
+  log_->appendPlainText(summary);
+  runError_ = exitCode == 0 ? QString() : summary;
+  refresh();
+  if (lastRun_ && !lastRun_->failedModule.empty()) canvas_->selectOnly({lastRun_->failedModule});
+  statusBar()->showMessage(summary, 15000);
+  Q_EMIT runFinished(exitCode);
+}
+
+bool MainWindow::screenshot(const QString& path) {
+  QApplication::processEvents();
+  const QPixmap pixmap = grab();
+  return !pixmap.isNull() && pixmap.save(path, "PNG");
+}
+
+}  // namespace vrflow::editor::gui

@@ -1,0 +1,176 @@
+#pragma once
+
+#include <QElapsedTimer>
+#include <QMainWindow>
+#include <QProcess>
+#include <QSettings>
+#include <QStringList>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "canvas.hpp"
+#include "panels.hpp"
+#include "vrflow/app/catalog.hpp"
+#include "vrflow/app/model.hpp"
+#include "vrflow/editor/analysis.hpp"
+#include "vrflow/editor/edit.hpp"
+
+class QUndoStack;
+class QListWidget;
+class QPlainTextEdit;
+class QMenu;
+class QDockWidget;
+class QAction;
+class QTemporaryDir;
+class QSocketNotifier;
+
+namespace vrflow::editor::gui {
+
+/// Where the window's messages go: dialogs by default; tests record them instead.
+class Reporter {
+ public:
+  enum class Choice { Save, Discard, Cancel };
+  virtual ~Reporter() = default;
+  virtual void error(QWidget* parent, const QString& title, const QString& text);
+  virtual void warning(QWidget* parent, const QString& title, const QString& text);
+  /// Unsaved changes are about to be lost: save them, discard them, or cancel.
+  virtual Choice askToSave(QWidget* parent, const QString& text);
+  /// A file name to open or save to; empty to cancel.
+  virtual QString fileName(QWidget* parent, bool forSaving, const QString& suggestion);
+  /// A host id and address for a new host; false to cancel.
+  virtual bool newHost(QWidget* parent, QString& id, QString& address);
+};
+
+struct EditorOptions {
+  std::vector<std::string> packageDirs;  ///< extra package folders, before the search path
+  QString settingsFile;                  ///< recent files; empty: the user's settings
+  Reporter* reporter = nullptr;          ///< not owned; null: dialogs
+  QString vrflowProgram;                 ///< empty: `vrflow` beside this program
+  bool rememberRecent = true;            ///< false: opening and saving leave the settings alone
+};
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+
+ public:
+  explicit MainWindow(EditorOptions options, QWidget* parent = nullptr);
+  ~MainWindow() override;
+
+  // File.
+  void newFile();
+  /// Opens a file; a file that cannot be read or is not well-formed keeps the current one and
+  /// is reported (false).
+  bool openFile(const QString& path);
+  bool save();
+  bool saveAs(const QString& path);
+  /// Asks about unsaved changes; false when the user cancels.
+  bool maybeSave();
+  QStringList recentFiles() const;
+
+  // Edits (each one undoable).
+  bool addNode(const QString& spec, QPointF scenePos);
+  bool connectPorts(const app::Endpoint& from, const app::Endpoint& to);
+  void deleteSelection();
+  void duplicateSelection();
+  void copySelection();
+  void paste();
+  void autoLayout();
+  void assignSelectionToHost(const std::string& host);
+
+  // Run.
+  void runApplication(int iterations = 0);
+  void stopRun();
+  bool running() const;
+
+  /// Renders the window to a PNG file.
+  bool screenshot(const QString& path);
+
+  const app::Application& application() const { return app_; }
+  const app::Catalog& catalog() const { return *catalog_; }
+  const std::vector<Problem>& problems() const { return problems_; }
+  const QString& filePath() const { return path_; }
+  bool modified() const;
+  Canvas* canvas() const { return canvas_; }
+  Palette* palette() const { return palette_; }
+  PropertiesPanel* properties() const { return properties_; }
+  HostsPanel* hosts() const { return hosts_; }
+  QListWidget* problemList() const { return problemList_; }
+  QPlainTextEdit* log() const { return log_; }
+  QUndoStack* undoStack() const { return undo_; }
+  const std::optional<RunReport>& lastRun() const { return lastRun_; }
+  /// Iterations/s per module from the running `vrflow`'s progress line (empty when none).
+  const std::map<std::string, double>& liveRates() const { return liveRates_; }
+
+  /// Applies an edit through the undo stack; reports why when it cannot be made.
+  bool apply(Result<Edit> edit, bool quietWhenUnchanged = true);
+  /// Called by undo commands after the application changed.
+  void applicationChanged();
+  app::Application& mutableApplication() { return app_; }
+
+ Q_SIGNALS:
+  void runFinished(int exitCode);
+  /// The runtime's live progress line was read: liveRates() changed.
+  void liveRatesUpdated();
+
+ protected:
+  void closeEvent(QCloseEvent* event) override;
+  void showEvent(QShowEvent* event) override;
+
+ private:
+  void buildMenus();
+  void refresh();
+  void updateTitle();
+  void addRecent(const QString& path);
+  void rebuildRecentMenu();
+  void showSelection();
+  void problemActivated(int row);
+  void finishRun(int exitCode);
+  void readTerminal();
+  void closeTerminal();
+  void handleRunOutput(const QString& text);
+  void setDocument(app::Application app, OpenedText opened, const QString& path);
+  void computeFallbackLayout();
+  Reporter& reporter() { return *reporter_; }
+
+  EditorOptions options_;
+  std::unique_ptr<Reporter> ownReporter_;
+  Reporter* reporter_;
+  std::unique_ptr<app::Catalog> catalog_;
+  QString catalogProblems_;
+  app::Application app_;
+  OpenedText opened_;
+  QString path_;
+  std::vector<Problem> problems_;
+  std::unique_ptr<QSettings> settings_;
+
+  QUndoStack* undo_;
+  Canvas* canvas_;
+  Palette* palette_;
+  PropertiesPanel* properties_;
+  HostsPanel* hosts_;
+  QListWidget* problemList_;
+  QPlainTextEdit* log_;
+  QMenu* recentMenu_ = nullptr;
+  QDockWidget* paletteDock_ = nullptr;
+  QDockWidget* propertiesDock_ = nullptr;
+  QDockWidget* hostsDock_ = nullptr;
+  bool shown_ = false;
+  QAction* runAction_ = nullptr;
+  QAction* stopAction_ = nullptr;
+
+  QProcess* process_ = nullptr;
+  std::unique_ptr<QTemporaryDir> runDir_;
+  QElapsedTimer runClock_;
+  std::optional<RunReport> lastRun_;
+  QString runError_;
+  // The run's stderr is a pseudo-terminal, so that `vrflow` shows its live progress line.
+  int terminal_ = -1;
+  QSocketNotifier* terminalNotifier_ = nullptr;
+  QString terminalPending_;
+  std::map<std::string, double> liveRates_;
+};
+
+}  // namespace vrflow::editor::gui

@@ -1,0 +1,537 @@
+#include "panels.hpp"
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QFileDialog>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QLineEdit>
+#include <QMimeData>
+#include <QPushButton>
+#include <QScrollArea>
+#include <QSpinBox>
+#include <QTableWidget>
+#include <QTimer>
+#include <QToolButton>
+#include <QVBoxLayout>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "canvas.hpp"
+#include "vrflow/editor/edit.hpp"
+
+namespace vrflow::editor::gui {
+
+namespace {
+
+QString q(const std::string& text) { return QString::fromStdString(text); }
+std::string s(const QString& text) { return text.toStdString(); }
+
+QString kindGroup(app::ModuleKind kind) {
+  switch (kind) {
+    case app::ModuleKind::Animator: return "Animators";
+    case app::ModuleKind::Interactor: return "Interactors";
+    case app::ModuleKind::Viewer: return "Viewers";
+    case app::ModuleKind::Input: return "Inputs";
+    case app::ModuleKind::Other: break;
+  }
+  return "Other modules";
+}
+
+constexpr int kSpecRole = Qt::UserRole + 1;
+
+// A table whose rows drag as kHostMime (the host's id).
+class HostTable : public QTableWidget {
+ public:
+  using QTableWidget::QTableWidget;
+  std::vector<std::string>* ids = nullptr;
+
+ protected:
+  QMimeData* mimeData(const QList<QTableWidgetItem*>& items) const override {
+    if (items.isEmpty() || ids == nullptr) return nullptr;
+    const int row = items.front()->row();
+    if (row < 0 || static_cast<std::size_t>(row) >= ids->size()) return nullptr;
+    auto* mime = new QMimeData;
+    mime->setData(kHostMime, QByteArray::fromStdString((*ids)[static_cast<std::size_t>(row)]));
+    return mime;
+  }
+};
+
+}  // namespace
+
+// ---- Palette -----------------------------------------------------------------------------
+
+Palette::Palette(QWidget* parent) : QWidget(parent), search_(new QLineEdit), tree_(new PaletteTree) {
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(4, 4, 4, 4);
+  search_->setPlaceholderText("Search node types\u2026");
+  search_->setClearButtonEnabled(true);
+  layout->addWidget(search_);
+  layout->addWidget(tree_);
+  tree_->setHeaderHidden(true);
+  tree_->setDragEnabled(true);
+  tree_->setDragDropMode(QAbstractItemView::DragOnly);
+  tree_->setSelectionMode(QAbstractItemView::SingleSelection);
+  connect(search_, &QLineEdit::textChanged, this, &Palette::setFilterText);
+  connect(tree_, &QTreeWidget::itemDoubleClicked, this, [this](QTreeWidgetItem* item) {
+    const QString spec = item->data(0, kSpecRole).toString();
+    if (!spec.isEmpty()) Q_EMIT addRequested(spec);
+  });
+}
+
+void Palette::setCatalog(const app::Catalog& catalog) {
+  tree_->clear();
+  std::map<QString, QTreeWidgetItem*> groups;
+  const QStringList order = {"Animators", "Interactors", "Viewers", "Inputs", "Other modules", "Filters"};
+  for (const auto& name : order) {
+    auto* group = new QTreeWidgetItem(tree_, QStringList{name});
+    group->setFlags(Qt::ItemIsEnabled);
+    QFont font = group->font(0);
+    font.setBold(true);
+    group->setFont(0, font);
+    groups[name] = group;
+  }
+  for (const app::ModuleType* type : catalog.moduleTypes()) {
+    auto* item = new QTreeWidgetItem(groups[kindGroup(type->kind)],
+                                     QStringList{q(type->type) + "  (" + q(type->package) + ")"});
+    item->setData(0, kSpecRole, "module " + q(type->package) + " " + q(type->type));
+    item->setToolTip(0, q(type->package + "/" + type->type) + (type->doc.empty() ? "" : "\n" + q(type->doc)));
+    item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsDragEnabled);
+  }
+  for (const app::FilterType* type : catalog.filterTypes()) {
+    auto* item = new QTreeWidgetItem(groups["Filters"], QStringList{q(type->name)});
+    item->setData(0, kSpecRole, "filter " + q(type->name));
+    item->setToolTip(0, q(type->name) + (type->doc.empty() ? "" : "\n" + q(type->doc)));
+    item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsDragEnabled);
+  }
+  for (auto& [name, group] : groups) {
+    if (group->childCount() == 0) {
+      delete group;
+    } else {
+      group->setText(0, name + QString(" (%1)").arg(group->childCount()));
+    }
+  }
+  tree_->expandAll();
+  setFilterText(search_->text());
+}
+
+void Palette::setFilterText(const QString& text) {
+  for (int g = 0; g < tree_->topLevelItemCount(); ++g) {
+    QTreeWidgetItem* group = tree_->topLevelItem(g);
+    int shown = 0;
+    for (int i = 0; i < group->childCount(); ++i) {
+      QTreeWidgetItem* item = group->child(i);
+      const bool match = text.isEmpty() || item->text(0).contains(text, Qt::CaseInsensitive) ||
+                         item->toolTip(0).contains(text, Qt::CaseInsensitive);
+      item->setHidden(!match);
+      shown += match ? 1 : 0;
+    }
+    group->setHidden(shown == 0);
+  }
+}
+
+QTreeWidgetItem* Palette::findEntry(const QString& spec) const {
+  for (int g = 0; g < tree_->topLevelItemCount(); ++g) {
+    QTreeWidgetItem* group = tree_->topLevelItem(g);
+    for (int i = 0; i < group->childCount(); ++i) {
+      if (group->child(i)->data(0, kSpecRole).toString() == spec) return group->child(i);
+    }
+  }
+  return nullptr;
+}
+
+QMimeData* PaletteTree::mimeData(const QList<QTreeWidgetItem*>& items) const {
+  if (items.isEmpty()) return nullptr;
+  const QString spec = items.front()->data(0, kSpecRole).toString();
+  if (spec.isEmpty()) return nullptr;
+  auto* mime = new QMimeData;
+  mime->setData(kNodeMime, spec.toUtf8());
+  mime->setText(spec);
+  return mime;
+}
+
+// ---- Properties --------------------------------------------------------------------------
+
+PropertiesPanel::PropertiesPanel(QWidget* parent) : QWidget(parent), layout_(new QVBoxLayout(this)) {
+  layout_->setContentsMargins(0, 0, 0, 0);
+  clear();
+}
+
+// The old body goes later: show() runs from the signals of its own widgets (an edit is applied,
+// the window refreshes), and a widget must not be deleted inside its own signal.
+static void dropLater(QWidget*& body) {
+  if (body == nullptr) return;
+  body->hide();
+  body->setParent(nullptr);
+  body->deleteLater();
+  body = nullptr;
+}
+
+void PropertiesPanel::clear() {
+  dropLater(body_);
+  body_ = new QWidget;
+  auto* scroll = new QScrollArea;
+  scroll->setWidgetResizable(true);
+  scroll->setWidget(new QLabel("  Select a node to edit its properties."));
+  auto* l = new QVBoxLayout(body_);
+  l->setContentsMargins(0, 0, 0, 0);
+  l->addWidget(scroll);
+  layout_->addWidget(body_);
+}
+
+QWidget* PropertiesPanel::parameterWidget(const QString& name) const {
+  return body_ == nullptr ? nullptr : body_->findChild<QWidget*>("param:" + name);
+}
+
+QWidget* PropertiesPanel::initialMessagesWidget(const QString& port) const {
+  return body_ == nullptr ? nullptr : body_->findChild<QWidget*>("initial:" + port);
+}
+
+QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::string& value, bool set) {
+  const std::string node = node_;
+  const std::string name = spec.name;
+  const std::string shown = set ? value : spec.defaultValue;
+  const bool numeric = spec.type == app::ParamType::Int || spec.type == app::ParamType::Float ||
+                       spec.type == app::ParamType::Vec3;
+  // A widget left without a change (focus passing through) must not write the value it shows:
+  // an unset parameter would become set to its default, "1e-3" would become "0.001".
+  auto emitValue = [this, node, name, shown, numeric](const std::string& v) {
+    if (v == shown) return;
+    if (numeric) {
+      std::istringstream a(v), b(shown);
+      double x = 0, y = 0;
+      bool same = true, any = false;
+      while (a >> x) {
+        if (!(b >> y) || x != y) same = false;
+        any = true;
+      }
+      if (any && same && !(b >> y)) return;
+    }
+    Q_EMIT parameterEdited(node, name, v);
+  };
+  QWidget* widget = nullptr;
+  switch (spec.type) {
+    case app::ParamType::Int: {
+      auto* box = new QSpinBox;
+      const double lo = spec.min.value_or(-1e9), hi = spec.max.value_or(1e9);
+      box->setRange(static_cast<int>(std::max(lo, -2147483647.0)), static_cast<int>(std::min(hi, 2147483647.0)));
+      box->setValue(static_cast<int>(std::strtoll(shown.c_str(), nullptr, 10)));
+      box->setKeyboardTracking(false);
+      connect(box, &QSpinBox::editingFinished, this, [box, emitValue] { emitValue(std::to_string(box->value())); });
+      widget = box;
+      break;
+    }
+    case app::ParamType::Float: {
+      auto* box = new QDoubleSpinBox;
+      box->setDecimals(6);
+      box->setRange(spec.min.value_or(-1e12), spec.max.value_or(1e12));
+      box->setValue(std::strtod(shown.c_str(), nullptr));
+      box->setKeyboardTracking(false);
+      connect(box, &QDoubleSpinBox::editingFinished, this, [box, emitValue] {
+        std::ostringstream text;
+        text << std::setprecision(12) << box->value();
+        emitValue(text.str());
+      });
+      widget = box;
+      break;
+    }
+    case app::ParamType::Bool: {
+      auto* box = new QCheckBox;
+      box->setChecked(shown == "true" || shown == "1");
+      connect(box, &QCheckBox::toggled, this, [emitValue](bool on) { emitValue(on ? "true" : "false"); });
+      widget = box;
+      break;
+    }
+    case app::ParamType::Enum: {
+      auto* box = new QComboBox;
+      for (const auto& choice : spec.choices) box->addItem(q(choice));
+      box->setCurrentText(q(shown));
+      connect(box, &QComboBox::activated, this, [box, emitValue] { emitValue(s(box->currentText())); });
+      widget = box;
+      break;
+    }
+    case app::ParamType::Vec3: {
+      auto* row = new QWidget;
+      auto* h = new QHBoxLayout(row);
+      h->setContentsMargins(0, 0, 0, 0);
+      std::istringstream in(shown);
+      std::vector<QDoubleSpinBox*> boxes;
+      for (int i = 0; i < 3; ++i) {
+        double v = 0;
+        in >> v;
+        auto* box = new QDoubleSpinBox;
+        box->setDecimals(4);
+        box->setRange(spec.min.value_or(-1e9), spec.max.value_or(1e9));
+        box->setValue(v);
+        box->setKeyboardTracking(false);
+        box->setObjectName(QString("component%1").arg(i));
+        h->addWidget(box);
+        boxes.push_back(box);
+      }
+      for (auto* box : boxes) {
+        connect(box, &QDoubleSpinBox::editingFinished, this, [boxes, emitValue] {
+          std::ostringstream text;
+          text << std::setprecision(12) << boxes[0]->value() << ' ' << boxes[1]->value() << ' ' << boxes[2]->value();
+          emitValue(text.str());
+        });
+      }
+      widget = row;
+      break;
+    }
+    case app::ParamType::File: {
+      auto* row = new QWidget;
+      auto* h = new QHBoxLayout(row);
+      h->setContentsMargins(0, 0, 0, 0);
+      auto* edit = new QLineEdit(q(shown));
+      edit->setObjectName("text");
+      auto* browse = new QToolButton;
+      browse->setText("\u2026");
+      h->addWidget(edit);
+      h->addWidget(browse);
+      connect(edit, &QLineEdit::editingFinished, this, [edit, emitValue] { emitValue(s(edit->text())); });
+      connect(browse, &QToolButton::clicked, this, [this, edit, emitValue] {
+        const QString file = QFileDialog::getSaveFileName(this, "Choose a file", edit->text(), QString(), nullptr,
+                                                          QFileDialog::DontConfirmOverwrite);
+        if (!file.isEmpty()) {
+          edit->setText(file);
+          emitValue(s(file));
+        }
+      });
+      widget = row;
+      break;
+    }
+    case app::ParamType::String: {
+      auto* edit = new QLineEdit(q(shown));
+      connect(edit, &QLineEdit::editingFinished, this, [edit, emitValue] { emitValue(s(edit->text())); });
+      widget = edit;
+      break;
+    }
+  }
+  widget->setObjectName("param:" + q(name));
+  // Spin boxes with wide ranges ask for much width: let them shrink to the panel.
+  for (auto* box : widget->findChildren<QAbstractSpinBox*>()) box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+  if (auto* box = qobject_cast<QAbstractSpinBox*>(widget)) box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+  widget->setMinimumWidth(60);
+  QString tip = q(spec.doc);
+  tip += (tip.isEmpty() ? "" : "\n") + QString("type: ") + q(app::toString(spec.type));
+  tip += "\ndefault: " + (spec.defaultValue.empty() ? QString("(empty)") : q(spec.defaultValue));
+  if (spec.min) tip += QString("\nmin: %1").arg(*spec.min);
+  if (spec.max) tip += QString("\nmax: %1").arg(*spec.max);
+  widget->setToolTip(tip);
+  return widget;
+}
+
+void PropertiesPanel::show(const app::Application& app, const app::Catalog& catalog, const std::string& node) {
+  node_ = node;
+  dropLater(body_);
+  if (node.empty() || nodeKind(app, node) == NodeKind::None) {
+    clear();
+    return;
+  }
+  body_ = new QWidget;
+  auto* outer = new QVBoxLayout(body_);
+  outer->setContentsMargins(0, 0, 0, 0);
+  auto* scroll = new QScrollArea;
+  scroll->setWidgetResizable(true);
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  auto* content = new QWidget;
+  auto* form = new QFormLayout(content);
+  form->setFieldGrowthPolicy(QFormLayout::AllNonFixedFieldsGrow);
+  scroll->setWidget(content);
+  outer->addWidget(scroll);
+  layout_->addWidget(body_);
+
+  const app::Module* module = app::findModule(app, node);
+  const app::Filter* filter = app::findFilter(app, node);
+  const app::Instance* instance = app::findInstance(app, node);
+  const std::vector<app::Param>* params = nullptr;
+  const std::vector<app::ParamSpec>* specs = nullptr;
+  std::string host;
+  QString typeText, doc;
+  if (module != nullptr) {
+    params = &module->params;
+    host = module->host;
+    typeText = "module " + q(module->package + "/" + module->type);
+    if (const auto* type = catalog.findModule(module->package, module->type)) {
+      specs = &type->params;
+      doc = q(type->doc);
+    } else {
+      doc = "Unknown module type: no installed package declares it.";
+    }
+  } else if (filter != nullptr) {
+    params = &filter->params;
+    host = filter->host;
+    typeText = "filter " + q(filter->type);
+    if (const auto* type = catalog.findFilter(filter->type)) {
+      specs = &type->params;
+      doc = q(type->doc);
+    } else {
+      doc = "Unknown filter type.";
+    }
+  } else {
+    params = &instance->params;
+    host = instance->host;
+    typeText = "composite " + q(instance->composite);
+  }
+
+  auto* id = new QLineEdit(q(node));
+  id->setObjectName("id");
+  connect(id, &QLineEdit::editingFinished, this, [this, id, node] {
+    if (s(id->text()) != node) Q_EMIT renameRequested(node, s(id->text()));
+  });
+  form->addRow("Id", id);
+  auto* type = new QLabel("<b>" + typeText.toHtmlEscaped() + "</b>");
+  form->addRow("Type", type);
+  if (!doc.isEmpty()) {
+    auto* docLabel = new QLabel(doc);
+    docLabel->setWordWrap(true);
+    docLabel->setStyleSheet("color: #555;");
+    form->addRow(docLabel);
+  }
+  auto* hosts = new QComboBox;
+  hosts->setObjectName("host");
+  for (const auto& h : app.hosts) hosts->addItem(q(h.id));
+  hosts->setCurrentText(q(app::effectiveHost(app, host)));
+  connect(hosts, &QComboBox::activated, this, [this, hosts, node] { Q_EMIT hostChosen(node, s(hosts->currentText())); });
+  form->addRow("Host", hosts);
+
+  auto* heading = new QLabel("<b>Parameters</b>");
+  form->addRow(heading);
+  std::set<std::string> shownNames;
+  if (specs != nullptr) {
+    for (const auto& spec : *specs) {
+      const app::Param* p = app::findParam(*params, spec.name);
+      QWidget* editor = editorFor(spec, p == nullptr ? std::string() : p->value, p != nullptr);
+      auto* row = new QWidget;
+      auto* h = new QHBoxLayout(row);
+      h->setContentsMargins(0, 0, 0, 0);
+      h->addWidget(editor, 1);
+      auto* reset = new QToolButton;
+      reset->setText("\u21ba");
+      reset->setToolTip("Reset to the default (" + q(spec.defaultValue) + ")");
+      reset->setEnabled(p != nullptr);
+      const std::string name = spec.name;
+      connect(reset, &QToolButton::clicked, this, [this, node, name] { Q_EMIT parameterEdited(node, name, ""); });
+      h->addWidget(reset);
+      auto* label = new QLabel(q(spec.name) + (p == nullptr ? "" : " \u2022"));
+      label->setToolTip(editor->toolTip());
+      if (p == nullptr) label->setStyleSheet("color: #777;");
+      form->addRow(label, row);
+      shownNames.insert(spec.name);
+    }
+  }
+  // Parameters the type does not declare (or of an instance): plain text.
+  for (const auto& p : *params) {
+    if (shownNames.count(p.name) != 0) continue;
+    app::ParamSpec spec;
+    spec.name = p.name;
+    spec.doc = specs == nullptr ? "" : "Not declared by the type: validation reports it.";
+    QWidget* editor = editorFor(spec, p.value, true);
+    form->addRow(q(p.name), editor);
+  }
+  if (module != nullptr) {
+    const auto* mtype = catalog.findModule(module->package, module->type);
+    if (mtype != nullptr) {
+      form->addRow(new QLabel("<b>Inputs: initial messages</b>"));
+      for (const auto& port : mtype->ports) {
+        if (!port.isInput) continue;
+        auto* box = new QSpinBox;
+        box->setObjectName("initial:" + q(port.name));
+        box->setRange(0, 1000);
+        box->setValue(app::inputConfigOrDefault(*module, port.name).initialMessages);
+        box->setKeyboardTracking(false);
+        box->setToolTip("Messages the input holds before the first iteration (what breaks a cycle)");
+        const std::string portName = port.name;
+        connect(box, &QSpinBox::editingFinished, this,
+                [this, box, node, portName] { Q_EMIT initialMessagesEdited(node, portName, box->value()); });
+        form->addRow(q(port.name), box);
+      }
+    }
+  }
+}
+
+// ---- Hosts -------------------------------------------------------------------------------
+
+HostsPanel::HostsPanel(QWidget* parent) : QWidget(parent) {
+  auto* table = new HostTable(0, 3);
+  table->ids = &ids_;
+  table_ = table;
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(4, 4, 4, 4);
+  table_->setHorizontalHeaderLabels({"", "Host", "Address"});
+  table_->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Fixed);
+  table_->setColumnWidth(0, 22);
+  table_->horizontalHeader()->setStretchLastSection(true);
+  table_->verticalHeader()->hide();
+  table_->setSelectionBehavior(QAbstractItemView::SelectRows);
+  table_->setSelectionMode(QAbstractItemView::SingleSelection);
+  table_->setDragEnabled(true);
+  table_->setDragDropMode(QAbstractItemView::DragOnly);
+  table_->setToolTip("Drag a host onto a node to run it there");
+  layout->addWidget(table_);
+  auto* buttons = new QHBoxLayout;
+  auto* add = new QPushButton("Add");
+  auto* remove = new QPushButton("Remove");
+  auto* import = new QPushButton("Import\u2026");
+  auto* assign = new QPushButton("Assign selection");
+  assign->setToolTip("Run the selected nodes on this host");
+  buttons->addWidget(add);
+  buttons->addWidget(remove);
+  buttons->addWidget(import);
+  buttons->addWidget(assign);
+  layout->addLayout(buttons);
+  connect(add, &QPushButton::clicked, this, &HostsPanel::addRequested);
+  connect(import, &QPushButton::clicked, this, &HostsPanel::importRequested);
+  connect(remove, &QPushButton::clicked, this, [this] {
+    if (!currentHost().empty()) Q_EMIT removeRequested(currentHost());
+  });
+  connect(assign, &QPushButton::clicked, this, [this] {
+    if (!currentHost().empty()) Q_EMIT assignSelectionRequested(currentHost());
+  });
+  connect(table_, &QTableWidget::itemChanged, this, [this](QTableWidgetItem* item) {
+    if (filling_ || item->row() < 0 || static_cast<std::size_t>(item->row()) >= ids_.size()) return;
+    const std::string host = ids_[static_cast<std::size_t>(item->row())];
+    const std::string text = s(item->text());
+    const int column = item->column();
+    // Applied after the table is done with its item (the refresh replaces the rows).
+    QTimer::singleShot(0, this, [this, host, text, column] {
+      if (column == 1) Q_EMIT renameRequested(host, text);
+      if (column == 2) Q_EMIT addressChanged(host, text);
+    });
+  });
+}
+
+std::string HostsPanel::currentHost() const {
+  const int row = table_->currentRow();
+  if (row < 0 || static_cast<std::size_t>(row) >= ids_.size()) return {};
+  return ids_[static_cast<std::size_t>(row)];
+}
+
+void HostsPanel::show(const app::Application& app) {
+  filling_ = true;
+  const int current = table_->currentRow();
+  ids_.clear();
+  table_->setRowCount(static_cast<int>(app.hosts.size()));
+  for (std::size_t i = 0; i < app.hosts.size(); ++i) {
+    const int row = static_cast<int>(i);
+    ids_.push_back(app.hosts[i].id);
+    auto* swatch = new QTableWidgetItem;
+    swatch->setBackground(colorOfHost(i));
+    swatch->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsDragEnabled);
+    table_->setItem(row, 0, swatch);
+    auto* id = new QTableWidgetItem(q(app.hosts[i].id));
+    id->setFlags(id->flags() | Qt::ItemIsDragEnabled);
+    table_->setItem(row, 1, id);
+    table_->setItem(row, 2, new QTableWidgetItem(q(app.hosts[i].address)));
+  }
+  if (current >= 0 && current < table_->rowCount()) table_->setCurrentCell(current, 1);
+  filling_ = false;
+}
+
+}  // namespace vrflow::editor::gui
