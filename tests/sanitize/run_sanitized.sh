@@ -8,7 +8,7 @@ type=$1 src=$2 build=$3
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 cmake -S "$src" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$type" -DVRFLOW_BUILD_BENCH=OFF \
-  -DVRFLOW_SANITIZER_TESTS=OFF -DVRFLOW_FUZZ_TESTS=OFF -DVRFLOW_WARNINGS_AS_ERRORS=OFF \
+  -DVRFLOW_SANITIZER_TESTS=OFF -DVRFLOW_FUZZ_TESTS=OFF -DVRFLOW_EDITOR=OFF -DVRFLOW_NODES=OFF -DVRFLOW_WARNINGS_AS_ERRORS=OFF \
   "${launcher[@]}" >/dev/null
 cmake --build "$build" -j "$(nproc)" >/dev/null
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
