@@ -1,0 +1,123 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "tank.hpp"
+#include "vrflow/fluid/solver.hpp"
+
+namespace vrflow::fluid {
+namespace {
+
+using testing::cornerLevel;
+using testing::makeTank;
+using testing::smallTank;
+
+// A box integrated here from the forces the fluid returns (semi-implicit Euler, translation
+// only: the tests are about buoyancy and drag, and a cube of density 0.5 would roll), with the
+// tank's floor as a contact.
+struct TestBox {
+  RigidBody body;
+  double half = 0.0;
+
+  TestBox(double halfEdge, double relativeDensity, msg::Vec3 position) : half(halfEdge) {
+    body.id = 7;
+    body.shape = msg::Shape::box({halfEdge, halfEdge, halfEdge});
+    body.position = position;
+    body.mass = relativeDensity * 1000.0 * 8 * halfEdge * halfEdge * halfEdge;
+  }
+
+  void integrate(const BodyForce& f, double dt) {
+    for (int a = 0; a < 3; ++a) {
+      const double g = a == 1 ? -9.81 : 0.0;
+      body.linearVelocity[a] += (f.force[a] / body.mass + g) * dt;
+      body.position[a] += body.linearVelocity[a] * dt;
+    }
+    if (body.position[1] - half < 0.0) {  // the floor
+      body.position[1] = half;
+      body.linearVelocity[1] = std::max(0.0, body.linearVelocity[1]);
+    }
+  }
+
+  double bottom() const { return body.position[1] - half; }
+};
+
+BodyForce stepWith(FluidSolver& solver, TestBox& box, double dt) {
+  auto forces = solver.step(dt, {box.body});
+  EXPECT_TRUE(forces.ok()) << (forces.ok() ? "" : forces.error().message);
+  EXPECT_EQ(forces->size(), 1u);
+  const BodyForce f = forces->front();
+  EXPECT_EQ(f.id, box.body.id);
+  box.integrate(f, dt);
+  return f;
+}
+
+TEST(RigidFluidCoupling, BoxOfHalfTheWatersDensityFloatsHalfSubmerged) {
+  auto tank = makeTank(smallTank(16, 20, 16), 0.5);
+  TestBox box(0.15, 0.5, {0.4, 0.5, 0.4});  // 6 cells wide, centred on the surface
+  const double dt = 0.01;
+  double sumSubmerged = 0.0;
+  int samples = 0;
+  for (int step = 0; step < 300; ++step) {
+    stepWith(*tank, box, dt);
+    if (step >= 200) {
+      sumSubmerged += (cornerLevel(*tank) - box.bottom()) / (2 * box.half);
+      ++samples;
+    }
+  }
+  const double submerged = sumSubmerged / samples;
+  std::printf("density 0.5 box: submerged fraction %.3f (mean of steps 200-300), y %.3f, v %.3f\n",
+              submerged, box.body.position[1], box.body.linearVelocity[1]);
+  EXPECT_NEAR(submerged, 0.5, 0.15);
+  EXPECT_LT(std::abs(box.body.linearVelocity[1]), 0.1);
+  EXPECT_GT(box.bottom(), 0.1);  // still afloat, far from the floor
+}
+
+TEST(RigidFluidCoupling, BoxOfTwiceTheWatersDensitySinksToTheFloor) {
+  auto tank = makeTank(smallTank(16, 20, 16), 0.5);
+  TestBox box(0.1, 2.0, {0.4, 0.4, 0.4});
+  const double dt = 0.01;
+  double fastest = 0.0;
+  int floorStep = -1;
+  for (int step = 0; step < 200 && floorStep < 0; ++step) {
+    const auto f = stepWith(*tank, box, dt);
+    (void)f;
+    fastest = std::max(fastest, -box.body.linearVelocity[1]);
+    if (box.bottom() <= 1e-9) floorStep = step;
+  }
+  std::printf("density 2 box: reached the floor at step %d, fastest sinking %.3f m/s\n", floorStep,
+              fastest);
+  ASSERT_GE(floorStep, 0) << "the heavy box never reached the floor";
+  // Free fall through 0.3 m takes 0.25 s; buoyancy (half the weight) and drag make it slower.
+  EXPECT_GT(floorStep, 30);
+}
+
+TEST(RigidFluidCoupling, DroppedBoxSlowsDownAndRaisesTheWater) {
+  auto tank = makeTank(smallTank(16, 24, 16), 0.4);
+  for (int step = 0; step < 5; ++step) ASSERT_TRUE(tank->step(0.01, {}).ok());
+  const double level0 = cornerLevel(*tank);
+  TestBox box(0.125, 0.9, {0.4, 0.8, 0.4});
+  const double dt = 0.01;
+  double entrySpeed = 0.0;
+  double slowest = 1e9;
+  double waterSpeed = 0.0;
+  for (int step = 0; step < 150; ++step) {
+    stepWith(*tank, box, dt);
+    const double speed = -box.body.linearVelocity[1];
+    if (box.bottom() > level0) entrySpeed = speed;
+    else slowest = std::min(slowest, speed);
+    waterSpeed = std::max(waterSpeed, tank->maxParticleSpeed());
+  }
+  const double level1 = cornerLevel(*tank);
+  std::printf("dropped box: entry %.3f m/s, slowest after entry %.3f m/s, level %.4f -> %.4f, "
+              "water speed %.3f m/s\n",
+              entrySpeed, slowest, level0, level1, waterSpeed);
+  EXPECT_GT(entrySpeed, 1.0);
+  EXPECT_LT(slowest, 0.5 * entrySpeed);
+  // 0.9 of the box's 15.6 litres under water spread over the 0.64 m^2 tank: about 2 cm.
+  EXPECT_GT(level1 - level0, 0.01);
+  EXPECT_GT(waterSpeed, 0.2);
+}
+
+}  // namespace
+}  // namespace vrflow::fluid
