@@ -138,28 +138,21 @@ void rasterise(const Grid& g, const std::vector<PreparedBody>& bodies, std::vect
   }
 }
 
-BodyForce bodyForce(const Grid& g, const PreparedBody& body, int bodyIndex,
-                    const std::vector<int>* faceBody, const std::vector<double>* uNew,
-                    const std::vector<double>* uOld, const msg::Vec3& gravity, double dt) {
-  BodyForce out;
-  out.id = body.id;
-  out.index = body.index;
-  out.point = body.position;
-  out.duration = dt;
-  const int lo[3] = {std::max(0, static_cast<int>(std::floor((body.bounds.min[0] - g.ox) / g.h)) - 1),
-                     std::max(0, static_cast<int>(std::floor((body.bounds.min[1] - g.oy) / g.h)) - 1),
-                     std::max(0, static_cast<int>(std::floor((body.bounds.min[2] - g.oz) / g.h)) - 1)};
-  const int hiCell[3] = {static_cast<int>(std::ceil((body.bounds.max[0] - g.ox) / g.h)) + 1,
-                         static_cast<int>(std::ceil((body.bounds.max[1] - g.oy) / g.h)) + 1,
-                         static_cast<int>(std::ceil((body.bounds.max[2] - g.oz) / g.h)) + 1};
-  msg::Vec3 torque{};
-  bool complete = true;
+void bodyForceSums(const Grid& g, const PreparedBody& body, int bodyIndex,
+                   const std::vector<int>* faceBody, const std::vector<double>* uNew,
+                   const std::vector<double>* uOld, const msg::Vec3& gravity, double dt, int k0,
+                   const int kEnd[3], double* sums) {
+  const double o[3] = {g.ox, g.oy, g.oz};
   for (int a = 0; a < 3; ++a) {
-    double sum = 0.0;
-    int count = 0;
-    msg::Vec3 axisTorque{};
-    const int hi[3] = {std::min(hiCell[0], g.fdim(a, 0) - 1), std::min(hiCell[1], g.fdim(a, 1) - 1),
-                       std::min(hiCell[2], g.fdim(a, 2) - 1)};
+    int lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::max(0, static_cast<int>(std::floor((body.bounds.min[d] - o[d]) / g.h)) - 1);
+      hi[d] = std::min(g.fdim(a, d) - 1,
+                       static_cast<int>(std::ceil((body.bounds.max[d] - o[d]) / g.h)) + 1);
+    }
+    lo[2] = std::max(lo[2], k0);
+    hi[2] = std::min(hi[2], kEnd[a] - 1);
+    double* out = sums + 5 * a;
     for (int k = lo[2]; k <= hi[2]; ++k) {
       for (int j = lo[1]; j <= hi[1]; ++j) {
         for (int i = lo[0]; i <= hi[0]; ++i) {
@@ -167,31 +160,38 @@ BodyForce bodyForce(const Grid& g, const PreparedBody& body, int bodyIndex,
           if (faceBody[a][f] != bodyIndex) continue;
           // Momentum change per unit mass on this face, gravity removed: -grad p / rho.
           const double d = uNew[a][f] - uOld[a][f] - gravity[a] * dt;
-          sum += d;
-          ++count;
+          out[0] += d;
+          out[1] += 1.0;
           msg::Vec3 x{g.ox + (i + 0.5) * g.h, g.oy + (j + 0.5) * g.h, g.oz + (k + 0.5) * g.h};
           x[static_cast<std::size_t>(a)] -= 0.5 * g.h;
           msg::Vec3 e{};
           e[static_cast<std::size_t>(a)] = d;
-          const auto t = cross({x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]}, e);
-          for (int c = 0; c < 3; ++c) axisTorque[c] += t[c];
+          const auto t = cross(
+              {x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]}, e);
+          for (int c = 0; c < 3; ++c) out[2 + c] += t[c];
         }
       }
     }
-    out.cells += count;
-    if (count == 0) {
-      complete = false;
-      continue;
-    }
-    // Each face carries mass / count of the body along this axis.
-    const double perFace = body.mass / count;
-    out.force[a] = body.mass * (sum / count) / dt;
-    for (int c = 0; c < 3; ++c) torque[c] += perFace * axisTorque[c] / dt;
   }
-  if (!complete) {  // too small for the grid on some axis: no reliable force
-    out.force = {};
-    torque = {};
-    out.cells = 0;
+}
+
+BodyForce finishBodyForce(const PreparedBody& body, const double* sums, double dt) {
+  BodyForce out;
+  out.id = body.id;
+  out.index = body.index;
+  out.point = body.position;
+  out.duration = dt;
+  for (int a = 0; a < 3; ++a) {
+    if (sums[5 * a + 1] < 1.0) return out;  // too small for the grid on some axis: no force
+  }
+  msg::Vec3 torque{};
+  for (int a = 0; a < 3; ++a) {
+    const double* s = sums + 5 * a;
+    const int count = static_cast<int>(s[1]);
+    out.cells += count;
+    // Each face carries mass / count of the body along this axis.
+    out.force[a] = body.mass * (s[0] / count) / dt;
+    for (int c = 0; c < 3; ++c) torque[c] += body.mass / count * s[2 + c] / dt;
   }
   if (!body.point) out.torque = torque;
   return out;

@@ -36,9 +36,16 @@ msg::Vec3 rigidVelocity(const PreparedBody& body, const msg::Vec3& x);
 /// Marks cells and faces whose centres lie inside a body with its index (first body wins).
 void rasterise(const Grid& grid, const std::vector<PreparedBody>& bodies, std::vector<int>& cellBody,
                std::vector<int>* faceBody);
-/// Force and torque from the momentum change on the body's faces, less gravity.
-BodyForce bodyForce(const Grid& grid, const PreparedBody& body, int bodyIndex,
-                    const std::vector<int>* faceBody, const std::vector<double>* uNew,
-                    const std::vector<double>* uOld, const msg::Vec3& gravity, double dt);
+/// Values bodyForceSums() adds up per body: per axis the summed velocity change, the face count
+/// and the torque of the change (3), so that blocks can add theirs before finishBodyForce().
+inline constexpr int kBodySums = 15;
+/// Adds the momentum change per unit mass (less gravity) of the body's faces in z-planes
+/// [k0, k1) of each component (k1 of the w faces is given by `kEnd[2]`) to `sums`.
+void bodyForceSums(const Grid& grid, const PreparedBody& body, int bodyIndex,
+                   const std::vector<int>* faceBody, const std::vector<double>* uNew,
+                   const std::vector<double>* uOld, const msg::Vec3& gravity, double dt, int k0,
+                   const int kEnd[3], double* sums);
+/// Force and torque from the summed changes: mass times the mean change per axis, over dt.
+BodyForce finishBodyForce(const PreparedBody& body, const double* sums, double dt);
 
 }  // namespace vrflow::fluid::detail

@@ -21,7 +21,7 @@ double localDot(const std::vector<double>& a, const std::vector<double>& b, cons
 }
 
 double dot(const std::vector<double>& a, const std::vector<double>& b, const Slab& s,
-           PressureComm* comm) {
+           BlockComm* comm) {
   const double local = localDot(a, b, s);
   return comm ? comm->sum(local) : local;
 }
@@ -135,7 +135,7 @@ void applyPreconditioner(const Grid& g, const PressureSystem& A, const std::vect
 
 PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vector<double>& b,
                          std::vector<double>& p, double tol, int maxIterations,
-                         PressureComm* comm) {
+                         BlockComm* comm) {
   const std::size_t n = g.cells();
   const int planeSize = g.nx * g.ny;
   Slab slab;
@@ -162,7 +162,7 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
   double rho = dot(r, z, slab, comm);
   double rNorm = bNorm;
   for (int it = 1; it <= maxIterations; ++it) {
-    if (comm) comm->exchangeHalo(s, planeSize, slab.k0, slab.k1);
+    if (comm) comm->exchangeHalo(s, planeSize, g.nz, slab.k0, slab.k1, 1);
     multiply(g, A, s, q, slab);
     const double sq = dot(s, q, slab, comm);
     if (sq <= 0.0) break;  // breakdown: no descent left (round-off at convergence)

@@ -4,10 +4,10 @@
 #include <vector>
 
 #include "grid.hpp"
-#include "vrflow/fluid/pressure_comm.hpp"
+#include "vrflow/fluid/block_comm.hpp"
 
 // The pressure Poisson system on the cell grid (7-point, symmetric positive definite on the
-// unknown cells) and its MIC(0)-preconditioned conjugate gradient. With a PressureComm each block
+// unknown cells) and its MIC(0)-preconditioned conjugate gradient. With a BlockComm each block
 // solves its slab of planes; the preconditioner is then MIC(0) of the block's own part of the
 // matrix (block Jacobi across blocks), so iteration counts and the last bits of the result
 // depend on the number of blocks.
@@ -32,6 +32,6 @@ struct PcgOutcome {
 /// `comm`, only this block's slab of `p` is computed; the caller gathers it.
 PcgOutcome solvePressure(const Grid& grid, const PressureSystem& system,
                          const std::vector<double>& b, std::vector<double>& p, double tol,
-                         int maxIterations, PressureComm* comm);
+                         int maxIterations, BlockComm* comm);
 
 }  // namespace vrflow::fluid::detail

@@ -64,9 +64,8 @@ struct StepStats {
   double targetDivergence = 0.0; ///< what volume control would ask at the mean density, 1/s
 };
 
-/// Scatter/gather of a distributed pressure solve (one block per MPI rank). The serial solver
-/// uses none; see mpi_pressure.hpp.
-class PressureComm;
+/// A distributed run's link between blocks (block_comm.hpp); the serial solver uses none.
+class BlockComm;
 
 /// The fluid simulation. Not thread-safe; owns no threads.
 class FluidSolver {
@@ -86,19 +85,24 @@ class FluidSolver {
   Result<std::vector<BodyForce>> step(double dt, const std::vector<RigidBody>& bodies,
                                       const std::vector<PointMass>& points = {});
 
-  /// Uses `comm` for the pressure solve (distributed CG); nullptr for the serial solve.
-  void setPressureComm(PressureComm* comm);
+  /// Makes this solver one block of a distributed run: it owns the z-planes of its slab and the
+  /// particles in them, and every step, addLiquidBox and query below becomes collective (every
+  /// block calls it). Call before addLiquidBox; nullptr (the default) is the serial solver.
+  Status setBlockComm(BlockComm* comm);
 
   const FluidSettings& settings() const;
   const StepStats& lastStats() const;
-  /// Particle positions, xyz per particle.
+  /// This block's particle positions, xyz per particle (all of them in a serial run).
   const std::vector<float>& particlePositions() const;
+  /// Every block's particle positions, in block order, complete on block 0 (collective).
+  std::vector<float> gatherParticlePositions() const;
+  /// Number of particles over every block (collective).
   std::size_t particleCount() const;
   /// Liquid volume estimated as the number of cells holding particles times the cell volume.
   double liquidVolume() const;
   /// Largest |velocity| sampled at the particles.
   double maxParticleSpeed() const;
-  /// Highest particle y, and mean y of the top particles in the column around (x, z).
+  /// Highest particle y in the grid column holding (x, z).
   double surfaceHeightAt(double x, double z) const;
   /// Largest |divergence - target| of the face velocities over liquid cells after the last
   /// projection, in 1/s; the per-cell target is 0 unless volume control is on (see FluidSettings).
