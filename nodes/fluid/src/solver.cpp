@@ -1,6 +1,7 @@
 #include "vrflow/fluid/solver.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -421,8 +422,12 @@ struct FluidSolver::Impl {
         }
       }
     }
+    exchangeCells(A.az);  // the product needs the lower block's couplings to this block
+    const auto start = std::chrono::steady_clock::now();
     const auto outcome = detail::solvePressure(grid, A, rhs, pressure, settings.cgTolerance,
                                                settings.cgMaxIterations, comm);
+    stats.pressureSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     exchangeCells(pressure);
     stats.cgIterations = outcome.iterations;
     stats.cgResidual = outcome.residual;

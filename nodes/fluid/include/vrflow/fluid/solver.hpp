@@ -59,7 +59,8 @@ struct StepStats {
   int fluidCells = 0;            ///< cells holding liquid particles
   int bodyCells = 0;             ///< cells inside bodies
   double maxSpeed = 0.0;         ///< largest face velocity magnitude after projection
-  std::uint64_t bytesTouched = 0;///< estimate of memory traffic in the pressure solve
+  std::uint64_t bytesTouched = 0;///< estimate of this block's memory traffic in the pressure CG
+  double pressureSeconds = 0.0;  ///< wall time of the pressure CG (for bandwidth estimates)
   double particleDensity = 1.0;  ///< mean particles per interior liquid cell / particlesPerCell
   double targetDivergence = 0.0; ///< what volume control would ask at the mean density, 1/s
 };
