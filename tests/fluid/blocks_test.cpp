@@ -26,6 +26,7 @@ nlohmann::json runBlocks(int ranks) {
   setenv("OMPI_MCA_btl", "self,vader", 0);
   setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
   setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
+  setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
   std::vector<std::string> argv;
   if (ranks > 0) {
     argv = {VRFLOW_MPIEXEC, "--oversubscribe", "-np", std::to_string(ranks)};

@@ -28,6 +28,7 @@ struct Options {
   int steps = 50;
   int warmup = 3;
   int bodies = 0;
+  int maxParticles = 200000;
   double dt = 0.005;
   bool serial = false;
 };
@@ -45,11 +46,16 @@ bool parse(int argc, char** argv, Options& o) {
     if (a == "--serial") {
       o.serial = true;
     } else if (a == "--nx" || a == "--ny" || a == "--nz" || a == "--steps" || a == "--bodies" ||
-               a == "--warmup") {
+               a == "--warmup" || a == "--max-particles") {
       if (!next(v)) return false;
       const int n = static_cast<int>(v);
-      (a == "--nx" ? o.nx : a == "--ny" ? o.ny : a == "--nz" ? o.nz : a == "--steps" ? o.steps
-                    : a == "--warmup" ? o.warmup : o.bodies) = n;
+      (a == "--nx"       ? o.nx
+       : a == "--ny"     ? o.ny
+       : a == "--nz"     ? o.nz
+       : a == "--steps"  ? o.steps
+       : a == "--warmup" ? o.warmup
+       : a == "--bodies" ? o.bodies
+                         : o.maxParticles) = n;
     } else if (a == "--h") {
       if (!next(o.h)) return false;
     } else if (a == "--dt") {
@@ -121,7 +127,7 @@ int main(int argc, char** argv) {
     if (rank == 0) {
       std::fprintf(stderr,
                    "usage: vrflow-fluid-blocks [--nx N --ny N --nz N --h M --dt S --steps N "
-                   "--warmup N --bodies N --serial]\n");
+                   "--warmup N --bodies N --max-particles N --serial]\n");
     }
     MPI_Finalize();
     return 2;
@@ -136,6 +142,7 @@ int main(int argc, char** argv) {
   s.ny = o.ny;
   s.nz = o.nz;
   s.cellSize = o.h;
+  s.maxParticles = o.maxParticles;
   auto created = fluid::FluidSolver::create(s);
   if (!created) {
     if (rank == 0) std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", created.error().message.c_str());
