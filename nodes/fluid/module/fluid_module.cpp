@@ -13,6 +13,7 @@
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/module/module.hpp"
 #include "vrflow/fluid/solver.hpp"
+#include "blocks.hpp"
 #include "world.hpp"
 
 namespace {
@@ -34,7 +35,10 @@ int fail(const std::string& message) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "--block-worker") {
+    return fluid::runBlockWorker(argc, argv);
+  }
   Module module;
   auto& objectsIn = module.addInput("objects");
   auto& forcesOut = module.addOutput("forces");
@@ -66,11 +70,23 @@ int main() {
   const auto particlesEvery = module.paramInt("particles-every", 1);
   const double nodeRadius = module.paramDouble("node-radius", 0.0);
 
-  auto created = fluid::FluidSolver::create(s);
-  if (!created) return fail(created.error().message);
-  auto solver = std::move(created.value());
+  const auto blocks = module.paramInt("blocks", 1);
+
+  if (auto status = fluid::validateSettings(s); !status) return fail(status.error().message);
   if (auto status = fluid::validateTimeStep(s, dt); !status) return fail(status.error().message);
-  if (auto status = solver->addLiquidBox(fill); !status) return fail(status.error().message);
+  std::unique_ptr<fluid::FluidSolver> serial;
+  std::unique_ptr<fluid::BlockGroup> group;
+  if (blocks <= 1) {
+    auto created = fluid::FluidSolver::create(s);
+    if (!created) return fail(created.error().message);
+    serial = std::move(created.value());
+    if (auto status = serial->addLiquidBox(fill); !status) return fail(status.error().message);
+  } else {
+    auto started = fluid::BlockGroup::start(argv[0], static_cast<int>(blocks), s, fill);
+    if (!started) return fail(started.error().message);
+    group = std::move(started.value());
+  }
+  fluid::FluidSolver& solver = serial ? *serial : group->solver();
 
   std::ofstream stats;
   if (const auto path = module.param("stats"); !path.empty()) {
@@ -100,14 +116,22 @@ int main() {
         warnedUncoupled = true;
       }
     }
-    auto stepped = solver->step(dt, bodies, points);
+    const bool sendParticles =
+        particlesEvery > 0 && (module.iteration() % static_cast<std::uint64_t>(particlesEvery) == 0);
+    fluid::BlockStep request;
+    request.dt = dt;
+    request.bodies = bodies;
+    request.points = points;
+    request.gatherParticles = sendParticles;
+    request.stats = stats.is_open();
+    auto stepped = group ? group->step(request) : fluid::stepBlock(solver, request);
     if (!stepped) return fail(stepped.error().message);
     time += dt;
 
     auto forces = module.newMessage(256 + 128 * bodies.size());
     forces.builder().setSimTime(time);
     forces.builder().setTimeStep(dt);
-    for (const auto& f : *stepped) {
+    for (const auto& f : stepped->forces) {
       // Rigid bodies only: mass-spring nodes' forces need the massspring package's node event.
       if (f.cells == 0 || f.index != 0 || f.id == 0) continue;
       bool rigid = false;
@@ -117,27 +141,26 @@ int main() {
     }
     if (!module.put(forcesOut, std::move(forces))) break;
 
-    const auto& xyz = solver->particlePositions();
-    const bool sendParticles =
-        particlesEvery > 0 && (module.iteration() % static_cast<std::uint64_t>(particlesEvery) == 0);
+    const auto& xyz = stepped->particles;
     auto out = module.newMessage(512 + (sendParticles ? xyz.size() * sizeof(float) : 0));
     out.builder().setSimTime(time);
     out.builder().setTimeStep(dt);
     if (module.iteration() == 0) {
       out.builder()
           .addObject(fluidId, msg::fluidType(), msg::ObjectOp::Add)
-          .set(msg::FluidParam::kBounds, solver->bounds())
+          .set(msg::FluidParam::kBounds, solver.bounds())
           .set(msg::FluidParam::kParticles, particlesId);
     }
     if (sendParticles) out.builder().addMesh(particlesId, true, xyz, {});
     if (!module.put(objectsOut, std::move(out))) break;
 
     if (stats.is_open()) {
-      const auto& st = solver->lastStats();
+      const auto& st = solver.lastStats();
       stats << module.iteration() << ',' << time << ',' << st.cgIterations << ',' << st.cgResidual
-            << ',' << st.fluidCells << ',' << st.bodyCells << ',' << solver->liquidVolume() << ','
-            << solver->maxParticleSpeed() << ',' << bodies.size() << '\n';
+            << ',' << st.fluidCells << ',' << st.bodyCells << ',' << stepped->volume << ','
+            << stepped->maxSpeed << ',' << bodies.size() << '\n';
     }
   }
+  if (group) group->stop();
   return module.exitStatus();
 }
