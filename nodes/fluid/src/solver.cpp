@@ -63,15 +63,23 @@ struct FluidSolver::Impl {
   void exchangeCells(std::vector<double>& field) {
     if (comm) comm->exchangeHalo(field, grid.nx * grid.ny, grid.nz, k0, k1, 1);
   }
+  // Byte fields travel as doubles; only the planes sent (k0, k1 - 1) and received (k0 - 1, k1)
+  // are converted, in a scratch field kept between calls.
+  std::vector<double> byteScratch;
   void exchangeBytes(std::vector<unsigned char>& bytes, int planeSizeBytes, int planes) {
     if (!comm) return;
-    std::vector<double> tmp(bytes.begin(), bytes.end());
-    comm->exchangeHalo(tmp, planeSizeBytes, planes, k0, k1, 1);
     const std::size_t ps = static_cast<std::size_t>(planeSizeBytes);
+    byteScratch.resize(bytes.size());
+    // The received planes start as they are, so a plane no neighbour sends stays unchanged.
+    for (int k : {k0 - 1, k0, k1 - 1, k1}) {
+      if (k < 0 || k >= planes) continue;
+      for (std::size_t c = k * ps; c < (k + 1) * ps; ++c) byteScratch[c] = bytes[c];
+    }
+    comm->exchangeHalo(byteScratch, planeSizeBytes, planes, k0, k1, 1);
     for (int k : {k0 - 1, k1}) {
       if (k < 0 || k >= planes) continue;
       for (std::size_t c = k * ps; c < (k + 1) * ps; ++c) {
-        bytes[c] = static_cast<unsigned char>(tmp[c]);
+        bytes[c] = static_cast<unsigned char>(byteScratch[c]);
       }
     }
   }
