@@ -234,11 +234,31 @@ struct FluidSolver::Impl {
     vel.swap(v2);
   }
 
+  // Only particles in cells that some body's bounds touch are tested against the bodies.
+  std::vector<unsigned char> nearBody;
   void pushParticlesOut(const std::vector<PreparedBody>& bodies) {
-    const std::size_t n = pos.size() / 3;
+    if (bodies.empty()) return;
+    nearBody.assign(grid.cells(), 0);
+    const double o[3] = {grid.ox, grid.oy, grid.oz};
+    const int n[3] = {grid.nx, grid.ny, grid.nz};
     for (const auto& body : bodies) {
-      for (std::size_t p = 0; p < n; ++p) {
-        double* x = &pos[3 * p];
+      int lo[3], hi[3];
+      for (int d = 0; d < 3; ++d) {
+        lo[d] = std::max(0, static_cast<int>(std::floor((body.bounds.min[d] - o[d]) * invH)) - 1);
+        hi[d] = std::min(n[d] - 1, static_cast<int>(std::floor((body.bounds.max[d] - o[d]) * invH)) + 1);
+      }
+      for (int k = lo[2]; k <= hi[2]; ++k) {
+        for (int j = lo[1]; j <= hi[1]; ++j) {
+          for (int i = lo[0]; i <= hi[0]; ++i) nearBody[grid.cell(i, j, k)] = 1;
+        }
+      }
+    }
+    const std::size_t count = pos.size() / 3;
+    for (std::size_t p = 0; p < count; ++p) {
+      double* x = &pos[3 * p];
+      int i, j, k;
+      if (!cellOf(x, i, j, k) || !nearBody[grid.cell(i, j, k)]) continue;
+      for (const auto& body : bodies) {
         if (!detail::inBounds(body.bounds, x)) continue;
         detail::pushOut(body, x, 0.25 * grid.h);
         clampToDomain(x);
