@@ -121,3 +121,58 @@ TEST(RigidFluidCoupling, DroppedBoxSlowsDownAndRaisesTheWater) {
 
 }  // namespace
 }  // namespace vrflow::fluid
+
+namespace vrflow::fluid {
+namespace {
+
+// A box spinning about z in still water: the liquid resists, so the torque opposes the spin;
+// the same box at rest gets (almost) no torque, and its force is buoyancy (upward).
+TEST(RigidFluidCoupling, SpinningBoxFeelsATorqueAgainstItsSpin) {
+  auto tank = testing::makeTank(testing::smallTank(16, 16, 16), 0.6);
+  RigidBody box;
+  box.id = 3;
+  box.shape = msg::Shape::box({0.1, 0.1, 0.1});
+  box.position = {0.4, 0.3, 0.4};
+  box.mass = 1000.0 * 0.008;  // neutrally buoyant
+  // Held still while the particles it displaced settle around it.
+  for (int step = 0; step < 100; ++step) ASSERT_TRUE(tank->step(0.01, {box}).ok());
+  auto atRest = tank->step(0.01, {box});
+  ASSERT_TRUE(atRest.ok());
+  const auto& rest = atRest->front();
+  box.angularVelocity = {0, 0, 4.0};
+  auto spinning = tank->step(0.01, {box});
+  ASSERT_TRUE(spinning.ok());
+  const auto& spin = spinning->front();
+  std::printf("box at rest: force y %.2f N (weight %.2f N), torque z %.4f N m; spinning: torque "
+              "z %.4f N m\n",
+              rest.force[1], box.mass * 9.81, rest.torque[2], spin.torque[2]);
+  EXPECT_NEAR(rest.force[1], box.mass * 9.81, 0.1 * box.mass * 9.81);  // buoyancy = weight
+  EXPECT_LT(std::abs(rest.torque[2]), 0.05);  // particle noise; the spin gives ~2 N m
+  EXPECT_LT(spin.torque[2], -0.1);  // against the spin
+}
+
+// A mass-spring node under water is a small sphere: it is pushed up (buoyancy), gets no torque.
+TEST(RigidFluidCoupling, SubmergedNetNodeIsPushedUp) {
+  auto tank = testing::makeTank(testing::smallTank(12, 12, 12), 0.45);
+  PointMass node;
+  node.id = 9;
+  node.index = 17;
+  node.position = {0.3, 0.2, 0.3};
+  node.mass = 0.2;
+  node.radius = 0.06;
+  for (int step = 0; step < 3; ++step) ASSERT_TRUE(tank->step(0.01, {}, {node}).ok());
+  auto forces = tank->step(0.01, {}, {node});
+  ASSERT_TRUE(forces.ok());
+  ASSERT_EQ(forces->size(), 1u);
+  const auto& f = forces->front();
+  const double buoyancy = 1000.0 * 9.81 * 4.0 / 3.0 * 3.14159265 * 0.06 * 0.06 * 0.06;
+  std::printf("net node: force y %.3f N (buoyancy of the sphere %.3f N), %d faces\n", f.force[1],
+              buoyancy, f.cells);
+  EXPECT_EQ(f.index, 17u);
+  EXPECT_GT(f.cells, 0);
+  EXPECT_NEAR(f.force[1], buoyancy, 0.35 * buoyancy);  // a 2.4-cell sphere on the grid
+  EXPECT_EQ(f.torque, (msg::Vec3{0, 0, 0}));
+}
+
+}  // namespace
+}  // namespace vrflow::fluid
