@@ -3,6 +3,7 @@
 #include <mpi.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -112,7 +113,10 @@ void broadcast(std::vector<char>& bytes, MPI_Comm comm) {
   MPI_Bcast(bytes.data(), static_cast<int>(n), MPI_CHAR, 0, comm);
 }
 
-void allowRoot() {
+void prepareMpi() {
+  // Open MPI's I/O forwarding may write to the module's output pipes after vrflow stopped
+  // reading them at the end of a run; a write error must not kill the process with SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
   // Open MPI refuses root unless told; oversubscription: more blocks than cores is allowed.
   if (geteuid() == 0) {
     setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
@@ -160,7 +164,7 @@ Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, in
     return makeError("fluid: " + std::to_string(blocks) + " blocks for " +
                      std::to_string(settings.nz) + " z-planes: use 2 to nz blocks (1 = serial)");
   }
-  allowRoot();
+  prepareMpi();
   int argc = 0;
   char** argv = nullptr;
   MPI_Init(&argc, &argv);
@@ -210,7 +214,7 @@ void BlockGroup::stop() {
 }
 
 int runBlockWorker(int argc, char** argv) {
-  allowRoot();
+  prepareMpi();
   MPI_Init(&argc, &argv);
   MPI_Comm parent = MPI_COMM_NULL;
   MPI_Comm_get_parent(&parent);

@@ -99,18 +99,35 @@ struct FluidSolver::Impl {
     std::size_t sy, sz;
     double f[3];
   };
-  Stencil stencil(int a, const double* x) const {
-    int b[3];
-    Stencil s{};
+  // Per dimension, the clamped cell coordinate of a point on the face lattice (the component
+  // along that dimension) and on the centre lattice (the two others): shared by the 3 stencils.
+  struct Coords {
+    int faceBase[3], centreBase[3];
+    double faceFrac[3], centreFrac[3];
+  };
+  Coords coords(const double* x) const {
+    Coords c{};
     const double o[3] = {grid.ox, grid.oy, grid.oz};
+    const int n[3] = {grid.nx, grid.ny, grid.nz};
     for (int d = 0; d < 3; ++d) {
-      double c = (x[d] - o[d]) * invH - (d == a ? 0.0 : 0.5);
-      const int hi = grid.fdim(a, d) - 1;
-      c = std::clamp(c, 0.0, static_cast<double>(hi));
-      int bb = static_cast<int>(c);
-      if (bb >= hi) bb = hi - 1;
-      b[d] = bb;
-      s.f[d] = c - bb;
+      for (int face = 0; face < 2; ++face) {
+        double v = (x[d] - o[d]) * invH - (face ? 0.0 : 0.5);
+        const int hi = n[d] - (face ? 0 : 1);
+        v = std::clamp(v, 0.0, static_cast<double>(hi));
+        int b = static_cast<int>(v);
+        if (b >= hi) b = hi - 1;
+        (face ? c.faceBase : c.centreBase)[d] = b;
+        (face ? c.faceFrac : c.centreFrac)[d] = v - b;
+      }
+    }
+    return c;
+  }
+  Stencil stencil(int a, const Coords& c) const {
+    Stencil s{};
+    int b[3];
+    for (int d = 0; d < 3; ++d) {
+      b[d] = d == a ? c.faceBase[d] : c.centreBase[d];
+      s.f[d] = d == a ? c.faceFrac[d] : c.centreFrac[d];
     }
     s.sy = static_cast<std::size_t>(grid.fdim(a, 0));
     s.sz = s.sy * static_cast<std::size_t>(grid.fdim(a, 1));
@@ -320,9 +337,9 @@ struct FluidSolver::Impl {
     }
     const std::size_t n = pos.size() / 3;
     for (std::size_t p = 0; p < n; ++p) {
-      const double* x = &pos[3 * p];
+      const Coords c = coords(&pos[3 * p]);
       for (int a = 0; a < 3; ++a) {
-        const Stencil s = stencil(a, x);
+        const Stencil s = stencil(a, c);
         const double va = vel[3 * p + a];
         for (int dk = 0; dk < 2; ++dk) {
           const double wz = dk ? s.f[2] : 1 - s.f[2];
@@ -534,8 +551,9 @@ struct FluidSolver::Impl {
       double* x = &pos[3 * p];
       double* v = &vel[3 * p];
       double un[3];
+      const Coords c = coords(x);
       for (int a = 0; a < 3; ++a) {
-        const Stencil s = stencil(a, x);
+        const Stencil s = stencil(a, c);
         un[a] = gather(u[a], s);
         const double uo = gather(uOld[a], s);
         v[a] = flip * (v[a] + un[a] - uo) + (1.0 - flip) * un[a];
@@ -543,7 +561,8 @@ struct FluidSolver::Impl {
       // Midpoint (RK2) through the divergence-free grid velocity.
       double mid[3] = {x[0] + 0.5 * dt * un[0], x[1] + 0.5 * dt * un[1], x[2] + 0.5 * dt * un[2]};
       clampToDomain(mid);
-      for (int a = 0; a < 3; ++a) x[a] += dt * gather(u[a], stencil(a, mid));
+      const Coords cm = coords(mid);
+      for (int a = 0; a < 3; ++a) x[a] += dt * gather(u[a], stencil(a, cm));
       clampToDomain(x);
     }
   }
