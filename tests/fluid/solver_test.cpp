@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "tank.hpp"
 #include "vrflow/fluid/solver.hpp"
@@ -59,12 +60,15 @@ TEST(FluidSolver, StillTankStaysStillFor500Steps) {
   EXPECT_NEAR(tank->liquidVolume(), volume0, 0.01 * volume0);
 }
 
-// The liquid's volume, counted as cells holding particles (a measure that sees particles
-// compressing or spreading apart, unlike their number): a dam of 8 x 12 cells across the tank's
-// 6 cells of depth breaks, sloshes and settles into 6 full layers of the 16-cell-wide tank, so
-// the count at the start and at the end are comparable cell for cell.
+// The liquid's volume, estimated from the particles and the particle density of interior cells
+// (FluidSolver::liquidVolume: particles that clump or drift apart change it; without volume
+// control it drifted by 5-9 % here): a dam of 8 x 12 x 6 cells breaks and sloshes for 1000
+// steps (10 s) in a 16 x 16 x 6 tank; checked at the end (right after the break, while few
+// interior cells remain, the estimate swings by up to ~5 %, printed).
 TEST(FluidSolver, VolumeIsConservedWithin2PercentOver1000Steps) {
   auto s = smallTank(16, 16, 6);
+  // VRFLOW_FLUID_VOLUME_CORRECTION=0 shows the check failing without volume control (+3.3 %).
+  if (const char* vc = std::getenv("VRFLOW_FLUID_VOLUME_CORRECTION")) s.volumeCorrection = std::atof(vc);
   auto solver = std::move(FluidSolver::create(s).value());
   ASSERT_TRUE(solver->addLiquidBox({{0, 0, 0}, {8 * s.cellSize, 12 * s.cellSize, 6 * s.cellSize}})
                   .ok());
@@ -75,7 +79,7 @@ TEST(FluidSolver, VolumeIsConservedWithin2PercentOver1000Steps) {
     worst = std::max(worst, std::abs(solver->liquidVolume() - volume0) / volume0);
   }
   const double final = solver->liquidVolume();
-  std::printf("volume %.5f -> %.5f m^3 (%.2f %%), largest deviation while sloshing %.2f %%\n",
+  std::printf("volume %.5f -> %.5f m^3 (%.2f %%), largest deviation over the 1000 steps %.2f %%\n",
               volume0, final, 100.0 * (final - volume0) / volume0, 100.0 * worst);
   EXPECT_NEAR(final, volume0, 0.02 * volume0);
 }

@@ -18,6 +18,7 @@ using detail::PreparedBody;
 namespace {
 constexpr int kHaloForParticles = 3;  // planes of velocity a block's particles may sample
 constexpr int kParticleRecord = 6;    // position and velocity
+constexpr double kMinTheta = 0.2;     // keeps ghost-fluid coefficients (1 / theta) bounded
 }  // namespace
 
 struct FluidSolver::Impl {
@@ -36,6 +37,10 @@ struct FluidSolver::Impl {
   std::vector<double> cellDensity;
   std::vector<int> particlesInCell;
   std::vector<double> divTarget;  // per cell, times 1/dt
+  // Free surface (ghost fluid): distance, in cells, from an unknown cell's centre to where
+  // p = 0 lies towards an air neighbour. A liquid cell's particle count says how full it is:
+  // full puts the surface at the face (0.5); a body cell's surface is taken at its face (0.5).
+  std::vector<double> theta;
   detail::PressureSystem system;
   std::vector<double> rhs, pressure;
   StepStats stats;
@@ -328,6 +333,13 @@ struct FluidSolver::Impl {
     total = sum(total);
     count = sum(count);
     stats.particleDensity = count > 0 ? total / (count * n0) : 1.0;
+    theta.assign(kind.size(), 0.5);
+    for (std::size_t c = k0 * plane; c < k1 * plane; ++c) {
+      if (kind[c] != detail::kLiquid) continue;
+      const double full = std::min(1.0, particlesInCell[c] / n0);
+      theta[c] = std::clamp(full - 0.5, kMinTheta, 0.5);
+    }
+    exchangeCells(theta);
   }
 
   void particlesToGrid() {
@@ -460,7 +472,7 @@ struct FluidSolver::Impl {
               const double rho =
                   unknown(nbr) ? 0.5 * (cellDensity[c] + cellDensity[nbr]) : cellDensity[c];
               const double beta = dt / (rho * h * h);
-              A.diag[c] += beta;
+              A.diag[c] += unknown(nbr) ? beta : beta / theta[c];
               if (side > 0 && unknown(nbr)) (a == 0 ? A.ax : a == 1 ? A.ay : A.az)[c] = -beta;
             }
           }
@@ -488,8 +500,10 @@ struct FluidSolver::Impl {
         if (!ulo && !uhi) return;
         const double rho = (ulo && uhi) ? 0.5 * (cellDensity[lo] + cellDensity[hi])
                                         : (ulo ? cellDensity[lo] : cellDensity[hi]);
+        // Next to air, p = 0 lies theta cells from the unknown cell's centre.
+        const double gap = (ulo && uhi) ? 1.0 : (ulo ? theta[lo] : theta[hi]);
         const double plo = ulo ? pressure[lo] : 0.0, phi = uhi ? pressure[hi] : 0.0;
-        u[a][f] -= dt / (rho * h) * (phi - plo);
+        u[a][f] -= dt / (rho * h) * (phi - plo) / gap;
       });
     }
   }
@@ -756,16 +770,13 @@ std::size_t FluidSolver::particleCount() const {
 }
 
 double FluidSolver::liquidVolume() const {
+  // Particle-estimated: particles / (particlesPerCell x the mean particles per cell of interior
+  // liquid cells, relative) cells. Particles that clump (denser interior) read as lost volume,
+  // particles that drift apart as gained volume; splashes and surface cells do not bias it.
   auto& m = *impl_;
-  std::vector<unsigned char> occupied(m.grid.cells(), 0);
-  const std::size_t n = m.pos.size() / 3;
-  for (std::size_t p = 0; p < n; ++p) {
-    int i, j, k;
-    if (m.cellOf(&m.pos[3 * p], i, j, k)) occupied[m.grid.cell(i, j, k)] = 1;
-  }
-  double count = 0;
-  for (const auto o : occupied) count += o;
-  return m.sum(count) * m.grid.h * m.grid.h * m.grid.h;
+  const double particles = m.sum(static_cast<double>(m.pos.size() / 3));
+  const double density = m.stats.particleDensity > 0.0 ? m.stats.particleDensity : 1.0;
+  return particles / (m.settings.particlesPerCell * density) * m.grid.h * m.grid.h * m.grid.h;
 }
 
 double FluidSolver::maxParticleSpeed() const {

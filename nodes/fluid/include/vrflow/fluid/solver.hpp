@@ -99,7 +99,10 @@ class FluidSolver {
   std::vector<float> gatherParticlePositions() const;
   /// Number of particles over every block (collective).
   std::size_t particleCount() const;
-  /// Liquid volume estimated as the number of cells holding particles times the cell volume.
+  /// Liquid volume estimated from the particles: their number over particlesPerCell times the
+  /// relative particle density of interior liquid cells at the last step (StepStats), in cells,
+  /// times the cell volume. Clumping reads as lost volume, drifting apart as gained volume
+  /// (collective).
   double liquidVolume() const;
   /// Largest |velocity| sampled at the particles.
   double maxParticleSpeed() const;
