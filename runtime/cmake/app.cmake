@@ -15,6 +15,7 @@ vrflow_add_library(app
     src/app/expand_body.cpp
     src/app/file_io.cpp
     src/app/filter_types_routing.cpp
+    src/app/filter_types_patterns.cpp
     src/app/filter_types_sampling.cpp
     src/app/graph.cpp
     src/app/manifest_reader.cpp

@@ -11,6 +11,8 @@ vrflow_add_library(runtime
     src/daemon/filters/gate.cpp
     src/daemon/filters/latest.cpp
     src/daemon/filters/max_frequency.cpp
+    src/daemon/filters/multi_rate.cpp
+    src/daemon/filters/route.cpp
     src/daemon/filters/multiplex.cpp
     src/daemon/filters/rotate.cpp
     src/daemon/filters/scatter.cpp

@@ -85,9 +85,10 @@ TEST(Catalog, RegistersTheBuiltinFilters) {
   std::vector<std::string> names;
   for (const FilterType* type : catalog.filterTypes()) names.push_back(type->name);
   EXPECT_EQ(names,
-            (std::vector<std::string>{"broadcast", "gate", "gather", "initial", "latest",
-                                      "maxfrequency", "merge", "multiplex", "passthrough", "rotate",
-                                      "scatter", "stampfilter", "typefilter", "unrotate"}));
+            (std::vector<std::string>{"broadcast", "decimate", "gate", "gather", "initial",
+                                      "latest", "maxfrequency", "merge", "multiplex",
+                                      "passthrough", "repeat", "rotate", "route", "scatter",
+                                      "stampfilter", "typefilter", "unrotate"}));
   const FilterType* merge = catalog.findFilter("merge");
   EXPECT_EQ(namesOf(merge->portsFor({})), (std::vector<std::string>{"in0", "in1", "out"}));
   EXPECT_EQ(namesOf(merge->portsFor({Param{"inputs", "3", {}}})),
@@ -118,6 +119,11 @@ TEST(Catalog, StandardFiltersDeclareTheirPortsFromTheirParameters) {
   EXPECT_EQ(portsOf("maxfrequency", {}), (Names{"in", "out"}));
   EXPECT_EQ(portsOf("stampfilter", {}), (Names{"in", "order", "out"}));
   EXPECT_EQ(portsOf("typefilter", {}), (Names{"in", "out"}));
+  EXPECT_EQ(portsOf("repeat", {}), (Names{"in", "out"}));
+  EXPECT_EQ(portsOf("decimate", {}), (Names{"in", "out"}));
+  EXPECT_EQ(portsOf("route", {}), (Names{"in", "interest0", "out0"}));
+  EXPECT_EQ(portsOf("route", {Param{"outputs", "2", {}}}),
+            (Names{"in", "interest0", "interest1", "out0", "out1"}));
   // Every input is required; every parameter has a default that is a valid value.
   for (const FilterType* type : catalog.filterTypes()) {
     for (const PortSpec& port : type->portsFor({})) {

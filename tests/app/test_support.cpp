@@ -12,7 +12,7 @@ namespace vrflow::app::testing {
 
 std::string sourceDir() {
   if (const char* dir = std::getenv("VRFLOW_SOURCE_DIR")) return dir;
-  return std::filesystem::path(__FILE__).parent_path().parent_path().parent_path().string();
+  return VRFLOW_TEST_SOURCE_DIR;
 }
 
 std::string dataDir() {

@@ -9,7 +9,7 @@
 
 namespace vrflow::app::testing {
 
-/// The repository root: $VRFLOW_SOURCE_DIR, or found from this file's path.
+/// The repository root: $VRFLOW_SOURCE_DIR, or the source tree the tests were built from.
 std::string sourceDir();
 /// tests/app/data.
 std::string dataDir();

@@ -116,9 +116,9 @@ TEST(Validate, UnknownFilterTypeListsTheKnownFilters) {
 </application>
 )"),
                        3, 20,
-                       "unknown filter type 'mrge' (known: broadcast, gate, gather, initial, "
-                       "latest, maxfrequency, merge, multiplex, passthrough, rotate, scatter, "
-                       "stampfilter and 2 more); did you mean 'merge'?");
+                       "unknown filter type 'mrge' (known: broadcast, decimate, gate, gather, "
+                       "initial, latest, maxfrequency, merge, multiplex, passthrough, repeat, "
+                       "rotate and 5 more); did you mean 'merge'?");
 }
 
 TEST(Validate, ConnectionFromAMissingNodeIsReportedAtFrom) {

@@ -129,6 +129,7 @@ std::vector<FilterType> builtinFilterTypes() {
 
   addRoutingFilterTypes(types);
   addSamplingFilterTypes(types);
+  addPatternFilterTypes(types);
   return types;
 }
 

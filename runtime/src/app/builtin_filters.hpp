@@ -14,6 +14,8 @@ std::vector<FilterType> builtinFilterTypes();
 void addRoutingFilterTypes(std::vector<FilterType>& types);
 /// latest, maxfrequency, stampfilter, typefilter.
 void addSamplingFilterTypes(std::vector<FilterType>& types);
+/// repeat, decimate, route.
+void addPatternFilterTypes(std::vector<FilterType>& types);
 
 /// Most inputs or outputs a filter with a numbered port family may have.
 inline constexpr long long kMaxFilterPorts = 256;

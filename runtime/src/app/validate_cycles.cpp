@@ -17,7 +17,8 @@ struct Edge {
 
 // The graph in which a cycle deadlocks: connections between known nodes, minus those that
 // start with messages already waiting (a module input with initial messages) and minus every
-// connection touching a filter that emits initial messages.
+// connection touching a filter that emits initial messages, minus those into a filter's control
+// inputs (PortSpec::gating false).
 std::vector<std::vector<Edge>> blockingGraph(const Validation& v) {
   std::vector<bool> primed(v.nodes.size(), false);
   for (std::size_t i = 0; i < v.nodes.size(); ++i) {
@@ -31,6 +32,11 @@ std::vector<std::vector<Edge>> blockingGraph(const Validation& v) {
     const std::size_t from = v.indexOf(connection.from.node);
     const std::size_t to = v.indexOf(connection.to.node);
     if (from == v.nodes.size() || to == v.nodes.size() || primed[from] || primed[to]) continue;
+    const auto& ports = v.nodes[to].ports;
+    const auto port = std::find_if(ports.begin(), ports.end(), [&](const PortSpec& spec) {
+      return spec.isInput && spec.name == connection.to.port;
+    });
+    if (v.nodes[to].filter != nullptr && port != ports.end() && !port->gating) continue;
     const Module* module = v.nodes[to].module;
     if (module != nullptr &&
         inputConfigOrDefault(*module, connection.to.port).initialMessages > 0) {

@@ -153,6 +153,8 @@ void registerBuiltinFilters(FilterRegistry& registry) {
   filters::registerMaxFrequency(registry);
   filters::registerStampFilter(registry);
   filters::registerTypeFilter(registry);
+  filters::registerMultiRate(registry);
+  filters::registerRoute(registry);
 }
 
 }  // namespace vrflow::daemon

@@ -5,6 +5,7 @@
 #include <bit>
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -149,6 +150,21 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     std::map<std::string, std::string> values;
     for (const auto& spec : type->params) values[spec.name] = spec.defaultValue;
     for (const auto& p : module.params) values[p.name] = p.value;
+    // A relative path in a file parameter names a file beside the application when one exists
+    // there (input data shipped with it); otherwise it stays relative to the working directory
+    // (outputs). The same rule as a manifest's executable.
+    if (!application.file.empty()) {
+      const auto base = std::filesystem::path(application.file).parent_path();
+      for (const auto& spec : type->params) {
+        auto found = values.find(spec.name);
+        if (spec.type != app::ParamType::File || found == values.end() || found->second.empty()) continue;
+        const std::filesystem::path path(found->second);
+        std::error_code error;
+        if (path.is_relative() && std::filesystem::exists(base / path, error)) {
+          found->second = (base / path).lexically_normal().string();
+        }
+      }
+    }
     std::string text;
     for (const auto& [name, value] : values) text += name + "=" + value + "\n";
     slot->paramsOffset = segment.reserve(text.size() + 1, 8);

@@ -25,6 +25,9 @@ struct PortSpec {
   std::string data = std::string(kAnyData);  ///< data type name; "any" matches all
   bool stampsOnly = false;                   ///< carries stamps without payload
   bool required = false;                     ///< inputs only: must be connected
+  /// Filter inputs only: false for a control input that the filter emits without (a route's
+  /// interest, a gate's open), so a cycle through it needs no initial message.
+  bool gating = true;
   std::string doc;
 };
 

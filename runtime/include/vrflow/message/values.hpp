@@ -2,6 +2,10 @@
 
 #include <array>
 
+// ParamKind names its enumerators after these types; declaring it first keeps GCC's -Wshadow
+// quiet whatever order a file includes the two headers in.
+#include "vrflow/message/object_type.hpp"
+
 // Plain value types carried by object parameters and events. Doubles, one world frame.
 
 namespace vrflow::msg {

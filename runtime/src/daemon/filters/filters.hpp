@@ -19,6 +19,8 @@ void registerLatest(FilterRegistry& registry);
 void registerMaxFrequency(FilterRegistry& registry);
 void registerStampFilter(FilterRegistry& registry);
 void registerTypeFilter(FilterRegistry& registry);
+void registerMultiRate(FilterRegistry& registry);  ///< repeat and decimate
+void registerRoute(FilterRegistry& registry);
 
 /// A factory for a filter built without arguments.
 template <typename T>

@@ -1,0 +1,92 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <tuple>
+#include <vector>
+
+#include "vrflow/massspring/net.hpp"
+#include "vrflow/message/shape.hpp"
+
+// Contacts of net nodes with other nets' surfaces and with rigid shapes.
+//
+// Response (both kinds): a node closer than `thickness` to a surface gets a repulsive force along
+// the surface normal n, of size
+//   f = max(0, (-vn + beta * (thickness - d) / dt) / (dt * (1/m_node + 1/m_other)))
+// where d is the distance, vn the relative normal velocity (node minus surface point) and m_other
+// the other side's mass (a rigid's mass; for a net triangle, its nodes' masses weighted by the
+// barycentric coordinates; pinned nodes and kinematic rigids are infinitely heavy). That is the
+// impulse that stops the approach within one outer step plus a fraction beta of the overlap, as a
+// force held for dt: stable at any dt, no stiffness to tune. The other side gets the opposite force.
+
+namespace vrflow::massspring {
+
+struct ContactParams {
+  double thickness = 0.02;  ///< contact distance (m), > 0
+  double beta = 0.2;        ///< fraction of the overlap removed per step, in [0, 1]
+  double dt = 0.01;         ///< the outer step the forces are held for (s), > 0
+  /// Rigid contacts only: a node weighs its mass plus springMassWeight * dt^2 * (stiffness of
+  /// its springs along the contact normal), since a node held by stiff springs does not give way
+  /// like a free particle within one outer step. 0: free particles (a heavy rigid then sinks deep
+  /// into a net); large values overshoot. 0.01 was tuned on the box-on-net test (README).
+  double springMassWeight = 0.01;
+};
+Status validateContactParams(const ContactParams& params);
+
+/// A rigid body as the interactors see it (from a rigid object and its shape resource).
+struct RigidBody {
+  msg::Vec3 position{};
+  msg::Quat orientation{0, 0, 0, 1};
+  msg::Vec3 linearVelocity{};
+  msg::Vec3 angularVelocity{};
+  double mass = 0.0;  ///< <= 0 or infinite: kinematic (infinitely heavy)
+  msg::Shape shape;
+};
+
+/// Forces on nets (xyz per node, keyed by net id) and on rigids (one ForceEvent per touched
+/// rigid: the sum of its contact forces at its centre of mass `position`, with the torque of
+/// those forces about it; duration dt).
+struct ContactForces {
+  std::map<std::uint64_t, std::vector<double>> nodeForces;
+  std::map<std::uint64_t, msg::ForceEvent> rigidForces;
+  std::size_t contacts = 0;
+};
+
+/// What the contact functions remember between steps. netCollisions: for each (net, node, other
+/// net) in contact, the side (+1/-1 along the other net's triangle normals) the node came from,
+/// kept while the contact lasts. rigidContacts: for each (rigid, net, node) in contact, the
+/// body-frame plane (outward normal, offset) of the surface where the contact began. While the
+/// contact lasts, the node is pushed out along that plane, so a node that went deep into a shape
+/// is never pushed out through the far side. Keep one per interactor; pass it every step.
+struct ContactMemory {
+  struct Plane {
+    msg::Vec3 normal{};
+    double offset = 0.0;
+  };
+  std::map<std::tuple<std::uint64_t, std::uint64_t, std::uint32_t>, Plane> planes;
+  std::map<std::tuple<std::uint64_t, std::uint32_t, std::uint64_t>, int> sides;
+};
+
+/// Nodes of every net against the surface triangles of every other net (nets without a surface
+/// are seen as their nodes: node/node repulsion). Nets are visited in id order (deterministic).
+/// A node's side of a triangle is the side it was on one step before (x - v_rel dt), so a node
+/// that crossed a triangle within one step is pushed back, not through.
+ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& params,
+                            ContactMemory* memory = nullptr);
+
+/// Nodes of every net against every rigid shape (signed distance in the body frame), and the
+/// vertices of box, hull and mesh shapes against every net's surface triangles (so that a corner
+/// cannot slip between nodes), each side of a triangle as in netCollisions. All contacts of one
+/// rigid are gathered first and share its mass (each sees count / m_rigid as its inverse mass).
+ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
+                            const std::map<std::uint64_t, RigidBody>& rigids,
+                            const ContactParams& params, ContactMemory* memory = nullptr);
+
+/// Closest point of triangle abc to p, with its barycentric weights (Ericson's algorithm).
+struct TrianglePoint {
+  msg::Vec3 point{};
+  double wa = 0, wb = 0, wc = 0;
+};
+TrianglePoint closestPointOnTriangle(const msg::Vec3& p, const msg::Vec3& a, const msg::Vec3& b, const msg::Vec3& c);
+
+}  // namespace vrflow::massspring

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <span>
+
+#include "vrflow/massspring/net.hpp"
+
+// Explicit integration of a net with internal sub-steps.
+//
+// The choice: one outer step of length dt is cut into `substeps` sub-steps of h = dt / substeps.
+// External forces (what interactors sent for this outer step, and gravity) are held constant over
+// the sub-steps; the net's own spring forces are recomputed at every sub-step from the current
+// positions and velocities (when `internalSprings` is set). Each sub-step is symplectic
+// (semi-implicit) Euler: v += h f / m, then x += h v, for free nodes; pinned nodes never move.
+// After each sub-step the maximum-stretch constraint is projected (see enforceMaxStretch).
+
+namespace vrflow::massspring {
+
+struct StepOptions {
+  double dt = 0.01;              ///< outer step (s)
+  int substeps = 10;             ///< sub-steps per outer step (>= 1)
+  bool internalSprings = true;   ///< evaluate the net's springs at every sub-step
+  msg::Vec3 gravity{0, 0, 0};         ///< acceleration applied to every free node (m/s^2)
+  int constraintIterations = 50;  ///< most Gauss-Seidel sweeps of the max-stretch projection
+};
+Status validateStepOptions(const StepOptions& options);
+
+/// Adds the spring forces of `net` (Hooke + damping along the spring) to `forces` (xyz per node).
+void addSpringForces(const Net& net, std::span<double> forces);
+/// Same for a subset of springs (used by the spring interactor and by tests).
+void addSpringForces(const Net& net, std::span<const Spring> springs, std::span<double> forces);
+
+/// Projects every spring with maxStretch > 0 back to length <= maxStretch * restLength (moving
+/// its free ends, inverse-mass weighted, pinned nodes immovable) in Gauss-Seidel sweeps until no
+/// spring exceeds its limit by more than 1e-9 relative or `maxIterations` sweeps ran. The
+/// position change of each node is added to its velocity divided by `h` (the separating speed
+/// the constraint removed). If the sweeps did not converge and `feasible` (positions that met
+/// every limit, e.g. those at the start of the sub-step) is given, the positions are moved back
+/// along the straight path from `feasible` to the largest fraction at which every limit holds:
+/// the limit then holds exactly (the motion of that sub-step is cut short instead).
+/// Returns the largest length / (maxStretch * restLength) left (0 if no spring has a limit).
+double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible = {});
+
+/// Advances the net by one outer step. `externalForces` holds xyz per node (or is empty).
+/// Returns the largest constraint ratio left (see enforceMaxStretch), 0 if no spring has a limit.
+double step(Net& net, std::span<const double> externalForces, const StepOptions& options);
+
+/// Energies: kinetic, elastic (sum of k/2 (L - L0)^2) and gravitational (-sum m g.x).
+double kineticEnergy(const Net& net);
+double elasticEnergy(const Net& net);
+double gravityEnergy(const Net& net, const msg::Vec3& gravity);
+/// Largest length / restLength over the springs.
+double maxStretchRatio(const Net& net);
+/// Largest length / (maxStretch * restLength) over the springs that have a limit (0 if none).
+double maxConstraintRatio(const Net& net);
+
+}  // namespace vrflow::massspring

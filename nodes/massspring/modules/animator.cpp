@@ -1,0 +1,131 @@
+// massspring/animator: owns one mass-spring net (generated, or loaded from a file) and integrates
+// it with internal sub-steps from the forces it receives (see vrflow/massspring/solver.hpp).
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "common.hpp"
+#include "vrflow/massspring/objects.hpp"
+#include "vrflow/massspring/solver.hpp"
+#include "vrflow/message/builtin_types.hpp"
+
+int main() {
+  using namespace vrflow;
+  using namespace vrflow::massspring;
+  const char* program = "vrflow-massspring-animator";
+  Module module;
+  auto& events = module.addInput("events");
+  auto& objects = module.addOutput("objects");
+  if (auto status = module.init(); !status) {
+    std::fprintf(stderr, "%s: %s\n", program, status.error().message.c_str());
+    return 2;
+  }
+  modules::Params params(module, program);
+  const double inf = std::numeric_limits<double>::max();
+  StepOptions options;
+  options.dt = params.number("dt", 0.01, 1e-9, 10);
+  options.substeps = params.integer("substeps", 10, 1, 100000);
+  options.internalSprings = params.flag("internal-springs", true);
+  options.constraintIterations = params.integer("constraint-iterations", 50, 0, 1000000);
+  const auto g = params.vector("gravity", "0 0 0", 3);
+  options.gravity = {g[0], g[1], g[2]};
+
+  Net net;
+  const std::string file = params.text("file");
+  if (!file.empty()) {
+    auto loaded = loadNet(file);
+    if (!loaded) params.fail(loaded.error().message);
+    else net = std::move(*loaded);
+  } else {
+    GridParams grid;
+    grid.n = params.integer("n", 20, 2, 4096);
+    grid.m = params.integer("m", 20, 2, 4096);
+    grid.spacing = params.number("spacing", 0.1, 1e-9, inf);
+    grid.mass = params.number("mass", 1.0, 1e-12, inf);
+    grid.stiffness = params.number("stiffness", 500, 0, inf);
+    grid.shearFactor = params.number("shear", 0.5, 0, inf);
+    grid.bendFactor = params.number("bend", 0.1, 0, inf);
+    grid.damping = params.number("damping", 0.05, 0, inf);
+    grid.maxStretch = params.number("max-stretch", 1.1, 0, inf);
+    grid.pinCorners = params.flag("pin-corners", true);
+    const auto origin = params.vector("origin", "0 0 0", 3);
+    grid.origin = {origin[0], origin[1], origin[2]};
+    const auto q = params.vector("orientation", "0 0 0 1", 4);
+    grid.orientation = {q[0], q[1], q[2], q[3]};
+    if (!params.report()) {
+      auto generated = generateGrid(grid);
+      if (!generated) params.fail(generated.error().message);
+      else net = std::move(*generated);
+    }
+  }
+  if (auto status = validateStepOptions(options); !status) params.fail(status.error().message);
+  const std::string stateFile = params.text("state-file");
+  if (params.report()) return 2;
+
+  const std::uint64_t id = module.newId();
+  modules::Warnings warnings(program);
+  std::vector<double> external(3 * net.nodeCount());
+  double totalFreeMass = 0;
+  for (std::size_t i = 0; i < net.nodeCount(); ++i) {
+    if (!net.pinned[i]) totalFreeMass += net.masses[i];
+  }
+  double time = 0.0;
+  bool warnedStretch = false;
+  while (module.wait()) {
+    std::fill(external.begin(), external.end(), 0.0);
+    const Message& received = module.get(events);
+    if (received.valid()) {
+      for (const auto chunk : received.view()) {
+        const auto event = chunk.asEvent();
+        if (!event || event->id() != id) continue;
+        if (event->isForce()) {
+          // A force on the whole net: a uniform acceleration F / (free mass).
+          const auto force = event->force();
+          if (!force || totalFreeMass <= 0) continue;
+          for (std::size_t i = 0; i < net.nodeCount(); ++i) {
+            if (net.pinned[i]) continue;
+            for (int k = 0; k < 3; ++k) external[3 * i + k] += force->force[k] * net.masses[i] / totalFreeMass;
+          }
+        } else if (event->kind() == kNodeForcesEvent) {
+          auto forces = decodeNodeForces(event->payload());
+          if (!forces) {
+            warnings.warn("ignored an event: " + forces.error().message);
+            continue;
+          }
+          bool inRange = true;
+          for (const auto& f : *forces) inRange = inRange && f.node < net.nodeCount();
+          if (!inRange) {
+            warnings.warn("ignored a node forces event naming a node beyond the net's " +
+                          std::to_string(net.nodeCount()) + " nodes");
+            continue;
+          }
+          for (const auto& f : *forces) {
+            for (int k = 0; k < 3; ++k) external[3 * f.node + k] += f.force[k];
+          }
+        }
+      }
+    }
+    if (module.iteration() > 0) {
+      const double worst = step(net, external, options);
+      if (worst > 1 + 1e-6 && !warnedStretch) {
+        warnedStretch = true;
+        warnings.warn("a spring is beyond its maximum stretch (worst length/limit " + std::to_string(worst) +
+                      "): the net started beyond its limits; the projection pulls it back over the next steps");
+      }
+      time += options.dt;
+    }
+    auto out = module.newMessage(256 + net.nodeCount() * 56 + (module.iteration() == 0 ? net.springs.size() * 40 + net.surface.size() * 4 + net.nodeCount() * 9 : 0));
+    auto& builder = out.builder();
+    builder.setSimTime(time);
+    builder.setTimeStep(options.dt);
+    writeNet(builder, id, net, module.iteration() == 0);
+    if (!module.put(objects, std::move(out))) break;
+  }
+  if (!stateFile.empty()) {
+    if (auto status = saveNet(net, stateFile); !status) {
+      std::fprintf(stderr, "%s: %s\n", program, status.error().message.c_str());
+      return 1;
+    }
+  }
+  return module.exitStatus();
+}

@@ -1,0 +1,124 @@
+#pragma once
+
+// Helpers shared by the mass-spring modules: parameter parsing with clear errors, and sending
+// per-node forces as "massspring node forces" events.
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "vrflow/massspring/events.hpp"
+#include "vrflow/message/builder.hpp"
+#include "vrflow/module/module.hpp"
+
+namespace vrflow::massspring::modules {
+
+/// Reads `count` numbers from a parameter, or nullopt when the text is not exactly that.
+inline std::optional<std::vector<double>> numbers(const std::string& text, std::size_t count) {
+  std::istringstream in(text);
+  std::vector<double> values;
+  for (std::string word; in >> word;) {
+    char* end = nullptr;
+    const double v = std::strtod(word.c_str(), &end);
+    if (!end || *end != '\0' || !std::isfinite(v)) return std::nullopt;
+    values.push_back(v);
+  }
+  if (values.size() != count) return std::nullopt;
+  return values;
+}
+
+/// A parameter read by a module, with the first error kept for the module to report.
+class Params {
+ public:
+  Params(const Module& module, std::string program) : module_(module), program_(std::move(program)) {}
+
+  double number(const char* name, double fallback, double min, double max) {
+    const auto text = module_.param(name);
+    if (text.empty()) return fallback;
+    const auto v = numbers(text, 1);
+    if (!v || (*v)[0] < min || (*v)[0] > max) {
+      fail(std::string("parameter '") + name + "' = '" + text + "' must be a number in [" + format(min) + ", " +
+           format(max) + "]");
+      return fallback;
+    }
+    return (*v)[0];
+  }
+  int integer(const char* name, int fallback, int min, int max) {
+    const double v = number(name, fallback, min, max);
+    if (v != std::floor(v)) {
+      fail(std::string("parameter '") + name + "' must be an integer");
+      return fallback;
+    }
+    return static_cast<int>(v);
+  }
+  bool flag(const char* name, bool fallback) {
+    const auto text = module_.param(name);
+    if (text.empty()) return fallback;
+    if (text == "true" || text == "1" || text == "yes" || text == "on") return true;
+    if (text == "false" || text == "0" || text == "no" || text == "off") return false;
+    fail(std::string("parameter '") + name + "' = '" + text + "' must be true or false");
+    return fallback;
+  }
+  std::vector<double> vector(const char* name, const std::string& fallback, std::size_t count) {
+    auto text = module_.param(name);
+    if (text.empty()) text = fallback;
+    const auto v = numbers(text, count);
+    if (!v) {
+      fail(std::string("parameter '") + name + "' = '" + text + "' must be " + std::to_string(count) + " finite numbers");
+      return std::vector<double>(count, 0.0);
+    }
+    return *v;
+  }
+  std::string text(const char* name) const { return module_.param(name); }
+
+  void fail(std::string message) {
+    if (error_.empty()) error_ = std::move(message);
+  }
+  /// Prints the first error and returns true when there was one.
+  bool report() const {
+    if (error_.empty()) return false;
+    std::fprintf(stderr, "%s: %s\n", program_.c_str(), error_.c_str());
+    return true;
+  }
+
+ private:
+  static std::string format(double v) {
+    std::ostringstream out;
+    out << v;
+    return out.str();
+  }
+  const Module& module_;
+  std::string program_;
+  std::string error_;
+};
+
+/// Adds one node-forces event per net with a non-zero force (nets in id order).
+inline void addNodeForces(msg::MessageBuilder& builder, const std::map<std::uint64_t, std::vector<double>>& forces) {
+  for (const auto& [id, dense] : forces) {
+    const auto sparse = sparseForces(dense);
+    if (sparse.empty()) continue;
+    const auto payload = encodeNodeForces(sparse);
+    builder.addEvent(id, kNodeForcesEvent, payload);
+  }
+}
+
+/// Prints a problem with received data once per distinct message (a module keeps running).
+class Warnings {
+ public:
+  explicit Warnings(std::string program) : program_(std::move(program)) {}
+  void warn(const std::string& message) {
+    if (last_ == message) return;
+    last_ = message;
+    std::fprintf(stderr, "%s: warning: %s\n", program_.c_str(), message.c_str());
+  }
+
+ private:
+  std::string program_;
+  std::string last_;
+};
+
+}  // namespace vrflow::massspring::modules

@@ -1,0 +1,418 @@
+#include "vrflow/massspring/contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vrflow::massspring {
+namespace {
+
+msg::Vec3 sub(const msg::Vec3& a, const msg::Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+msg::Vec3 add(const msg::Vec3& a, const msg::Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+msg::Vec3 scale(const msg::Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+double dot(const msg::Vec3& a, const msg::Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+msg::Vec3 cross(const msg::Vec3& a, const msg::Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+double invMass(const Net& net, std::size_t i) { return net.pinned[i] ? 0.0 : 1.0 / net.masses[i]; }
+
+void addTo(std::vector<double>& forces, std::size_t node, const msg::Vec3& f) {
+  for (int k = 0; k < 3; ++k) forces[3 * node + k] += f[k];
+}
+
+/// The contact force magnitude of the header's formula (0 when not approaching enough).
+double contactMagnitude(double distance, double vn, double invMassSum, const ContactParams& p) {
+  if (invMassSum <= 0) return 0.0;
+  const double target = -vn + p.beta * (p.thickness - distance) / p.dt;
+  return std::max(0.0, target / (p.dt * invMassSum));
+}
+
+std::vector<double>& forcesOf(ContactForces& out, std::uint64_t id, const Net& net) {
+  auto& f = out.nodeForces[id];
+  if (f.empty()) f.assign(3 * net.nodeCount(), 0.0);
+  return f;
+}
+
+bool inBox(const msg::Vec3& p, const msg::Aabb& box, double margin) {
+  for (int k = 0; k < 3; ++k) {
+    if (p[k] < box.min[k] - margin || p[k] > box.max[k] + margin) return false;
+  }
+  return true;
+}
+
+struct PlaneHit {
+  bool hit = false;
+  double distance = 0;   ///< along normal, negative once crossed
+  double gap = 0;        ///< 3-D distance to the closest point (to choose among triangles)
+  msg::Vec3 normal{};    ///< unit, pointing to the side the point came from
+  TrianglePoint closest;
+  int side = 0;          ///< that side along the triangle's own normal (+1 / -1)
+};
+
+/// A point x moving at `relative` (point minus surface) against triangle abc.
+PlaneHit pointTriangle(const msg::Vec3& x, const msg::Vec3& relative, const msg::Vec3& a, const msg::Vec3& b,
+                       const msg::Vec3& c, const ContactParams& p, int knownSide = 0) {
+  PlaneHit out;
+  msg::Vec3 n = cross(sub(b, a), sub(c, a));
+  const double length = std::sqrt(dot(n, n));
+  if (length < 1e-300) return out;
+  n = scale(n, 1.0 / length);
+  const double s = dot(sub(x, a), n);
+  const double along = dot(relative, n);
+  const double before = s - along * p.dt;
+  const double side = knownSide != 0 ? knownSide : before > 0 ? 1.0 : before < 0 ? -1.0 : (s >= 0 ? 1.0 : -1.0);
+  const double distance = s * side;
+  const double deepest = std::abs(along) * p.dt + (knownSide != 0 ? 5.0 : 1.0) * p.thickness;
+  if (distance >= p.thickness || distance < -deepest) return out;
+  const msg::Vec3 onPlane = sub(x, scale(n, s));
+  const auto closest = closestPointOnTriangle(onPlane, a, b, c);
+  const msg::Vec3 off = sub(onPlane, closest.point);
+  if (dot(off, off) > p.thickness * p.thickness) return out;
+  const msg::Vec3 gap = sub(x, closest.point);
+  out.hit = true;
+  out.distance = distance;
+  out.gap = std::sqrt(dot(gap, gap));
+  out.normal = scale(n, side);
+  out.closest = closest;
+  out.side = side > 0 ? 1 : -1;
+  return out;
+}
+
+/// Springs touching each node (CSR), to weigh a node with the springs that hold it.
+struct Adjacency {
+  std::vector<std::size_t> start;
+  std::vector<std::size_t> springs;
+};
+Adjacency adjacency(const Net& net) {
+  Adjacency out;
+  out.start.assign(net.nodeCount() + 1, 0);
+  for (const auto& s : net.springs) {
+    ++out.start[s.a + 1];
+    ++out.start[s.b + 1];
+  }
+  for (std::size_t i = 0; i < net.nodeCount(); ++i) out.start[i + 1] += out.start[i];
+  out.springs.resize(out.start.back());
+  std::vector<std::size_t> fill(out.start.begin(), out.start.end() - 1);
+  for (std::size_t k = 0; k < net.springs.size(); ++k) {
+    out.springs[fill[net.springs[k].a]++] = k;
+    out.springs[fill[net.springs[k].b]++] = k;
+  }
+  return out;
+}
+
+/// The inverse of a node's effective mass for a push along n held for dt: its mass plus
+/// springMassWeight * dt^2 times the stiffness of its springs along n (axial k (u.n)^2 plus the
+/// tension's transverse stiffness T/L (1 - (u.n)^2)): a node held by its springs does not give
+/// way like a free particle within one outer step.
+double effectiveInvMass(const Net& net, const Adjacency& adj, std::size_t i,
+                        const msg::Vec3& n, const ContactParams& p) {
+  if (net.pinned[i]) return 0.0;
+  double stiffness = 0;
+  const auto x = net.position(i);
+  for (std::size_t k = adj.start[i]; k < adj.start[i + 1]; ++k) {
+    const auto& s = net.springs[adj.springs[k]];
+    const auto other = net.position(s.a == i ? s.b : s.a);
+    const msg::Vec3 d = sub(other, x);
+    const double length = std::sqrt(dot(d, d));
+    if (length < 1e-12) continue;
+    const double c = dot(d, n) / length;
+    const double tension = std::max(0.0, s.stiffness * (length - s.restLength));
+    stiffness += s.stiffness * c * c + tension / length * (1 - c * c);
+  }
+  const double mass = (net.masses[i] + p.springMassWeight * p.dt * p.dt * stiffness);
+  return 1.0 / mass;
+}
+
+}  // namespace
+
+Status validateContactParams(const ContactParams& p) {
+  if (!(p.thickness > 0) || !std::isfinite(p.thickness)) return makeError("contact: thickness must be finite and > 0");
+  if (!(p.beta >= 0 && p.beta <= 1)) return makeError("contact: beta must be in [0, 1]");
+  if (!(p.dt > 0) || !std::isfinite(p.dt)) return makeError("contact: dt must be finite and > 0");
+  if (!(p.springMassWeight >= 0) || !std::isfinite(p.springMassWeight)) return makeError("contact: spring mass weight must be >= 0");
+  return {};
+}
+
+TrianglePoint closestPointOnTriangle(const msg::Vec3& p, const msg::Vec3& a, const msg::Vec3& b, const msg::Vec3& c) {
+  const msg::Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return {a, 1, 0, 0};
+  const msg::Vec3 bp = sub(p, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return {b, 0, 1, 0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return {add(a, scale(ab, v)), 1 - v, v, 0};
+  }
+  const msg::Vec3 cp = sub(p, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return {c, 0, 0, 1};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double w = d2 / (d2 - d6);
+    return {add(a, scale(ac, w)), 1 - w, 0, w};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {add(b, scale(sub(c, b), w)), 0, 1 - w, w};
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  return {add(a, add(scale(ab, v), scale(ac, w))), 1 - v - w, v, w};
+}
+
+ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& p, ContactMemory* memory) {
+  ContactForces out;
+  std::map<std::tuple<std::uint64_t, std::uint32_t, std::uint64_t>, int> sides;
+  std::map<std::uint64_t, msg::Aabb> boxes;
+  std::map<std::uint64_t, Adjacency> adjacent;
+  for (const auto& [id, net] : nets) {
+    boxes[id] = bounds(net);
+    adjacent[id] = adjacency(net);
+  }
+  for (const auto& [idA, a] : nets) {
+    for (const auto& [idB, b] : nets) {
+      if (idA == idB || a.nodeCount() == 0 || b.nodeCount() == 0) continue;
+      const auto& boxA = boxes[idA];
+      const auto& boxB = boxes[idB];
+      bool overlap = true;
+      const double margin = p.thickness + 1.0;  // nodes up to 1 m/step fast still seen
+      for (int k = 0; k < 3; ++k) {
+        overlap = overlap && boxA.min[k] <= boxB.max[k] + margin && boxB.min[k] <= boxA.max[k] + margin;
+      }
+      if (!overlap) continue;
+      for (std::size_t i = 0; i < a.nodeCount(); ++i) {
+        const msg::Vec3 x = a.position(i);
+        const auto& vi = a.velocity(i);
+        if (!inBox(x, boxB, p.thickness + (std::abs(vi[0]) + std::abs(vi[1]) + std::abs(vi[2])) * p.dt)) continue;
+        const double invA = invMass(a, i);
+        if (invA == 0) continue;
+        // The nearest feature of net b within the thickness: a triangle, or a node.
+        double best = p.thickness;
+        msg::Vec3 normal{}, surfaceVelocity{};
+        double invB = 0;
+        std::size_t tri[3] = {0, 0, 0};
+        double weights[3] = {0, 0, 0};
+        int featureNodes = 0;
+        const auto key = std::tuple{idA, static_cast<std::uint32_t>(i), idB};
+        int knownSide = 0;
+        if (memory) {
+          const auto found = memory->sides.find(key);
+          if (found != memory->sides.end()) knownSide = found->second;
+        }
+        int side = 0;
+        if (!b.surface.empty()) {
+          double bestGap = 1e300;
+          for (std::size_t t = 0; t + 2 < b.surface.size(); t += 3) {
+            const std::size_t ia = b.surface[t], ib = b.surface[t + 1], ic = b.surface[t + 2];
+            const auto pa = b.position(ia), pb = b.position(ib), pc = b.position(ic);
+            const double reach = p.thickness + std::abs(a.velocity(i)[0]) * p.dt + std::abs(a.velocity(i)[1]) * p.dt +
+                                 std::abs(a.velocity(i)[2]) * p.dt;
+            bool near = true;
+            for (int k = 0; k < 3 && near; ++k) {
+              near = x[k] >= std::min({pa[k], pb[k], pc[k]}) - reach && x[k] <= std::max({pa[k], pb[k], pc[k]}) + reach;
+            }
+            if (!near) continue;
+            const auto& w0 = b.velocity(ia);
+            const auto& w1 = b.velocity(ib);
+            const auto& w2 = b.velocity(ic);
+            const msg::Vec3 centre = scale(add(add(w0, w1), w2), 1.0 / 3.0);
+            const auto hit = pointTriangle(x, sub(a.velocity(i), centre), pa, pb, pc, p, knownSide);
+            if (!hit.hit || hit.gap >= bestGap) continue;
+            bestGap = hit.gap;
+            side = hit.side;
+            best = hit.distance;
+            normal = hit.normal;
+            tri[0] = ia, tri[1] = ib, tri[2] = ic;
+            weights[0] = hit.closest.wa, weights[1] = hit.closest.wb, weights[2] = hit.closest.wc;
+            featureNodes = 3;
+          }
+        } else {
+          for (std::size_t j = 0; j < b.nodeCount(); ++j) {
+            const msg::Vec3 d = sub(x, b.position(j));
+            const double dist = std::sqrt(dot(d, d));
+            if (dist >= best || dist < 1e-12) continue;
+            best = dist;
+            normal = scale(d, 1.0 / dist);
+            tri[0] = j;
+            weights[0] = 1;
+            featureNodes = 1;
+          }
+        }
+        if (featureNodes == 0) continue;
+        if (side != 0) sides[key] = knownSide != 0 ? knownSide : side;
+        surfaceVelocity = {0, 0, 0};
+        for (int f = 0; f < featureNodes; ++f) {
+          surfaceVelocity = add(surfaceVelocity, scale(b.velocity(tri[f]), weights[f]));
+          invB += weights[f] * weights[f] * effectiveInvMass(b, adjacent[idB], tri[f], normal, p);
+        }
+        const double invNode = effectiveInvMass(a, adjacent[idA], i, normal, p);
+        const double vn = dot(sub(a.velocity(i), surfaceVelocity), normal);
+        const double magnitude = contactMagnitude(best, vn, invNode + invB, p);
+        if (magnitude <= 0) continue;
+        ++out.contacts;
+        const msg::Vec3 f = scale(normal, magnitude);
+        addTo(forcesOf(out, idA, a), i, f);
+        auto& fb = forcesOf(out, idB, b);
+        for (int k = 0; k < featureNodes; ++k) {
+          if (!b.pinned[tri[k]]) addTo(fb, tri[k], scale(f, -weights[k]));
+        }
+      }
+    }
+  }
+  if (memory) memory->sides = std::move(sides);
+  return out;
+}
+
+ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std::map<std::uint64_t, RigidBody>& rigids,
+                            const ContactParams& p, ContactMemory* memory) {
+  ContactForces out;
+  ContactMemory next;
+  std::map<std::uint64_t, Adjacency> adjacent;
+  for (const auto& [netId, net] : nets) adjacent[netId] = adjacency(net);
+  std::map<std::uint64_t, msg::Aabb> netBoxes;
+  for (const auto& [netId, net] : nets) netBoxes[netId] = bounds(net);
+  for (const auto& [rigidId, body] : rigids) {
+    auto box = msg::worldBounds(body.shape, body.position, body.orientation);
+    // Nets whose box (grown by the thickness and one step of the rigid's motion) misses the
+    // rigid's box are skipped.
+    const double speed = std::abs(body.linearVelocity[0]) + std::abs(body.linearVelocity[1]) + std::abs(body.linearVelocity[2]);
+    const double spin = std::abs(body.angularVelocity[0]) + std::abs(body.angularVelocity[1]) + std::abs(body.angularVelocity[2]);
+    double radius = 0;
+    for (int k = 0; k < 3; ++k) radius = std::max(radius, 0.5 * (box.max[k] - box.min[k]));
+    const double margin = p.thickness + (speed + spin * radius) * p.dt;
+    auto netNear = [&](std::uint64_t netId) {
+      const auto& nb = netBoxes[netId];
+      for (int k = 0; k < 3; ++k) {
+        if (nb.min[k] > box.max[k] + margin || nb.max[k] < box.min[k] - margin) return false;
+      }
+      return true;
+    };
+    const bool kinematic = !(body.mass > 0) || !std::isfinite(body.mass);
+    const double invRigid = kinematic ? 0.0 : 1.0 / body.mass;
+    msg::Vec3 totalForce{}, totalTorque{};
+    bool touched = false;
+    // Contacts are gathered first, then answered with the rigid's mass shared among them (each
+    // contact sees 1/count of it), so that many simultaneous contacts do not each push the
+    // rigid as if alone.
+    struct Candidate {
+      std::uint64_t netId;
+      const Net* net;
+      std::size_t nodes[3];
+      double w[3];
+      int count;
+      msg::Vec3 normal;  // pushes the nodes along it (the rigid the other way)
+      double distance, vn, invNet;
+      msg::Vec3 r;
+    };
+    std::vector<Candidate> candidates;
+    auto pointVelocity = [&](const msg::Vec3& r) { return add(body.linearVelocity, cross(body.angularVelocity, r)); };
+    // Nodes against the shape.
+    for (const auto& [netId, net] : nets) {
+      if (!netNear(netId)) continue;
+      for (std::size_t i = 0; i < net.nodeCount(); ++i) {
+        const msg::Vec3 x = net.position(i);
+        if (!inBox(x, box, p.thickness)) continue;
+        if (invMass(net, i) + invRigid == 0) continue;
+        const msg::Vec3 r = sub(x, body.position);
+        const msg::Vec3 local = msg::rotateInverse(body.orientation, r);
+        auto sd = msg::signedDistance(body.shape, local);
+        const auto key = std::tuple{rigidId, netId, static_cast<std::uint32_t>(i)};
+        const ContactMemory::Plane* plane = nullptr;
+        if (memory) {
+          const auto found = memory->planes.find(key);
+          if (found != memory->planes.end()) plane = &found->second;
+        }
+        if (plane && sd.distance < p.thickness) {
+          // A lasting contact: distance to the plane where it began.
+          sd.normal = plane->normal;
+          sd.distance = dot(local, plane->normal) - plane->offset;
+        }
+        if (sd.distance >= p.thickness) continue;
+        const msg::Vec3 relative = sub(net.velocity(i), pointVelocity(r));
+        if (!plane && sd.distance < 0) {
+          // Inside: take the normal of where the node was one step before, if it was outside then.
+          const msg::Vec3 before = sub(r, scale(relative, p.dt));
+          const auto sdBefore = msg::signedDistance(body.shape, msg::rotateInverse(body.orientation, before));
+          if (sdBefore.distance > 0) sd.normal = sdBefore.normal;
+        }
+        next.planes[key] = plane ? *plane : ContactMemory::Plane{sd.normal, dot(local, sd.normal) - sd.distance};
+        const msg::Vec3 normal = msg::rotate(body.orientation, sd.normal);
+        const double invNode = effectiveInvMass(net, adjacent[netId], i, normal, p);
+        candidates.push_back({netId, &net, {i, 0, 0}, {1, 0, 0}, 1, normal, sd.distance, dot(relative, normal), invNode, r});
+      }
+    }
+    // Corners of boxes, vertices of hulls and meshes against the nets' triangles.
+    std::vector<msg::Vec3> corners;
+    if (body.shape.kind == msg::ShapeKind::Box) {
+      const auto& h = body.shape.halfExtents;
+      for (int c = 0; c < 8; ++c) corners.push_back({c & 1 ? h[0] : -h[0], c & 2 ? h[1] : -h[1], c & 4 ? h[2] : -h[2]});
+    } else if (body.shape.kind == msg::ShapeKind::ConvexHull || body.shape.kind == msg::ShapeKind::TriangleMesh) {
+      for (std::size_t v = 0; v + 2 < body.shape.vertices.size(); v += 3) {
+        corners.push_back({body.shape.vertices[v], body.shape.vertices[v + 1], body.shape.vertices[v + 2]});
+      }
+    }
+    for (const auto& [netId, net] : nets) {
+      if (corners.empty() || net.surface.empty() || !netNear(netId)) continue;
+      for (const auto& corner : corners) {
+        const msg::Vec3 r = msg::rotate(body.orientation, corner);
+        const msg::Vec3 x = add(body.position, r);
+        const msg::Vec3 vx = pointVelocity(r);
+        const double reach = p.thickness + (std::abs(vx[0]) + std::abs(vx[1]) + std::abs(vx[2])) * p.dt;
+        PlaneHit best;
+        best.gap = 1e300;
+        std::size_t tri[3] = {0, 0, 0};
+        for (std::size_t t = 0; t + 2 < net.surface.size(); t += 3) {
+          const std::size_t ia = net.surface[t], ib = net.surface[t + 1], ic = net.surface[t + 2];
+          const auto pa = net.position(ia), pb = net.position(ib), pc = net.position(ic);
+          bool near = true;
+          for (int k = 0; k < 3 && near; ++k) {
+            near = x[k] >= std::min({pa[k], pb[k], pc[k]}) - reach && x[k] <= std::max({pa[k], pb[k], pc[k]}) + reach;
+          }
+          if (!near) continue;
+          const msg::Vec3 surface = scale(add(add(net.velocity(ia), net.velocity(ib)), net.velocity(ic)), 1.0 / 3.0);
+          const auto hit = pointTriangle(x, sub(vx, surface), pa, pb, pc, p);
+          if (!hit.hit || hit.gap >= best.gap) continue;
+          best = hit;
+          tri[0] = ia, tri[1] = ib, tri[2] = ic;
+        }
+        if (!best.hit) continue;
+        const double w[3] = {best.closest.wa, best.closest.wb, best.closest.wc};
+        double invSurface = 0;
+        msg::Vec3 surfaceVelocity{};
+        for (int k = 0; k < 3; ++k) {
+          // The triangle point's inverse mass: sum of w^2 / m over its nodes (pinned: 0).
+          invSurface += w[k] * w[k] * effectiveInvMass(net, adjacent[netId], tri[k], best.normal, p);
+          surfaceVelocity = add(surfaceVelocity, scale(net.velocity(tri[k]), w[k]));
+        }
+        if (invSurface + invRigid == 0) continue;
+        // best.normal points to the rigid's side: the triangle is pushed against it.
+        const msg::Vec3 n = scale(best.normal, -1.0);
+        candidates.push_back({netId, &net, {tri[0], tri[1], tri[2]}, {w[0], w[1], w[2]}, 3, n, best.distance,
+                              dot(sub(surfaceVelocity, vx), n), invSurface, r});
+      }
+    }
+    const double share = invRigid * static_cast<double>(std::max<std::size_t>(1, candidates.size()));
+    for (const auto& c : candidates) {
+      const double magnitude = contactMagnitude(c.distance, c.vn, c.invNet + share, p);
+      if (magnitude <= 0) continue;
+      ++out.contacts;
+      const msg::Vec3 f = scale(c.normal, magnitude);  // on the net
+      auto& forces = forcesOf(out, c.netId, *c.net);
+      for (int k = 0; k < c.count; ++k) {
+        if (invMass(*c.net, c.nodes[k]) > 0) addTo(forces, c.nodes[k], scale(f, c.w[k]));
+      }
+      totalForce = sub(totalForce, f);
+      totalTorque = sub(totalTorque, cross(c.r, f));
+      touched = true;
+    }
+    if (touched && !kinematic) out.rigidForces[rigidId] = msg::ForceEvent{totalForce, totalTorque, body.position, p.dt};
+  }
+  if (memory) *memory = std::move(next);
+  return out;
+}
+
+}  // namespace vrflow::massspring

@@ -1,0 +1,86 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "vrflow/base/result.hpp"
+#include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
+#include "vrflow/message/values.hpp"
+#include "vrflow/rigid/body.hpp"
+
+// The rigid interactor's solver: Bullet finds the contacts (btCollisionWorld with a
+// btDbvtBroadphase and btCollisionDispatcher; persistent manifolds), then our own sequential
+// impulse solver (friction, restitution, warm starting, Baumgarte position correction,
+// speculative contacts) computes per-body impulses. They are returned as force events
+// (force = impulse / dt, torque = angular impulse / dt, duration = dt, point = the body's centre
+// of mass) so that the animator, which applies them on its next step, stays the only writer of
+// state. Bullet's headers stay inside the implementation.
+
+namespace vrflow::rigid {
+
+struct ContactParams {
+  /// External acceleration every dynamic body receives during the step (the force field's
+  /// gravity): the solver predicts v + g dt before solving, so resting contact holds.
+  Vec3 gravity{0, -9.81, 0};
+  double restitution = 0.3;           ///< coefficient of restitution (one value for every pair)
+  double friction = 0.6;              ///< Coulomb friction coefficient
+  double restitutionThreshold = 0.5;  ///< closing speeds (m/s) below this do not bounce
+  int iterations = 20;                ///< sequential impulse iterations
+  double baumgarte = 0.2;             ///< fraction of the penetration removed per step
+  double slop = 0.005;                ///< penetration (m) left alone, keeps contacts alive
+  double margin = 0.005;              ///< Bullet collision margin of hull shapes (m)
+  /// Rolling and spinning resistance (m): a contact where a sphere or a capsule takes part resists
+  /// relative rotation with a torque of at most this times the normal force, so that they come to
+  /// rest (flat-faced shapes need none: their face contacts stop rolling).
+  double rollingFriction = 0.01;
+  /// Contacts are found up to this gap (m) and solved speculatively (approach allowed up to the
+  /// gap): catches objects moving up to about this far per step against each other.
+  double speculativeDistance = 0.04;
+  bool warmStart = true;
+};
+
+/// One contact point found in the last solve (for tests and diagnostics).
+struct ContactInfo {
+  std::uint64_t a = 0, b = 0;
+  Vec3 point{};         ///< on b, world frame
+  Vec3 normal{};        ///< from b to a
+  double distance = 0;  ///< negative when penetrating
+};
+
+class RigidContactSolver {
+ public:
+  explicit RigidContactSolver(ContactParams params = {});
+  ~RigidContactSolver();
+  RigidContactSolver(const RigidContactSolver&) = delete;
+  RigidContactSolver& operator=(const RigidContactSolver&) = delete;
+
+  const ContactParams& params() const { return params_; }
+  void setParams(const ContactParams& params) { params_ = params; }
+
+  /// Adds a body or replaces its state (a new shape rebuilds its collision object).
+  Status setBody(const Body& body);
+  /// Updates the pose and velocities of a known body (false if unknown).
+  bool setState(std::uint64_t id, const Vec3& position, const Quat& orientation,
+                const Vec3& linearVelocity, const Vec3& angularVelocity);
+  void removeBody(std::uint64_t id);
+  bool contains(std::uint64_t id) const;
+  std::size_t size() const;
+
+  /// Collision detection on the current local copy, then the impulse solve over dt. Returns a
+  /// force event per dynamic body that receives a non-zero impulse, ordered by id.
+  std::vector<std::pair<std::uint64_t, msg::ForceEvent>> solve(double dt);
+
+  /// The contacts of the last solve(), ordered by body ids.
+  const std::vector<ContactInfo>& contacts() const { return contacts_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  ContactParams params_;
+  std::vector<ContactInfo> contacts_;
+};
+
+}  // namespace vrflow::rigid

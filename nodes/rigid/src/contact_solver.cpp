@@ -1,0 +1,379 @@
+#include "vrflow/rigid/contact_solver.hpp"
+
+#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
+#include <btBulletCollisionCommon.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace vrflow::rigid {
+namespace {
+
+btVector3 toBt(const Vec3& v) {
+  return {static_cast<btScalar>(v[0]), static_cast<btScalar>(v[1]), static_cast<btScalar>(v[2])};
+}
+Vec3 fromBt(const btVector3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+btTransform transformOf(const Vec3& position, const Quat& q) {
+  return btTransform(btQuaternion(static_cast<btScalar>(q[0]), static_cast<btScalar>(q[1]),
+                                  static_cast<btScalar>(q[2]), static_cast<btScalar>(q[3])),
+                     toBt(position));
+}
+
+// A deterministic tangent basis of a unit normal (as btPlaneSpace1).
+void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  if (std::abs(n[2]) > 0.7071067811865476) {
+    const double a = n[1] * n[1] + n[2] * n[2];
+    const double k = 1.0 / std::sqrt(a);
+    t1 = {0, -n[2] * k, n[1] * k};
+    t2 = {a * k, -n[0] * t1[2], n[0] * t1[1]};
+  } else {
+    const double a = n[0] * n[0] + n[1] * n[1];
+    const double k = 1.0 / std::sqrt(a);
+    t1 = {-n[1] * k, n[0] * k, 0};
+    t2 = {-n[2] * t1[1], n[2] * t1[0], a * k};
+  }
+}
+
+}  // namespace
+
+struct RigidContactSolver::Impl {
+  struct Entry {
+    Body body;
+    std::vector<btScalar> vertices;
+    std::vector<int> indices;
+    std::unique_ptr<btTriangleIndexVertexArray> meshData;
+    std::unique_ptr<btCollisionShape> shape;
+    std::unique_ptr<btCollisionObject> object;
+    std::size_t dense = 0;  // index in the solve's arrays
+  };
+
+  explicit Impl(double margin) : margin_(margin) {
+    // No perturbation iterations: their extra points carry distances of the perturbed pose (off
+    // by millimetres, which breaks speculative contacts); boxes and hulls get full manifolds from
+    // polyhedral clipping instead, other pairs build theirs over steps (persistent manifolds).
+    // One contact distance for every shape (gContactBreakingThreshold, set around each query),
+    // not Bullet's default that shrinks it with the shape's size.
+    dispatcher.setDispatcherFlags(0);
+  }
+  ~Impl() {
+    for (auto& [id, entry] : entries) world.removeCollisionObject(entry->object.get());
+  }
+
+  Status build(Entry& e) {
+    const msg::Shape& s = e.body.shape;
+    if (auto status = msg::validateShape(s); !status) return status;
+    const bool concave = s.kind == msg::ShapeKind::TriangleMesh && e.body.kinematic;
+    if (s.kind == msg::ShapeKind::ConvexHull ||
+        (s.kind == msg::ShapeKind::TriangleMesh && !concave)) {
+      // Moving triangle meshes collide as their convex hull (documented approximation).
+      auto hull = std::make_unique<btConvexHullShape>();
+      for (std::size_t i = 0; i + 2 < s.vertices.size(); i += 3)
+        hull->addPoint(btVector3(static_cast<btScalar>(s.vertices[i]),
+                                 static_cast<btScalar>(s.vertices[i + 1]),
+                                 static_cast<btScalar>(s.vertices[i + 2])),
+                       false);
+      hull->recalcLocalAabb();
+      hull->setMargin(static_cast<btScalar>(margin_));
+      hull->initializePolyhedralFeatures();
+      e.shape = std::move(hull);
+    } else if (concave) {
+      e.vertices.clear();
+      for (double v : s.vertices) e.vertices.push_back(static_cast<btScalar>(v));
+      e.indices.assign(s.indices.begin(), s.indices.end());
+      btIndexedMesh mesh;
+      mesh.m_numTriangles = static_cast<int>(e.indices.size() / 3);
+      mesh.m_triangleIndexBase = reinterpret_cast<const unsigned char*>(e.indices.data());
+      mesh.m_triangleIndexStride = 3 * static_cast<int>(sizeof(int));
+      mesh.m_numVertices = static_cast<int>(e.vertices.size() / 3);
+      mesh.m_vertexBase = reinterpret_cast<const unsigned char*>(e.vertices.data());
+      mesh.m_vertexStride = 3 * static_cast<int>(sizeof(btScalar));
+      e.meshData = std::make_unique<btTriangleIndexVertexArray>();
+      e.meshData->addIndexedMesh(mesh, PHY_INTEGER);
+      e.shape = std::make_unique<btBvhTriangleMeshShape>(e.meshData.get(), true);
+    } else if (s.kind == msg::ShapeKind::Sphere) {
+      e.shape = std::make_unique<btSphereShape>(static_cast<btScalar>(s.radius));
+    } else if (s.kind == msg::ShapeKind::Box) {
+      auto box = std::make_unique<btBoxShape>(toBt(s.halfExtents));
+      const double smallest = std::min({s.halfExtents[0], s.halfExtents[1], s.halfExtents[2]});
+      box->setMargin(static_cast<btScalar>(std::min(margin_, 0.2 * smallest)));
+      box->initializePolyhedralFeatures();
+      e.shape = std::move(box);
+    } else {
+      e.shape = std::make_unique<btCapsuleShape>(static_cast<btScalar>(s.radius),
+                                                 static_cast<btScalar>(2.0 * s.halfHeight));
+    }
+    e.object = std::make_unique<btCollisionObject>();
+    e.object->setCollisionShape(e.shape.get());
+    e.object->setWorldTransform(transformOf(e.body.position, e.body.orientation));
+    e.object->setUserPointer(&e);
+    if (e.body.kinematic) {
+      e.object->setCollisionFlags(btCollisionObject::CF_STATIC_OBJECT);
+      world.addCollisionObject(e.object.get(), btBroadphaseProxy::StaticFilter,
+                               btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
+    } else {
+      e.object->setCollisionFlags(0);
+      world.addCollisionObject(e.object.get(), btBroadphaseProxy::DefaultFilter,
+                               btBroadphaseProxy::AllFilter);
+    }
+    return {};
+  }
+
+  double margin_;
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher{&config};
+  btDbvtBroadphase broadphase;
+  btCollisionWorld world{&dispatcher, &broadphase, &config};
+  std::map<std::uint64_t, std::unique_ptr<Entry>> entries;
+};
+
+RigidContactSolver::RigidContactSolver(ContactParams params)
+    : impl_(std::make_unique<Impl>(params.margin)), params_(params) {}
+
+RigidContactSolver::~RigidContactSolver() = default;
+
+Status RigidContactSolver::setBody(const Body& body) {
+  auto it = impl_->entries.find(body.id);
+  if (it != impl_->entries.end() && it->second->body.shape == body.shape &&
+      it->second->body.kinematic == body.kinematic) {
+    it->second->body = body;
+    it->second->object->setWorldTransform(transformOf(body.position, body.orientation));
+    return {};
+  }
+  removeBody(body.id);
+  auto entry = std::make_unique<Impl::Entry>();
+  entry->body = body;
+  if (auto status = impl_->build(*entry); !status)
+    return makeError("rigid body " + std::to_string(body.id) + ": " + status.error().message);
+  impl_->entries.emplace(body.id, std::move(entry));
+  return {};
+}
+
+bool RigidContactSolver::setState(std::uint64_t id, const Vec3& position, const Quat& orientation,
+                                  const Vec3& linearVelocity, const Vec3& angularVelocity) {
+  const auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return false;
+  Body& b = it->second->body;
+  b.position = position;
+  b.orientation = orientation;
+  b.linearVelocity = linearVelocity;
+  b.angularVelocity = angularVelocity;
+  it->second->object->setWorldTransform(transformOf(position, orientation));
+  return true;
+}
+
+void RigidContactSolver::removeBody(std::uint64_t id) {
+  const auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return;
+  impl_->world.removeCollisionObject(it->second->object.get());
+  impl_->entries.erase(it);
+}
+
+bool RigidContactSolver::contains(std::uint64_t id) const {
+  return impl_->entries.contains(id);
+}
+std::size_t RigidContactSolver::size() const {
+  return impl_->entries.size();
+}
+
+std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve(double dt) {
+  contacts_.clear();
+  std::vector<std::pair<std::uint64_t, msg::ForceEvent>> result;
+  if (!(dt > 0)) return result;
+  const ContactParams& p = params_;
+
+  // Dense per-body arrays in id order; predicted velocities include the external acceleration.
+  const std::size_t n = impl_->entries.size();
+  std::vector<Impl::Entry*> bodies;
+  bodies.reserve(n);
+  std::vector<double> invMass(n);
+  std::vector<Mat3> invInertia(n);
+  std::vector<Vec3> v(n), w(n), linear(n), angular(n);
+  for (auto& [id, entry] : impl_->entries) {
+    const std::size_t k = bodies.size();
+    entry->dense = k;
+    bodies.push_back(entry.get());
+    const Body& b = entry->body;
+    invMass[k] = b.inverseMass();
+    invInertia[k] = worldInverseInertia(b);
+    v[k] = b.kinematic ? b.linearVelocity : add(b.linearVelocity, scale(p.gravity, dt));
+    w[k] = b.angularVelocity;
+  }
+
+  {
+    // Bullet reads its contact distance from a global: set it for this query only.
+    const btScalar saved = gContactBreakingThreshold;
+    gContactBreakingThreshold = static_cast<btScalar>(p.speculativeDistance);
+    impl_->world.performDiscreteCollisionDetection();
+    gContactBreakingThreshold = saved;
+  }
+
+  // Axis 0 is the normal (from b to a), 1 and 2 the friction tangents. For each axis the
+  // Jacobian's angular parts r x d and their images through the inverse inertia are precomputed.
+  struct Constraint {
+    std::size_t a, b;
+    Vec3 ra, rb;
+    std::array<Vec3, 3> dir, raxd, rbxd, ia, ib;
+    std::array<double, 3> mass, acc;
+    double target;
+    Vec3 accRoll;
+    Mat3 rollMass;  // inverse of (Ia^-1 + Ib^-1)
+    bool rolls;     // a sphere or capsule is involved
+    btManifoldPoint* point;
+  };
+  std::vector<Constraint> constraints;
+  auto velocityAlong = [&](const Constraint& c, int axis) {
+    return dot(v[c.a], c.dir[axis]) + dot(w[c.a], c.raxd[axis]) - dot(v[c.b], c.dir[axis]) -
+           dot(w[c.b], c.rbxd[axis]);
+  };
+  auto push = [&](const Constraint& c, int axis, double impulse) {
+    v[c.a] = add(v[c.a], scale(c.dir[axis], impulse * invMass[c.a]));
+    w[c.a] = add(w[c.a], scale(c.ia[axis], impulse));
+    v[c.b] = sub(v[c.b], scale(c.dir[axis], impulse * invMass[c.b]));
+    w[c.b] = sub(w[c.b], scale(c.ib[axis], impulse));
+  };
+
+  // Manifolds in the order of their pair of ids (then Bullet's order, deterministic too).
+  struct PairRef {
+    std::uint64_t lo, hi;
+    int index;
+  };
+  std::vector<PairRef> pairs;
+  const int manifolds = impl_->dispatcher.getNumManifolds();
+  for (int m = 0; m < manifolds; ++m) {
+    btPersistentManifold* manifold = impl_->dispatcher.getManifoldByIndexInternal(m);
+    if (manifold->getNumContacts() == 0) continue;
+    const auto* ea = static_cast<const Impl::Entry*>(manifold->getBody0()->getUserPointer());
+    const auto* eb = static_cast<const Impl::Entry*>(manifold->getBody1()->getUserPointer());
+    if (ea->body.kinematic && eb->body.kinematic) continue;
+    pairs.push_back({std::min(ea->body.id, eb->body.id), std::max(ea->body.id, eb->body.id), m});
+  }
+  std::stable_sort(pairs.begin(), pairs.end(), [](const PairRef& x, const PairRef& y) {
+    return x.lo != y.lo ? x.lo < y.lo : x.hi < y.hi;
+  });
+  for (const PairRef& pair : pairs) {
+    btPersistentManifold* manifold = impl_->dispatcher.getManifoldByIndexInternal(pair.index);
+    const auto* ea = static_cast<const Impl::Entry*>(manifold->getBody0()->getUserPointer());
+    const auto* eb = static_cast<const Impl::Entry*>(manifold->getBody1()->getUserPointer());
+    for (int i = 0; i < manifold->getNumContacts(); ++i) {
+      btManifoldPoint& pt = manifold->getContactPoint(i);
+      Constraint c{};
+      c.a = ea->dense;
+      c.b = eb->dense;
+      c.point = &pt;
+      Vec3 normal = fromBt(pt.m_normalWorldOnB);
+      const double len = std::sqrt(dot(normal, normal));
+      if (!(len > 0)) continue;
+      normal = scale(normal, 1.0 / len);
+      // One point for both bodies (the middle of the pair of closest points), so that the
+      // contact's impulses are equal, opposite and collinear: momenta are conserved.
+      const Vec3 pa = fromBt(pt.getPositionWorldOnA());
+      const Vec3 pb = fromBt(pt.getPositionWorldOnB());
+      const Vec3 middle = scale(add(pa, pb), 0.5);
+      c.ra = sub(middle, ea->body.position);
+      c.rb = sub(middle, eb->body.position);
+      c.dir[0] = normal;
+      tangents(normal, c.dir[1], c.dir[2]);
+      for (int axis = 0; axis < 3; ++axis) {
+        c.raxd[axis] = cross(c.ra, c.dir[axis]);
+        c.rbxd[axis] = cross(c.rb, c.dir[axis]);
+        c.ia[axis] = mul(invInertia[c.a], c.raxd[axis]);
+        c.ib[axis] = mul(invInertia[c.b], c.rbxd[axis]);
+        const double k = invMass[c.a] + invMass[c.b] + dot(c.ia[axis], c.raxd[axis]) +
+                         dot(c.ib[axis], c.rbxd[axis]);
+        c.mass[axis] = k > 0 ? 1.0 / k : 0.0;
+      }
+      auto round = [](const Impl::Entry* e) {
+        return e->body.shape.kind == msg::ShapeKind::Sphere ||
+               e->body.shape.kind == msg::ShapeKind::Capsule;
+      };
+      c.rolls = p.rollingFriction > 0 && (round(ea) || round(eb));
+      if (c.rolls) {
+        Mat3 sum{};
+        for (int k = 0; k < 9; ++k) sum[k] = invInertia[c.a][k] + invInertia[c.b][k];
+        c.rollMass = inverse(sum);
+      }
+      const double distance = pt.getDistance();
+      const double vn = velocityAlong(c, 0);
+      const bool bounce = vn < -p.restitutionThreshold;
+      if (distance > 0) {
+        // Speculative: approach allowed up to the gap; a bounce when the gap closes this step.
+        c.target = -distance / dt;
+        if (bounce && vn * dt < -distance) c.target = std::max(c.target, -p.restitution * vn);
+      } else {
+        c.target = std::max(bounce ? -p.restitution * vn : 0.0,
+                            p.baumgarte / dt * std::max(-distance - p.slop, 0.0));
+      }
+      if (p.warmStart) {
+        c.acc = {pt.m_appliedImpulse, pt.m_appliedImpulseLateral1, pt.m_appliedImpulseLateral2};
+      }
+      constraints.push_back(c);
+      contacts_.push_back({ea->body.id, eb->body.id, pb, normal, distance});
+    }
+  }
+
+  for (const Constraint& c : constraints)
+    for (int axis = 0; axis < 3; ++axis)
+      if (c.acc[axis] != 0) push(c, axis, c.acc[axis]);
+
+  for (int iteration = 0; iteration < p.iterations; ++iteration) {
+    for (Constraint& c : constraints) {
+      // Friction within the cone of the current normal impulse (box approximation).
+      const double limit = p.friction * c.acc[0];
+      for (int axis = 1; axis < 3; ++axis) {
+        const double next =
+            std::clamp(c.acc[axis] - c.mass[axis] * velocityAlong(c, axis), -limit, limit);
+        const double delta = next - c.acc[axis];
+        c.acc[axis] = next;
+        if (delta != 0) push(c, axis, delta);
+      }
+      if (c.rolls && c.acc[0] > 0) {
+        // Rolling and spinning resistance: an angular impulse against the relative rotation,
+        // each component within rollingFriction * the normal impulse.
+        const Vec3 wrel = sub(w[c.a], w[c.b]);
+        const double rollLimit = p.rollingFriction * c.acc[0];
+        const Vec3 wanted = sub(c.accRoll, mul(c.rollMass, wrel));
+        const Vec3 next{std::clamp(wanted[0], -rollLimit, rollLimit),
+                        std::clamp(wanted[1], -rollLimit, rollLimit),
+                        std::clamp(wanted[2], -rollLimit, rollLimit)};
+        const Vec3 delta = sub(next, c.accRoll);
+        c.accRoll = next;
+        if (delta != Vec3{}) {
+          w[c.a] = add(w[c.a], mul(invInertia[c.a], delta));
+          w[c.b] = sub(w[c.b], mul(invInertia[c.b], delta));
+        }
+      }
+      const double next = std::max(c.acc[0] + c.mass[0] * (c.target - velocityAlong(c, 0)), 0.0);
+      const double delta = next - c.acc[0];
+      c.acc[0] = next;
+      if (delta != 0) push(c, 0, delta);
+    }
+  }
+
+  // The impulses each body received: the sums of the accumulated contact impulses.
+  for (const Constraint& c : constraints) {
+    c.point->m_appliedImpulse = static_cast<btScalar>(c.acc[0]);
+    c.point->m_appliedImpulseLateral1 = static_cast<btScalar>(c.acc[1]);
+    c.point->m_appliedImpulseLateral2 = static_cast<btScalar>(c.acc[2]);
+    const Vec3 impulse =
+        add(scale(c.dir[0], c.acc[0]), add(scale(c.dir[1], c.acc[1]), scale(c.dir[2], c.acc[2])));
+    linear[c.a] = add(linear[c.a], impulse);
+    linear[c.b] = sub(linear[c.b], impulse);
+    angular[c.a] = add(angular[c.a], add(cross(c.ra, impulse), c.accRoll));
+    angular[c.b] = sub(angular[c.b], add(cross(c.rb, impulse), c.accRoll));
+  }
+
+  for (std::size_t k = 0; k < n; ++k) {
+    const Body& b = bodies[k]->body;
+    if (b.kinematic) continue;
+    if (linear[k] == Vec3{} && angular[k] == Vec3{}) continue;
+    result.emplace_back(b.id, msg::ForceEvent{scale(linear[k], 1.0 / dt),
+                                              scale(angular[k], 1.0 / dt), b.position, dt});
+  }
+  return result;
+}
+
+}  // namespace vrflow::rigid

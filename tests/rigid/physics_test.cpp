@@ -1,0 +1,400 @@
+// The rigid solvers against analytic answers and invariants, stepped in one process.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include "vrflow/rigid/scene.hpp"
+#include "vrflow/rigid/world.hpp"
+
+namespace vrflow::rigid {
+namespace {
+
+constexpr double kDt = 0.01;  // the demo's time step
+const Vec3 kG{0, -9.81, 0};
+
+ForceField gravityField() {
+  return ForceField({FieldTerm{FieldTerm::Kind::Gravity, kG}});
+}
+
+Body ground(std::uint64_t id = 1) {
+  return makeKinematic(id, msg::Shape::box({5, 0.5, 5}), {0, -0.5, 0});
+}
+
+double norm(const Vec3& v) {
+  return std::sqrt(dot(v, v));
+}
+
+TEST(RigidPhysics, FreeFallMatchesSemiImplicitEulerAndTheAnalyticCurve) {
+  RigidWorld world(gravityField(), {});
+  Body ball = makeBody(7, msg::Shape::sphere(0.1), 2.0, {0, 10, 0});
+  ball.linearVelocity = {1, 2, 0};
+  ASSERT_TRUE(world.add({ball}));
+  const int n = 100;
+  for (int i = 0; i < n; ++i) world.step(kDt);
+  const Body& b = *world.state().find(7);
+  const double t = n * kDt;
+  // Semi-implicit Euler: y_n = y0 + v0 t - g dt^2 n(n+1)/2, exact up to round-off.
+  EXPECT_NEAR(b.position[1], 10 + 2 * t - 9.81 * kDt * kDt * n * (n + 1) / 2, 1e-9);
+  EXPECT_NEAR(b.position[0], 1 * t, 1e-12);
+  EXPECT_NEAR(b.linearVelocity[1], 2 - 9.81 * t, 1e-9);
+  // The continuous answer differs by g dt t / 2.
+  EXPECT_NEAR(b.position[1], 10 + 2 * t - 0.5 * 9.81 * t * t, 0.5 * 9.81 * kDt * t + 1e-9);
+  EXPECT_DOUBLE_EQ(world.state().time(), t);
+}
+
+// Drops a sphere from `height` (its bottom), returns the first rebound's peak height.
+double reboundHeight(double restitution, double height, double dt) {
+  ContactParams params;
+  params.restitution = restitution;
+  params.restitutionThreshold = 0.1;
+  RigidWorld world(gravityField(), params);
+  const double r = 0.1;
+  EXPECT_TRUE(world.add({ground(), makeBody(2, msg::Shape::sphere(r), 1.0, {0, height + r, 0})}));
+  bool rising = false;
+  double peak = 0;
+  for (int i = 0; i < static_cast<int>(4.0 / dt); ++i) {
+    world.step(dt);
+    const Body& b = *world.state().find(2);
+    if (b.linearVelocity[1] > 0) rising = true;
+    if (rising) {
+      peak = std::max(peak, b.position[1] - r);
+      if (b.linearVelocity[1] < 0) break;
+    }
+  }
+  EXPECT_TRUE(rising) << "the sphere never bounced";
+  return peak;
+}
+
+TEST(RigidPhysics, BouncingSphereReboundsToRestitutionSquared) {
+  // The impact happens within a step: the sphere rebounds from where the step before contact
+  // left it, up to |v| dt (4.4 cm here) above the ground, so the rebound is that much higher.
+  const double travel = std::sqrt(2 * 9.81 * 1.0) * kDt;
+  for (double e : {0.3, 0.5, 0.8}) {
+    const double ratio = reboundHeight(e, 1.0, kDt) / 1.0;
+    std::printf("[bounce] e = %.1f, dt = %.3f: rebound ratio %.4f (e^2 = %.4f)\n", e, kDt, ratio,
+                e * e);
+    EXPECT_GT(ratio, e * e - 0.005) << "e = " << e;
+    EXPECT_LT(ratio, e * e + travel) << "e = " << e;
+  }
+  // A finer step is closer.
+  for (double e : {0.3, 0.5, 0.8}) {
+    const double ratio = reboundHeight(e, 1.0, 0.001);
+    std::printf("[bounce] e = %.1f, dt = 0.001: rebound ratio %.4f (e^2 = %.4f)\n", e, ratio,
+                e * e);
+    EXPECT_NEAR(ratio, e * e, 0.006) << "e = " << e;
+  }
+}
+
+TEST(RigidPhysics, TwoBodyCollisionConservesMomentum) {
+  ContactParams params;
+  params.gravity = {0, 0, 0};
+  params.restitution = 0.9;
+  params.restitutionThreshold = 0.01;
+  RigidWorld world(ForceField{}, params);
+  Body a = makeBody(1, msg::Shape::sphere(0.2), 1.0, {-1, 0, 0});
+  Body b = makeBody(2, msg::Shape::box({0.2, 0.15, 0.25}), 3.0, {1, 0.05, 0.02},
+                    {0.0, 0.0, std::sin(0.2), std::cos(0.2)});
+  a.linearVelocity = {2, 0.1, 0};
+  b.linearVelocity = {-1, 0, 0.05};
+  b.angularVelocity = {0, 0, 0.3};
+  ASSERT_TRUE(world.add({a, b}));
+  auto momentum = [&] {
+    Vec3 p{};
+    for (const Body& x : world.state().bodies()) p = add(p, scale(x.linearVelocity, x.mass));
+    return p;
+  };
+  auto angular = [&] {  // about the origin: r x m v + I_w w
+    Vec3 l{};
+    for (const Body& x : world.state().bodies())
+      l = add(l, add(cross(x.position, scale(x.linearVelocity, x.mass)), angularMomentum(x)));
+    return l;
+  };
+  const Vec3 p0 = momentum(), l0 = angular();
+  const double va0 = world.state().find(1)->linearVelocity[0];
+  for (int i = 0; i < 150; ++i) world.step(kDt);
+  const Vec3 p1 = momentum(), l1 = angular();
+  EXPECT_LT(world.state().find(1)->linearVelocity[0], va0 - 1.0) << "no collision happened";
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(p1[k], p0[k], 1e-9 * (1 + norm(p0)));
+    EXPECT_NEAR(l1[k], l0[k], 1e-6 * (1 + norm(l0)));
+  }
+  // Separating after the impact.
+  EXPECT_GT(world.state().find(2)->linearVelocity[0], world.state().find(1)->linearVelocity[0]);
+}
+
+TEST(RigidPhysics, StackOfFiveBoxesStandsForTenSeconds) {
+  auto bodies = generateScene("stack:5");
+  ASSERT_TRUE(bodies);
+  RigidWorld world(gravityField(), {});
+  world.state().setSleep({.enabled = false});  // the solver alone holds the stack
+  ASSERT_TRUE(world.add(*bodies));
+  const auto start = world.state().bodies();
+  for (int i = 0; i < 1000; ++i) world.step(kDt);  // 10 s
+  double drift = 0, speed = 0, tilt = 0;
+  for (std::size_t i = 1; i < start.size(); ++i) {
+    const Body& b = world.state().bodies()[i];
+    drift = std::max(drift, norm(sub(b.position, start[i].position)));
+    speed = std::max(speed, norm(b.linearVelocity));
+    tilt = std::max(tilt, std::abs(1 - std::abs(b.orientation[3])));
+  }
+  std::printf("[stack] max drift %.3g m, max speed %.3g m/s, max tilt %.3g\n", drift, speed, tilt);
+  EXPECT_LT(drift, 0.005);  // 5 mm: the boxes sink by at most the slop each and stay in column
+  EXPECT_LT(speed, 1e-3);
+  EXPECT_LT(tilt, 1e-3);
+  EXPECT_GT(world.state().bodies().back().position[1], 2.25 - 0.03);
+}
+
+struct RestResult {
+  double maxSpeed = 0, maxPenetration = 0, lowest = 1e9, maxAbsXZ = 0;
+};
+
+RestResult settleMixed(RigidWorld& world, int steps) {
+  auto bodies = generateScene("mixed:20");
+  EXPECT_TRUE(bodies);
+  EXPECT_TRUE(world.add(*bodies));
+  RestResult r;
+  for (int i = 0; i < steps; ++i) {
+    world.step(kDt);
+    if (i >= steps - 50) {  // the last half second: at rest and no jitter
+      for (const Body& b : world.state().bodies()) {
+        if (b.kinematic) continue;
+        r.maxSpeed = std::max(r.maxSpeed, norm(b.linearVelocity) + 0.2 * norm(b.angularVelocity));
+      }
+    }
+    for (const auto& c : world.solver().contacts())
+      r.maxPenetration = std::max(r.maxPenetration, -c.distance);
+  }
+  for (const Body& b : world.state().bodies()) {
+    if (b.kinematic) continue;
+    const auto box = msg::worldBounds(b.shape, b.position, b.orientation);
+    r.lowest = std::min(r.lowest, box.min[1]);
+    r.maxAbsXZ = std::max({r.maxAbsXZ, std::abs(b.position[0]), std::abs(b.position[2])});
+  }
+  return r;
+}
+
+TEST(RigidPhysics, TwentyMixedObjectsComeToRestInTheBox) {
+  RigidWorld world(gravityField(), {});
+  world.state().setSleep({.enabled = false});  // measure the solver's own rest, without sleeping
+  const auto r = settleMixed(world, 600);      // 6 s
+  std::printf(
+      "[mixed] max speed in the last 0.5 s %.3g m/s, worst penetration %.3g m, lowest point %.3g "
+      "m\n",
+      r.maxSpeed, r.maxPenetration, r.lowest);
+  EXPECT_LT(r.maxSpeed, 0.05);
+  EXPECT_LT(r.maxPenetration, 0.03);  // over the whole run, impacts included
+  EXPECT_GT(r.lowest, -0.01);         // nothing sank through the ground
+  EXPECT_LT(r.maxAbsXZ, 1.0);         // nothing left the box through a wall
+}
+
+// A concave static triangle mesh (a V-shaped trough) catches a sphere, a box and a moving
+// triangle-mesh body (which collides as its convex hull); they settle in the trough's valley.
+TEST(RigidPhysics, StaticTriangleMeshCatchesConvexAndMeshBodies) {
+  // Two planes meeting along the z axis at y = 0, sloping up to y = 1 at x = +-2.
+  std::vector<double> v{-2, 1, -2, -2, 1, 2, 0, 0, -2, 0, 0, 2, 2, 1, -2, 2, 1, 2};
+  std::vector<std::uint32_t> t{0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4};
+  const auto trough = msg::Shape::triangleMesh(v, t);
+  // A closed tetrahedron as a moving mesh.
+  const auto tetra =
+      msg::Shape::triangleMesh({0.2, -0.1, 0, -0.1, -0.1, 0.17, -0.1, -0.1, -0.17, 0, 0.2, 0},
+                               {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0});
+  RigidWorld world(gravityField(), {});
+  ASSERT_TRUE(world.add({makeKinematic(1, trough, {0, 0, 0}),
+                         makeBody(2, msg::Shape::sphere(0.15), 1.0, {0.8, 1.5, 0}),
+                         makeBody(3, msg::Shape::box({0.1, 0.1, 0.1}), 1.0, {-0.6, 1.2, 0.5}),
+                         makeBody(4, tetra, 1.0, {0.1, 1.0, -0.8})}));
+  for (int i = 0; i < 500; ++i) world.step(kDt);
+  for (std::uint64_t id : {2u, 3u, 4u}) {
+    const Body& b = *world.state().find(id);
+    const auto box = msg::worldBounds(b.shape, b.position, b.orientation);
+    // Above the trough's surface y = |x| / 2 at its lowest point, and near the valley.
+    EXPECT_GT(box.min[1], -0.02) << id;
+    EXPECT_LT(box.min[1], 0.3) << id;
+    EXPECT_GT(b.position[1], 0.5 * std::abs(b.position[0])) << id;
+    EXPECT_LT(std::abs(b.position[0]), 0.4) << id;
+  }
+}
+
+// Fast bodies thrown at the demo box's 0.2 m walls stay inside: contacts are found up to 4 cm
+// ahead (speculative) and deeper overlaps are still seen by Bullet as penetrations.
+TEST(RigidPhysics, FastBodiesDoNotTunnelThroughTheWalls) {
+  for (double speed : {5.0, 10.0, 15.0}) {
+    auto bodies = generateScene("mixed:1");  // ground, four walls, one sphere
+    ASSERT_TRUE(bodies);
+    bodies->pop_back();
+    Body ball = makeBody(100, msg::Shape::sphere(0.1), 1.0, {0, 0.3, 0});
+    ball.linearVelocity = {speed, 0, 0};
+    Body box = makeBody(101, msg::Shape::box({0.1, 0.1, 0.1}), 1.0, {0, 0.3, 0.5});
+    box.linearVelocity = {0, -2, -speed};
+    bodies->push_back(ball);
+    bodies->push_back(box);
+    RigidWorld world(gravityField(), {});
+    ASSERT_TRUE(world.add(*bodies));
+    for (int i = 0; i < 200; ++i) {
+      world.step(kDt);
+      for (std::uint64_t id : {100u, 101u}) {
+        const Body& b = *world.state().find(id);
+        ASSERT_LT(std::abs(b.position[0]), 1.0) << "speed " << speed << ", step " << i;
+        ASSERT_LT(std::abs(b.position[2]), 1.0) << "speed " << speed << ", step " << i;
+        ASSERT_GT(b.position[1], 0.0) << "speed " << speed << ", step " << i;
+      }
+    }
+  }
+}
+
+TEST(RigidPhysics, SettledBodiesSleepAndWakeWhenHit) {
+  RigidWorld world(gravityField(), {});
+  const auto r = settleMixed(world, 400);
+  EXPECT_EQ(r.maxSpeed, 0.0);
+  for (const Body& b : world.state().bodies())
+    if (!b.kinematic) {
+      EXPECT_TRUE(world.state().asleep(b.id)) << b.id;
+    }
+  EXPECT_TRUE(world.step(kDt).empty()) << "a settled scene reports no change";
+  // A heavy sphere dropped on the pile wakes what it hits.
+  ASSERT_TRUE(world.add({makeBody(1000, msg::Shape::sphere(0.2), 20.0, {0, 1.5, 0})}));
+  std::set<std::uint64_t> woken;
+  for (int i = 0; i < 200; ++i)
+    for (const Change& c : world.step(kDt))
+      if (c.id != 1000) woken.insert(c.id);
+  EXPECT_FALSE(woken.empty());
+  const Body& ball = *world.state().find(1000);
+  EXPECT_LT(ball.position[1], 1.0);  // it landed on the pile, not in the air
+  EXPECT_GT(msg::worldBounds(ball.shape, ball.position, ball.orientation).min[1], -0.01);
+}
+
+TEST(RigidPhysics, KinematicBodyNeverMoves) {
+  RigidWorld world(gravityField(), {});
+  Body platform = makeKinematic(1, msg::Shape::box({1, 0.1, 1}), {0, 0.5, 0},
+                                {0, std::sin(0.1), 0, std::cos(0.1)});
+  ASSERT_TRUE(
+      world.add({platform, makeBody(2, msg::Shape::box({0.2, 0.2, 0.2}), 50.0, {0.3, 1.5, 0}),
+                 makeBody(3, msg::Shape::sphere(0.2), 5.0, {-0.3, 2.0, 0.1})}));
+  // Forces sent to it are ignored too.
+  EXPECT_TRUE(
+      world.state().applyForce(1, msg::ForceEvent{{0, 1e6, 0}, {1e6, 0, 0}, {1, 1, 1}, kDt}));
+  for (int i = 0; i < 300; ++i) world.step(kDt);
+  const Body& p = *world.state().find(1);
+  EXPECT_EQ(p.position, platform.position);
+  EXPECT_EQ(p.orientation, platform.orientation);
+  EXPECT_GT(world.state().find(2)->position[1], 0.6 + 0.15);  // resting on it
+  // A kinematic body with a velocity moves with it, whatever hits it.
+  RigidAnimatorState state;
+  Body mover = makeKinematic(4, msg::Shape::sphere(1), {0, 0, 0});
+  mover.linearVelocity = {1, 0, 0};
+  ASSERT_TRUE(state.addBody(mover));
+  state.applyForce(4, msg::ForceEvent{{-100, 0, 0}, {}, {}, 1.0});
+  for (int i = 0; i < 10; ++i) state.step(0.1);
+  EXPECT_NEAR(state.find(4)->position[0], 1.0, 1e-12);
+}
+
+TEST(RigidPhysics, SameRunTwiceGivesIdenticalBits) {
+  std::vector<Body> results[2];
+  for (auto& result : results) {
+    RigidWorld world(gravityField(), {});
+    settleMixed(world, 200);
+    result = world.state().bodies();
+  }
+  ASSERT_EQ(results[0].size(), results[1].size());
+  for (std::size_t i = 0; i < results[0].size(); ++i) {
+    const Body& a = results[0][i];
+    const Body& b = results[1][i];
+    EXPECT_EQ(0, std::memcmp(a.position.data(), b.position.data(), sizeof(a.position))) << a.id;
+    EXPECT_EQ(0, std::memcmp(a.orientation.data(), b.orientation.data(), sizeof(a.orientation)))
+        << a.id;
+    EXPECT_EQ(
+        0, std::memcmp(a.linearVelocity.data(), b.linearVelocity.data(), sizeof(a.linearVelocity)))
+        << a.id;
+    EXPECT_EQ(0, std::memcmp(a.angularVelocity.data(), b.angularVelocity.data(),
+                             sizeof(a.angularVelocity)))
+        << a.id;
+  }
+}
+
+TEST(RigidPhysics, FreeAsymmetricBodyConservesAngularMomentum) {
+  RigidAnimatorState state;
+  Body body =
+      makeBody(1, msg::Shape::box({0.5, 0.2, 0.1}), 3.0, {0, 0, 0}, {0.1, 0.3, -0.2, 0.927});
+  body.angularVelocity = {0.4, 2.0, 0.3};  // near the unstable middle axis: tumbles
+  ASSERT_TRUE(state.addBody(body));
+  const Vec3 l0 = angularMomentum(*state.find(1));
+  const double e0 = kineticEnergy(*state.find(1));
+  const Vec3 w0 = state.find(1)->angularVelocity;
+  for (int i = 0; i < 2000; ++i) state.step(0.001);
+  const Body& b = *state.find(1);
+  const Vec3 l1 = angularMomentum(b);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(l1[k], l0[k], 1e-9 * norm(l0));
+  EXPECT_GT(norm(sub(b.angularVelocity, w0)), 0.1) << "w should precess for an asymmetric body";
+  EXPECT_NEAR(kineticEnergy(b), e0, 0.02 * e0);
+  const double qn = std::sqrt(dot({b.orientation[0], b.orientation[1], b.orientation[2]},
+                                  {b.orientation[0], b.orientation[1], b.orientation[2]}) +
+                              b.orientation[3] * b.orientation[3]);
+  EXPECT_NEAR(qn, 1.0, 1e-12);
+}
+
+TEST(RigidPhysics, TorqueUsesTheRotatedInertia) {
+  // A body turned 90 degrees about z: its body x axis is the world y axis. A world torque about
+  // y meets the body's x inertia.
+  RigidAnimatorState state;
+  Body body = makeBody(1, msg::Shape::box({0.5, 0.1, 0.2}), 2.0, {0, 0, 0},
+                       {0, 0, std::sqrt(0.5), std::sqrt(0.5)});
+  ASSERT_TRUE(state.addBody(body));
+  const double ixx = body.inertia[0], iyy = body.inertia[4];
+  ASSERT_GT(std::abs(ixx - iyy), 0.01);
+  const double dt = 1e-3;
+  state.applyForce(1, msg::ForceEvent{{0, 0, 0}, {0, 1.0, 0}, {0, 0, 0}, dt});
+  state.step(dt);
+  EXPECT_NEAR(state.find(1)->angularVelocity[1], dt / ixx, 1e-9);
+  EXPECT_NEAR(state.find(1)->angularVelocity[0], 0.0, 1e-9);
+  // A force off the centre gives torque (point - position) x force.
+  RigidAnimatorState second;
+  ASSERT_TRUE(second.addBody(makeBody(2, msg::Shape::sphere(1), 1.0, {1, 2, 3})));
+  const double i = second.find(2)->inertia[0];
+  second.applyForce(2, msg::ForceEvent{{0, 0, 3}, {0, 0, 0}, {1, 3, 3}, 0.5});  // arm (0,1,0)
+  second.step(0.5);
+  EXPECT_NEAR(second.find(2)->angularVelocity[0], 1.5 / i, 1e-12);
+  EXPECT_NEAR(second.find(2)->linearVelocity[2], 1.5, 1e-12);
+}
+
+TEST(RigidPhysics, AnimatorReportsOnlyChangedBodies) {
+  RigidAnimatorState state;
+  ASSERT_TRUE(state.addBody(makeBody(1, msg::Shape::sphere(1), 1.0, {0, 0, 0})));
+  ASSERT_TRUE(state.addBody(makeBody(2, msg::Shape::sphere(1), 1.0, {5, 0, 0})));
+  ASSERT_TRUE(state.addBody(makeKinematic(3, msg::Shape::sphere(1), {9, 0, 0})));
+  EXPECT_TRUE(state.step(0.01).empty());
+  state.applyForce(2, msg::ForceEvent{{1, 0, 0}, {}, {5, 0, 0}, 0.01});
+  auto changes = state.step(0.01);
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].id, 2u);
+  EXPECT_TRUE(changes[0].pose && changes[0].velocity);
+  changes = state.step(0.01);  // coasting: pose changes, velocity does not
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_TRUE(changes[0].pose);
+  EXPECT_FALSE(changes[0].velocity);
+  EXPECT_FALSE(state.applyForce(99, msg::ForceEvent{}));
+  EXPECT_FALSE(state.addBody(makeBody(1, msg::Shape::sphere(1), 1.0, {0, 0, 0})));
+}
+
+TEST(RigidPhysics, ForceFieldTerms) {
+  auto field =
+      ForceField::parse("gravity 0 -10 0; uniform 1 0 0; attractor 0 0 10 2 0.5; drag 0.5 0.25");
+  ASSERT_TRUE(field) << field.error().message;
+  FieldTarget t{2.0, {0, 0, 0}, {1, 0, 0}, {0, 4, 0}};
+  const auto f = field->forceOn(t, 0.01);
+  EXPECT_NEAR(f.force[0], 1 - 0.5, 1e-12);
+  EXPECT_NEAR(f.force[1], -20, 1e-12);
+  EXPECT_NEAR(f.force[2], 2.0 * 2 / 100, 1e-12);  // m mu / r^2 towards the centre
+  EXPECT_NEAR(f.torque[1], -1.0, 1e-12);
+  EXPECT_EQ(f.duration, 0.01);
+  EXPECT_EQ(field->gravity(), (Vec3{0, -10, 0}));
+  t.mass = kInfiniteMass;
+  EXPECT_EQ(field->forceOn(t, 0.01).force, (Vec3{0, 0, 0}));
+  EXPECT_FALSE(ForceField::parse("gravity 0 1"));
+  EXPECT_FALSE(ForceField::parse("magnet 1 2 3"));
+  EXPECT_FALSE(ForceField::parse("drag x"));
+}
+
+}  // namespace
+}  // namespace vrflow::rigid

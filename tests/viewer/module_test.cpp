@@ -1,0 +1,214 @@
+// The viewer module in a `vrflow run`: frames on disk, bad parameters refused by name.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "../runtime/process_helpers.hpp"
+#include "vrflow/viewer/frame_writer.hpp"
+#include "vrflow/viewer/image.hpp"
+
+namespace vrflow::viewer {
+namespace {
+
+namespace fs = std::filesystem;
+using vrflow::testing::TempDir;
+
+// The application: bodies -> view, with the viewer's parameters as given.
+std::string application(const std::string& viewerParams, const std::string& bodiesParams = "") {
+  return R"(<?xml version="1.0" encoding="UTF-8"?>
+<application name="viewer-test" version="1">
+  <hosts><host id="local" address="127.0.0.1"/></hosts>
+  <modules>
+    <module id="bodies" package="viewer-testing" type="bodies" host="local">)" +
+         bodiesParams + R"(</module>
+    <module id="view" package="viewer" type="viewer" host="local">)" +
+         viewerParams + R"(</module>
+  </modules>
+  <connections>
+    <connection from="bodies.objects" to="view.objects"/>
+  </connections>
+</application>
+)";
+}
+
+std::string param(const std::string& name, const std::string& value) {
+  return "<param name=\"" + name + "\" value=\"" + value + "\"/>";
+}
+
+// Pixels whose channels differ by more than 60: objects, not the grey ground or the pale sky.
+int colouredPixels(const Image& image) {
+  int coloured = 0;
+  for (std::size_t i = 0; i < image.rgb.size(); i += 3) {
+    const int r = image.rgb[i], g = image.rgb[i + 1], b = image.rgb[i + 2];
+    if (std::max({r, g, b}) - std::min({r, g, b}) > 60) ++coloured;
+  }
+  return coloured;
+}
+
+std::vector<std::string> filesIn(const std::string& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    names.push_back(entry.path().filename());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+vrflow::testing::CommandResult run(const TempDir& dir, const std::string& app) {
+  const auto file = dir.write("app.xml", app);
+  return vrflow::testing::runVrflow({"run", file}, 60);
+}
+
+std::string common(const std::string& out) {
+  return param("output-dir", out) + param("format", "png") + param("width", "160") +
+         param("height", "120") + param("eye", "0 2.5 7") + param("target", "0 1 0");
+}
+
+TEST(ViewerModule, WritesOnePngPerIterationOfTheRun) {
+  TempDir dir;
+  const auto out = dir.file("frames");
+  const auto result = run(dir, application(common(out)));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(filesIn(out),
+            (std::vector<std::string>{"frame_000000.png", "frame_000001.png", "frame_000002.png",
+                                      "frame_000003.png", "frame_000004.png"}));
+  EXPECT_NE(result.err.find("PNG frames"), std::string::npos) << result.err;
+  const auto first = readPng(out + "/frame_000000.png");
+  const auto last = readPng(out + "/frame_000004.png");
+  ASSERT_TRUE(first.ok() && last.ok());
+  EXPECT_EQ(first->width, 160);
+  EXPECT_EQ(first->height, 120);
+  EXPECT_NE(first->rgb, last->rgb);        // the objects moved
+  EXPECT_GT(colouredPixels(*first), 500);  // the objects are drawn
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+}
+
+TEST(ViewerModule, RendersEveryNthIterationWithAPrefix) {
+  TempDir dir;
+  const auto out = dir.file("frames");
+  const auto result =
+      run(dir, application(common(out) + param("every", "2") + param("prefix", "shot"),
+                           param("count", "6")));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(filesIn(out),
+            (std::vector<std::string>{"shot_000000.png", "shot_000001.png", "shot_000002.png"}));
+}
+
+TEST(ViewerModule, DeletedObjectDisappearsAndForgedShapeIsLoggedNotFatal) {
+  TempDir dir;
+  const auto out = dir.file("frames");
+  const auto result =
+      run(dir, application(common(out), param("delete-at", "2") + param("forged", "true")));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_NE(result.err.find("rejected"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("module 'view'"), std::string::npos) << result.err;
+  ASSERT_EQ(filesIn(out).size(), 5u);
+  // The sphere (about 0.5 m across at 7 m: hundreds of pixels) is gone after iteration 2.
+  const auto before = readPng(out + "/frame_000001.png");
+  const auto after = readPng(out + "/frame_000003.png");
+  ASSERT_TRUE(before.ok() && after.ok());
+  EXPECT_GT(colouredPixels(*before), colouredPixels(*after) + 150);
+}
+
+TEST(ViewerModule, ScriptedCameraMovesTheView) {
+  TempDir dir;
+  const auto out = dir.file("frames");
+  const auto path = dir.write("camera.txt", "0 0 2.5 7 0 1 0\n4 7 2.5 0 0 1 0 60\n");
+  const auto result =
+      run(dir, application(common(out) + param("camera-path", path), param("count", "5")));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  ASSERT_EQ(filesIn(out).size(), 5u);
+}
+
+TEST(ViewerModule, BadParametersStopTheRunNamingModuleAndParameter) {
+  struct Case {
+    std::string params, name;
+  };
+  for (const Case& c :
+       {Case{param("eye", "0 1 0") + param("target", "0 1 0"), "'eye'"},
+        Case{param("camera-path", "/nonexistent/camera.txt"), "'camera-path'"},
+        Case{param("width", "3"), "width"}, Case{param("format", "gif"), "format"}}) {
+    TempDir dir;
+    const auto result = run(dir, application(param("output-dir", dir.file("f")) + c.params));
+    EXPECT_NE(result.exitCode, 0) << c.params;
+    EXPECT_NE(result.err.find(c.name), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find("view"), std::string::npos) << result.err;
+    EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+  }
+}
+
+// The digests of every output port but the viewer's, from a run report.
+std::map<std::string, std::string> simulationDigests(const std::string& reportPath) {
+  std::map<std::string, std::string> digests;
+  const auto report = nlohmann::json::parse(vrflow::testing::readFile(reportPath));
+  for (const auto& output : report["outputs"]) {
+    if (output["module"] == "view") continue;
+    digests[output["module"].get<std::string>() + "." + output["port"].get<std::string>()] =
+        output["last_digest"].dump();
+  }
+  return digests;
+}
+
+TEST(ViewerExample, ChainWithAViewerComputesTheSameBitsAsWithout) {
+  TempDir dir;
+  const std::string source = vrflow::testing::readFile(vrflow::testing::sourceDir() +
+                                                       "/nodes/viewer/examples/chain_viewer.xml");
+  // The same application without the viewer module and its connection.
+  std::string without = source;
+  const auto begin = without.find("    <module id=\"view\"");
+  const auto end = without.find("</module>", begin);
+  ASSERT_NE(begin, std::string::npos);
+  without.erase(begin, end + std::string("</module>\n").size() - begin);
+  const std::string connection = "    <connection from=\"chain.objects\" to=\"view.objects\"/>\n";
+  ASSERT_NE(without.find(connection), std::string::npos);
+  without.erase(without.find(connection), connection.size());
+  const auto withFile = dir.write("with.xml", source);
+  const auto withoutFile = dir.write("without.xml", without);
+  const auto run = [&](const std::string& app, const std::string& report) {
+    return vrflow::testing::runCommand({"/bin/sh", "-c",
+                                        "cd " + dir.path() + " && " + vrflow::testing::binDir() +
+                                            "/vrflow run " + app + " -n 60 --report " + report});
+  };
+  const auto a = run(withFile, dir.file("with.json"));
+  ASSERT_EQ(a.exitCode, 0) << a.err;
+  const auto b = run(withoutFile, dir.file("without.json"));
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  const auto withDigests = simulationDigests(dir.file("with.json"));
+  EXPECT_EQ(withDigests.size(), 3u);  // chain.objects, springs.forces, gravity.forces
+  for (const auto& [port, digest] : withDigests) EXPECT_NE(digest, "null") << port;
+  EXPECT_EQ(withDigests, simulationDigests(dir.file("without.json")));
+  EXPECT_EQ(filesIn(dir.file("out/chain-viewer")).size(), 6u);  // iterations 0, 10, ..., 50
+}
+
+TEST(ViewerExample, SnapshotWritesTheSampleScene) {
+  TempDir dir;
+  const auto png = dir.file("snapshot.png");
+  const auto result = vrflow::testing::runCommand(
+      {vrflow::testing::binDir() + "/vrflow-viewer-snapshot", png, "200", "100"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto image = readPng(png);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  EXPECT_EQ(image->width, 200);
+  EXPECT_EQ(image->height, 100);
+  EXPECT_GT(colouredPixels(*image), 300);
+}
+
+TEST(ViewerModule, WritesAnMp4WhenFfmpegIsPresent) {
+  if (findOnPath("ffmpeg").empty()) GTEST_SKIP() << "ffmpeg is not on PATH; PNG output is tested";
+  TempDir dir;
+  const auto out = dir.file("video");
+  const auto result = run(dir, application(param("output-dir", out) + param("format", "mp4") +
+                                           param("width", "160") + param("height", "120")));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(filesIn(out), (std::vector<std::string>{"frame.mp4"}));
+  EXPECT_GT(fs::file_size(out + "/frame.mp4"), 0u);
+  EXPECT_NE(result.err.find("MP4"), std::string::npos) << result.err;
+}
+
+}  // namespace
+}  // namespace vrflow::viewer
