@@ -1,6 +1,7 @@
 // fluid/fluid: the grid fluid as one module with the ports of an animator and an interactor.
 // In: `objects` (rigid bodies with their shape resources; mass-spring nets when node-radius > 0).
-// Out: `forces` (one force event per coupled rigid body per iteration, duration = dt) and
+// Out: `forces` (one force event per coupled rigid body per iteration, duration = dt, and one
+// massspring node-forces event per net) and
 // `objects` (its own fluid object, then its particles as a dynamic Mesh resource of xyz floats
 // with no triangles).
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "vrflow/module/module.hpp"
 #include "vrflow/fluid/solver.hpp"
 #include "blocks.hpp"
+#include "node_forces.hpp"
 #include "world.hpp"
 
 namespace {
@@ -131,13 +133,16 @@ int main(int argc, char** argv) {
     auto forces = module.newMessage(256 + 128 * bodies.size());
     forces.builder().setSimTime(time);
     forces.builder().setTimeStep(dt);
-    for (const auto& f : stepped->forces) {
-      // Rigid bodies only: mass-spring nodes' forces need the massspring package's node event.
-      if (f.cells == 0 || f.index != 0 || f.id == 0) continue;
-      bool rigid = false;
-      for (const auto& b : bodies) rigid = rigid || b.id == f.id;
-      if (!rigid) continue;
-      forces.builder().addForce(f.id, {f.force, f.torque, f.point, f.duration});
+    // The step returns the bodies' forces first, then the nodes'.
+    for (std::size_t b = 0; b < bodies.size() && b < stepped->forces.size(); ++b) {
+      const auto& f = stepped->forces[b];
+      if (f.cells > 0) forces.builder().addForce(f.id, {f.force, f.torque, f.point, f.duration});
+    }
+    if (!points.empty() && stepped->forces.size() >= bodies.size()) {
+      const std::vector<fluid::BodyForce> nodeForces(
+          stepped->forces.begin() + static_cast<std::ptrdiff_t>(bodies.size()),
+          stepped->forces.end());
+      fluid::addNodeForceEvents(forces.builder(), points, nodeForces);
     }
     if (!module.put(forcesOut, std::move(forces))) break;
 
