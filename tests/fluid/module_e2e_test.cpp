@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <cstdio>
 #include <cstdlib>  // unsetenv
 #include <sstream>
@@ -132,6 +133,43 @@ TEST(FluidModule, TwoBlocksSpawnedByTheModuleFollowTheSerialPath) {
   std::printf("box y after 100 iterations: 1 block %.9f, 2 blocks %.9f\n", finalY[0], finalY[1]);
   EXPECT_NEAR(finalY[1], finalY[0], 1e-3);
   EXPECT_GT(std::abs(finalY[0] - 0.5), 0.01);  // it moved: the comparison is not of a box at rest
+}
+
+// With the rigid package's own animator and gravity field: a 0.3 m box of density 500 floats
+// (free to turn: a cube of half the water's density tips onto an edge, so only its height is
+// checked: between half under water and resting on the surface, not sunk, not flying).
+TEST(FluidModule, BoxOfTheRigidPackageFloats) {
+  TempDir dir;
+  const auto scene = dir.write("scene.json", R"({
+  "bodies": [
+    {"name": "float", "shape": {"type": "box", "halfExtents": [0.15, 0.15, 0.15]}, "density": 500,
+     "position": [0.4, 0.5, 0.4]}
+  ]
+}
+)");
+  const std::string rigid = R"(    <module id="bodies" package="rigid" type="animator" host="local">
+      <param name="scene" value=")" + scene + R"("/>
+      <param name="state-file" value=")" + dir.file("state.json") + R"("/>
+      <input port="events" initial-messages="1"/>
+    </module>
+    <module id="gravity" package="rigid" type="forcefield" host="local"/>
+)";
+  const auto app = dir.write(
+      "rigid.xml", application(fluidModule("") + rigid,
+                               "    <connection from=\"bodies.objects\" to=\"water.objects\"/>\n"
+                               "    <connection from=\"bodies.objects\" to=\"gravity.objects\"/>\n"
+                               "    <connection from=\"water.forces\" to=\"bodies.events\"/>\n"
+                               "    <connection from=\"gravity.forces\" to=\"bodies.events\"/>\n"));
+  const auto result = runVrflow({"run", app, "--iterations", "250", "--no-progress"}, 180);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto state = nlohmann::json::parse(readFile(dir.file("state.json")));
+  ASSERT_EQ(state["bodies"].size(), 1u);
+  const double y = state["bodies"][0]["position"][1].get<double>();
+  const double vy = state["bodies"][0]["linearVelocity"][1].get<double>();
+  std::printf("rigid-package box after 250 iterations: y %.3f m, vy %.3f m/s\n", y, vy);
+  EXPECT_GT(y, 0.42);  // the water is 0.5 m deep: sunk would be 0.15 to 0.26
+  EXPECT_LT(y, 0.66);  // resting on the surface at most
+  EXPECT_LT(std::abs(vy), 0.2);
 }
 
 TEST(FluidModule, AbsurdTimeStepStopsTheRunWithTheSolversMessage) {
