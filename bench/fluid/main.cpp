@@ -56,10 +56,9 @@ nlohmann::json runCase(int nx, int ny, int nz, int bodies, int ranks, int steps)
   std::string cmd = std::string(VRFLOW_MPIEXEC) + " --oversubscribe -np " + std::to_string(ranks);
   if (geteuid() == 0) cmd += " --allow-run-as-root";
   cmd += " " + binDir() + "/vrflow-fluid-blocks --nx " + std::to_string(nx) + " --ny " +
-         std::to_string(ny) + " --nz " + std::to_string(nz) + " --h " +
-         std::to_string(1.0 / nx) + " --dt 0.005 --warmup 3 --steps " +
-         std::to_string(steps + 3) + " --bodies " + std::to_string(bodies) +
-         " --max-particles 2000000";
+         std::to_string(ny) + " --nz " + std::to_string(nz) + " --h " + std::to_string(1.0 / nx) +
+         " --dt 0.005 --warmup 3 --steps " + std::to_string(steps + 3) + " --bodies " +
+         std::to_string(bodies) + " --max-particles 2000000";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return {};
   std::string out;

@@ -19,8 +19,9 @@
 namespace vrflow::testing {
 namespace {
 
-const std::vector<std::string> kScene = {"--nx", "16", "--ny", "16", "--nz", "16", "--h", "0.05",
-                                         "--steps", "40", "--dt", "0.01", "--bodies", "3"};
+const std::vector<std::string> kScene = {"--nx", "16",   "--ny",     "16",      "--nz",
+                                         "16",   "--h",  "0.05",     "--steps", "40",
+                                         "--dt", "0.01", "--bodies", "3"};
 
 nlohmann::json runBlocks(int ranks) {
   setenv("OMPI_MCA_btl", "self,vader", 0);
@@ -71,8 +72,8 @@ TEST(FluidBlocks, TwoAndFourBlocksAgreeWithOneWithinTheStatedTolerance) {
     const auto& b = many["body_y"];
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t i = 0; i < a.size(); ++i) {
-      EXPECT_NEAR(b[i].get<double>(), a[i].get<double>(), 1e-5) << "body " << i << ", " << ranks
-                                                                 << " blocks";
+      EXPECT_NEAR(b[i].get<double>(), a[i].get<double>(), 1e-5)
+          << "body " << i << ", " << ranks << " blocks";
     }
     // The bodies did move: the comparison is not of a scene at rest.
     EXPECT_GT(one["max_speed"].get<double>(), 0.5);

@@ -23,7 +23,8 @@ int main() {
   const double density = module.paramDouble("density", 500);
   const double dt = module.paramDouble("dt", 0.01);
   msg::Vec3 position{};
-  std::istringstream(module.param("start", "0.4 0.5 0.4")) >> position[0] >> position[1] >> position[2];
+  std::istringstream(module.param("start", "0.4 0.5 0.4")) >> position[0] >> position[1] >>
+      position[2];
   std::ofstream trajectory(module.param("trajectory", "box.csv"), std::ios::trunc);
   const double mass = density * 8 * half * half * half;
   const auto shape = msg::Shape::box({half, half, half});

@@ -104,14 +104,17 @@ TEST(RigidFluidCoupling, DroppedBoxSlowsDownAndRaisesTheWater) {
   for (int step = 0; step < 150; ++step) {
     stepWith(*tank, box, dt);
     const double speed = -box.body.linearVelocity[1];
-    if (box.bottom() > level0) entrySpeed = speed;
-    else slowest = std::min(slowest, speed);
+    if (box.bottom() > level0)
+      entrySpeed = speed;
+    else
+      slowest = std::min(slowest, speed);
     waterSpeed = std::max(waterSpeed, tank->maxParticleSpeed());
   }
   const double level1 = cornerLevel(*tank);
-  std::printf("dropped box: entry %.3f m/s, slowest after entry %.3f m/s, level %.4f -> %.4f, "
-              "water speed %.3f m/s\n",
-              entrySpeed, slowest, level0, level1, waterSpeed);
+  std::printf(
+      "dropped box: entry %.3f m/s, slowest after entry %.3f m/s, level %.4f -> %.4f, "
+      "water speed %.3f m/s\n",
+      entrySpeed, slowest, level0, level1, waterSpeed);
   EXPECT_GT(entrySpeed, 1.0);
   EXPECT_LT(slowest, 0.5 * entrySpeed);
   // 0.9 of the box's 15.6 litres under water spread over the 0.64 m^2 tank: about 2 cm.
@@ -143,12 +146,13 @@ TEST(RigidFluidCoupling, SpinningBoxFeelsATorqueAgainstItsSpin) {
   auto spinning = tank->step(0.01, {box});
   ASSERT_TRUE(spinning.ok());
   const auto& spin = spinning->front();
-  std::printf("box at rest: force y %.2f N (weight %.2f N), torque z %.4f N m; spinning: torque "
-              "z %.4f N m\n",
-              rest.force[1], box.mass * 9.81, rest.torque[2], spin.torque[2]);
+  std::printf(
+      "box at rest: force y %.2f N (weight %.2f N), torque z %.4f N m; spinning: torque "
+      "z %.4f N m\n",
+      rest.force[1], box.mass * 9.81, rest.torque[2], spin.torque[2]);
   EXPECT_NEAR(rest.force[1], box.mass * 9.81, 0.1 * box.mass * 9.81);  // buoyancy = weight
   EXPECT_LT(std::abs(rest.torque[2]), 0.05);  // particle noise; the spin gives ~2 N m
-  EXPECT_LT(spin.torque[2], -0.1);  // against the spin
+  EXPECT_LT(spin.torque[2], -0.1);            // against the spin
 }
 
 // A mass-spring node under water is a small sphere: it is pushed up (buoyancy), gets no torque.

@@ -1,9 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <nlohmann/json.hpp>
 #include <cstdio>
 #include <cstdlib>  // unsetenv
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -22,7 +22,8 @@ std::string fluidModule(const std::string& extra) {
       <param name="nz" value="16"/>
       <param name="cell-size" value="0.05"/>
       <param name="fill-max" value="0.8 0.5 0.8"/>
-)" + extra + "    </module>\n";
+)" + extra +
+         "    </module>\n";
 }
 
 std::string application(const std::string& modules, const std::string& connections) {
@@ -32,7 +33,8 @@ std::string application(const std::string& modules, const std::string& connectio
     <host id="local" address="127.0.0.1"/>
   </hosts>
   <modules>
-)" + modules + "  </modules>\n  <connections>\n" + connections + "  </connections>\n</application>\n";
+)" + modules +
+         "  </modules>\n  <connections>\n" + connections + "  </connections>\n</application>\n";
 }
 
 std::vector<std::vector<double>> readCsv(const std::string& path, bool header) {
@@ -50,17 +52,17 @@ std::vector<std::vector<double>> readCsv(const std::string& path, bool header) {
 
 TEST(FluidModule, RunsAloneAndReportsItsStats) {
   TempDir dir;
-  const auto app = dir.write(
-      "alone.xml", application(fluidModule("      <param name=\"stats\" value=\"" +
-                                           dir.file("stats.csv") + "\"/>\n"),
-                               ""));
+  const auto app =
+      dir.write("alone.xml", application(fluidModule("      <param name=\"stats\" value=\"" +
+                                                     dir.file("stats.csv") + "\"/>\n"),
+                                         ""));
   const auto result = runVrflow({"run", app, "--iterations", "40", "--no-progress"}, 120);
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto rows = readCsv(dir.file("stats.csv"), true);
   ASSERT_EQ(rows.size(), 40u);
   const double volume0 = rows.front()[6];
   for (const auto& row : rows) {
-    EXPECT_GT(row[2], 0) << "CG iterations";       // a hydrostatic tank still needs a solve
+    EXPECT_GT(row[2], 0) << "CG iterations";  // a hydrostatic tank still needs a solve
     EXPECT_LE(row[3], 1e-6) << "CG residual";
     EXPECT_NEAR(row[6], volume0, 0.02 * volume0);  // volume
     EXPECT_LT(row[7], 0.01);                       // a still tank stays still
@@ -73,13 +75,15 @@ TEST(FluidModule, LightBoxFloatsThroughTheAnimatorInteractorCycle) {
       <param name="half" value="0.15"/>
       <param name="density" value="500"/>
       <param name="start" value="0.4 0.5 0.4"/>
-      <param name="trajectory" value=")" + dir.file("box.csv") + R"("/>
+      <param name="trajectory" value=")" +
+                          dir.file("box.csv") + R"("/>
       <input port="events" initial-messages="1"/>
     </module>
 )";
   const auto app = dir.write(
       "float.xml", application(fluidModule("      <param name=\"stats\" value=\"" +
-                                           dir.file("stats.csv") + "\"/>\n") + box,
+                                           dir.file("stats.csv") + "\"/>\n") +
+                                   box,
                                "    <connection from=\"box.objects\" to=\"water.objects\"/>\n"
                                "    <connection from=\"water.forces\" to=\"box.events\"/>\n"));
   const auto result = runVrflow({"run", app, "--iterations", "250", "--no-progress"}, 180);
@@ -113,17 +117,17 @@ TEST(FluidModule, TwoBlocksSpawnedByTheModuleFollowTheSerialPath) {
   for (int blocks : {1, 2}) {
     TempDir dir;
     const std::string box = R"(    <module id="box" package="fluidtest" type="box" host="local">
-      <param name="trajectory" value=")" + dir.file("box.csv") + R"("/>
+      <param name="trajectory" value=")" +
+                            dir.file("box.csv") + R"("/>
       <input port="events" initial-messages="1"/>
     </module>
 )";
     const auto app = dir.write(
-        "blocks.xml",
-        application(fluidModule("      <param name=\"blocks\" value=\"" + std::to_string(blocks) +
-                                "\"/>\n") +
-                        box,
-                    "    <connection from=\"box.objects\" to=\"water.objects\"/>\n"
-                    "    <connection from=\"water.forces\" to=\"box.events\"/>\n"));
+        "blocks.xml", application(fluidModule("      <param name=\"blocks\" value=\"" +
+                                              std::to_string(blocks) + "\"/>\n") +
+                                      box,
+                                  "    <connection from=\"box.objects\" to=\"water.objects\"/>\n"
+                                  "    <connection from=\"water.forces\" to=\"box.events\"/>\n"));
     const auto result = runVrflow({"run", app, "--iterations", "100", "--no-progress"}, 180);
     ASSERT_EQ(result.exitCode, 0) << blocks << " blocks: " << result.err;
     const auto rows = readCsv(dir.file("box.csv"), false);
@@ -148,8 +152,10 @@ TEST(FluidModule, BoxOfTheRigidPackageFloats) {
 }
 )");
   const std::string rigid = R"(    <module id="bodies" package="rigid" type="animator" host="local">
-      <param name="scene" value=")" + scene + R"("/>
-      <param name="state-file" value=")" + dir.file("state.json") + R"("/>
+      <param name="scene" value=")" +
+                            scene + R"("/>
+      <param name="state-file" value=")" +
+                            dir.file("state.json") + R"("/>
       <input port="events" initial-messages="1"/>
     </module>
     <module id="gravity" package="rigid" type="forcefield" host="local"/>
@@ -174,7 +180,8 @@ TEST(FluidModule, BoxOfTheRigidPackageFloats) {
 
 TEST(FluidModule, AbsurdTimeStepStopsTheRunWithTheSolversMessage) {
   TempDir dir;
-  const auto app = dir.write("bad.xml", application(fluidModule("      <param name=\"dt\" value=\"0.9\"/>\n"), ""));
+  const auto app = dir.write(
+      "bad.xml", application(fluidModule("      <param name=\"dt\" value=\"0.9\"/>\n"), ""));
   const auto result = runVrflow({"run", app, "--iterations", "5", "--no-progress"}, 60);
   EXPECT_EQ(result.exitCode, 1);
   EXPECT_NE((result.out + result.err).find("time step"), std::string::npos) << result.err;
@@ -182,7 +189,8 @@ TEST(FluidModule, AbsurdTimeStepStopsTheRunWithTheSolversMessage) {
 
 TEST(FluidModule, ZeroGridSizeIsRejectedByValidation) {
   TempDir dir;
-  const auto app = dir.write("zero.xml", application(fluidModule("      <param name=\"ny\" value=\"0\"/>\n"), ""));
+  const auto app = dir.write(
+      "zero.xml", application(fluidModule("      <param name=\"ny\" value=\"0\"/>\n"), ""));
   const auto result = runVrflow({"validate", app}, 60);
   EXPECT_EQ(result.exitCode, 1);
   EXPECT_NE((result.out + result.err).find("ny"), std::string::npos) << result.out << result.err;

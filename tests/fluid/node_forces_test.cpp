@@ -1,6 +1,7 @@
+#include "node_forces.hpp"
+
 #include <gtest/gtest.h>
 
-#include "node_forces.hpp"
 #include "tank.hpp"
 #include "vrflow/massspring/events.hpp"
 #include "vrflow/message/byte_sink.hpp"

@@ -1,10 +1,11 @@
+#include "vrflow/fluid/settings.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
 #include "tank.hpp"
-#include "vrflow/fluid/settings.hpp"
 #include "vrflow/fluid/solver.hpp"
 
 namespace vrflow::fluid {
@@ -70,11 +71,13 @@ TEST(FluidSettings, AbsurdTimeStepsAreRejectedAndNothingMoves) {
   for (double dt : {0.0, -0.01, 10.0, 0.5, std::numeric_limits<double>::quiet_NaN()}) {
     auto result = tank->step(dt, {});
     ASSERT_FALSE(result.ok()) << dt;
-    EXPECT_NE(result.error().message.find("time step"), std::string::npos) << result.error().message;
+    EXPECT_NE(result.error().message.find("time step"), std::string::npos)
+        << result.error().message;
   }
   // 0.5 s with 5 cm cells: gravity alone moves the liquid 49 cells; the message says what fits.
   auto result = tank->step(0.5, {});
-  EXPECT_NE(result.error().message.find("use at most"), std::string::npos) << result.error().message;
+  EXPECT_NE(result.error().message.find("use at most"), std::string::npos)
+      << result.error().message;
   EXPECT_EQ(tank->particlePositions(), before);
   EXPECT_TRUE(tank->step(0.01, {}).ok());
 }

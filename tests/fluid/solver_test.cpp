@@ -1,3 +1,5 @@
+#include "vrflow/fluid/solver.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -6,7 +8,6 @@
 #include <cstdlib>
 
 #include "tank.hpp"
-#include "vrflow/fluid/solver.hpp"
 
 namespace vrflow::fluid {
 namespace {
@@ -19,8 +20,9 @@ std::unique_ptr<FluidSolver> damBreak(int nx, int ny, int nz, double volumeCorre
   auto s = smallTank(nx, ny, nz);
   s.volumeCorrection = volumeCorrection;
   auto solver = std::move(FluidSolver::create(s).value());
-  EXPECT_TRUE(solver->addLiquidBox({{0, 0, 0}, {0.4 * nx * s.cellSize, 0.6 * ny * s.cellSize,
-                                               nz * s.cellSize}})
+  EXPECT_TRUE(solver
+                  ->addLiquidBox(
+                      {{0, 0, 0}, {0.4 * nx * s.cellSize, 0.6 * ny * s.cellSize, nz * s.cellSize}})
                   .ok());
   return solver;
 }
@@ -68,10 +70,11 @@ TEST(FluidSolver, StillTankStaysStillFor500Steps) {
 TEST(FluidSolver, VolumeIsConservedWithin2PercentOver1000Steps) {
   auto s = smallTank(16, 16, 6);
   // VRFLOW_FLUID_VOLUME_CORRECTION=0 shows the check failing without volume control (+3.3 %).
-  if (const char* vc = std::getenv("VRFLOW_FLUID_VOLUME_CORRECTION")) s.volumeCorrection = std::atof(vc);
+  if (const char* vc = std::getenv("VRFLOW_FLUID_VOLUME_CORRECTION"))
+    s.volumeCorrection = std::atof(vc);
   auto solver = std::move(FluidSolver::create(s).value());
-  ASSERT_TRUE(solver->addLiquidBox({{0, 0, 0}, {8 * s.cellSize, 12 * s.cellSize, 6 * s.cellSize}})
-                  .ok());
+  ASSERT_TRUE(
+      solver->addLiquidBox({{0, 0, 0}, {8 * s.cellSize, 12 * s.cellSize, 6 * s.cellSize}}).ok());
   const double volume0 = solver->liquidVolume();
   double worst = 0.0;
   for (int step = 0; step < 1000; ++step) {

@@ -1,8 +1,8 @@
 #pragma once
 
-#include <memory>
-
 #include <gtest/gtest.h>
+
+#include <memory>
 
 #include "vrflow/fluid/solver.hpp"
 
@@ -21,14 +21,13 @@ inline FluidSettings smallTank(int nx, int ny, int nz) {
 inline std::unique_ptr<FluidSolver> makeTank(const FluidSettings& s, double depth) {
   auto solver = FluidSolver::create(s);
   EXPECT_TRUE(solver.ok()) << (solver.ok() ? "" : solver.error().message);
-  auto status = (*solver)->addLiquidBox(
-      {{0, 0, 0}, {s.nx * s.cellSize, depth, s.nz * s.cellSize}});
+  auto status = (*solver)->addLiquidBox({{0, 0, 0}, {s.nx * s.cellSize, depth, s.nz * s.cellSize}});
   EXPECT_TRUE(status.ok()) << (status.ok() ? "" : status.error().message);
   return std::move(*solver);
 }
 
-/// The liquid's surface height: mean of the highest particle plus half the particle spacing in the columns at the four corners' neighbourhoods, away from
-/// the centre where the tests put bodies.
+/// The liquid's surface height: mean of the highest particle plus half the particle spacing in the
+/// columns at the four corners' neighbourhoods, away from the centre where the tests put bodies.
 inline double cornerLevel(const FluidSolver& solver) {
   const auto b = solver.bounds();
   const double h = solver.settings().cellSize;
@@ -40,7 +39,9 @@ inline double cornerLevel(const FluidSolver& solver) {
       ++n;
     }
   }
-  const int per = solver.settings().particlesPerCell == 27 ? 3 : solver.settings().particlesPerCell == 8 ? 2 : 1;
+  const int per = solver.settings().particlesPerCell == 27  ? 3
+                  : solver.settings().particlesPerCell == 8 ? 2
+                                                            : 1;
   return sum / n + 0.5 * h / per;
 }
 

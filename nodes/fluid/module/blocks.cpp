@@ -154,8 +154,12 @@ struct BlockGroup::Impl {
 };
 
 BlockGroup::BlockGroup(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-BlockGroup::~BlockGroup() { stop(); }
-FluidSolver& BlockGroup::solver() { return *impl_->solver; }
+BlockGroup::~BlockGroup() {
+  stop();
+}
+FluidSolver& BlockGroup::solver() {
+  return *impl_->solver;
+}
 
 Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, int blocks,
                                                       const FluidSettings& settings,

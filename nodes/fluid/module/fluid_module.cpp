@@ -11,11 +11,11 @@
 
 // The message headers come first: object_type.hpp's enumerators Vec3, Quat, Mat3 trip -Wshadow
 // when values.hpp's aliases of the same names were seen before it.
-#include "vrflow/message/builtin_types.hpp"
-#include "vrflow/module/module.hpp"
-#include "vrflow/fluid/solver.hpp"
 #include "blocks.hpp"
 #include "node_forces.hpp"
+#include "vrflow/fluid/solver.hpp"
+#include "vrflow/message/builtin_types.hpp"
+#include "vrflow/module/module.hpp"
 #include "world.hpp"
 
 namespace {
@@ -119,7 +119,8 @@ int main(int argc, char** argv) {
       }
     }
     const bool sendParticles =
-        particlesEvery > 0 && (module.iteration() % static_cast<std::uint64_t>(particlesEvery) == 0);
+        particlesEvery > 0 &&
+        (module.iteration() % static_cast<std::uint64_t>(particlesEvery) == 0);
     fluid::BlockStep request;
     request.dt = dt;
     request.bodies = bodies;

@@ -54,8 +54,10 @@ Status World::apply(const msg::MessageView& message) {
         continue;
       }
       auto& net = nets_[object->id()];
-      if (auto a = object->doubleArray(msg::MassSpringParam::kPositions)) net.positions = toVector(*a);
-      if (auto a = object->doubleArray(msg::MassSpringParam::kVelocities)) net.velocities = toVector(*a);
+      if (auto a = object->doubleArray(msg::MassSpringParam::kPositions))
+        net.positions = toVector(*a);
+      if (auto a = object->doubleArray(msg::MassSpringParam::kVelocities))
+        net.velocities = toVector(*a);
       if (auto a = object->doubleArray(msg::MassSpringParam::kMasses)) net.masses = toVector(*a);
     }
   }
@@ -101,7 +103,8 @@ std::vector<std::string> World::uncoupled() const {
       out.push_back("rigid " + std::to_string(id) + ": shape resource " +
                     std::to_string(rigid.shapeId) + " not received");
     } else if (!(rigid.body.mass > 0.0)) {
-      out.push_back("rigid " + std::to_string(id) + ": mass is not positive (kinematic bodies are "
+      out.push_back("rigid " + std::to_string(id) +
+                    ": mass is not positive (kinematic bodies are "
                     "not coupled)");
     }
   }

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "vrflow/message/reader.hpp"  // first: see fluid_module.cpp
 #include "vrflow/fluid/solver.hpp"
+#include "vrflow/message/reader.hpp"  // first: see fluid_module.cpp
 
 // The fluid module's copy of the objects it couples with: rigid bodies (and their shape
 // resources) and, optionally, mass-spring nodes as independent point masses. Only changes

@@ -145,7 +145,8 @@ int main(int argc, char** argv) {
   s.maxParticles = o.maxParticles;
   auto created = fluid::FluidSolver::create(s);
   if (!created) {
-    if (rank == 0) std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", created.error().message.c_str());
+    if (rank == 0)
+      std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", created.error().message.c_str());
     MPI_Finalize();
     return 1;
   }
@@ -153,16 +154,19 @@ int main(int argc, char** argv) {
   fluid::MpiBlockComm comm(MPI_COMM_WORLD);
   if (!o.serial) {
     if (auto status = solver->setBlockComm(&comm); !status) {
-      if (rank == 0) std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", status.error().message.c_str());
+      if (rank == 0)
+        std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", status.error().message.c_str());
       MPI_Finalize();
       return 1;
     }
   }
   const auto tank = solver->bounds();
-  const msg::Aabb liquid{tank.min, {tank.min[0] + 0.5 * (tank.max[0] - tank.min[0]),
-                                    tank.min[1] + 0.5 * (tank.max[1] - tank.min[1]), tank.max[2]}};
+  const msg::Aabb liquid{tank.min,
+                         {tank.min[0] + 0.5 * (tank.max[0] - tank.min[0]),
+                          tank.min[1] + 0.5 * (tank.max[1] - tank.min[1]), tank.max[2]}};
   if (auto status = solver->addLiquidBox(liquid); !status) {
-    if (rank == 0) std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", status.error().message.c_str());
+    if (rank == 0)
+      std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", status.error().message.c_str());
     MPI_Finalize();
     return 1;
   }
@@ -179,11 +183,13 @@ int main(int argc, char** argv) {
     MPI_Barrier(MPI_COMM_WORLD);
     const double t1 = MPI_Wtime();
     if (!forces) {
-      if (rank == 0) std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", forces.error().message.c_str());
+      if (rank == 0)
+        std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", forces.error().message.c_str());
       MPI_Finalize();
       return 1;
     }
-    for (std::size_t b = 0; b < boxes.size(); ++b) integrate(boxes[b], (*forces)[b], o.dt, s.gravity, tank);
+    for (std::size_t b = 0; b < boxes.size(); ++b)
+      integrate(boxes[b], (*forces)[b], o.dt, s.gravity, tank);
     const auto& st = solver->lastStats();
     if (step >= o.warmup) {
       timed += t1 - t0;
@@ -212,15 +218,16 @@ int main(int argc, char** argv) {
       ys += buf;
     }
     const int n = std::max(1, timedSteps);
-    std::printf("{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"serial\":%s,\"steps\":%d,"
-                "\"particles\":%zu,\"ms_per_step\":%.3f,\"cg_iterations\":%.1f,"
-                "\"pressure_ms_per_step\":%.3f,\"cg_bytes_per_step\":%.0f,\"bandwidth_gbs\":%.3f,"
-                "\"volume\":%.9g,\"mean_y\":%.9g,\"max_speed\":%.6g,\"body_y\":[%s],"
-                "\"digest\":\"%016llx\"}\n",
-                o.nx, o.ny, o.nz, o.bodies, size, o.serial ? "true" : "false", o.steps, particles,
-                1e3 * timed / n, static_cast<double>(cgIterations) / n, 1e3 * pressureTime / n,
-                bytes / n, pressureTime > 0 ? bytes / pressureTime / 1e9 : 0.0, volume, meanY,
-                speed, ys.c_str(), static_cast<unsigned long long>(fnv(all)));
+    std::printf(
+        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"serial\":%s,\"steps\":%d,"
+        "\"particles\":%zu,\"ms_per_step\":%.3f,\"cg_iterations\":%.1f,"
+        "\"pressure_ms_per_step\":%.3f,\"cg_bytes_per_step\":%.0f,\"bandwidth_gbs\":%.3f,"
+        "\"volume\":%.9g,\"mean_y\":%.9g,\"max_speed\":%.6g,\"body_y\":[%s],"
+        "\"digest\":\"%016llx\"}\n",
+        o.nx, o.ny, o.nz, o.bodies, size, o.serial ? "true" : "false", o.steps, particles,
+        1e3 * timed / n, static_cast<double>(cgIterations) / n, 1e3 * pressureTime / n, bytes / n,
+        pressureTime > 0 ? bytes / pressureTime / 1e9 : 0.0, volume, meanY, speed, ys.c_str(),
+        static_cast<unsigned long long>(fnv(all)));
   }
   MPI_Finalize();
   return 0;

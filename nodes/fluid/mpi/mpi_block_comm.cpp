@@ -137,8 +137,8 @@ std::vector<float> MpiBlockComm::gatherToRoot(const std::vector<float>& values) 
     total += counts[static_cast<std::size_t>(r)];
   }
   std::vector<float> all(rank_ == 0 ? static_cast<std::size_t>(total) : 0);
-  MPI_Gatherv(values.data(), count, MPI_FLOAT, all.data(), counts.data(), offsets.data(),
-              MPI_FLOAT, 0, comm_);
+  MPI_Gatherv(values.data(), count, MPI_FLOAT, all.data(), counts.data(), offsets.data(), MPI_FLOAT,
+              0, comm_);
   return all;
 }
 

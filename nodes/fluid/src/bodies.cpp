@@ -18,7 +18,9 @@ msg::Vec3 cross(const msg::Vec3& a, const msg::Vec3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-std::string name(std::uint64_t id) { return "body " + std::to_string(id); }
+std::string name(std::uint64_t id) {
+  return "body " + std::to_string(id);
+}
 
 Status finish(PreparedBody& p) {
   if (auto status = msg::validateShape(p.shape); !status) {
@@ -32,8 +34,9 @@ Status finish(PreparedBody& p) {
       !finite(p.linearVelocity.data(), 3) || !finite(p.angularVelocity.data(), 3)) {
     return makeError("fluid: " + name(p.id) + ": position, orientation or velocity is not finite");
   }
-  const double qn = std::sqrt(p.orientation[0] * p.orientation[0] + p.orientation[1] * p.orientation[1] +
-                              p.orientation[2] * p.orientation[2] + p.orientation[3] * p.orientation[3]);
+  const double qn =
+      std::sqrt(p.orientation[0] * p.orientation[0] + p.orientation[1] * p.orientation[1] +
+                p.orientation[2] * p.orientation[2] + p.orientation[3] * p.orientation[3]);
   if (qn < 1e-9) return makeError("fluid: " + name(p.id) + ": orientation quaternion is zero");
   for (double& c : p.orientation) c /= qn;
   const double volume = msg::massProperties(p.shape, p.mass).volume;
@@ -84,7 +87,8 @@ bool inBounds(const msg::Aabb& box, const double* x) {
 
 void pushOut(const PreparedBody& body, double* x, double margin) {
   const msg::Vec3 local = msg::rotateInverse(
-      body.orientation, {x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]});
+      body.orientation,
+      {x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]});
   const auto sd = msg::signedDistance(body.shape, local);
   if (sd.distance >= 0.0) return;
   const msg::Vec3 n = msg::rotate(body.orientation, sd.normal);
@@ -166,8 +170,8 @@ void bodyForceSums(const Grid& g, const PreparedBody& body, int bodyIndex,
           x[static_cast<std::size_t>(a)] -= 0.5 * g.h;
           msg::Vec3 e{};
           e[static_cast<std::size_t>(a)] = d;
-          const auto t = cross(
-              {x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]}, e);
+          const auto t =
+              cross({x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]}, e);
           for (int c = 0; c < 3; ++c) out[2 + c] += t[c];
         }
       }

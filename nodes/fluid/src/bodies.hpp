@@ -14,15 +14,15 @@ namespace vrflow::fluid::detail {
 struct PreparedBody {
   std::uint64_t id = 0;
   std::uint32_t index = 0;
-  bool point = false;          ///< a mass-spring node: no torque reported
+  bool point = false;  ///< a mass-spring node: no torque reported
   msg::Shape shape;
   msg::Vec3 position{};
   msg::Quat orientation{0, 0, 0, 1};
   msg::Vec3 linearVelocity{};
   msg::Vec3 angularVelocity{};
   double mass = 1.0;
-  double density = 1.0;        ///< mass / volume, used in the projection
-  msg::Aabb bounds;            ///< world bounds
+  double density = 1.0;  ///< mass / volume, used in the projection
+  msg::Aabb bounds;      ///< world bounds
 };
 
 Result<PreparedBody> prepareBody(const RigidBody& body);
@@ -34,8 +34,8 @@ void pushOut(const PreparedBody& body, double* x, double margin);
 /// Velocity of the body's material at world point x.
 msg::Vec3 rigidVelocity(const PreparedBody& body, const msg::Vec3& x);
 /// Marks cells and faces whose centres lie inside a body with its index (first body wins).
-void rasterise(const Grid& grid, const std::vector<PreparedBody>& bodies, std::vector<int>& cellBody,
-               std::vector<int>* faceBody);
+void rasterise(const Grid& grid, const std::vector<PreparedBody>& bodies,
+               std::vector<int>& cellBody, std::vector<int>* faceBody);
 /// Values bodyForceSums() adds up per body: per axis the summed velocity change, the face count
 /// and the torque of the change (3), so that blocks can add theirs before finishBodyForce().
 inline constexpr int kBodySums = 15;

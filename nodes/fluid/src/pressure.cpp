@@ -134,8 +134,7 @@ void applyPreconditioner(const Grid& g, const PressureSystem& A, const std::vect
 }  // namespace
 
 PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vector<double>& b,
-                         std::vector<double>& p, double tol, int maxIterations,
-                         BlockComm* comm) {
+                         std::vector<double>& p, double tol, int maxIterations, BlockComm* comm) {
   const std::size_t n = g.cells();
   const int planeSize = g.nx * g.ny;
   Slab slab;

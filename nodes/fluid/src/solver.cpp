@@ -25,7 +25,7 @@ struct FluidSolver::Impl {
   FluidSettings settings;
   Grid grid;
   double invH = 1.0;
-  int k0 = 0, k1 = 0;  // this block's cell planes
+  int k0 = 0, k1 = 0;       // this block's cell planes
   std::vector<double> pos;  // xyz per particle (this block's)
   std::vector<double> vel;
   std::vector<float> posOut;
@@ -267,7 +267,8 @@ struct FluidSolver::Impl {
       int lo[3], hi[3];
       for (int d = 0; d < 3; ++d) {
         lo[d] = std::max(0, static_cast<int>(std::floor((body.bounds.min[d] - o[d]) * invH)) - 1);
-        hi[d] = std::min(n[d] - 1, static_cast<int>(std::floor((body.bounds.max[d] - o[d]) * invH)) + 1);
+        hi[d] = std::min(n[d] - 1,
+                         static_cast<int>(std::floor((body.bounds.max[d] - o[d]) * invH)) + 1);
       }
       for (int k = lo[2]; k <= hi[2]; ++k) {
         for (int j = lo[1]; j <= hi[1]; ++j) {
@@ -434,7 +435,7 @@ struct FluidSolver::Impl {
   bool unknown(std::size_t c) const { return kind[c] != detail::kAir; }
 
   std::size_t stride(int a) const {
-    return a == 0 ? 1
+    return a == 0   ? 1
            : a == 1 ? static_cast<std::size_t>(grid.nx)
                     : static_cast<std::size_t>(grid.nx) * grid.ny;
   }
@@ -663,7 +664,8 @@ Status FluidSolver::addLiquidBox(const msg::Aabb& box) {
   }
   // Every block draws the same jitter sequence and keeps the particles in its slab, so the
   // particles are those of the serial run.
-  const std::size_t existing = static_cast<std::size_t>(m.sum(static_cast<double>(m.pos.size() / 3)));
+  const std::size_t existing =
+      static_cast<std::size_t>(m.sum(static_cast<double>(m.pos.size() / 3)));
   const std::size_t total = existing + seeded.size() * static_cast<std::size_t>(per * per * per);
   if (total > static_cast<std::size_t>(m.settings.maxParticles)) {
     return makeError("fluid: the liquid box needs " + std::to_string(total) +
@@ -757,9 +759,15 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   return forces;
 }
 
-const FluidSettings& FluidSolver::settings() const { return impl_->settings; }
-const StepStats& FluidSolver::lastStats() const { return impl_->stats; }
-const std::vector<float>& FluidSolver::particlePositions() const { return impl_->posOut; }
+const FluidSettings& FluidSolver::settings() const {
+  return impl_->settings;
+}
+const StepStats& FluidSolver::lastStats() const {
+  return impl_->stats;
+}
+const std::vector<float>& FluidSolver::particlePositions() const {
+  return impl_->posOut;
+}
 
 std::vector<float> FluidSolver::gatherParticlePositions() const {
   return impl_->comm ? impl_->comm->gatherToRoot(impl_->posOut) : impl_->posOut;
@@ -802,7 +810,9 @@ double FluidSolver::surfaceHeightAt(double x, double z) const {
   return m.max(top);
 }
 
-double FluidSolver::maxDivergence() const { return impl_->maxDiv; }
+double FluidSolver::maxDivergence() const {
+  return impl_->maxDiv;
+}
 
 msg::Aabb FluidSolver::bounds() const {
   const auto& g = impl_->grid;

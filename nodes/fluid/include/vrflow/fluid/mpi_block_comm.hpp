@@ -21,8 +21,7 @@ class MpiBlockComm final : public BlockComm {
   void sum(std::vector<double>& values) override;
   void exchangeHalo(std::vector<double>& field, int planeSize, int planeCount, int k0, int k1,
                     int depth) override;
-  void addHalo(std::vector<double>& field, int planeSize, int planeCount, int k0,
-               int k1) override;
+  void addHalo(std::vector<double>& field, int planeSize, int planeCount, int k0, int k1) override;
   std::vector<double> exchange(const std::vector<std::vector<double>>& outgoing,
                                int stride) override;
   std::vector<float> gatherToRoot(const std::vector<float>& values) override;

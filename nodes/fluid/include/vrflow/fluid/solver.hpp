@@ -20,49 +20,49 @@ namespace vrflow::fluid {
 
 /// A rigid body as the fluid sees it at the start of a step (state from its animator).
 struct RigidBody {
-  std::uint64_t id = 0;             ///< object id, echoed in BodyForce
-  msg::Shape shape;                 ///< collision shape in the body frame (origin = centre of mass)
-  msg::Vec3 position{};             ///< centre of mass, world
-  msg::Quat orientation{0, 0, 0, 1};///< body to world, xyzw
-  msg::Vec3 linearVelocity{};       ///< m/s
-  msg::Vec3 angularVelocity{};      ///< rad/s, world frame
-  double mass = 1.0;                ///< kg; the body's density is mass / shape volume
+  std::uint64_t id = 0;  ///< object id, echoed in BodyForce
+  msg::Shape shape;      ///< collision shape in the body frame (origin = centre of mass)
+  msg::Vec3 position{};  ///< centre of mass, world
+  msg::Quat orientation{0, 0, 0, 1};  ///< body to world, xyzw
+  msg::Vec3 linearVelocity{};         ///< m/s
+  msg::Vec3 angularVelocity{};        ///< rad/s, world frame
+  double mass = 1.0;                  ///< kg; the body's density is mass / shape volume
 };
 
 /// An independent point mass (a mass-spring node) as the fluid sees it: a small sphere.
 struct PointMass {
-  std::uint64_t id = 0;       ///< object id of the net
-  std::uint32_t index = 0;    ///< node index in the net
+  std::uint64_t id = 0;     ///< object id of the net
+  std::uint32_t index = 0;  ///< node index in the net
   msg::Vec3 position{};
   msg::Vec3 velocity{};
   double mass = 0.01;
-  double radius = 0.02;       ///< radius of the sphere rasterised for it
+  double radius = 0.02;  ///< radius of the sphere rasterised for it
 };
 
 /// What the liquid did to one body over the step: apply `force` and `torque` (about the centre
 /// of mass `point`) for `duration` seconds. Gravity is not included: the animator adds its own.
 struct BodyForce {
   std::uint64_t id = 0;
-  std::uint32_t index = 0;    ///< node index for point masses, 0 for rigid bodies
+  std::uint32_t index = 0;  ///< node index for point masses, 0 for rigid bodies
   msg::Vec3 force{};
   msg::Vec3 torque{};
   msg::Vec3 point{};
   double duration = 0.0;
-  int cells = 0;              ///< grid faces the body covered (0: too small or outside: no force)
+  int cells = 0;  ///< grid faces the body covered (0: too small or outside: no force)
 };
 
 /// Numbers about the last step, for tests and benchmarks.
 struct StepStats {
   int cgIterations = 0;
-  double cgResidual = 0.0;       ///< final |r| / |b| (0 when b = 0)
+  double cgResidual = 0.0;  ///< final |r| / |b| (0 when b = 0)
   bool cgConverged = true;
-  int fluidCells = 0;            ///< cells holding liquid particles
-  int bodyCells = 0;             ///< cells inside bodies
-  double maxSpeed = 0.0;         ///< largest face velocity magnitude after projection
-  std::uint64_t bytesTouched = 0;///< estimate of this block's memory traffic in the pressure CG
-  double pressureSeconds = 0.0;  ///< wall time of the pressure CG (for bandwidth estimates)
-  double particleDensity = 1.0;  ///< mean particles per interior liquid cell / particlesPerCell
-  double targetDivergence = 0.0; ///< what volume control would ask at the mean density, 1/s
+  int fluidCells = 0;              ///< cells holding liquid particles
+  int bodyCells = 0;               ///< cells inside bodies
+  double maxSpeed = 0.0;           ///< largest face velocity magnitude after projection
+  std::uint64_t bytesTouched = 0;  ///< estimate of this block's memory traffic in the pressure CG
+  double pressureSeconds = 0.0;    ///< wall time of the pressure CG (for bandwidth estimates)
+  double particleDensity = 1.0;    ///< mean particles per interior liquid cell / particlesPerCell
+  double targetDivergence = 0.0;   ///< what volume control would ask at the mean density, 1/s
 };
 
 /// A distributed run's link between blocks (block_comm.hpp); the serial solver uses none.
