@@ -9,8 +9,6 @@
 #include <sstream>
 #include <string>
 
-// The message headers come first: object_type.hpp's enumerators Vec3, Quat, Mat3 trip -Wshadow
-// when values.hpp's aliases of the same names were seen before it.
 #include "blocks.hpp"
 #include "node_forces.hpp"
 #include "vrflow/fluid/solver.hpp"

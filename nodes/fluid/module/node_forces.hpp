@@ -3,7 +3,7 @@
 #include <vector>
 
 #include "vrflow/fluid/solver.hpp"
-#include "vrflow/message/builder.hpp"  // first: see fluid_module.cpp
+#include "vrflow/message/builder.hpp"
 
 // Forces on mass-spring nodes go back to the net's animator as the massspring package's
 // node-forces event (user event kind 1025, vrflow/massspring/events.hpp): one event per net,

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "vrflow/fluid/solver.hpp"
-#include "vrflow/message/reader.hpp"  // first: see fluid_module.cpp
+#include "vrflow/message/reader.hpp"
 
 // The fluid module's copy of the objects it couples with: rigid bodies (and their shape
 // resources) and, optionally, mass-spring nodes as independent point masses. Only changes
