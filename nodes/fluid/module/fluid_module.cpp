@@ -135,7 +135,9 @@ int main(int argc, char** argv) {
     // The step returns the bodies' forces first, then the nodes'.
     for (std::size_t b = 0; b < bodies.size() && b < stepped->forces.size(); ++b) {
       const auto& f = stepped->forces[b];
-      if (f.cells > 0) forces.builder().addForce(f.id, {f.force, f.torque, f.point, f.duration});
+      if (f.cells > 0 && !bodies[b].kinematic) {
+        forces.builder().addForce(f.id, {f.force, f.torque, f.point, f.duration});
+      }
     }
     if (!points.empty() && stepped->forces.size() >= bodies.size()) {
       const std::vector<fluid::BodyForce> nodeForces(

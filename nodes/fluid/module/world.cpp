@@ -68,9 +68,11 @@ std::vector<RigidBody> World::rigidBodies() const {
   std::vector<RigidBody> out;
   for (const auto& [id, rigid] : rigids_) {
     const auto shape = shapes_.find(rigid.shapeId);
-    if (shape == shapes_.end() || !(rigid.body.mass > 0.0)) continue;
+    if (shape == shapes_.end()) continue;
     out.push_back(rigid.body);
     out.back().shape = shape->second;
+    // The rigid package sends kinematic bodies (infinite mass) with mass 0.
+    out.back().kinematic = !(rigid.body.mass > 0.0);
   }
   return out;
 }
@@ -102,10 +104,6 @@ std::vector<std::string> World::uncoupled() const {
     if (!shapes_.contains(rigid.shapeId)) {
       out.push_back("rigid " + std::to_string(id) + ": shape resource " +
                     std::to_string(rigid.shapeId) + " not received");
-    } else if (!(rigid.body.mass > 0.0)) {
-      out.push_back("rigid " + std::to_string(id) +
-                    ": mass is not positive (kinematic bodies are "
-                    "not coupled)");
     }
   }
   return out;

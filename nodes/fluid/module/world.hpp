@@ -22,11 +22,11 @@ class World {
   /// Applies every chunk of a message. Errors (an undecodable shape) are returned, naming it.
   Status apply(const msg::MessageView& message);
 
-  /// Rigid bodies whose shape has arrived, in id order (deterministic), with positive mass.
+  /// Rigid bodies whose shape has arrived, in id order (deterministic); mass 0 means kinematic.
   std::vector<RigidBody> rigidBodies() const;
   /// Mass-spring nodes (empty when nodeRadius is 0), in net id then node order.
   std::vector<PointMass> pointMasses() const;
-  /// Rigid objects seen without a usable shape or mass (not coupled), for the log.
+  /// Rigid objects seen without their shape (not coupled yet), for the log.
   std::vector<std::string> uncoupled() const;
 
  private:

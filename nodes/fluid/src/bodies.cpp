@@ -50,7 +50,7 @@ Status finish(PreparedBody& p) {
 
 }  // namespace
 
-Result<PreparedBody> prepareBody(const RigidBody& body) {
+Result<PreparedBody> prepareBody(const RigidBody& body, double liquidDensity) {
   PreparedBody p;
   p.id = body.id;
   p.shape = body.shape;
@@ -59,6 +59,16 @@ Result<PreparedBody> prepareBody(const RigidBody& body) {
   p.linearVelocity = body.linearVelocity;
   p.angularVelocity = body.angularVelocity;
   p.mass = body.mass;
+  p.kinematic = body.kinematic;
+  if (body.kinematic) {
+    // Infinite mass, for the projection the shape filled at kKinematicDensityRatio times the
+    // liquid's density (finish() derives the density from this mass and the volume).
+    const double volume =
+        msg::validateShape(body.shape) ? msg::massProperties(body.shape, 1.0).volume : 0.0;
+    p.mass = (volume > 0.0 && std::isfinite(volume))
+                 ? kKinematicDensityRatio * liquidDensity * volume
+                 : 1.0;  // a bad shape: finish() reports it
+  }
   if (auto status = finish(p); !status) return status.error();
   return p;
 }

@@ -14,7 +14,8 @@ namespace vrflow::fluid::detail {
 struct PreparedBody {
   std::uint64_t id = 0;
   std::uint32_t index = 0;
-  bool point = false;  ///< a mass-spring node: no torque reported
+  bool point = false;      ///< a mass-spring node: no torque reported
+  bool kinematic = false;  ///< a moving wall for the liquid
   msg::Shape shape;
   msg::Vec3 position{};
   msg::Quat orientation{0, 0, 0, 1};
@@ -25,7 +26,8 @@ struct PreparedBody {
   msg::Aabb bounds;      ///< world bounds
 };
 
-Result<PreparedBody> prepareBody(const RigidBody& body);
+/// `liquidDensity` gives kinematic bodies theirs (kKinematicDensityRatio times it).
+Result<PreparedBody> prepareBody(const RigidBody& body, double liquidDensity);
 Result<PreparedBody> preparePoint(const PointMass& point);
 
 bool inBounds(const msg::Aabb& box, const double* x);

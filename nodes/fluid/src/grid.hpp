@@ -9,7 +9,9 @@
 namespace vrflow::fluid::detail {
 
 /// What a cell holds this step.
-enum CellKind : unsigned char { kAir = 0, kLiquid = 1, kBody = 2 };
+/// kSolid: inside a kinematic body, a moving wall (no pressure unknown, its faces keep the
+/// body's velocity).
+enum CellKind : unsigned char { kAir = 0, kLiquid = 1, kBody = 2, kSolid = 3 };
 
 struct Grid {
   int nx = 0, ny = 0, nz = 0;

@@ -293,8 +293,9 @@ struct FluidSolver::Impl {
     detail::rasterise(grid, bodies, cellBody, faceBody);
     for (std::size_t c = 0; c < kind.size(); ++c) {
       if (cellBody[c] >= 0) {
-        kind[c] = detail::kBody;
-        cellDensity[c] = bodies[static_cast<std::size_t>(cellBody[c])].density;
+        const auto& body = bodies[static_cast<std::size_t>(cellBody[c])];
+        kind[c] = body.kinematic ? detail::kSolid : detail::kBody;
+        cellDensity[c] = body.density;
       } else {
         kind[c] = detail::kAir;
         cellDensity[c] = settings.density;
@@ -421,18 +422,29 @@ struct FluidSolver::Impl {
     }
   }
 
-  void enforceBodies(const std::vector<PreparedBody>& bodies) {
+  // Rigid motion on the faces of bodies (and of kinematic bodies' cells); `kinematicOnly`
+  // re-imposes it on kinematic bodies after gravity (a moving wall does not fall).
+  void enforceBodies(const std::vector<PreparedBody>& bodies, bool kinematicOnly = false) {
     for (int a = 0; a < 3; ++a) {
       forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
-        const int b = faceBody[a][f];
+        int b = faceBody[a][f];
+        if (b < 0 && !onWall(a, i, j, k)) {  // the faces of a kinematic body's cells too
+          const std::size_t hi = grid.cell(i, j, k), lo = hi - stride(a);
+          if (kind[hi] == detail::kSolid) b = cellBody[hi];
+          if (kind[lo] == detail::kSolid) b = cellBody[lo];
+        }
         if (b < 0) return;
+        if (kinematicOnly && !bodies[static_cast<std::size_t>(b)].kinematic) return;
         u[a][f] = detail::rigidVelocity(bodies[static_cast<std::size_t>(b)],
                                         facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
       });
     }
   }
 
-  bool unknown(std::size_t c) const { return kind[c] != detail::kAir; }
+  bool unknown(std::size_t c) const {
+    return kind[c] == detail::kLiquid || kind[c] == detail::kBody;
+  }
+  bool solid(std::size_t c) const { return kind[c] == detail::kSolid; }
 
   std::size_t stride(int a) const {
     return a == 0   ? 1
@@ -470,6 +482,7 @@ struct FluidSolver::Impl {
               const int m = idx[a] + side;
               if (m < 0 || m >= dims[a]) continue;  // wall: Neumann, no coefficient
               const std::size_t nbr = side > 0 ? c + stride(a) : c - stride(a);
+              if (solid(nbr)) continue;  // a kinematic body: a moving wall, like the walls
               const double rho =
                   unknown(nbr) ? 0.5 * (cellDensity[c] + cellDensity[nbr]) : cellDensity[c];
               const double beta = dt / (rho * h * h);
@@ -498,7 +511,7 @@ struct FluidSolver::Impl {
         const std::size_t hi = grid.cell(i, j, k);
         const std::size_t lo = hi - stride(a);
         const bool ulo = unknown(lo), uhi = unknown(hi);
-        if (!ulo && !uhi) return;
+        if ((!ulo && !uhi) || solid(lo) || solid(hi)) return;
         const double rho = (ulo && uhi) ? 0.5 * (cellDensity[lo] + cellDensity[hi])
                                         : (ulo ? cellDensity[lo] : cellDensity[hi]);
         // Next to air, p = 0 lies theta cells from the unknown cell's centre.
@@ -547,9 +560,16 @@ struct FluidSolver::Impl {
     for (int a = 0; a < 3; ++a) {
       forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
         const int along = a == 0 ? i : a == 1 ? j : k;
+        // Projected faces and the faces of kinematic bodies keep their values.
         bool touches = false;
-        if (along > 0) touches = unknown(grid.cell(i, j, k) - stride(a));
-        if (along < grid.fdim(a, a) - 1) touches = touches || unknown(grid.cell(i, j, k));
+        if (along > 0) {
+          const std::size_t lo = grid.cell(i, j, k) - stride(a);
+          touches = unknown(lo) || solid(lo);
+        }
+        if (along < grid.fdim(a, a) - 1) {
+          const std::size_t hi = grid.cell(i, j, k);
+          touches = touches || unknown(hi) || solid(hi);
+        }
         valid[a][f] = touches ? 1 : 0;
       });
     }
@@ -706,7 +726,7 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   std::vector<PreparedBody> prepared;
   prepared.reserve(bodies.size() + points.size());
   for (const auto& body : bodies) {
-    auto p = detail::prepareBody(body);
+    auto p = detail::prepareBody(body, m.settings.density);
     if (!p) return p.error();
     prepared.push_back(std::move(*p));
   }
@@ -731,6 +751,7 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
       m.u[a][f] += dv;
     });
   }
+  m.enforceBodies(prepared, true);
   m.zeroWalls(m.u);
   m.project(dt);
   m.measureDivergence();

@@ -27,7 +27,14 @@ struct RigidBody {
   msg::Vec3 linearVelocity{};         ///< m/s
   msg::Vec3 angularVelocity{};        ///< rad/s, world frame
   double mass = 1.0;                  ///< kg; the body's density is mass / shape volume
+  /// Moved by its animator whatever the liquid does (infinite mass, e.g. a ground or a captured
+  /// user): it pushes the liquid with kKinematicDensityRatio times its density; mass is ignored
+  /// and its force is meaningless.
+  bool kinematic = false;
 };
+
+/// Density of kinematic bodies in the projection, relative to the liquid's.
+inline constexpr double kKinematicDensityRatio = 1000.0;
 
 /// An independent point mass (a mass-spring node) as the fluid sees it: a small sphere.
 struct PointMass {
