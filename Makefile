@@ -33,11 +33,28 @@ build: deps
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
+# What `make demo` adds: an encoder for the video (without it the viewer writes PNG frames).
+DEMO_PACKAGES := ffmpeg
+
 demo: build
-	@mkdir -p out/demo
-	$(BUILD)/bin/vrflow run examples/pipeline/pipeline.xml --iterations 200 \
-	  --report out/demo/report.json
-	@echo "demo results in out/demo/"
+	@missing=$$(for p in $(DEMO_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; \
+	done); \
+	if [ -n "$$missing" ]; then \
+	  echo "Installing: $$missing"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null \
+	    || echo "could not install $$missing: the demo writes PNG frames instead of a video"; \
+	fi
+	@rm -rf out/demo && mkdir -p out/demo
+	cd out/demo && $(abspath $(BUILD))/bin/vrflow run $(CURDIR)/examples/paper_scene/paper_scene.xml \
+	  --iterations 300 --no-progress --report report.json
+	@cd out/demo && if [ -f demo.mp4 ]; then \
+	  ffmpeg -loglevel error -y -sseof -0.2 -i demo.mp4 -frames:v 1 -update 1 frame.png; \
+	else cp "$$(ls demo_*.png | tail -1)" frame.png; fi
+	@QT_QPA_PLATFORM=offscreen $(BUILD)/bin/vrflow-editor examples/paper_scene/paper_scene.xml \
+	  --screenshot out/demo/editor.png >/dev/null 2>&1 || echo "(no editor screenshot)"
+	@echo "demo results in out/demo/: $$(cd out/demo && ls demo.mp4 2>/dev/null || echo PNG frames), frame.png, editor.png, report.json"
 
 clean:
 	rm -rf $(BUILD) out

@@ -91,7 +91,7 @@ TEST(PaperScene, AfterTwoHundredIterationsEverythingRestsAboveTheGroundAndApart)
   // The viewer wrote the frames: a video or one image per iteration.
   std::size_t frames = 0;
   bool video = false;
-  for (const auto& entry : std::filesystem::directory_iterator(dir.file("frames"))) {
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
     if (entry.path().extension() == ".png") ++frames;
     if (entry.path().extension() == ".mp4" && entry.file_size() > 0) video = true;
   }

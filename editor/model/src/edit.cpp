@@ -143,8 +143,8 @@ std::vector<app::PortSpec> nodePorts(const app::Application& app, const app::Cat
   if (const auto* i = app::findInstance(app, id)) {
     std::vector<app::PortSpec> ports;
     if (auto composite = compositeFor(app, *i)) {
-      for (const auto& p : composite->inputs) ports.push_back({p.name, true, "any", false, false, p.doc});
-      for (const auto& p : composite->outputs) ports.push_back({p.name, false, "any", false, false, p.doc});
+      for (const auto& p : composite->inputs) ports.push_back({.name = p.name, .isInput = true, .data = "any", .doc = p.doc});
+      for (const auto& p : composite->outputs) ports.push_back({.name = p.name, .isInput = false, .data = "any", .doc = p.doc});
     }
     return ports;
   }

@@ -1,0 +1,129 @@
+// vrflow-bench-fluid: see CMakeLists.txt. `--quick` runs few steps (a smoke run); `--steps N`
+// sets the timed steps of the small grid (the large one runs a quarter, at least 4).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+std::string binDir() {
+  char path[4096];
+  const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
+  if (n <= 0) return ".";
+  path[n] = '\0';
+  std::string p(path);
+  return p.substr(0, p.rfind('/'));
+}
+
+std::string machine() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line, model = "unknown CPU";
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      model = line.substr(line.find(':') + 2);
+      break;
+    }
+  }
+  return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " cores";
+}
+
+// STREAM "copy": c[i] = a[i] over arrays far larger than the caches; bytes moved = 2 x 8 x n per
+// pass (read a, write c), best of 5 passes.
+double streamCopyGBs() {
+  const std::size_t n = 1u << 24;  // 128 MiB per array
+  std::vector<double> a(n, 1.0), c(n, 0.0);
+  double best = 1e30;
+  for (int pass = 0; pass < 5; ++pass) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::memcpy(c.data(), a.data(), n * sizeof(double));
+    const auto t1 = std::chrono::steady_clock::now();
+    best = std::min(best, std::chrono::duration<double>(t1 - t0).count());
+    a[pass] = c[n - 1 - static_cast<std::size_t>(pass)] + 1.0;  // keep the copies observable
+  }
+  return 2.0 * 8.0 * static_cast<double>(n) / best / 1e9;
+}
+
+nlohmann::json runCase(int nx, int ny, int nz, int bodies, int ranks, int steps) {
+  std::string cmd = std::string(VRFLOW_MPIEXEC) + " --oversubscribe -np " + std::to_string(ranks);
+  if (geteuid() == 0) cmd += " --allow-run-as-root";
+  cmd += " " + binDir() + "/vrflow-fluid-blocks --nx " + std::to_string(nx) + " --ny " +
+         std::to_string(ny) + " --nz " + std::to_string(nz) + " --h " + std::to_string(1.0 / nx) +
+         " --dt 0.005 --warmup 3 --steps " + std::to_string(steps + 3) + " --bodies " +
+         std::to_string(bodies) + " --max-particles 2000000";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return {};
+  std::string out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe)) out += buf;
+  const int status = pclose(pipe);
+  const auto start = out.find('{');
+  if (status != 0 || start == std::string::npos) {
+    std::fprintf(stderr, "vrflow-bench-fluid: '%s' failed (status %d): %s\n", cmd.c_str(), status,
+                 out.c_str());
+    return {};
+  }
+  return nlohmann::json::parse(out.substr(start, out.find('\n', start) - start));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int steps = 30;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quick") == 0) {
+      steps = 4;
+    } else if (std::strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
+      steps = std::max(1, std::atoi(argv[++i]));
+    } else {
+      std::fprintf(stderr, "usage: vrflow-bench-fluid [--quick] [--steps N]\n");
+      return 2;
+    }
+  }
+  setenv("OMPI_MCA_btl", "self,vader", 0);
+  setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
+  // Ranks yield while they wait: on a shared 2-core machine busy-polling ranks starve each other.
+  setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
+  const std::string where = machine();
+  int failures = 0;
+  struct Grid {
+    int nx, ny, nz;
+  };
+  for (const Grid g : {Grid{32, 64, 32}, Grid{64, 128, 64}}) {
+    for (int bodies : {0, 20}) {
+      for (int ranks : {1, 2}) {
+        const int n = g.nx == 32 ? steps : std::max(4, steps / 4);
+        // The copy is measured right before each case, so both see the same machine load.
+        const double stream = streamCopyGBs();
+        auto result = runCase(g.nx, g.ny, g.nz, bodies, ranks, n);
+        if (result.empty()) {
+          ++failures;
+          continue;
+        }
+        nlohmann::json line;
+        line["grid"] = result["grid"];
+        line["rigid"] = bodies;
+        line["ranks"] = ranks;
+        line["ms_per_step"] = result["ms_per_step"];
+        line["cg_iterations"] = result["cg_iterations"];
+        line["pressure_ms_per_step"] = result["pressure_ms_per_step"];
+        line["bandwidth_gbs"] = result["bandwidth_gbs"];
+        line["stream_copy_gbs"] = stream;
+        line["particles"] = result["particles"];
+        line["steps"] = n;
+        line["machine"] = where;
+        std::printf("%s\n", line.dump().c_str());
+        std::fflush(stdout);
+      }
+    }
+  }
+  return failures == 0 ? 0 : 1;
+}

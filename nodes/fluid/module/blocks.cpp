@@ -1,0 +1,254 @@
+#include "blocks.hpp"
+
+#include <mpi.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "vrflow/fluid/mpi_block_comm.hpp"
+
+namespace vrflow::fluid {
+namespace {
+
+// A flat little-endian byte stream for the step broadcast (same machine, same layout).
+struct Writer {
+  std::vector<char> bytes;
+  template <typename T>
+  void put(const T& v) {
+    const char* p = reinterpret_cast<const char*>(&v);
+    bytes.insert(bytes.end(), p, p + sizeof(T));
+  }
+  void putBytes(const std::vector<std::byte>& b) {
+    put(static_cast<std::uint64_t>(b.size()));
+    const char* p = reinterpret_cast<const char*>(b.data());
+    bytes.insert(bytes.end(), p, p + b.size());
+  }
+};
+
+struct Reader {
+  const std::vector<char>& bytes;
+  std::size_t at = 0;
+  bool ok = true;
+  template <typename T>
+  T get() {
+    T v{};
+    if (at + sizeof(T) > bytes.size()) {
+      ok = false;
+      return v;
+    }
+    std::memcpy(&v, bytes.data() + at, sizeof(T));
+    at += sizeof(T);
+    return v;
+  }
+  std::vector<std::byte> getBytes() {
+    const auto n = get<std::uint64_t>();
+    if (!ok || at + n > bytes.size()) {
+      ok = false;
+      return {};
+    }
+    std::vector<std::byte> out(n);
+    std::memcpy(out.data(), bytes.data() + at, n);
+    at += n;
+    return out;
+  }
+};
+
+std::vector<char> encodeStep(const BlockStep& s) {
+  Writer w;
+  w.put(static_cast<std::uint8_t>(s.stop));
+  w.put(s.dt);
+  w.put(static_cast<std::uint8_t>(s.gatherParticles));
+  w.put(static_cast<std::uint8_t>(s.stats));
+  w.put(static_cast<std::uint64_t>(s.bodies.size()));
+  for (const auto& b : s.bodies) {
+    w.put(b.id);
+    w.put(b.position);
+    w.put(b.orientation);
+    w.put(b.linearVelocity);
+    w.put(b.angularVelocity);
+    w.put(b.mass);
+    w.putBytes(msg::encodeShape(b.shape));
+  }
+  w.put(static_cast<std::uint64_t>(s.points.size()));
+  for (const auto& p : s.points) w.put(p);
+  return w.bytes;
+}
+
+bool decodeStep(const std::vector<char>& bytes, BlockStep& s) {
+  Reader r{bytes};
+  s.stop = r.get<std::uint8_t>() != 0;
+  s.dt = r.get<double>();
+  s.gatherParticles = r.get<std::uint8_t>() != 0;
+  s.stats = r.get<std::uint8_t>() != 0;
+  const auto n = r.get<std::uint64_t>();
+  s.bodies.clear();
+  for (std::uint64_t i = 0; r.ok && i < n; ++i) {
+    RigidBody b;
+    b.id = r.get<std::uint64_t>();
+    b.position = r.get<msg::Vec3>();
+    b.orientation = r.get<msg::Quat>();
+    b.linearVelocity = r.get<msg::Vec3>();
+    b.angularVelocity = r.get<msg::Vec3>();
+    b.mass = r.get<double>();
+    auto shape = msg::decodeShape(r.getBytes());
+    if (!shape) return false;
+    b.shape = std::move(*shape);
+    s.bodies.push_back(std::move(b));
+  }
+  const auto m = r.get<std::uint64_t>();
+  s.points.clear();
+  for (std::uint64_t i = 0; r.ok && i < m; ++i) s.points.push_back(r.get<PointMass>());
+  return r.ok;
+}
+
+void broadcast(std::vector<char>& bytes, MPI_Comm comm) {
+  std::uint64_t n = bytes.size();
+  MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm);
+  bytes.resize(n);
+  MPI_Bcast(bytes.data(), static_cast<int>(n), MPI_CHAR, 0, comm);
+}
+
+void prepareMpi() {
+  // Open MPI's I/O forwarding may write to the module's output pipes after vrflow stopped
+  // reading them at the end of a run; a write error must not kill the process with SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
+  // Open MPI refuses root unless told; oversubscription: more blocks than cores is allowed.
+  if (geteuid() == 0) {
+    setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+    setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+  }
+  setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
+  setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
+}
+
+struct Setup {
+  FluidSettings settings;
+  msg::Aabb fill;
+};
+
+}  // namespace
+
+Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& s) {
+  auto forces = solver.step(s.dt, s.bodies, s.points);
+  if (!forces) return forces.error();
+  BlockResult out;
+  out.forces = std::move(*forces);
+  if (s.gatherParticles) out.particles = solver.gatherParticlePositions();
+  if (s.stats) {
+    out.volume = solver.liquidVolume();
+    out.maxSpeed = solver.maxParticleSpeed();
+  }
+  return out;
+}
+
+struct BlockGroup::Impl {
+  MPI_Comm world = MPI_COMM_NULL;
+  std::unique_ptr<MpiBlockComm> comm;
+  std::unique_ptr<FluidSolver> solver;
+  bool stopped = false;
+};
+
+BlockGroup::BlockGroup(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+BlockGroup::~BlockGroup() {
+  stop();
+}
+FluidSolver& BlockGroup::solver() {
+  return *impl_->solver;
+}
+
+Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, int blocks,
+                                                      const FluidSettings& settings,
+                                                      const msg::Aabb& fill) {
+  if (blocks < 2 || blocks > settings.nz) {
+    return makeError("fluid: " + std::to_string(blocks) + " blocks for " +
+                     std::to_string(settings.nz) + " z-planes: use 2 to nz blocks (1 = serial)");
+  }
+  prepareMpi();
+  int argc = 0;
+  char** argv = nullptr;
+  MPI_Init(&argc, &argv);
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  auto impl = std::make_unique<Impl>();
+  MPI_Comm inter;
+  char workerFlag[] = "--block-worker";
+  char* args[] = {workerFlag, nullptr};
+  std::vector<int> codes(static_cast<std::size_t>(blocks - 1));
+  const int rc = MPI_Comm_spawn(executable, args, blocks - 1, MPI_INFO_NULL, 0, MPI_COMM_SELF,
+                                &inter, codes.data());
+  if (rc != MPI_SUCCESS) {
+    MPI_Finalize();
+    return makeError(std::string("fluid: MPI_Comm_spawn of ") + executable + " failed");
+  }
+  MPI_Intercomm_merge(inter, 0, &impl->world);
+  Setup setup{settings, fill};
+  MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, impl->world);
+  impl->comm = std::make_unique<MpiBlockComm>(impl->world);
+  auto created = FluidSolver::create(settings);
+  if (!created) return created.error();
+  impl->solver = std::move(created.value());
+  if (auto status = impl->solver->setBlockComm(impl->comm.get()); !status) return status.error();
+  if (auto status = impl->solver->addLiquidBox(fill); !status) return status.error();
+  return std::unique_ptr<BlockGroup>(new BlockGroup(std::move(impl)));
+}
+
+Result<BlockResult> BlockGroup::step(const BlockStep& s) {
+  auto bytes = encodeStep(s);
+  broadcast(bytes, impl_->world);
+  auto result = stepBlock(*impl_->solver, s);
+  if (!result && !impl_->stopped) {  // every block failed the same way and left its loop
+    impl_->stopped = true;
+    MPI_Finalize();
+  }
+  return result;
+}
+
+void BlockGroup::stop() {
+  if (impl_->stopped) return;
+  impl_->stopped = true;
+  BlockStep last;
+  last.stop = true;
+  auto bytes = encodeStep(last);
+  broadcast(bytes, impl_->world);
+  MPI_Finalize();
+}
+
+int runBlockWorker(int argc, char** argv) {
+  prepareMpi();
+  MPI_Init(&argc, &argv);
+  MPI_Comm parent = MPI_COMM_NULL;
+  MPI_Comm_get_parent(&parent);
+  if (parent == MPI_COMM_NULL) {
+    std::fprintf(stderr, "vrflow-fluid --block-worker: not started by a fluid module\n");
+    MPI_Finalize();
+    return 2;
+  }
+  MPI_Comm world;
+  MPI_Intercomm_merge(parent, 1, &world);
+  Setup setup;
+  MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, world);
+  MpiBlockComm comm(world);
+  auto created = FluidSolver::create(setup.settings);
+  if (!created) return 1;  // rank 0 made the same check and reports it
+  auto solver = std::move(created.value());
+  if (!solver->setBlockComm(&comm) || !solver->addLiquidBox(setup.fill)) return 1;
+  for (;;) {
+    std::vector<char> bytes;
+    broadcast(bytes, world);
+    BlockStep s;
+    if (!decodeStep(bytes, s)) {
+      std::fprintf(stderr, "vrflow-fluid --block-worker: malformed step from rank 0\n");
+      MPI_Abort(world, 3);
+    }
+    if (s.stop) break;
+    if (!stepBlock(*solver, s)) break;  // rank 0 fails the same way and reports it
+  }
+  MPI_Finalize();
+  return 0;
+}
+
+}  // namespace vrflow::fluid

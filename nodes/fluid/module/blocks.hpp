@@ -1,0 +1,63 @@
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "vrflow/fluid/solver.hpp"
+
+// The fluid module as several MPI blocks. The module process (started by vrflow like any module,
+// holding the run's shared memory) initialises MPI as a singleton and spawns `blocks - 1` copies
+// of its own executable with `--block-worker` (MPI_Comm_spawn); together they form one
+// communicator, rank 0 being the module. Each iteration rank 0 broadcasts the step (dt, bodies,
+// what to report) and every rank steps its slab; forces and particles come back to rank 0 through
+// the solver's collective calls. mpirun is not used: it would close the shared-memory descriptor
+// that a module inherits from vrflow.
+
+namespace vrflow::fluid {
+
+/// What rank 0 asks of every block for one iteration.
+struct BlockStep {
+  bool stop = false;
+  double dt = 0.0;
+  std::vector<RigidBody> bodies;
+  std::vector<PointMass> points;
+  bool gatherParticles = false;
+  bool stats = false;
+};
+
+/// What one step gave back on this block (particles, volume, speed only when asked).
+struct BlockResult {
+  std::vector<BodyForce> forces;
+  std::vector<float> particles;  ///< every block's, on rank 0
+  double volume = 0.0;
+  double maxSpeed = 0.0;
+};
+
+/// Runs one step on this block, with the collective queries the step asks for.
+Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& step);
+
+/// Rank 0's side: spawns the workers and drives them.
+class BlockGroup {
+ public:
+  /// Starts MPI and `blocks - 1` workers running `executable --block-worker`; sends them the
+  /// settings and the liquid box. The solver returned is rank 0's block.
+  static Result<std::unique_ptr<BlockGroup>> start(const char* executable, int blocks,
+                                                   const FluidSettings& settings,
+                                                   const msg::Aabb& fill);
+  ~BlockGroup();
+  /// Runs one step on every block (collective). After an error the workers are gone.
+  Result<BlockResult> step(const BlockStep& step);
+  /// Tells the workers to stop and finalises MPI.
+  void stop();
+  FluidSolver& solver();
+
+ private:
+  struct Impl;
+  explicit BlockGroup(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// A worker's main (the executable run with --block-worker).
+int runBlockWorker(int argc, char** argv);
+
+}  // namespace vrflow::fluid

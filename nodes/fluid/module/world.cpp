@@ -1,0 +1,112 @@
+#include "world.hpp"
+
+#include "vrflow/message/builtin_types.hpp"
+
+namespace vrflow::fluid {
+namespace {
+
+std::vector<double> toVector(const msg::PackedArray<double>& array) {
+  std::vector<double> out(array.size());
+  array.copyTo(out);
+  return out;
+}
+
+}  // namespace
+
+Status World::apply(const msg::MessageView& message) {
+  const auto rigidId = msg::rigidType().id();
+  const auto netId = msg::massSpringType().id();
+  for (const auto chunk : message) {
+    if (auto resource = chunk.asResource()) {
+      if (resource->kind() != msg::ResourceKind::Raw) continue;
+      // Only resources named by a rigid object's shape are decoded; others are not ours.
+      bool named = false;
+      for (const auto& [id, rigid] : rigids_) named = named || rigid.shapeId == resource->id();
+      auto shape = msg::decodeShape(resource->raw());
+      if (!shape) {
+        if (named) {
+          return makeError("fluid: shape resource " + std::to_string(resource->id()) +
+                           " cannot be decoded: " + shape.error().message);
+        }
+        continue;
+      }
+      shapes_[resource->id()] = std::move(*shape);
+      continue;
+    }
+    auto object = chunk.asObject();
+    if (!object) continue;
+    if (object->typeId() == rigidId) {
+      if (object->op() == msg::ObjectOp::Delete) {
+        rigids_.erase(object->id());
+        continue;
+      }
+      auto& rigid = rigids_[object->id()];
+      rigid.body.id = object->id();
+      if (auto v = object->vec3(msg::RigidParam::kPosition)) rigid.body.position = *v;
+      if (auto q = object->quat(msg::RigidParam::kOrientation)) rigid.body.orientation = *q;
+      if (auto v = object->vec3(msg::RigidParam::kLinearVelocity)) rigid.body.linearVelocity = *v;
+      if (auto v = object->vec3(msg::RigidParam::kAngularVelocity)) rigid.body.angularVelocity = *v;
+      if (auto m = object->scalar(msg::RigidParam::kMass)) rigid.body.mass = *m;
+      if (auto s = object->idParam(msg::RigidParam::kShape)) rigid.shapeId = *s;
+    } else if (object->typeId() == netId) {
+      if (object->op() == msg::ObjectOp::Delete) {
+        nets_.erase(object->id());
+        continue;
+      }
+      auto& net = nets_[object->id()];
+      if (auto a = object->doubleArray(msg::MassSpringParam::kPositions))
+        net.positions = toVector(*a);
+      if (auto a = object->doubleArray(msg::MassSpringParam::kVelocities))
+        net.velocities = toVector(*a);
+      if (auto a = object->doubleArray(msg::MassSpringParam::kMasses)) net.masses = toVector(*a);
+    }
+  }
+  return {};
+}
+
+std::vector<RigidBody> World::rigidBodies() const {
+  std::vector<RigidBody> out;
+  for (const auto& [id, rigid] : rigids_) {
+    const auto shape = shapes_.find(rigid.shapeId);
+    if (shape == shapes_.end()) continue;
+    out.push_back(rigid.body);
+    out.back().shape = shape->second;
+    // The rigid package sends kinematic bodies (infinite mass) with mass 0.
+    out.back().kinematic = !(rigid.body.mass > 0.0);
+  }
+  return out;
+}
+
+std::vector<PointMass> World::pointMasses() const {
+  std::vector<PointMass> out;
+  if (nodeRadius_ <= 0.0) return out;
+  for (const auto& [id, net] : nets_) {
+    const std::size_t n = net.positions.size() / 3;
+    for (std::size_t i = 0; i < n; ++i) {
+      PointMass p;
+      p.id = id;
+      p.index = static_cast<std::uint32_t>(i);
+      p.position = {net.positions[3 * i], net.positions[3 * i + 1], net.positions[3 * i + 2]};
+      if (net.velocities.size() >= 3 * (i + 1)) {
+        p.velocity = {net.velocities[3 * i], net.velocities[3 * i + 1], net.velocities[3 * i + 2]};
+      }
+      p.mass = i < net.masses.size() && net.masses[i] > 0.0 ? net.masses[i] : 0.01;
+      p.radius = nodeRadius_;
+      out.push_back(p);
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> World::uncoupled() const {
+  std::vector<std::string> out;
+  for (const auto& [id, rigid] : rigids_) {
+    if (!shapes_.contains(rigid.shapeId)) {
+      out.push_back("rigid " + std::to_string(id) + ": shape resource " +
+                    std::to_string(rigid.shapeId) + " not received");
+    }
+  }
+  return out;
+}
+
+}  // namespace vrflow::fluid

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "vrflow/fluid/solver.hpp"
+#include "vrflow/message/reader.hpp"
+
+// The fluid module's copy of the objects it couples with: rigid bodies (and their shape
+// resources) and, optionally, mass-spring nodes as independent point masses. Only changes
+// travel, so each chunk updates the copy; objects of other types are ignored.
+
+namespace vrflow::fluid {
+
+class World {
+ public:
+  /// `nodeRadius` > 0: mass-spring nodes are rasterised as spheres of that radius.
+  explicit World(double nodeRadius) : nodeRadius_(nodeRadius) {}
+
+  /// Applies every chunk of a message. Errors (an undecodable shape) are returned, naming it.
+  Status apply(const msg::MessageView& message);
+
+  /// Rigid bodies whose shape has arrived, in id order (deterministic); mass 0 means kinematic.
+  std::vector<RigidBody> rigidBodies() const;
+  /// Mass-spring nodes (empty when nodeRadius is 0), in net id then node order.
+  std::vector<PointMass> pointMasses() const;
+  /// Rigid objects seen without their shape (not coupled yet), for the log.
+  std::vector<std::string> uncoupled() const;
+
+ private:
+  struct Rigid {
+    RigidBody body;
+    std::uint64_t shapeId = 0;
+  };
+  struct Net {
+    std::vector<double> positions, velocities, masses;
+  };
+  double nodeRadius_;
+  std::map<std::uint64_t, Rigid> rigids_;
+  std::map<std::uint64_t, Net> nets_;
+  std::map<std::uint64_t, msg::Shape> shapes_;
+};
+
+}  // namespace vrflow::fluid

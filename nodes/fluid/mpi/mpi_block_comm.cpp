@@ -1,0 +1,145 @@
+#include "vrflow/fluid/mpi_block_comm.hpp"
+
+#include <algorithm>
+#include <cstddef>
+
+namespace vrflow::fluid {
+namespace {
+constexpr int kTagUp = 11;
+constexpr int kTagDown = 12;
+}  // namespace
+
+MpiBlockComm::MpiBlockComm(MPI_Comm comm) : comm_(comm) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+}
+
+double MpiBlockComm::sum(double value) {
+  std::vector<double> all(static_cast<std::size_t>(size_));
+  MPI_Allgather(&value, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, comm_);
+  double total = 0.0;
+  for (const double v : all) total += v;
+  return total;
+}
+
+double MpiBlockComm::max(double value) {
+  double out = value;
+  MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  return out;
+}
+
+void MpiBlockComm::sum(std::vector<double>& values) {
+  const int n = static_cast<int>(values.size());
+  std::vector<double> all(values.size() * static_cast<std::size_t>(size_));
+  MPI_Allgather(values.data(), n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, comm_);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    double total = 0.0;
+    for (int r = 0; r < size_; ++r) total += all[static_cast<std::size_t>(r) * values.size() + i];
+    values[i] = total;
+  }
+}
+
+void MpiBlockComm::exchangeHalo(std::vector<double>& field, int planeSize, int planeCount, int k0,
+                                int k1, int depth) {
+  const int lower = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL;
+  const int upper = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
+  const int d = std::min(depth, k1 - k0);
+  const std::size_t ps = static_cast<std::size_t>(planeSize);
+  buffer_.resize(static_cast<std::size_t>(depth) * ps);
+  MPI_Status status;
+  int count = 0;
+  // My top planes go up; the lower block's top planes land below k0.
+  MPI_Sendrecv(field.data() + static_cast<std::size_t>(k1 - d) * ps, d * planeSize, MPI_DOUBLE,
+               upper, kTagUp, buffer_.data(), depth * planeSize, MPI_DOUBLE, lower, kTagUp, comm_,
+               &status);
+  if (lower != MPI_PROC_NULL) {
+    MPI_Get_count(&status, MPI_DOUBLE, &count);
+    const int planes = count / planeSize;
+    const int first = std::max(0, k0 - planes);
+    std::copy(buffer_.begin() + static_cast<std::ptrdiff_t>((first - (k0 - planes)) * ps),
+              buffer_.begin() + static_cast<std::ptrdiff_t>(planes * ps),
+              field.begin() + static_cast<std::ptrdiff_t>(first * ps));
+  }
+  // My bottom planes go down; the upper block's bottom planes land from k1 up.
+  MPI_Sendrecv(field.data() + static_cast<std::size_t>(k0) * ps, d * planeSize, MPI_DOUBLE, lower,
+               kTagDown, buffer_.data(), depth * planeSize, MPI_DOUBLE, upper, kTagDown, comm_,
+               &status);
+  if (upper != MPI_PROC_NULL) {
+    MPI_Get_count(&status, MPI_DOUBLE, &count);
+    const int planes = std::min(count / planeSize, planeCount - k1);
+    std::copy(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(planes * ps),
+              field.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(k1) * ps));
+  }
+}
+
+void MpiBlockComm::addHalo(std::vector<double>& field, int planeSize, int planeCount, int k0,
+                           int k1) {
+  const std::size_t ps = static_cast<std::size_t>(planeSize);
+  buffer_.assign(ps, 0.0);
+  std::vector<double> zeros(ps, 0.0);
+  MPI_Status status;
+  // Plane k1 (contributions to the upper block's first plane) goes up; the lower block's
+  // contributions to my plane k0 arrive.
+  const int upper = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
+  const int lower = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL;
+  const double* up = (upper != MPI_PROC_NULL && k1 < planeCount)
+                         ? field.data() + static_cast<std::size_t>(k1) * ps
+                         : zeros.data();
+  MPI_Sendrecv(up, planeSize, MPI_DOUBLE, upper, kTagUp, buffer_.data(), planeSize, MPI_DOUBLE,
+               lower, kTagUp, comm_, &status);
+  if (lower != MPI_PROC_NULL) {
+    for (std::size_t i = 0; i < ps; ++i) field[static_cast<std::size_t>(k0) * ps + i] += buffer_[i];
+  }
+  const double* down = (lower != MPI_PROC_NULL && k0 > 0)
+                           ? field.data() + static_cast<std::size_t>(k0 - 1) * ps
+                           : zeros.data();
+  std::fill(buffer_.begin(), buffer_.end(), 0.0);
+  MPI_Sendrecv(down, planeSize, MPI_DOUBLE, lower, kTagDown, buffer_.data(), planeSize, MPI_DOUBLE,
+               upper, kTagDown, comm_, &status);
+  if (upper != MPI_PROC_NULL) {
+    for (std::size_t i = 0; i < ps; ++i) {
+      field[static_cast<std::size_t>(k1 - 1) * ps + i] += buffer_[i];
+    }
+  }
+}
+
+std::vector<double> MpiBlockComm::exchange(const std::vector<std::vector<double>>& outgoing,
+                                           int stride) {
+  (void)stride;
+  std::vector<int> sendCounts(static_cast<std::size_t>(size_)), recvCounts(sendCounts.size());
+  std::vector<int> sendOffsets(sendCounts.size()), recvOffsets(sendCounts.size());
+  std::vector<double> send;
+  for (int r = 0; r < size_; ++r) {
+    const auto& o = outgoing[static_cast<std::size_t>(r)];
+    sendOffsets[static_cast<std::size_t>(r)] = static_cast<int>(send.size());
+    sendCounts[static_cast<std::size_t>(r)] = static_cast<int>(o.size());
+    send.insert(send.end(), o.begin(), o.end());
+  }
+  MPI_Alltoall(sendCounts.data(), 1, MPI_INT, recvCounts.data(), 1, MPI_INT, comm_);
+  int total = 0;
+  for (int r = 0; r < size_; ++r) {
+    recvOffsets[static_cast<std::size_t>(r)] = total;
+    total += recvCounts[static_cast<std::size_t>(r)];
+  }
+  std::vector<double> received(static_cast<std::size_t>(total));
+  MPI_Alltoallv(send.data(), sendCounts.data(), sendOffsets.data(), MPI_DOUBLE, received.data(),
+                recvCounts.data(), recvOffsets.data(), MPI_DOUBLE, comm_);
+  return received;
+}
+
+std::vector<float> MpiBlockComm::gatherToRoot(const std::vector<float>& values) {
+  const int count = static_cast<int>(values.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_)), offsets(counts.size());
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
+  int total = 0;
+  for (int r = 0; r < size_; ++r) {
+    offsets[static_cast<std::size_t>(r)] = total;
+    total += counts[static_cast<std::size_t>(r)];
+  }
+  std::vector<float> all(rank_ == 0 ? static_cast<std::size_t>(total) : 0);
+  MPI_Gatherv(values.data(), count, MPI_FLOAT, all.data(), counts.data(), offsets.data(), MPI_FLOAT,
+              0, comm_);
+  return all;
+}
+
+}  // namespace vrflow::fluid

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+// The staggered grid's storage: cell-centred scalars, and the three face-velocity components
+// (u on x-faces: (nx+1) x ny x nz, v on y-faces, w on z-faces), all x-fastest.
+
+namespace vrflow::fluid::detail {
+
+/// What a cell holds this step.
+/// kSolid: inside a kinematic body, a moving wall (no pressure unknown, its faces keep the
+/// body's velocity).
+enum CellKind : unsigned char { kAir = 0, kLiquid = 1, kBody = 2, kSolid = 3 };
+
+struct Grid {
+  int nx = 0, ny = 0, nz = 0;
+  double h = 1.0;
+  double ox = 0, oy = 0, oz = 0;
+
+  std::size_t cells() const { return static_cast<std::size_t>(nx) * ny * nz; }
+  std::size_t cell(int i, int j, int k) const {
+    return (static_cast<std::size_t>(k) * ny + j) * nx + i;
+  }
+  /// Faces of component `axis`: dims are (nx+1, ny, nz), (nx, ny+1, nz), (nx, ny, nz+1).
+  int fdim(int axis, int d) const {
+    const int n[3] = {nx, ny, nz};
+    return n[d] + (axis == d ? 1 : 0);
+  }
+  std::size_t faces(int axis) const {
+    return static_cast<std::size_t>(fdim(axis, 0)) * fdim(axis, 1) * fdim(axis, 2);
+  }
+  std::size_t face(int axis, int i, int j, int k) const {
+    return (static_cast<std::size_t>(k) * fdim(axis, 1) + j) * fdim(axis, 0) + i;
+  }
+};
+
+}  // namespace vrflow::fluid::detail

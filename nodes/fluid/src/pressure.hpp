@@ -1,0 +1,37 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "grid.hpp"
+#include "vrflow/fluid/block_comm.hpp"
+
+// The pressure Poisson system on the cell grid (7-point, symmetric positive definite on the
+// unknown cells) and its MIC(0)-preconditioned conjugate gradient. With a BlockComm each block
+// solves its slab of planes; the preconditioner is then MIC(0) of the block's own part of the
+// matrix (block Jacobi across blocks), so iteration counts and the last bits of the result
+// depend on the number of blocks.
+
+namespace vrflow::fluid::detail {
+
+struct PressureSystem {
+  std::vector<double> diag;  ///< per cell; 0 for cells that are not unknowns
+  std::vector<double> ax;    ///< coupling of cell (i,j,k) with (i+1,j,k), <= 0
+  std::vector<double> ay;    ///< with (i,j+1,k)
+  std::vector<double> az;    ///< with (i,j,k+1)
+};
+
+struct PcgOutcome {
+  int iterations = 0;
+  double residual = 0.0;
+  bool converged = true;
+  std::uint64_t bytesTouched = 0;
+};
+
+/// Solves A p = b to |r| <= tol |b| (2-norms over the whole grid). `p` starts at zero. With
+/// `comm`, only this block's slab of `p` is computed; the caller gathers it.
+PcgOutcome solvePressure(const Grid& grid, const PressureSystem& system,
+                         const std::vector<double>& b, std::vector<double>& p, double tol,
+                         int maxIterations, BlockComm* comm);
+
+}  // namespace vrflow::fluid::detail
