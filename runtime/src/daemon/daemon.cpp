@@ -185,7 +185,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         if (spec.type != app::ParamType::File || found == values.end() || found->second.empty()) continue;
         const std::filesystem::path path(found->second);
         std::error_code error;
-        if (path.is_relative() && std::filesystem::exists(base / path, error)) {
+        if (path.is_relative() && std::filesystem::is_regular_file(base / path, error)) {
           found->second = (base / path).lexically_normal().string();
         }
       }
