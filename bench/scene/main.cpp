@@ -1,7 +1,10 @@
 // vrflow-bench-scene: iterations per second of the demo scene without rendering, in three forms
 // run one after the other on the same machine:
 //   "network"      the vrflow network (examples/paper_scene without its viewer): every module its
-//                  own process, messages through the daemon, started by `vrflow run`;
+//                  own process, messages through the daemon, started by `vrflow run`; the
+//                  net's collision and rigid/net interactors run beside the animators on
+//                  states one iteration old, as the demo ships (section 4.2 of the paper);
+//   "network-sequential" the same with every interactor after its animators, the loop's order;
 //   "monolithic"   the same solver classes called in one loop in one process;
 //   "bullet-world" Bullet's own btDiscreteDynamicsWorld stepping the same rigid bodies (no net:
 //                  Bullet's soft bodies are another solver, so only the rigid part compares).
@@ -69,7 +72,9 @@ Result<std::vector<rigid::Body>> bodiesFor(const Context& ctx, int objects) {
 
 // The network's application: the demo scene without its viewer, or the rigid network of figure 4
 // (animator, force field, rigid interactor) for the boxes scenes.
-Result<std::string> networkApp(const Context& ctx, int objects) {
+// `sequential`: the net's interactors get no initial message either, so every interactor runs
+// after its animators within the iteration (the monolithic loop's order) instead of beside them.
+Result<std::string> networkApp(const Context& ctx, int objects, bool sequential) {
   auto loaded = app::loadApplicationFile((ctx.source / "examples/paper_scene/paper_scene.xml").string());
   if (!loaded) return loaded.error();
   app::Application application = std::move(loaded).value();
@@ -83,13 +88,15 @@ Result<std::string> networkApp(const Context& ctx, int objects) {
   });
   for (auto& module : application.modules) {
     std::erase_if(module.params, [](const app::Param& p) { return p.name == "state-file"; });
+    if (sequential && module.id != "bodies" && module.id != "net") module.inputs.clear();
     if (module.id != "bodies") continue;
     for (auto& p : module.params) {
       if (p.name == "scene" && objects != 20) p = {"generate", "boxes:" + std::to_string(objects), p.loc};
       if (p.name == "scene" && objects == 20) p.value = (ctx.source / "examples/paper_scene/scene.json").string();
     }
   }
-  const fs::path file = ctx.work / ("scene-" + std::to_string(objects) + ".xml");
+  const fs::path file =
+      ctx.work / ("scene-" + std::to_string(objects) + (sequential ? "-sequential" : "") + ".xml");
   if (auto saved = app::saveApplicationFile(application, file.string()); !saved) return saved.error();
   return file.string();
 }
@@ -114,8 +121,8 @@ Result<double> runNetwork(const Context& ctx, const std::string& appFile, int it
 
 // Steady-state rate of the network: the difference of two runs of different lengths cancels the
 // start-up (spawning processes, loading the scene) and the shutdown.
-Result<double> networkRate(const Context& ctx, int objects, int warm, int measured) {
-  auto appFile = networkApp(ctx, objects);
+Result<double> networkRate(const Context& ctx, int objects, bool sequential, int warm, int measured) {
+  auto appFile = networkApp(ctx, objects, sequential);
   if (!appFile) return appFile.error();
   auto shorter = runNetwork(ctx, *appFile, warm);
   if (!shorter) return shorter.error();
@@ -286,28 +293,31 @@ int main(int argc, char** argv) {
   int failures = 0;
   for (const int objects : sizes) {
     // Steps before and during the measurement; the window covers falling, impacts and rest.
-    const int measured = quick ? 20 : objects <= 20 ? 600 : objects <= 200 ? 200 : 30;
-    const int warm = quick ? 5 : objects <= 200 ? 50 : 10;
+    const int measured = quick ? (objects <= 20 ? 200 : 60) : objects <= 20 ? 600 : objects <= 200 ? 200 : 30;
+    const int warm = quick ? 10 : objects <= 200 ? 50 : 10;
     auto bodies = bodiesFor(ctx, objects);
     if (!bodies) {
       std::fprintf(stderr, "vrflow-bench-scene: %s\n", bodies.error().message.c_str());
       return 2;
     }
-    auto network = networkRate(ctx, objects, warm, measured);
     Monolithic mono;
     if (auto ok = mono.init(*bodies, objects == 20); !ok) {
       std::fprintf(stderr, "vrflow-bench-scene: %s\n", ok.error().message.c_str());
       return 2;
     }
     const double monoRate = loopRate([&] { mono.step(); }, warm, measured);
-    if (network) {
+    // The demo scene as shipped, and (20 objects) with every interactor sequential.
+    for (const bool sequential : objects == 20 ? std::vector<bool>{false, true} : std::vector<bool>{false}) {
+      auto network = networkRate(ctx, objects, sequential, warm, measured);
+      if (!network) {
+        std::fprintf(stderr, "vrflow-bench-scene: network, %d objects: %s\n", objects,
+                     network.error().message.c_str());
+        ++failures;
+        continue;
+      }
       char extra[96];
       std::snprintf(extra, sizeof extra, ",\"of_monolithic\":%.3f", *network / monoRate);
-      print("network", objects, *network, extra);
-    } else {
-      std::fprintf(stderr, "vrflow-bench-scene: network, %d objects: %s\n", objects,
-                   network.error().message.c_str());
-      ++failures;
+      print(sequential ? "network-sequential" : "network", objects, *network, extra);
     }
     print("monolithic", objects, monoRate);
     BulletWorld bullet;
