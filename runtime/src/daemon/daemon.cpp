@@ -131,6 +131,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
   }
   auto* table = new (segment.at<void>(tableOffset)) ipc::ControlTable();
   table->moduleCount = static_cast<uint32_t>(application.modules.size());
+  segment.header().idCounter.store(
+      (std::min<uint32_t>(table->moduleCount, ipc::kIdBlockModules) + 1) << ipc::kIdBlockBits);
   table->modulesOffset = slotsOffset;
   slots = segment.at<ipc::ModuleSlot>(slotsOffset);
   ended = std::vector<std::atomic<bool>>(application.modules.size());

@@ -6,6 +6,7 @@
 
 #include <csignal>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -54,6 +55,8 @@ msg::MessageBuilder& OutgoingMessage::builder() { return impl_->builder; }
 struct Module::Impl {
   ipc::Segment segment;
   ipc::ModuleSlot* slot = nullptr;
+  std::atomic<uint32_t> idNext{0};  // this module's own block of ids (ipc::kIdBlockBits)
+  uint32_t idEnd = 0;
   std::string id;
   std::deque<InputPort> inputs;
   std::deque<OutputPort> outputs;
@@ -212,6 +215,11 @@ Status Module::init() {
     return makeError("cannot join the run: module index out of range");
   }
   m.slot = m.segment.at<ipc::ModuleSlot>(table.modulesOffset) + index;
+  if (index < static_cast<long>(ipc::kIdBlockModules)) {
+    const auto block = static_cast<uint32_t>(index + 1);
+    m.idNext.store(block << ipc::kIdBlockBits);
+    m.idEnd = (block + 1) << ipc::kIdBlockBits;
+  }
   m.id = m.slot->id;
   m.slot->pid.store(static_cast<int32_t>(getpid()));
   m.current.resize(m.slot->portCount);
@@ -408,7 +416,11 @@ int64_t Module::paramInt(std::string_view name, int64_t fallback) const {
   return end != it->second.c_str() ? value : fallback;
 }
 
-uint64_t Module::newId() { return impl_->segment.newId(); }
+uint64_t Module::newId() {
+  const uint32_t next = impl_->idNext.fetch_add(1, std::memory_order_relaxed);
+  if (next < impl_->idEnd) return msg::makeId(impl_->segment.header().hostId, next);
+  return impl_->segment.newId();
+}
 
 int Module::exitStatus() const { return impl_->failed ? 1 : 0; }
 
