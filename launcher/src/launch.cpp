@@ -136,6 +136,9 @@ class Launcher {
  private:
   Status start();
   Status startMpirun(const std::string& daemonPath, const net::Secret& secret);
+  // The options every daemon gets, whatever the backend: trace, peer timeout, iterations and
+  // search paths (made absolute).
+  void appendDaemonOptions(std::vector<std::string>& argv) const;
   void pump(int timeoutMs);
   void onLine(HostDaemon& d, const std::string& line);
   void failWith(run::RunOutcome outcome, bool rootCause);
@@ -284,6 +287,21 @@ void Launcher::pump(int timeoutMs) {
 
 // mpirun: one process starts every daemon (rank i serves host i); each connects back to a
 // control socket here and proves it holds the run secret, handed over in mpirun's environment.
+void Launcher::appendDaemonOptions(std::vector<std::string>& argv) const {
+  std::error_code ec;
+  if (!options_.tracePath.empty()) argv.push_back("--trace");
+  char timeout[32];
+  std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
+  argv.insert(argv.end(), {"--peer-timeout", timeout});
+  if (options_.iterations > 0) argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
+  for (const auto& p : options_.packageDirs) {
+    argv.insert(argv.end(), {"--packages", std::filesystem::absolute(p, ec).string()});
+  }
+  for (const auto& c : options_.compositeDirs) {
+    argv.insert(argv.end(), {"--composites", std::filesystem::absolute(c, ec).string()});
+  }
+}
+
 Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& secret) {
   const int listenFd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   sockaddr_in addr{};
@@ -313,17 +331,7 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
   argv.insert(argv.end(), {"--host", loopback ? "localhost:" + std::to_string(n) : hostList});
   argv.insert(argv.end(), {daemonPath, std::filesystem::absolute(options_.appFile, ec).string(),
                            "--control-connect", control});
-  if (!options_.tracePath.empty()) argv.push_back("--trace");
-  char timeout[32];
-  std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
-  argv.insert(argv.end(), {"--peer-timeout", timeout});
-  if (options_.iterations > 0) argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
-  for (const auto& p : options_.packageDirs) {
-    argv.insert(argv.end(), {"--packages", std::filesystem::absolute(p, ec).string()});
-  }
-  for (const auto& c : options_.compositeDirs) {
-    argv.insert(argv.end(), {"--composites", std::filesystem::absolute(c, ec).string()});
-  }
+  appendDaemonOptions(argv);
   int toMpirun = -1, fromMpirun = -1;
   auto pid = spawnDaemon(argv, {"VRFLOW_RUN_SECRET=" + net::secretToHex(secret)}, toMpirun,
                          fromMpirun, /*stdoutToStderr=*/true);
@@ -434,17 +442,7 @@ Status Launcher::start() {
     const std::string appFile = std::filesystem::absolute(options_.appFile, ec).string();
     std::vector<std::string> argv{entry != nullptr && !entry->daemon.empty() ? entry->daemon : daemonPath,
                                   appFile, "--host", host.id, "--control", "--bind", d.bind};
-    if (!options_.tracePath.empty()) argv.push_back("--trace");
-    char timeout[32];
-    std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
-    argv.insert(argv.end(), {"--peer-timeout", timeout});
-    if (options_.iterations > 0) argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
-    for (const auto& p : options_.packageDirs) {
-      argv.insert(argv.end(), {"--packages", std::filesystem::absolute(p, ec).string()});
-    }
-    for (const auto& c : options_.compositeDirs) {
-      argv.insert(argv.end(), {"--composites", std::filesystem::absolute(c, ec).string()});
-    }
+    appendDaemonOptions(argv);
     if (ssh) {
       // ssh carries nothing of our environment: the search paths and the hostfile's env go
       // explicitly on the remote command line (the secret does not: it goes on stdin).

@@ -287,34 +287,28 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     Queue* queue;
   };
   std::vector<VariadicInput> variadicInputs;
-  for (std::size_t connectionIndex = 0; connectionIndex < application.connections.size();
-       ++connectionIndex) {
-    const app::Connection& c = application.connections[connectionIndex];
-    Node* from = nullptr;
-    std::size_t fromOutput = 0;
-    if (const int m = moduleIndex(c.from.node); m >= 0) {
-      from = portNodes[{m, c.from.port}];
-    } else if (filterNodes.count(c.from.node) != 0) {
-      from = filterNodes[c.from.node];
-      const auto& names = from->outputNames;
-      fromOutput = static_cast<std::size_t>(
-          std::find(names.begin(), names.end(), c.from.port) - names.begin());
-      if (fromOutput == names.size()) from = nullptr;
-    }
-    Node* to = nullptr;
-    int toInput = -1;
-    if (const int m = moduleIndex(c.to.node); m >= 0) {
-      to = portNodes[{m, c.to.port}];
-    } else if (filterNodes.count(c.to.node) != 0) {
-      to = filterNodes[c.to.node];
-      const auto& names = to->inputNames;
-      toInput = static_cast<int>(std::find(names.begin(), names.end(), c.to.port) - names.begin());
-      if (toInput == static_cast<int>(names.size())) to = nullptr;
-    }
-    if (from == nullptr || to == nullptr) {
-      return makeError("connection " + app::toString(c.from) + " -> " + app::toString(c.to) +
-                       " names a missing port");
-    }
+  // The node and output index a connection leaves from (nullptr: no such port).
+  auto findSource = [&](const app::Endpoint& e) -> std::pair<Node*, std::size_t> {
+    if (const int m = moduleIndex(e.node); m >= 0) return {portNodes[{m, e.port}], 0};
+    if (filterNodes.count(e.node) == 0) return {nullptr, 0};
+    Node* node = filterNodes[e.node];
+    const auto& names = node->outputNames;
+    const auto index = static_cast<std::size_t>(std::find(names.begin(), names.end(), e.port) - names.begin());
+    return {index == names.size() ? nullptr : node, index};
+  };
+  // The node and input index a connection arrives at: -1 for a module port or a filter's
+  // variadic input (nullptr: no such port).
+  auto findTarget = [&](const app::Endpoint& e) -> std::pair<Node*, int> {
+    if (const int m = moduleIndex(e.node); m >= 0) return {portNodes[{m, e.port}], -1};
+    if (filterNodes.count(e.node) == 0) return {nullptr, -1};
+    Node* node = filterNodes[e.node];
+    const auto& names = node->inputNames;
+    const auto index = static_cast<int>(std::find(names.begin(), names.end(), e.port) - names.begin());
+    return {index == static_cast<int>(names.size()) ? nullptr : node, index};
+  };
+  // The connection's queue in front of `to`; `key` orders it among a variadic input's queues.
+  auto attachQueue = [&](const app::Connection& c, Node* to, int toInput,
+                         uint32_t key) -> Result<Queue*> {
     Queue& queue = graph->newQueue();
     queue.capacity = c.capacity > 0 ? static_cast<std::size_t>(c.capacity) : options.defaultCapacity;
     queue.policy = c.policy;
@@ -322,9 +316,6 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     queue.to = app::toString(c.to);
     queue.isConnection = true;
     if (toInput < 0) {
-      const uint32_t key = connectionIndex < options.connectionChannels.size()
-                               ? options.connectionChannels[connectionIndex]
-                               : static_cast<uint32_t>(connectionIndex);
       variadicInputs.push_back({key, to, &queue});
     } else {
       if (to->inputs[static_cast<std::size_t>(toInput)] != nullptr) {
@@ -332,54 +323,39 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
       }
       to->inputs[static_cast<std::size_t>(toInput)] = &queue;
     }
-    from->outputs[fromOutput].push_back(std::make_unique<QueueSink>(queue));
+    return &queue;
+  };
+  for (std::size_t connectionIndex = 0; connectionIndex < application.connections.size();
+       ++connectionIndex) {
+    const app::Connection& c = application.connections[connectionIndex];
+    const auto [from, fromOutput] = findSource(c.from);
+    const auto [to, toInput] = findTarget(c.to);
+    if (from == nullptr || to == nullptr) {
+      return makeError("connection " + app::toString(c.from) + " -> " + app::toString(c.to) +
+                       " names a missing port");
+    }
+    const uint32_t key = connectionIndex < options.connectionChannels.size()
+                             ? options.connectionChannels[connectionIndex]
+                             : static_cast<uint32_t>(connectionIndex);
+    auto queue = attachQueue(c, to, toInput, key);
+    if (!queue) return queue.error();
+    from->outputs[fromOutput].push_back(std::make_unique<QueueSink>(**queue));
   }
   // Connections from or to another host: a sink that sends, or a queue fed by the transport.
   for (const net::RemoteConnection& r : options.remote) {
     const app::Connection& c = r.connection;
     if (options.transport == nullptr) return makeError("connection crosses hosts without a transport");
     if (r.outgoing) {
-      Node* from = nullptr;
-      std::size_t fromOutput = 0;
-      if (const int m = moduleIndex(c.from.node); m >= 0) {
-        from = portNodes[{m, c.from.port}];
-      } else if (filterNodes.count(c.from.node) != 0) {
-        from = filterNodes[c.from.node];
-        const auto& names = from->outputNames;
-        fromOutput = static_cast<std::size_t>(
-            std::find(names.begin(), names.end(), c.from.port) - names.begin());
-        if (fromOutput == names.size()) from = nullptr;
-      }
+      const auto [from, fromOutput] = findSource(c.from);
       if (from == nullptr) return makeError("connection " + app::toString(c.from) + " names a missing port");
       from->outputs[fromOutput].push_back(options.transport->makeSink(r.channel));
       continue;
     }
-    Node* to = nullptr;
-    int toInput = -1;
-    if (const int m = moduleIndex(c.to.node); m >= 0) {
-      to = portNodes[{m, c.to.port}];
-    } else if (filterNodes.count(c.to.node) != 0) {
-      to = filterNodes[c.to.node];
-      const auto& names = to->inputNames;
-      toInput = static_cast<int>(std::find(names.begin(), names.end(), c.to.port) - names.begin());
-      if (toInput == static_cast<int>(names.size())) to = nullptr;
-    }
+    const auto [to, toInput] = findTarget(c.to);
     if (to == nullptr) return makeError("connection " + app::toString(c.to) + " names a missing port");
-    Queue& queue = graph->newQueue();
-    queue.capacity = c.capacity > 0 ? static_cast<std::size_t>(c.capacity) : options.defaultCapacity;
-    queue.policy = c.policy;
-    queue.from = app::toString(c.from);
-    queue.to = app::toString(c.to);
-    queue.isConnection = true;
-    if (toInput < 0) {
-      variadicInputs.push_back({r.channel, to, &queue});
-    } else {
-      if (to->inputs[static_cast<std::size_t>(toInput)] != nullptr) {
-        return makeError("filter input " + app::toString(c.to) + " has more than one connection");
-      }
-      to->inputs[static_cast<std::size_t>(toInput)] = &queue;
-    }
-    remoteInputs.push_back({r.channel, &queue, std::make_unique<QueueSink>(queue)});
+    auto queue = attachQueue(c, to, toInput, r.channel);
+    if (!queue) return queue.error();
+    remoteInputs.push_back({r.channel, *queue, std::make_unique<QueueSink>(**queue)});
   }
   std::stable_sort(variadicInputs.begin(), variadicInputs.end(),
                    [](const VariadicInput& a, const VariadicInput& b) { return a.key < b.key; });
