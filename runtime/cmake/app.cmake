@@ -18,6 +18,7 @@ vrflow_add_library(app
     src/app/filter_types_patterns.cpp
     src/app/filter_types_sampling.cpp
     src/app/graph.cpp
+    src/app/rates.cpp
     src/app/manifest_reader.cpp
     src/app/model.cpp
     src/app/package.cpp

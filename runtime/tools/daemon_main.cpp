@@ -155,6 +155,9 @@ int main(int argc, char** argv) {
     options.hostLink = link.get();
   }
 
+  // Multi-rate: the iterations of each module come from the whole network, before the split.
+  if (options.iterations > 0) options.moduleIterations = vrflow::run::moduleIterations(*application, options.iterations);
+
   // Keep this host's share of the network.
   vrflow::app::Application local = *application;
   local.modules.clear();

@@ -90,6 +90,21 @@ TEST_F(Patterns, MultiRateRunsTenInnerStepsOfDtOverTenPerOuterStep) {
   }
 }
 
+// `--iterations N` counts outer iterations: the module behind repeat(10) runs 10 N, the ones
+// behind decimate(10) N (app::iterationRates), so the outer side still gets its N states.
+TEST_F(Patterns, IterationsCountOuterIterationsBehindRepeat) {
+  const auto result = run(example("multi_rate/multi_rate.xml"), "--iterations 5 --report r.json");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto json = report("r.json");
+  std::map<std::string, long> iterations;
+  for (const auto& m : json["modules"]) iterations[m["id"]] = m["iterations"].get<long>();
+  EXPECT_EQ(iterations["outer"], 5);
+  EXPECT_EQ(iterations["net"], 50);
+  EXPECT_EQ(iterations["inner_log"], 50);
+  EXPECT_EQ(iterations["outer_log"], 5);
+  EXPECT_EQ(states(dir.file("outer.csv")).size(), 5u);
+}
+
 // The paper's coupling: the slow module reads the fast one's decimated state (a cycle through
 // repeat and decimate, started by one initial message on the slow side). Each outer iteration
 // waits for the 10 inner ones; the states are those of the open chain.

@@ -31,6 +31,11 @@ FilterType decimate() {
   type.params.push_back(boolParam("restamp", "true",
                                   "iteration = group number, time step = the group's total (a "
                                   "copy); false forwards the message untouched, by reference"));
+  type.params.push_back(boolParam("merge", "true",
+                                  "the objects and resources of the dropped messages are folded "
+                                  "into the forwarded one (an add and later updates become one "
+                                  "add), so no state is lost; events of dropped messages are not "
+                                  "kept"));
   type.ports = inToOut;
   return type;
 }

@@ -166,6 +166,10 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     const std::string host = app::effectiveHost(application, module.host);
     copyName(slot->host, host);
     slot->iterationLimit = options.iterationLimit;
+    if (const auto limit = options.moduleIterationLimits.find(module.id);
+        limit != options.moduleIterationLimits.end()) {
+      slot->iterationLimit = limit->second;
+    }
     if (options.trace) {
       slot->traceOffset = segment.reserve(sizeof(ipc::TraceRing));
       if (slot->traceOffset == 0) return makeError("shared-memory segment too small for tracing");

@@ -17,6 +17,7 @@
 
 #include "report.hpp"
 #include "spawn.hpp"
+#include "vrflow/app/graph.hpp"
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/message/ids.hpp"
@@ -431,11 +432,24 @@ Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs) {
   return catalog;
 }
 
+std::map<std::string, uint64_t, std::less<>> moduleIterations(const app::Application& application,
+                                                              uint64_t outer) {
+  std::map<std::string, uint64_t, std::less<>> limits;
+  const auto rates = app::iterationRates(application, app::resolveGraph(application));
+  for (std::size_t m = 0; m < application.modules.size(); ++m) {
+    limits[application.modules[m].id] = rates[m].scale(outer);
+  }
+  return limits;
+}
+
 RunOutcome runApplication(const app::Application& application, const app::Catalog& catalog,
                           const RunOptions& options) {
   daemon::DaemonOptions daemonOptions;
   daemonOptions.segmentBytes = options.segmentBytes;
   daemonOptions.iterationLimit = options.iterations;
+  daemonOptions.moduleIterationLimits = options.moduleIterations.empty() && options.iterations > 0
+                                            ? moduleIterations(application, options.iterations)
+                                            : options.moduleIterations;
   daemonOptions.trace = options.trace || !options.tracePath.empty();
   if (!application.hosts.empty()) {
     if (auto id = msg::hostIdFromAddress(application.hosts.front().address)) {

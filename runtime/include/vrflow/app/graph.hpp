@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -39,5 +40,26 @@ struct ResolvedGraph {
 /// Groups the connections by port. Needs no catalog and does not validate: run validate()
 /// first; connections naming missing nodes are grouped like the others.
 ResolvedGraph resolveGraph(const Application& app);
+
+}  // namespace vrflow::app
+
+namespace vrflow::app {
+
+/// A module's iterations per iteration of the network's outer loop, as a fraction.
+struct IterationRate {
+  uint64_t numerator = 1;
+  uint64_t denominator = 1;
+  /// Iterations of this module in `outer` outer iterations, rounded up (at least 1 for outer > 0).
+  uint64_t scale(uint64_t outer) const;
+  friend bool operator==(const IterationRate&, const IterationRate&) = default;
+};
+
+/// The rate of every module of `app` (same order as app.modules), for `--iterations N` to count
+/// outer iterations: a node with no connected input runs at 1; a `repeat` of count k multiplies
+/// what enters it by k, a `decimate` of count k divides it by k; every other node runs at the
+/// fastest of its inputs. Cycles are settled by iterating to a fixed point; a cycle that makes
+/// a rate grow without bound (a repeat fed back without its decimate), a node fed only by a
+/// cycle, or a rate beyond 2^20 / 1 gets 1, the rate every module had before multi-rate.
+std::vector<IterationRate> iterationRates(const Application& app, const ResolvedGraph& graph);
 
 }  // namespace vrflow::app

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +19,8 @@ namespace vrflow::daemon {
 struct DaemonOptions {
   std::size_t segmentBytes = std::size_t{1} << 30;  ///< sparse: only touched pages cost memory
   uint64_t iterationLimit = 0;                        ///< per module; 0 = no limit
+  /// Per module id, replaces iterationLimit (multi-rate: see app::iterationRates).
+  std::map<std::string, uint64_t, std::less<>> moduleIterationLimits;
   std::size_t defaultCapacity = 16;                   ///< messages buffered per connection
   uint32_t hostId = 0x7f000001;                       ///< from the host's address
   /// Warn when a connection's buffer has stayed full this long (ns).

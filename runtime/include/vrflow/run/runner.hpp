@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,11 @@ class HostLink;
 
 /// How to run an application on this machine.
 struct RunOptions {
-  uint64_t iterations = 0;            ///< per module; 0 = until the modules end or Ctrl-C
+  uint64_t iterations = 0;            ///< outer iterations; 0 = until the modules end or Ctrl-C
+  /// Iterations of each module (by id) for `iterations` outer ones: a module behind a `repeat`
+  /// of count k runs k times as many (app::iterationRates). Empty: computed from the
+  /// application given to runApplication(), which must then be the whole one.
+  std::map<std::string, uint64_t, std::less<>> moduleIterations;
   double timeoutSeconds = 0;          ///< 0 = no limit
   double deadlockSeconds = 10;        ///< no progress this long with every module waiting
   std::size_t segmentBytes = std::size_t{1} << 30;
@@ -73,6 +78,11 @@ class HostLink {
 /// <folder of this executable>/../share/vrflow/packages (the build tree and installs alike);
 /// plus the filter plugins of $VRFLOW_FILTER_PATH.
 Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs);
+
+/// How many iterations each module of the whole `application` runs in `outer` outer
+/// iterations (RunOptions::moduleIterations).
+std::map<std::string, uint64_t, std::less<>> moduleIterations(const app::Application& application,
+                                                              uint64_t outer);
 
 /// Runs `application` with every host mapped to this machine (the embedded default): one
 /// daemon in this process, each module in its own process. Returns when every process of the
