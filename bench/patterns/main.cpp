@@ -37,7 +37,25 @@ struct Context {
   fs::path bin;       // folder of vrflow and the example modules
   fs::path packages;  // build/share/vrflow/example-packages
   fs::path work;      // scratch folder
+  int hosts = 1;      // > 1: `vrflow launch --backend local` over 127.0.0.1 ... 127.0.0.H
 };
+
+std::string hostId(int h) { return "h" + std::to_string(h); }
+
+// The <hosts> element of ctx.hosts loopback hosts, or nothing for one host.
+std::string hostsXml(const Context& ctx) {
+  if (ctx.hosts < 2) return "";
+  std::string xml = "  <hosts>\n";
+  for (int h = 0; h < ctx.hosts; ++h) {
+    xml += "    <host id=\"" + hostId(h) + "\" address=\"127.0.0." + std::to_string(h + 1) + "\"/>\n";
+  }
+  return xml + "  </hosts>\n";
+}
+
+// ` host="hK"` for a node on host k, or nothing for one host.
+std::string onHost(const Context& ctx, int k) {
+  return ctx.hosts < 2 ? "" : " host=\"" + hostId(k % ctx.hosts) + "\"";
+}
 
 std::string q(const std::string& s) {
   return "'" + s + "'";
@@ -52,8 +70,9 @@ bool runApp(const Context& ctx, const std::string& name, const std::string& xml,
   fs::remove(reportFile);
   const std::string command = "cd " + q(ctx.work.string()) + " && " +
                               q((ctx.bin / "vrflow").string()) + " --packages " +
-                              q(ctx.packages.string()) + " run " + q(app.string()) +
-                              " --no-progress --timeout 120 --shm-size 1024 --report " +
+                              q(ctx.packages.string()) +
+                              (ctx.hosts > 1 ? " launch --backend local " : " run --no-progress --shm-size 1024 ") +
+                              q(app.string()) + " --timeout 120 --report " +
                               q(reportFile.string()) + " > " + q(name + ".log") + " 2>&1";
   const int status = std::system(command.c_str());
   if (status != 0) {
@@ -88,14 +107,27 @@ double bytesFrom(const nlohmann::json& report, const std::string& prefix, bool t
   return total;
 }
 
+// Over H hosts the source is on h0 and the receivers in contiguous blocks on h1 ... h{H-1}
+// (receiver i on h{1 + i (H-1) / n}); a tree filter is on the host of the first receiver below
+// it, so each subtree stays on one host as far as it can and a message crosses the network
+// about once per host, against once per receiver when flat.
+int receiverHost(const Context& ctx, int i, int n) {
+  return ctx.hosts < 2 ? 0 : 1 + i * (ctx.hosts - 1) / n;
+}
+
+int filterHost(const Context& ctx, int x, int m, int n, int fanout) {
+  while (x < m) x = fanout * x + 1;  // leftmost child until a receiver (heap nodes m ... m+n-1)
+  return receiverHost(ctx, std::min(x - m, n - 1), n);
+}
+
 bool broadcast(const Context& ctx, const std::string& mode, int n, int messages, int fanout) {
-  std::string modules = "  <modules>\n    <module id=\"src\" package=\"core\" type=\"source\">\n" +
+  std::string modules = "  <modules>\n    <module id=\"src\" package=\"core\" type=\"source\"" + onHost(ctx, 0) + ">\n" +
                         param("size", "1048576") + param("count", std::to_string(messages)) +
                         "    </module>\n";
   std::string filters, connections;
   for (int i = 0; i < n; ++i) {
     modules += "    <module id=\"r" + std::to_string(i) +
-               "\" package=\"broadcast\" type=\"checker\">\n" +
+               "\" package=\"broadcast\" type=\"checker\"" + onHost(ctx, receiverHost(ctx, i, n)) + ">\n" +
                param("file", "received" + std::to_string(i) + ".csv") + "    </module>\n";
   }
   if (mode == "flat") {
@@ -104,7 +136,8 @@ bool broadcast(const Context& ctx, const std::string& mode, int n, int messages,
   } else {
     const int m = (n + fanout - 3) / (fanout - 1);  // broadcast filters: a heap, as the composite
     for (int k = 0; k < m; ++k)
-      filters += "    <filter id=\"b" + std::to_string(k) + "\" type=\"broadcast\"/>\n";
+      filters += "    <filter id=\"b" + std::to_string(k) + "\" type=\"broadcast\"" +
+                 onHost(ctx, filterHost(ctx, k, m, n, fanout)) + "/>\n";
     connections += connection("src.out", "b0.in");
     for (int x = 1; x < m; ++x) {
       connections += connection("b" + std::to_string((x - 1) / fanout) + ".out",
@@ -115,7 +148,7 @@ bool broadcast(const Context& ctx, const std::string& mode, int n, int messages,
                                 "r" + std::to_string(i) + ".in");
     }
   }
-  const std::string xml = header("broadcast") + modules + "  </modules>\n" +
+  const std::string xml = header("broadcast") + hostsXml(ctx) + modules + "  </modules>\n" +
                           (filters.empty() ? "" : "  <filters>\n" + filters + "  </filters>\n") +
                           "  <connections>\n" + connections + "  </connections>\n</application>\n";
   nlohmann::json report;
@@ -144,9 +177,9 @@ bool broadcast(const Context& ctx, const std::string& mode, int n, int messages,
   std::sort(toLast.begin(), toLast.end());
   const double median = toLast.empty() ? 0 : toLast[toLast.size() / 2];
   std::printf(
-      "{\"pattern\":\"broadcast\",\"mode\":\"%s\",\"receivers\":%d,\"ms_to_last\":%.3f,"
+      "{\"pattern\":\"broadcast\",\"mode\":\"%s\",\"receivers\":%d,\"hosts\":%d,\"ms_to_last\":%.3f,"
       "\"source_host_bytes\":%.0f}\n",
-      mode.c_str(), n, median / 1e6, bytesFrom(report, "src.out"));
+      mode.c_str(), n, ctx.hosts, median / 1e6, bytesFrom(report, "src.out"));
   std::fflush(stdout);
   return true;
 }
@@ -211,6 +244,11 @@ int main(int argc, char** argv) {
   cli.add_option("--iterations", iterations, "routing iterations")->check(CLI::Range(2, 1000000));
   cli.add_option("--pattern", only, "broadcast or routing (default: both)")
       ->check(CLI::IsMember({"broadcast", "routing"}));
+  int hosts = 1;
+  cli.add_option("--hosts", hosts,
+                 "broadcast over this many loopback hosts (vrflow launch --backend local; the "
+                 "source on the first, receivers and tree filters on the others)")
+      ->check(CLI::Range(1, 254));
   cli.add_flag("--quick", quick, "a small run (2 and 4 receivers, 5 messages, 20 iterations)");
   CLI11_PARSE(cli, argc, argv);
   if (quick) {
@@ -239,6 +277,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   ctx.work = scratch;
+  ctx.hosts = hosts;
   bool ok = true;
   if (only.empty() || only == "broadcast") {
     for (const int n : receivers) {
@@ -247,7 +286,9 @@ int main(int argc, char** argv) {
     }
   }
   if (only.empty() || only == "routing") {
-    for (const char* mode : {"none", "dynamic"}) ok = routing(ctx, mode, bodies, iterations) && ok;
+    Context oneHost = ctx;
+    oneHost.hosts = 1;  // the routing cases count bytes, which hosts do not change
+    for (const char* mode : {"none", "dynamic"}) ok = routing(oneHost, mode, bodies, iterations) && ok;
   }
   std::error_code ignored;
   fs::remove_all(ctx.work, ignored);
