@@ -9,6 +9,7 @@
 #include "vrflow/viewer/camera.hpp"
 #include "vrflow/viewer/image.hpp"
 #include "vrflow/viewer/scene_cache.hpp"
+#include "vrflow/viewer/view_volume.hpp"
 
 // Draws a SceneCache with OpenGL 1.x through OSMesa (Mesa's software rasteriser, no display).
 
@@ -16,8 +17,9 @@ namespace vrflow::viewer {
 
 /// How a frame looks. Colours are linear 0..1 RGB.
 struct RenderSettings {
-  int width = 960;
+  int width = 960;   ///< the image (of the tile, for a wall)
   int height = 540;
+  Tile tile;  ///< the part of the view drawn: the whole view is tile.cols*width x tile.rows*height
   std::array<float, 3> background{0.80f, 0.86f, 0.93f};  ///< where nothing is drawn
   bool ground = true;                                    ///< a checkered plane y = groundHeight
   double groundHeight = 0.0;
