@@ -222,6 +222,49 @@ TEST(ViewVolume, ClippingToTheSceneKeepsRowsOfATiltedViewApart) {
   EXPECT_NEAR(bottom->max[2], 5.0 - 4.0 / std::sqrt(3.0), 1e-9);
 }
 
+int colouredPixels(const Image& image) {
+  int coloured = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const auto p = image.at(x, y);
+      if (std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]}) > 60) ++coloured;
+    }
+  }
+  return coloured;
+}
+
+// A routed viewer draws only what meets its volume: the route stops updating an object that
+// leaves it, so the viewer's copy is stale.
+TEST(ViewVolume, RenderingWithinABoxLeavesOutObjectsWhoseBoundsMissIt) {
+  SceneCache scene;
+  feed(scene, [](msg::MessageBuilder& b) {
+    addShape(b, 101, msg::Shape::box({0.5, 0.5, 0.5}));
+    for (const double x : {-1.5, 1.5}) {
+      b.addObject(x < 0 ? 1 : 2, msg::rigidType(), msg::ObjectOp::Add)
+          .set(msg::RigidParam::kPosition, msg::Vec3{x, 0.5, 0.0})
+          .set(msg::RigidParam::kOrientation, msg::Quat{0, 0, 0, 1})
+          .set(msg::RigidParam::kBounds, msg::Aabb{{x - 0.5, 0.0, -0.5}, {x + 0.5, 1.0, 0.5}})
+          .set(msg::RigidParam::kShape, std::uint64_t{101});
+    }
+  });
+  ASSERT_TRUE(scene.find(1) && scene.find(1)->bounds);
+  RenderSettings settings;
+  settings.width = 160;
+  settings.height = 100;
+  settings.supersample = 1;
+  auto renderer = Renderer::create(settings);
+  ASSERT_TRUE(renderer.ok());
+  const msg::Aabb left{{-10.0, -1.0, -10.0}, {0.0, 5.0, 10.0}};
+  const msg::Aabb nothing{{1e9, 1e9, 1e9}, {-1e9, -1e9, -1e9}};
+  const auto all = renderer->render(scene, wallCamera());
+  const auto some = renderer->render(scene, wallCamera(), &left);
+  const auto none = renderer->render(scene, wallCamera(), &nothing);
+  ASSERT_TRUE(all.ok() && some.ok() && none.ok());
+  EXPECT_GT(colouredPixels(*some), 200);
+  EXPECT_GT(colouredPixels(*all), colouredPixels(*some) + 200);
+  EXPECT_EQ(colouredPixels(*none), 0);
+}
+
 TEST(ViewVolume, BoxesAreParsedAndWrittenInTheRouteFiltersFormat) {
   const auto box = parseBox("-3 -1.5 -2 3, 2.5, 2");
   ASSERT_TRUE(box.ok());

@@ -85,6 +85,13 @@ Matrix shadowMatrix(double h) {
   return m;
 }
 
+bool meets(const msg::Aabb& a, const msg::Aabb& b) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (a.min[k] > b.max[k] || b.min[k] > a.max[k]) return false;
+  }
+  return true;
+}
+
 bool finite(const msg::Vec3& v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
@@ -180,7 +187,7 @@ struct Renderer::Impl {
 
   void setUpFrame(const Camera& camera) const;
   void drawGround() const;
-  void drawObjects(const SceneCache& scene, bool shadowPass) const;
+  void drawObjects(const SceneCache& scene, bool shadowPass, const msg::Aabb* within) const;
 };
 
 void Renderer::Impl::setUpFrame(const Camera& camera) const {
@@ -256,8 +263,10 @@ void Renderer::Impl::drawGround() const {
   glDisable(GL_STENCIL_TEST);
 }
 
-void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass) const {
+void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass,
+                                 const msg::Aabb* within) const {
   for (const auto& [id, object] : scene.objects()) {
+    if (within != nullptr && object.bounds && !meets(*object.bounds, *within)) continue;
     if (!shadowPass) {
       const auto colour = objectColour(id);
       glColor3f(colour[0], colour[1], colour[2]);
@@ -383,7 +392,8 @@ Result<Renderer> Renderer::create(const RenderSettings& settings) {
   return Renderer(std::move(impl));
 }
 
-Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera) {
+Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera,
+                               const msg::Aabb* within) {
   Impl& r = *impl_;
   const auto& s = r.settings;
   if (!OSMesaMakeCurrent(r.context, r.rgba.data(), GL_UNSIGNED_BYTE, r.bufferWidth,
@@ -395,7 +405,7 @@ Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera) {
   }
   r.setUpFrame(camera);
   if (s.ground) r.drawGround();
-  r.drawObjects(scene, false);
+  r.drawObjects(scene, false, within);
   if (s.ground && s.shadows) {
     // Flattened objects, dark and translucent, on ground pixels not yet shadowed.
     glDisable(GL_LIGHTING);
@@ -411,7 +421,7 @@ Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera) {
     glPushMatrix();
     const Matrix shadow = shadowMatrix(s.groundHeight);
     glMultMatrixd(shadow.data());
-    r.drawObjects(scene, true);
+    r.drawObjects(scene, true, within);
     glPopMatrix();
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDisable(GL_STENCIL_TEST);

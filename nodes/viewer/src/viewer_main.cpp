@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -196,8 +197,12 @@ int main() {
   viewer::SceneCache scene(segments, [&prefix](const std::string& line) {
     std::fprintf(stderr, "%s%s\n", prefix.c_str(), line.c_str());
   });
-  // The volume of interest last published ("": none yet).
+  // The volume of interest last published ("": none yet), and the box a routed viewer draws
+  // within: the route stops updating objects that leave the volume, so their last state is
+  // stale (an empty box for "none").
   std::string published;
+  const double inf = std::numeric_limits<double>::infinity();
+  msg::Aabb within{{inf, inf, inf}, {-inf, -inf, -inf}};
   int status = 0;
   while (module.wait()) {
     const Message& message = module.get(objects);
@@ -210,6 +215,7 @@ int main() {
           viewer::viewVolume(cam, viewer::tileFrustum(cam, render.tile, render.width, render.height),
                              viewDepth, interestBox);
       const std::string text = volume ? viewer::formatBox(*volume) : "none";
+      within = volume ? *volume : msg::Aabb{{inf, inf, inf}, {-inf, -inf, -inf}};
       if (text != published) {
         auto out = module.newMessage();
         out.builder().setStampsOnly(true);
@@ -219,7 +225,8 @@ int main() {
       }
     }
     if (module.iteration() % static_cast<std::uint64_t>(every) != 0) continue;
-    auto image = renderer->render(scene, path->at(module.iteration()));
+    auto image = renderer->render(scene, path->at(module.iteration()),
+                                  interest.connected() ? &within : nullptr);
     Status written = image ? writer->write(*image) : Status(image.error());
     if (!written) {
       std::fprintf(stderr, "%s%s\n", prefix.c_str(), written.error().message.c_str());

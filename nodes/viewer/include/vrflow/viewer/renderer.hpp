@@ -61,8 +61,12 @@ class Renderer {
   Renderer& operator=(Renderer&&) noexcept;
   ~Renderer();
 
-  /// Renders the scene seen by `camera`; the image is settings.width x settings.height.
-  Result<Image> render(const SceneCache& scene, const Camera& camera);
+  /// Renders the scene seen by `camera`; the image is settings.width x settings.height. With
+  /// `within`, only the objects whose bounds meet that box are drawn (and those without bounds):
+  /// a routed viewer draws what its volume of interest holds, not objects the route stopped
+  /// updating.
+  Result<Image> render(const SceneCache& scene, const Camera& camera,
+                       const msg::Aabb* within = nullptr);
   const RenderSettings& settings() const;
   /// The OpenGL renderer and version strings ("llvmpipe (LLVM 15, 256 bits), 4.5 ..."), for logs.
   const std::string& description() const;
