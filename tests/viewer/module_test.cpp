@@ -132,7 +132,11 @@ TEST(ViewerModule, BadParametersStopTheRunNamingModuleAndParameter) {
   for (const Case& c :
        {Case{param("eye", "0 1 0") + param("target", "0 1 0"), "'eye'"},
         Case{param("camera-path", "/nonexistent/camera.txt"), "'camera-path'"},
-        Case{param("width", "3"), "width"}, Case{param("format", "gif"), "format"}}) {
+        Case{param("width", "3"), "width"}, Case{param("format", "gif"), "format"},
+        Case{param("tile", "2 0 2 2"), "parameter 'tile' expects 'COL ROW COLS ROWS'"},
+        Case{param("tile", "0 0 2"), "parameter 'tile'"},
+        Case{param("interest-box", "0 0 0 1 1"), "parameter 'interest-box'"},
+        Case{param("view-depth", "0.01"), "parameter 'view-depth' must be beyond the near plane"}}) {
     TempDir dir;
     const auto result = run(dir, application(param("output-dir", dir.file("f")) + c.params));
     EXPECT_NE(result.exitCode, 0) << c.params;
