@@ -34,7 +34,8 @@ std::string routedApplication(const std::string& frames) {
   replaceAll(app, "\"../paper_scene/scene.json\"",
              "\"" + vrflow::testing::sourceDir() + "/examples/paper_scene/scene.json\"");
   replaceAll(app, "<param name=\"width\" value=\"480\"/>", "<param name=\"width\" value=\"96\"/>");
-  replaceAll(app, "<param name=\"height\" value=\"270\"/>", "<param name=\"height\" value=\"54\"/>");
+  replaceAll(app, "<param name=\"height\" value=\"270\"/>",
+             "<param name=\"height\" value=\"54\"/>");
   replaceAll(app, "<param name=\"output-dir\" value=\"routed-wall\"/>",
              "<param name=\"output-dir\" value=\"" + frames +
                  "\"/><param name=\"format\" value=\"png\"/><param name=\"supersample\" "
@@ -126,8 +127,8 @@ TEST(RoutedWall, EachTileGetsLessThanADirectViewerAndTheSimulationIsUnchanged) {
   TempDir dir;
   const std::string routed = routedApplication(dir.file("routed/frames"));
   const WallRun withRoute = runIn(dir, "routed", routed);
-  const WallRun direct = runIn(dir, "direct", directApplication(routedApplication(
-                                              dir.file("direct/frames"))));
+  const WallRun direct =
+      runIn(dir, "direct", directApplication(routedApplication(dir.file("direct/frames"))));
   ASSERT_EQ(withRoute.report["status"], "ok");
   ASSERT_EQ(direct.report["status"], "ok");
 
@@ -148,8 +149,8 @@ TEST(RoutedWall, EachTileGetsLessThanADirectViewerAndTheSimulationIsUnchanged) {
     EXPECT_LT(bytes, directBytes.at(tile)) << tile;
     routedTotal += bytes;
     directTotal += directBytes.at(tile);
-    std::printf("%s: %.0f bytes/iteration routed, %.0f direct\n", tile.c_str(),
-                bytes / kIterations, directBytes.at(tile) / kIterations);
+    std::printf("%s: %.0f bytes/iteration routed, %.0f direct\n", tile.c_str(), bytes / kIterations,
+                directBytes.at(tile) / kIterations);
   }
   std::printf("4 tiles: %.0f bytes/iteration routed, %.0f direct (%.2fx less)\n",
               routedTotal / kIterations, directTotal / kIterations, directTotal / routedTotal);

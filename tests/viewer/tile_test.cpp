@@ -183,7 +183,7 @@ TEST(ViewVolume, IsTheBoxAroundTheTilesFrustumToViewDepth) {
   EXPECT_NEAR(volume->max[0], 0.0, 1e-9);
   EXPECT_NEAR(volume->min[1], 1.0 - 8.0, 1e-9);
   EXPECT_NEAR(volume->max[1], 1.0 + 8.0, 1e-9);
-  EXPECT_NEAR(volume->min[2], 2.0, 1e-9);                    // 10 - view depth
+  EXPECT_NEAR(volume->min[2], 2.0, 1e-9);                      // 10 - view depth
   EXPECT_NEAR(volume->max[2], 10.0 - camera.nearPlane, 1e-9);  // the near plane
   // Within a box: the smallest box around (frustum piece ∩ box), here the part of the box
   // x <= 0 in front of the camera, tighter than cutting the frustum's box by it.

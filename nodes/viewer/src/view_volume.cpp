@@ -59,9 +59,10 @@ Result<Tile> parseTile(std::string_view text) {
   }
   if (tile.cols < 1 || tile.rows < 1 || tile.cols > 256 || tile.rows > 256 || tile.col < 0 ||
       tile.row < 0 || tile.col >= tile.cols || tile.row >= tile.rows) {
-    return makeError("expects 'COL ROW COLS ROWS' with 1 <= COLS, ROWS <= 256, 0 <= COL < COLS "
-                     "and 0 <= ROW < ROWS, got '" +
-                     std::string(text) + "'");
+    return makeError(
+        "expects 'COL ROW COLS ROWS' with 1 <= COLS, ROWS <= 256, 0 <= COL < COLS "
+        "and 0 <= ROW < ROWS, got '" +
+        std::string(text) + "'");
   }
   return tile;
 }
@@ -80,8 +81,8 @@ Frustum tileFrustum(const Camera& camera, const Tile& tile, int width, int heigh
   f.nearPlane = camera.nearPlane;
   f.farPlane = camera.farPlane;
   const double top = camera.nearPlane * std::tan(camera.fovYDegrees * kPi / 360.0);
-  const double right = top * static_cast<double>(tile.cols * width) /
-                       static_cast<double>(tile.rows * height);
+  const double right =
+      top * static_cast<double>(tile.cols * width) / static_cast<double>(tile.rows * height);
   // The whole window spans [-right, right] x [-top, top]; for a 1 x 1 wall these are exact.
   f.left = -right + 2.0 * right * tile.col / tile.cols;
   f.right = -right + 2.0 * right * (tile.col + 1) / tile.cols;

@@ -185,11 +185,10 @@ int main() {
   }
   const std::string prefix = "vrflow-viewer: module '" + module.id() + "': ";
   const auto& t = render.tile;
-  const std::string tileText = t == viewer::Tile{} ? std::string()
-                                                   : ", tile " + std::to_string(t.col) + " " +
-                                                         std::to_string(t.row) + " of " +
-                                                         std::to_string(t.cols) + "x" +
-                                                         std::to_string(t.rows);
+  const std::string tileText =
+      t == viewer::Tile{} ? std::string()
+                          : ", tile " + std::to_string(t.col) + " " + std::to_string(t.row) +
+                                " of " + std::to_string(t.cols) + "x" + std::to_string(t.rows);
   std::fprintf(stderr, "%swriting %s, %dx%d%s, every %d iteration(s); drawing with %s\n",
                prefix.c_str(), writer->description().c_str(), render.width, render.height,
                tileText.c_str(), every, renderer->description().c_str());
@@ -211,9 +210,9 @@ int main() {
       // At iteration 0, then whenever the camera moves the tile's volume: the box around its
       // frustum from the near plane to view-depth, within interest-box ("none" when empty).
       const auto cam = path->at(module.iteration());
-      const auto volume =
-          viewer::viewVolume(cam, viewer::tileFrustum(cam, render.tile, render.width, render.height),
-                             viewDepth, interestBox);
+      const auto volume = viewer::viewVolume(
+          cam, viewer::tileFrustum(cam, render.tile, render.width, render.height), viewDepth,
+          interestBox);
       const std::string text = volume ? viewer::formatBox(*volume) : "none";
       within = volume ? *volume : msg::Aabb{{inf, inf, inf}, {-inf, -inf, -inf}};
       if (text != published) {

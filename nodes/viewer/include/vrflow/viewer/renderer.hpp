@@ -17,7 +17,7 @@ namespace vrflow::viewer {
 
 /// How a frame looks. Colours are linear 0..1 RGB.
 struct RenderSettings {
-  int width = 960;   ///< the image (of the tile, for a wall)
+  int width = 960;  ///< the image (of the tile, for a wall)
   int height = 540;
   Tile tile;  ///< the part of the view drawn: the whole view is tile.cols*width x tile.rows*height
   std::array<float, 3> background{0.80f, 0.86f, 0.93f};  ///< where nothing is drawn
