@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -26,46 +25,32 @@ void replaceAll(std::string& text, const std::string& from, const std::string& t
   }
 }
 
-// The example, made small for a test: tiles of 96 x 54 without supersampling, PNG frames into
+// An application of the example's folder (routed_wall.xml, or direct_wall.xml: the same without
+// routing), made small for a test: tiles of 96 x 54 without supersampling, PNG frames into
 // `frames`, the scene file named by its absolute path (the copy lives in a temporary folder).
-std::string routedApplication(const std::string& frames) {
-  std::string app = vrflow::testing::readFile(vrflow::testing::sourceDir() +
-                                              "/examples/routed_wall/routed_wall.xml");
+std::string smallApplication(const std::string& name, const std::string& frames) {
+  std::string app =
+      vrflow::testing::readFile(vrflow::testing::sourceDir() + "/examples/routed_wall/" + name);
   replaceAll(app, "\"../paper_scene/scene.json\"",
              "\"" + vrflow::testing::sourceDir() + "/examples/paper_scene/scene.json\"");
   replaceAll(app, "<param name=\"width\" value=\"480\"/>", "<param name=\"width\" value=\"96\"/>");
   replaceAll(app, "<param name=\"height\" value=\"270\"/>",
              "<param name=\"height\" value=\"54\"/>");
-  replaceAll(app, "<param name=\"output-dir\" value=\"routed-wall\"/>",
-             "<param name=\"output-dir\" value=\"" + frames +
-                 "\"/><param name=\"format\" value=\"png\"/><param name=\"supersample\" "
-                 "value=\"1\"/>");
+  for (const char* dir : {"routed-wall", "direct-wall"}) {
+    replaceAll(app, "<param name=\"output-dir\" value=\"" + std::string(dir) + "\"/>",
+               "<param name=\"output-dir\" value=\"" + frames +
+                   "\"/><param name=\"format\" value=\"png\"/><param name=\"supersample\" "
+                   "value=\"1\"/>");
+  }
   return app;
 }
 
-// The same application without routing: no filters, each tile fed by both animators, its
-// interest output unconnected (everything else, the pacing included, unchanged).
-std::string directApplication(const std::string& routed) {
-  std::istringstream lines(routed);
-  std::string out;
-  bool inFilters = false;
-  for (std::string line; std::getline(lines, line);) {
-    if (line.find("<filters>") != std::string::npos) inFilters = true;
-    const bool skip = inFilters || line.find("\"scene.") != std::string::npos ||
-                      line.find("\"wall.") != std::string::npos ||
-                      line.find(".interest\"") != std::string::npos;
-    if (line.find("</filters>") != std::string::npos) inFilters = false;
-    if (line.find("</connections>") != std::string::npos) {
-      for (int k = 0; k < 4; ++k) {
-        for (const char* from : {"bodies", "net"}) {
-          out += "    <connection from=\"" + std::string(from) + ".objects\" to=\"tile" +
-                 std::to_string(k) + ".objects\"/>\n";
-        }
-      }
-    }
-    if (!skip) out += line + "\n";
-  }
-  return out;
+// The <modules> section of an application.
+std::string modulesOf(const std::string& app) {
+  const auto begin = app.find("<modules>");
+  const auto end = app.find("</modules>");
+  return begin == std::string::npos || end == std::string::npos ? std::string()
+                                                                : app.substr(begin, end - begin);
 }
 
 struct WallRun {
@@ -125,10 +110,15 @@ std::size_t framesOf(const std::string& folder, const std::string& prefix) {
 
 TEST(RoutedWall, EachTileGetsLessThanADirectViewerAndTheSimulationIsUnchanged) {
   TempDir dir;
-  const std::string routed = routedApplication(dir.file("routed/frames"));
+  const std::string routed = smallApplication("routed_wall.xml", dir.file("routed/frames"));
+  const std::string directApp = smallApplication("direct_wall.xml", dir.file("direct/frames"));
+  // The two files differ only by routing: the same modules with the same parameters.
+  const std::string modules = modulesOf(smallApplication("routed_wall.xml", "FRAMES"));
+  ASSERT_FALSE(modules.empty());
+  ASSERT_EQ(modules, modulesOf(smallApplication("direct_wall.xml", "FRAMES")));
+  ASSERT_EQ(directApp.find("type=\"route\""), std::string::npos);
   const WallRun withRoute = runIn(dir, "routed", routed);
-  const WallRun direct =
-      runIn(dir, "direct", directApplication(routedApplication(dir.file("direct/frames"))));
+  const WallRun direct = runIn(dir, "direct", directApp);
   ASSERT_EQ(withRoute.report["status"], "ok");
   ASSERT_EQ(direct.report["status"], "ok");
 
