@@ -15,6 +15,13 @@
 //     routing/tile-viewers, each a quarter of the world along x, directly (none) or through a
 //     route filter (dynamic). B: bytes delivered to the 4 viewers together per iteration (the
 //     report's bytes of their input connections / iterations).
+//   {"pattern":"routing","mode":"none"|"dynamic","viewers":4,"bytes_per_iteration":B,
+//    "scene":"demo","tiles":[B0,B1,B2,B3]}
+//     examples/routed_wall: the demo scene on a 2 x 2 wall of viewer/viewer tiles, fed straight
+//     from the animators (direct_wall.xml, none) or through one route filter (routed_wall.xml,
+//     dynamic), `demo-iterations` iterations, tiles drawn at 96 x 54 (the bytes do not depend on
+//     the image size). Bk: bytes to tile k per iteration. Needs the node packages (skipped,
+//     with a note, when vrflow-viewer is not built).
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -228,12 +235,75 @@ bool routing(const Context& ctx, const std::string& mode, int bodies, int iterat
   return true;
 }
 
+void replaceAll(std::string& text, const std::string& from, const std::string& to) {
+  for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+}
+
+bool demoRouting(const Context& ctx, const std::string& mode, int iterations) {
+  const fs::path folder = fs::path(VRFLOW_SOURCE_DIR) / "examples" / "routed_wall";
+  std::ifstream in(folder / (mode == "none" ? "direct_wall.xml" : "routed_wall.xml"));
+  if (!in) {
+    std::fprintf(stderr, "vrflow-bench-patterns: cannot read the routed_wall example in %s\n",
+                 folder.c_str());
+    return false;
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string xml = text.str();
+  replaceAll(xml, "\"../paper_scene/scene.json\"",
+             "\"" + (folder.parent_path() / "paper_scene" / "scene.json").string() + "\"");
+  replaceAll(xml, param("width", "480"), param("width", "96"));
+  replaceAll(xml, param("height", "270"), param("height", "54"));
+  const std::string frames = (ctx.work / ("frames-" + mode)).string();
+  for (const char* dir : {"routed-wall", "direct-wall"}) {
+    replaceAll(xml, param("output-dir", dir),
+               param("output-dir", frames) + param("format", "png") + param("supersample", "1"));
+  }
+  const std::string name = "demo-routing-" + mode + "-" + std::to_string(iterations);
+  const fs::path app = ctx.work / (name + ".xml");
+  std::ofstream(app) << xml;
+  const fs::path reportFile = ctx.work / (name + ".json");
+  const std::string command = "cd " + q(ctx.work.string()) + " && " +
+                              q((ctx.bin / "vrflow").string()) + " run " + q(app.string()) +
+                              " -n " + std::to_string(iterations) +
+                              " --no-progress --timeout 600 --report " + q(reportFile.string()) +
+                              " > " + q(name + ".log") + " 2>&1";
+  if (const int status = std::system(command.c_str()); status != 0) {
+    std::fprintf(stderr, "vrflow-bench-patterns: %s failed (status %d); see %s\n", name.c_str(),
+                 status, (ctx.work / (name + ".log")).c_str());
+    return false;
+  }
+  nlohmann::json report;
+  std::ifstream(reportFile) >> report;
+  std::vector<double> tiles(4, 0.0);
+  for (const auto& c : report["connections"]) {
+    const std::string to = c["to"].get<std::string>();
+    const std::string tile = to.substr(0, to.find('.'));
+    for (std::size_t k = 0; k < tiles.size(); ++k) {
+      if (tile == "tile" + std::to_string(k) && to == tile + ".objects") {
+        tiles[k] += c["bytes"].get<double>();
+      }
+    }
+  }
+  double total = 0;
+  for (const double b : tiles) total += b;
+  std::printf(
+      "{\"pattern\":\"routing\",\"mode\":\"%s\",\"viewers\":4,\"bytes_per_iteration\":%.0f,"
+      "\"scene\":\"demo\",\"tiles\":[%.0f,%.0f,%.0f,%.0f]}\n",
+      mode.c_str(), total / iterations, tiles[0] / iterations, tiles[1] / iterations,
+      tiles[2] / iterations, tiles[3] / iterations);
+  std::fflush(stdout);
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App cli{"vrflow-bench-patterns: broadcast (flat vs tree) and routing (none vs dynamic)"};
   std::string receiversText = "2,4,8,16";
-  int messages = 50, fanout = 2, bodies = 256, iterations = 200;
+  int messages = 50, fanout = 2, bodies = 256, iterations = 200, demoIterations = 300;
   bool quick = false;
   std::string only;
   cli.add_option("--receivers", receiversText, "broadcast receiver counts, comma-separated");
@@ -242,6 +312,8 @@ int main(int argc, char** argv) {
   cli.add_option("--fanout", fanout, "fan-out of the broadcast tree")->check(CLI::Range(2, 256));
   cli.add_option("--bodies", bodies, "bodies of the routing scene")->check(CLI::Range(1, 1000000));
   cli.add_option("--iterations", iterations, "routing iterations")->check(CLI::Range(2, 1000000));
+  cli.add_option("--demo-iterations", demoIterations, "iterations of the demo scene's wall")
+      ->check(CLI::Range(2, 1000000));
   cli.add_option("--pattern", only, "broadcast or routing (default: both)")
       ->check(CLI::IsMember({"broadcast", "routing"}));
   int hosts = 1;
@@ -249,12 +321,14 @@ int main(int argc, char** argv) {
                  "broadcast over this many loopback hosts (vrflow launch --backend local; the "
                  "source on the first, receivers and tree filters on the others)")
       ->check(CLI::Range(1, 254));
-  cli.add_flag("--quick", quick, "a small run (2 and 4 receivers, 5 messages, 20 iterations)");
+  cli.add_flag("--quick", quick,
+               "a small run (2 and 4 receivers, 5 messages, 20 iterations of each scene)");
   CLI11_PARSE(cli, argc, argv);
   if (quick) {
     receiversText = "2,4";
     messages = 5;
     iterations = 20;
+    demoIterations = 20;
   }
   std::vector<int> receivers;
   std::stringstream list(receiversText);
@@ -289,6 +363,14 @@ int main(int argc, char** argv) {
     Context oneHost = ctx;
     oneHost.hosts = 1;  // the routing cases count bytes, which hosts do not change
     for (const char* mode : {"none", "dynamic"}) ok = routing(oneHost, mode, bodies, iterations) && ok;
+    if (fs::exists(ctx.bin / "vrflow-viewer")) {
+      for (const char* mode : {"none", "dynamic"})
+        ok = demoRouting(oneHost, mode, demoIterations) && ok;
+    } else {
+      std::fprintf(stderr,
+                   "vrflow-bench-patterns: no vrflow-viewer beside this program (node "
+                   "packages off): the demo scene's routing is skipped\n");
+    }
   }
   std::error_code ignored;
   fs::remove_all(ctx.work, ignored);

@@ -125,6 +125,48 @@ TEST(ViewerModule, ScriptedCameraMovesTheView) {
   ASSERT_EQ(filesIn(out).size(), 5u);
 }
 
+// bodies -> route -> view, the view's interest back into the route: the messages the view sent
+// on `interest` over a run of 5 iterations.
+int interestMessages(const std::string& viewerParams) {
+  TempDir dir;
+  const auto file =
+      dir.write("app.xml", R"(<?xml version="1.0" encoding="UTF-8"?>
+<application name="viewer-interest" version="1">
+  <modules>
+    <module id="bodies" package="viewer-testing" type="bodies"/>
+    <module id="view" package="viewer" type="viewer">)" +
+                               common(dir.file("frames")) + viewerParams + R"(</module>
+  </modules>
+  <filters>
+    <filter id="w" type="route"><param name="initially" value="all"/></filter>
+  </filters>
+  <connections>
+    <connection from="bodies.objects" to="w.in"/>
+    <connection from="w.out0" to="view.objects"/>
+    <connection from="view.interest" to="w.interest0"/>
+  </connections>
+</application>
+)");
+  const auto result =
+      vrflow::testing::runVrflow({"run", file, "--report", dir.file("report.json")}, 60);
+  EXPECT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(filesIn(dir.file("frames")).size(), 5u);
+  const auto report = nlohmann::json::parse(vrflow::testing::readFile(dir.file("report.json")));
+  for (const auto& c : report["connections"]) {
+    if (c["from"] == "view.interest") return c["messages"].get<int>();
+  }
+  ADD_FAILURE() << "no view.interest connection in the report";
+  return -1;
+}
+
+TEST(ViewerModule, PublishesItsVolumeAtIterationZeroAndWhenTheCameraMovesIt) {
+  EXPECT_EQ(interestMessages(""), 1);  // a fixed camera: once
+  // Keys at iterations 0 and 2: the camera moves at iterations 1 and 2, then holds.
+  TempDir dir;
+  const auto path = dir.write("camera.txt", "0 0 2.5 7 0 1 0\n2 7 2.5 0 0 1 0 60\n");
+  EXPECT_EQ(interestMessages(param("camera-path", path)), 3);
+}
+
 TEST(ViewerModule, BadParametersStopTheRunNamingModuleAndParameter) {
   struct Case {
     std::string params, name;
@@ -132,7 +174,12 @@ TEST(ViewerModule, BadParametersStopTheRunNamingModuleAndParameter) {
   for (const Case& c :
        {Case{param("eye", "0 1 0") + param("target", "0 1 0"), "'eye'"},
         Case{param("camera-path", "/nonexistent/camera.txt"), "'camera-path'"},
-        Case{param("width", "3"), "width"}, Case{param("format", "gif"), "format"}}) {
+        Case{param("width", "3"), "width"}, Case{param("format", "gif"), "format"},
+        Case{param("tile", "2 0 2 2"), "parameter 'tile' expects 'COL ROW COLS ROWS'"},
+        Case{param("tile", "0 0 2"), "parameter 'tile'"},
+        Case{param("interest-box", "0 0 0 1 1"), "parameter 'interest-box'"},
+        Case{param("view-depth", "0.01"),
+             "parameter 'view-depth' must be beyond the near plane"}}) {
     TempDir dir;
     const auto result = run(dir, application(param("output-dir", dir.file("f")) + c.params));
     EXPECT_NE(result.exitCode, 0) << c.params;

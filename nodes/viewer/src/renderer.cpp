@@ -11,8 +11,6 @@
 namespace vrflow::viewer {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Column-major 4x4 for glMultMatrixd.
 using Matrix = std::array<double, 16>;
 
@@ -25,16 +23,12 @@ msg::Vec3 cross(const msg::Vec3& a, const msg::Vec3& b) {
 double dot(const msg::Vec3& a, const msg::Vec3& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
-msg::Vec3 unit(const msg::Vec3& v) {
-  const double length = std::sqrt(dot(v, v));
-  return length > 0.0 ? msg::Vec3{v[0] / length, v[1] / length, v[2] / length} : msg::Vec3{0, 0, 0};
-}
 
 Matrix lookAt(const Camera& camera) {
-  const msg::Vec3 f = unit(sub(camera.target, camera.eye));
-  msg::Vec3 s = unit(cross(f, camera.up));
-  if (dot(s, s) == 0.0) s = unit(cross(f, {0.0, 0.0, 1.0}));  // up parallel to the view
-  const msg::Vec3 u = cross(s, f);
+  const ViewBasis b = viewBasis(camera);
+  const msg::Vec3& f = b.forward;
+  const msg::Vec3& s = b.side;
+  const msg::Vec3& u = b.up;
   return {s[0],
           u[0],
           -f[0],
@@ -89,6 +83,13 @@ Matrix shadowMatrix(double h) {
     }
   }
   return m;
+}
+
+bool meets(const msg::Aabb& a, const msg::Aabb& b) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (a.min[k] > b.max[k] || b.min[k] > a.max[k]) return false;
+  }
+  return true;
 }
 
 bool finite(const msg::Vec3& v) {
@@ -186,7 +187,7 @@ struct Renderer::Impl {
 
   void setUpFrame(const Camera& camera) const;
   void drawGround() const;
-  void drawObjects(const SceneCache& scene, bool shadowPass) const;
+  void drawObjects(const SceneCache& scene, bool shadowPass, const msg::Aabb* within) const;
 };
 
 void Renderer::Impl::setUpFrame(const Camera& camera) const {
@@ -197,9 +198,9 @@ void Renderer::Impl::setUpFrame(const Camera& camera) const {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
   glMatrixMode(GL_PROJECTION);
   glLoadIdentity();
-  const double top = camera.nearPlane * std::tan(camera.fovYDegrees * kPi / 360.0);
-  const double right = top * s.width / s.height;
-  glFrustum(-right, right, -top, top, camera.nearPlane, camera.farPlane);
+  // The tile's share of the whole view's window (the whole window for the default tile).
+  const Frustum f = tileFrustum(camera, s.tile, s.width, s.height);
+  glFrustum(f.left, f.right, f.bottom, f.top, f.nearPlane, f.farPlane);
   glMatrixMode(GL_MODELVIEW);
   const Matrix view = lookAt(camera);
   glLoadMatrixd(view.data());
@@ -262,8 +263,10 @@ void Renderer::Impl::drawGround() const {
   glDisable(GL_STENCIL_TEST);
 }
 
-void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass) const {
+void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass,
+                                 const msg::Aabb* within) const {
   for (const auto& [id, object] : scene.objects()) {
+    if (within != nullptr && object.bounds && !meets(*object.bounds, *within)) continue;
     if (!shadowPass) {
       const auto colour = objectColour(id);
       glColor3f(colour[0], colour[1], colour[2]);
@@ -362,6 +365,11 @@ Result<Renderer> Renderer::create(const RenderSettings& settings) {
     return makeError("supersample must be 1..4 and keep the drawn size within 8192 pixels, got " +
                      std::to_string(settings.supersample));
   }
+  const Tile& t = settings.tile;
+  if (t.cols < 1 || t.rows < 1 || t.col < 0 || t.row < 0 || t.col >= t.cols || t.row >= t.rows) {
+    return makeError("tile " + std::to_string(t.col) + " " + std::to_string(t.row) + " of " +
+                     std::to_string(t.cols) + " x " + std::to_string(t.rows) + " is not a tile");
+  }
   auto impl = std::make_unique<Impl>();
   impl->settings = settings;
   impl->context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
@@ -384,7 +392,8 @@ Result<Renderer> Renderer::create(const RenderSettings& settings) {
   return Renderer(std::move(impl));
 }
 
-Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera) {
+Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera,
+                               const msg::Aabb* within) {
   Impl& r = *impl_;
   const auto& s = r.settings;
   if (!OSMesaMakeCurrent(r.context, r.rgba.data(), GL_UNSIGNED_BYTE, r.bufferWidth,
@@ -396,7 +405,7 @@ Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera) {
   }
   r.setUpFrame(camera);
   if (s.ground) r.drawGround();
-  r.drawObjects(scene, false);
+  r.drawObjects(scene, false, within);
   if (s.ground && s.shadows) {
     // Flattened objects, dark and translucent, on ground pixels not yet shadowed.
     glDisable(GL_LIGHTING);
@@ -412,7 +421,7 @@ Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera) {
     glPushMatrix();
     const Matrix shadow = shadowMatrix(s.groundHeight);
     glMultMatrixd(shadow.data());
-    r.drawObjects(scene, true);
+    r.drawObjects(scene, true, within);
     glPopMatrix();
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDisable(GL_STENCIL_TEST);

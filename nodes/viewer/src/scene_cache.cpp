@@ -172,9 +172,13 @@ void SceneCache::applyObject(const msg::ObjectView& object) {
       if (auto p = object.vec3(msg::RigidParam::kPosition)) cached.position = *p;
       if (auto q = object.quat(msg::RigidParam::kOrientation)) cached.orientation = *q;
       if (auto s = object.idParam(msg::RigidParam::kShape)) cached.shapeId = *s;
+      if (auto b = object.aabb(msg::RigidParam::kBounds)) cached.bounds = *b;
       break;
     case ObjectKind::Point:
-      if (auto p = object.vec3(msg::PointParam::kPosition)) cached.position = *p;
+      if (auto p = object.vec3(msg::PointParam::kPosition)) {
+        cached.position = *p;
+        cached.bounds = msg::Aabb{*p, *p};
+      }
       break;
     case ObjectKind::MassSpring:
       if (auto p = object.doubleArray(msg::MassSpringParam::kPositions)) {
@@ -186,9 +190,11 @@ void SceneCache::applyObject(const msg::ObjectView& object) {
         cached.surface.resize(indices.size() - indices.size() % 3);
         for (std::size_t i = 0; i < cached.surface.size(); ++i) cached.surface[i] = indices[i];
       }
+      if (auto b = object.aabb(msg::MassSpringParam::kBounds)) cached.bounds = *b;
       break;
     case ObjectKind::Fluid:
       if (auto r = object.idParam(msg::FluidParam::kParticles)) cached.particlesId = *r;
+      if (auto b = object.aabb(msg::FluidParam::kBounds)) cached.bounds = *b;
       break;
   }
 }

@@ -1,9 +1,12 @@
-// viewer/viewer: renders the objects it receives with OSMesa into PNG frames or an MP4. It only
-// reads: its one output is the implicit endIt, so it cannot change what the simulation computes.
+// viewer/viewer: renders the objects it receives with OSMesa into PNG frames or an MP4, the whole
+// view or one tile of a wall. It only reads: its outputs are the implicit endIt and `interest`
+// (its volume of interest, for a `route` filter), so it cannot change what the simulation
+// computes.
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -11,6 +14,7 @@
 #include "vrflow/module/module.hpp"
 #include "vrflow/viewer/frame_writer.hpp"
 #include "vrflow/viewer/renderer.hpp"
+#include "vrflow/viewer/view_volume.hpp"
 
 namespace {
 
@@ -97,6 +101,7 @@ int main() {
 
   Module module;
   auto& objects = module.addInput("objects");
+  auto& interest = module.addOutput("interest");
   if (auto status = module.init(); !status) {
     std::fprintf(stderr, "vrflow-viewer: %s\n", status.error().message.c_str());
     return 2;
@@ -114,6 +119,20 @@ int main() {
   render.supersample = params.integer("supersample", 2, 1, 4);
   render.pointRadius = params.number("point-radius", 0.08, 1e-6, 1e6);
   render.particleSize = static_cast<float>(params.number("particle-size", 3.0, 1.0, 64.0));
+  if (auto tile = viewer::parseTile(params.text("tile", "0 0 1 1")); tile) {
+    render.tile = *tile;
+  } else {
+    params.fail("tile", tile.error().message);
+  }
+  const double viewDepth = params.number("view-depth", 20.0, 1e-3, 1e6);
+  std::optional<msg::Aabb> interestBox;
+  if (const auto text = params.text("interest-box", ""); !text.empty()) {
+    if (auto box = viewer::parseBox(text); box) {
+      interestBox = *box;
+    } else {
+      params.fail("interest-box", box.error().message);
+    }
+  }
   const int segments = params.integer("segments", 24, 4, 256);
   const int every = params.integer("every", 1, 1, 1000000);
   viewer::Camera camera;
@@ -133,6 +152,10 @@ int main() {
     params.fail("format", "expects png, mp4 or auto, got '" + params.text("format", "") + "'");
   }
   if (camera.eye == camera.target) params.fail("eye", "must differ from 'target'");
+  if (viewDepth <= camera.nearPlane) {
+    params.fail("view-depth", "must be beyond the near plane (" + std::to_string(camera.nearPlane) +
+                                  " m), got " + std::to_string(viewDepth));
+  }
   std::optional<viewer::CameraPath> path;
   if (const auto file = params.text("camera-path", ""); !file.empty()) {
     auto loaded = viewer::CameraPath::load(file, camera);
@@ -161,19 +184,48 @@ int main() {
     return 2;
   }
   const std::string prefix = "vrflow-viewer: module '" + module.id() + "': ";
-  std::fprintf(stderr, "%swriting %s, %dx%d, every %d iteration(s); drawing with %s\n",
-               prefix.c_str(), writer->description().c_str(), render.width, render.height, every,
-               renderer->description().c_str());
+  const auto& t = render.tile;
+  const std::string tileText =
+      t == viewer::Tile{} ? std::string()
+                          : ", tile " + std::to_string(t.col) + " " + std::to_string(t.row) +
+                                " of " + std::to_string(t.cols) + "x" + std::to_string(t.rows);
+  std::fprintf(stderr, "%swriting %s, %dx%d%s, every %d iteration(s); drawing with %s\n",
+               prefix.c_str(), writer->description().c_str(), render.width, render.height,
+               tileText.c_str(), every, renderer->description().c_str());
 
   viewer::SceneCache scene(segments, [&prefix](const std::string& line) {
     std::fprintf(stderr, "%s%s\n", prefix.c_str(), line.c_str());
   });
+  // The volume of interest last published ("": none yet), and the box a routed viewer draws
+  // within: the route stops updating objects that leave the volume, so their last state is
+  // stale (an empty box for "none").
+  std::string published;
+  const double inf = std::numeric_limits<double>::infinity();
+  msg::Aabb within{{inf, inf, inf}, {-inf, -inf, -inf}};
   int status = 0;
   while (module.wait()) {
     const Message& message = module.get(objects);
     if (message.valid()) scene.apply(message.view());
+    if (interest.connected()) {
+      // At iteration 0, then whenever the camera moves the tile's volume: the box around its
+      // frustum from the near plane to view-depth, within interest-box ("none" when empty).
+      const auto cam = path->at(module.iteration());
+      const auto volume = viewer::viewVolume(
+          cam, viewer::tileFrustum(cam, render.tile, render.width, render.height), viewDepth,
+          interestBox);
+      const std::string text = volume ? viewer::formatBox(*volume) : "none";
+      within = volume ? *volume : msg::Aabb{{inf, inf, inf}, {-inf, -inf, -inf}};
+      if (text != published) {
+        auto out = module.newMessage();
+        out.builder().setStampsOnly(true);
+        out.builder().addStringStamp("interest", text);
+        if (!module.put(interest, std::move(out))) break;
+        published = text;
+      }
+    }
     if (module.iteration() % static_cast<std::uint64_t>(every) != 0) continue;
-    auto image = renderer->render(scene, path->at(module.iteration()));
+    auto image = renderer->render(scene, path->at(module.iteration()),
+                                  interest.connected() ? &within : nullptr);
     Status written = image ? writer->write(*image) : Status(image.error());
     if (!written) {
       std::fprintf(stderr, "%s%s\n", prefix.c_str(), written.error().message.c_str());

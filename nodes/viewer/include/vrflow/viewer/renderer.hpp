@@ -9,6 +9,7 @@
 #include "vrflow/viewer/camera.hpp"
 #include "vrflow/viewer/image.hpp"
 #include "vrflow/viewer/scene_cache.hpp"
+#include "vrflow/viewer/view_volume.hpp"
 
 // Draws a SceneCache with OpenGL 1.x through OSMesa (Mesa's software rasteriser, no display).
 
@@ -16,8 +17,9 @@ namespace vrflow::viewer {
 
 /// How a frame looks. Colours are linear 0..1 RGB.
 struct RenderSettings {
-  int width = 960;
+  int width = 960;  ///< the image (of the tile, for a wall)
   int height = 540;
+  Tile tile;  ///< the part of the view drawn: the whole view is tile.cols*width x tile.rows*height
   std::array<float, 3> background{0.80f, 0.86f, 0.93f};  ///< where nothing is drawn
   bool ground = true;                                    ///< a checkered plane y = groundHeight
   double groundHeight = 0.0;
@@ -59,8 +61,12 @@ class Renderer {
   Renderer& operator=(Renderer&&) noexcept;
   ~Renderer();
 
-  /// Renders the scene seen by `camera`; the image is settings.width x settings.height.
-  Result<Image> render(const SceneCache& scene, const Camera& camera);
+  /// Renders the scene seen by `camera`; the image is settings.width x settings.height. With
+  /// `within`, only the objects whose bounds meet that box are drawn (and those without bounds):
+  /// a routed viewer draws what its volume of interest holds, not objects the route stopped
+  /// updating.
+  Result<Image> render(const SceneCache& scene, const Camera& camera,
+                       const msg::Aabb* within = nullptr);
   const RenderSettings& settings() const;
   /// The OpenGL renderer and version strings ("llvmpipe (LLVM 15, 256 bits), 4.5 ..."), for logs.
   const std::string& description() const;

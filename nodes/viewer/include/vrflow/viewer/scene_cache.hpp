@@ -40,6 +40,7 @@ struct CachedObject {
   std::vector<double> positions;       ///< massspring: xyz per mass
   std::vector<std::uint32_t> surface;  ///< massspring: three mass indices per triangle
   std::uint64_t particlesId = 0;       ///< fluid: the particle resource
+  std::optional<msg::Aabb> bounds;     ///< the sender's `bounds` (a point: its position)
 };
 
 /// Counters a viewer reports (and tests check).
