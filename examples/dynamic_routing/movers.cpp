@@ -3,7 +3,9 @@
 // and every body's full state (add: position, orientation, velocities, mass, inertia, bounds,
 // shape = one of the meshes); later iterations update position, linear velocity and bounds.
 // `meshes-at` sends the meshes at a later iteration instead (after the bodies that use them);
-// `delete-at` deletes body 0 at that iteration (0: never).
+// `delete-at` deletes body 0 at that iteration (0: never). `dynamic-meshes` makes the meshes
+// dynamic resources sent again every iteration (from `meshes-at` on) with vertex 0's x equal to
+// the iteration, so that a receiver can tell which copy it holds.
 // Body i: size 1, x = (i * 7.3 + speed_i * t) mod width with speed_i = 0.5 + (i mod 5) * 0.25,
 // y = (i mod 8) * 1.5, z = 0; t = iteration * dt.
 #include <cmath>
@@ -29,6 +31,7 @@ int main() {
   const auto triangles = static_cast<std::size_t>(module.paramInt("mesh-triangles", 200));
   const auto meshesAt = static_cast<uint64_t>(module.paramInt("meshes-at", 0));
   const auto deleteAt = static_cast<uint64_t>(module.paramInt("delete-at", 0));
+  const bool dynamicMeshes = module.param("dynamic-meshes", "false") == "true";
 
   std::vector<uint64_t> meshIds, bodyIds;
   for (std::size_t m = 0; m < meshCount; ++m) meshIds.push_back(module.newId());
@@ -42,7 +45,7 @@ int main() {
     auto& builder = out.builder();
     builder.setSimTime(t);
     builder.setTimeStep(dt);
-    if (it == meshesAt) {
+    if (it == meshesAt || (dynamicMeshes && it > meshesAt)) {
       for (std::size_t m = 0; m < meshCount; ++m) {  // a fan of triangles, different per mesh
         std::vector<float> xyz;
         std::vector<uint32_t> indices;
@@ -52,7 +55,8 @@ int main() {
                                  static_cast<float>(0.5 * std::sin(a)), 0.0f});
         }
         for (uint32_t v = 1; v <= triangles; ++v) indices.insert(indices.end(), {0u, v, v + 1});
-        builder.addMesh(meshIds[m], false, xyz, indices);
+        if (dynamicMeshes) xyz[0] = static_cast<float>(it);
+        builder.addMesh(meshIds[m], dynamicMeshes, xyz, indices);
       }
     }
     for (std::size_t i = 0; i < count; ++i) {

@@ -3,7 +3,8 @@
 // string user stamp `interest`: "minx miny minz maxx maxy maxz", the `box` parameter, or `box2`
 // from iteration `move-at` on). With `file`, it writes one CSV line per chunk received:
 // iteration,kind,id,op,mask,x,ref (objects: op add/update/delete, parameter mask in hex, the
-// x of the position or empty, the shape id or empty; resources: kind and id only).
+// x of the position or empty, the shape id or empty; resources: a mesh's vertex count as the
+// mask and its first vertex's x as x).
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -45,8 +46,14 @@ int main() {
           if (const auto p = object->vec3(msg::RigidParam::kPosition)) log << (*p)[0];
           log << ",";
           if (const auto shape = object->idParam(msg::RigidParam::kShape)) log << *shape;
-        } else if (chunk.asResource()) {
-          log << "resource," << chunk.id() << ",,,,";
+        } else if (const auto resource = chunk.asResource()) {
+          // A mesh: its vertex count as the mask, its first vertex's x as x.
+          log << "resource," << chunk.id() << ",,";
+          const auto mesh = resource->mesh();
+          if (mesh) log << mesh->vertexCount();
+          log << ",";
+          if (mesh && mesh->vertexCount() > 0) log << mesh->vertex(0)[0];
+          log << ",";
         } else {
           log << "event," << chunk.id() << ",,,,";
         }

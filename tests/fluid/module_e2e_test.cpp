@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>  // unsetenv
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -176,6 +177,80 @@ TEST(FluidModule, BoxOfTheRigidPackageFloats) {
   EXPECT_GT(y, 0.42);  // the water is 0.5 m deep: sunk would be 0.15 to 0.26
   EXPECT_LT(y, 0.66);  // resting on the surface at most
   EXPECT_LT(std::abs(vy), 0.2);
+}
+
+// particle-regions 2 1 1: the particles leave as two fluid objects, the halves x < 0.4 m and
+// x >= 0.4 m of the grid, each with its own particles and their bounds, so that a route filter
+// sends the tile-viewer that sees only x <= 0.3 m the left half, every iteration, and the one
+// that sees everything both halves, which together hold every particle.
+TEST(FluidModule, ParticleRegionsLetARouteFilterSendEachViewerOnlyWhatItSees) {
+  TempDir dir;
+  std::string modules = fluidModule("      <param name=\"particle-regions\" value=\"2 1 1\"/>\n");
+  const char* boxes[] = {"0 -1 -1 0.3 2 2", "all"};
+  std::string connections = "    <connection from=\"water.fluid\" to=\"wall.in\"/>\n";
+  for (int k = 0; k < 2; ++k) {
+    const std::string id = "v" + std::to_string(k);
+    modules += "    <module id=\"" + id + "\" package=\"routing\" type=\"tile-viewer\" host=\"local\">\n" +
+               "      <param name=\"box\" value=\"" + boxes[k] + "\"/>\n" +
+               "      <param name=\"file\" value=\"" + dir.file(id + ".csv") + "\"/>\n" +
+               "    </module>\n";
+    connections += "    <connection from=\"wall.out" + std::to_string(k) + "\" to=\"" + id +
+                   ".objects\"/>\n    <connection from=\"" + id + ".interest\" to=\"wall.interest" +
+                   std::to_string(k) + "\"/>\n";
+  }
+  std::string app = application(modules, connections);
+  app.replace(app.find("  <connections>"), 0,
+              "  <filters>\n    <filter id=\"wall\" type=\"route\" host=\"local\">\n"
+              "      <param name=\"outputs\" value=\"2\"/>\n    </filter>\n  </filters>\n");
+  const auto result = runVrflow({"--packages", binDir() + "/../share/vrflow/example-packages",
+                                 "run", dir.write("regions.xml", app), "--iterations", "12",
+                                 "--no-progress"},
+                                120);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  // iteration -> resource id -> vertex count, from iteration,kind,id,op,mask,x,ref lines
+  const auto meshes = [](const std::vector<std::string>& lines) {
+    std::map<long, std::map<std::string, long>> out;
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+      std::vector<std::string> f;
+      std::stringstream in(lines[i]);
+      std::string cell;
+      while (std::getline(in, cell, ',')) f.push_back(cell);
+      if (f.size() >= 5 && f[1] == "resource") out[std::stol(f[0])][f[2]] = std::stol(f[4]);
+    }
+    return out;
+  };
+  const auto left = meshes(readLines(dir.file("v0.csv")));
+  const auto all = meshes(readLines(dir.file("v1.csv")));
+  ASSERT_GE(all.size(), 10u);
+  long total = -1;
+  for (const auto& [it, regions] : all) {
+    ASSERT_EQ(regions.size(), 2u) << "both halves, iteration " << it;
+    long sum = 0;
+    for (const auto& [id, count] : regions) {
+      EXPECT_GT(count, 0) << "the tank is full across x";
+      sum += count;
+    }
+    if (total < 0) total = sum;
+    EXPECT_EQ(sum, total) << "every particle in one half or the other, iteration " << it;
+    const auto mine = left.find(it);
+    ASSERT_NE(mine, left.end()) << "the left tile's half, iteration " << it;
+    ASSERT_EQ(mine->second.size(), 1u) << "only the left half, iteration " << it;
+    const auto& [id, count] = *mine->second.begin();
+    ASSERT_EQ(regions.count(id), 1u);
+    EXPECT_EQ(count, regions.at(id)) << "iteration " << it;
+    EXPECT_LT(count, sum);
+  }
+  EXPECT_GT(total, 1000);
+}
+
+TEST(FluidModule, ParticleRegionsBeyondTheGridAreRefused) {
+  TempDir dir;
+  const auto app = dir.write(
+      "regions.xml",
+      application(fluidModule("      <param name=\"particle-regions\" value=\"17 1 1\"/>\n"), ""));
+  const auto result = runVrflow({"run", app, "--iterations", "3", "--no-progress"}, 60);
+  EXPECT_NE(result.exitCode, 0);
+  EXPECT_NE(result.err.find("particle-regions"), std::string::npos) << result.err;
 }
 
 TEST(FluidModule, AbsurdTimeStepStopsTheRunWithTheSolversMessage) {

@@ -446,6 +446,87 @@ TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
   EXPECT_EQ(byIteration(dir.file("v2.csv")).at(3).size(), 16u + 8u) << "all: 8 meshes, 16 bodies";
 }
 
+// A dynamic resource (a fluid region's particles, say) reaches a receiver only while it holds
+// an object that refers to it: one body with a dynamic mesh re-sent every iteration (vertex 0's
+// x = the iteration) moves along x through a volume, leaves, wraps around and comes back. The
+// volume's receiver gets the mesh with every update of the body it holds, nothing between, and
+// on re-entry the newest copy, before the body's entry; the receiver of everything gets every
+// copy.
+TEST_F(Patterns, RouteSendsDynamicResourcesOnlyWhileTheirObjectsAreInTheVolume) {
+  std::string modules = moduleXml(
+      "scene", "routing/movers",
+      paramXml("count", "1") + paramXml("meshes", "1") + paramXml("mesh-triangles", "4") +
+          paramXml("width", "4") + paramXml("dt", "0.1") + paramXml("iterations", "120") +
+          paramXml("dynamic-meshes", "true") +
+          "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
+  std::string connections = connectXml("scene.objects", "wall.in");
+  const char* boxes[] = {"0 -1 -1 1 1 1", "all"};
+  for (int k = 0; k < 2; ++k) {
+    const std::string id = "v" + std::to_string(k);
+    modules += moduleXml(id, "routing/tile-viewer",
+                         paramXml("box", boxes[k]) + paramXml("file", dir.file(id + ".csv")));
+    connections += connectXml("wall.out" + std::to_string(k), id + ".objects") +
+                   connectXml(id + ".interest", "wall.interest" + std::to_string(k)) +
+                   connectXml(id + ".endIt", "scene.beginIt");
+  }
+  const auto result = run(dir.write(
+      "dynamic.xml",
+      appXml(modules, filterXml("wall", "route", paramXml("outputs", "2")), connections)));
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto all = byIteration(dir.file("v1.csv"));
+  const auto got = byIteration(dir.file("v0.csv"));
+  std::map<long, double> copyAt;  // iteration -> the copy of the mesh the scene sent then
+  for (const auto& [it, chunks] : all) {
+    int meshes = 0;
+    for (const auto& c : chunks) {
+      if (c.kind == "resource") {
+        copyAt[it] = c.x;
+        ++meshes;
+      }
+    }
+    EXPECT_EQ(meshes, 1) << "the receiver of everything gets every copy, iteration " << it;
+  }
+  ASSERT_GT(copyAt.size(), 100u);
+  long entries = 0, absent = 0;
+  bool held = false;
+  for (long it = 1; it < 120; ++it) {
+    const auto found = got.find(it);
+    bool body = false, mesh = false, meshFirst = false;
+    double copy = -1;
+    std::string op;
+    if (found != got.end()) {
+      for (const auto& c : found->second) {
+        if (c.kind == "resource") {
+          mesh = true;
+          copy = c.x;
+          meshFirst = !body;
+        } else if (c.kind == "object") {
+          body = true;
+          op = c.op;
+        }
+      }
+    }
+    const bool holds = body && op != "delete";
+    if (!body) ++absent;
+    if (holds && !held) {
+      ++entries;
+      EXPECT_EQ(op, "add") << "an entry brings the full state, iteration " << it;
+      EXPECT_TRUE(meshFirst) << "the mesh comes before the body, iteration " << it;
+    }
+    if (holds) {
+      EXPECT_TRUE(mesh) << "the newest mesh with the body it holds, iteration " << it;
+      if (copyAt.count(it) != 0) {
+        EXPECT_EQ(copy, copyAt[it]) << "iteration " << it;
+      }
+    } else {
+      EXPECT_FALSE(mesh) << "no mesh for a body it does not hold, iteration " << it;
+    }
+    held = holds;
+  }
+  EXPECT_EQ(entries, 2) << "the body enters, leaves and enters again";
+  EXPECT_GT(absent, 20) << "and stays away a while";
+}
+
 // core/points: a point's bounds are its position. Four points at rest at x = 0, 1, 2, 3; a
 // volume over x in [-0.5, 1.5] gets points 0 and 1 only (their full state first: the add's
 // mass with the latest position and velocity), every iteration.

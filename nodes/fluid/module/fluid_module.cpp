@@ -2,8 +2,13 @@
 // In: `objects` (rigid bodies with their shape resources; mass-spring nets when node-radius > 0).
 // Out: `forces` (one force event per coupled rigid body per iteration, duration = dt, and one
 // massspring node-forces event per net) and
-// `objects` (its own fluid object, then its particles as a dynamic Mesh resource of xyz floats
-// with no triangles).
+// `fluid` (its own fluid object, then its particles as a dynamic Mesh resource of xyz floats
+// with no triangles; with `particle-regions` a b c, one fluid object per box of an a x b x c
+// split of the grid, each with its own particles and the bounds of them, so that a route
+// filter sends a viewer only the regions it sees).
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -27,6 +32,68 @@ bool parseVec3(const std::string& text, msg::Vec3& out) {
   out = v;
   return true;
 }
+
+bool parseCounts(const std::string& text, std::array<int, 3>& out) {
+  std::istringstream in(text);
+  std::array<int, 3> v{};
+  std::string rest;
+  if (!(in >> v[0] >> v[1] >> v[2]) || (in >> rest)) return false;
+  out = v;
+  return true;
+}
+
+// The particles cut into the boxes of an a x b x c split of the grid's bounds, in their order,
+// with each box's bounds: those of its particles, or the box itself when it holds none.
+struct Regions {
+  std::array<int, 3> counts{1, 1, 1};
+  msg::Aabb grid{};
+  std::vector<std::vector<float>> xyz;
+  std::vector<msg::Aabb> bounds;
+
+  int size() const { return counts[0] * counts[1] * counts[2]; }
+
+  msg::Aabb box(int r) const {
+    const std::array<int, 3> cell{r % counts[0], (r / counts[0]) % counts[1],
+                                  r / (counts[0] * counts[1])};
+    msg::Aabb b{};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const double step = (grid.max[a] - grid.min[a]) / counts[a];
+      b.min[a] = grid.min[a] + step * cell[a];
+      b.max[a] = cell[a] + 1 == counts[a] ? grid.max[a] : grid.min[a] + step * (cell[a] + 1);
+    }
+    return b;
+  }
+
+  void split(const std::vector<float>& all) {
+    xyz.assign(static_cast<std::size_t>(size()), {});
+    std::vector<msg::Aabb> tight(xyz.size());
+    std::vector<bool> any(xyz.size(), false);
+    for (std::size_t i = 0; i + 2 < all.size(); i += 3) {
+      int r = 0, stride = 1;
+      for (std::size_t a = 0; a < 3; ++a) {
+        const double t = (all[i + a] - grid.min[a]) / (grid.max[a] - grid.min[a]);
+        const int k = std::clamp(static_cast<int>(std::floor(t * counts[a])), 0, counts[a] - 1);
+        r += k * stride;
+        stride *= counts[a];
+      }
+      auto& out = xyz[static_cast<std::size_t>(r)];
+      out.insert(out.end(), all.begin() + static_cast<std::ptrdiff_t>(i),
+                 all.begin() + static_cast<std::ptrdiff_t>(i + 3));
+      auto& b = tight[static_cast<std::size_t>(r)];
+      for (std::size_t a = 0; a < 3; ++a) {
+        const double v = all[i + a];
+        b.min[a] = any[static_cast<std::size_t>(r)] ? std::min(b.min[a], v) : v;
+        b.max[a] = any[static_cast<std::size_t>(r)] ? std::max(b.max[a], v) : v;
+      }
+      any[static_cast<std::size_t>(r)] = true;
+    }
+    bounds.resize(xyz.size());
+    for (int r = 0; r < size(); ++r) {
+      const auto k = static_cast<std::size_t>(r);
+      bounds[k] = any[k] ? tight[k] : box(r);
+    }
+  }
+};
 
 int fail(const std::string& message) {
   std::fprintf(stderr, "vrflow-fluid: %s\n", message.c_str());
@@ -69,6 +136,18 @@ int main(int argc, char** argv) {
   const double dt = module.paramDouble("dt", 0.01);
   const auto particlesEvery = module.paramInt("particles-every", 1);
   const double nodeRadius = module.paramDouble("node-radius", 0.0);
+  Regions regions;
+  if (!parseCounts(module.param("particle-regions", "1 1 1"), regions.counts)) {
+    return fail("particle-regions must be three whole numbers (boxes along x, y and z)");
+  }
+  for (std::size_t a = 0; a < 3; ++a) {
+    const int cells = a == 0 ? s.nx : a == 1 ? s.ny : s.nz;
+    if (regions.counts[a] < 1 || regions.counts[a] > cells) {
+      return fail("particle-regions: " + std::to_string(regions.counts[a]) + " boxes along " +
+                  "xyz"[a] + " (there must be 1 to " + std::to_string(cells) +
+                  ", the grid's cells)");
+    }
+  }
 
   const auto blocks = module.paramInt("blocks", 1);
 
@@ -97,8 +176,12 @@ int main(int argc, char** argv) {
   }
 
   fluid::World world(nodeRadius);
-  const std::uint64_t fluidId = module.newId();
-  const std::uint64_t particlesId = module.newId();
+  regions.grid = solver.bounds();
+  std::vector<std::uint64_t> fluidIds, particlesIds;
+  for (int r = 0; r < regions.size(); ++r) {
+    fluidIds.push_back(module.newId());
+    particlesIds.push_back(module.newId());
+  }
   bool warnedUncoupled = false;
   double time = 0.0;
   while (module.wait()) {
@@ -148,16 +231,29 @@ int main(int argc, char** argv) {
     if (!module.put(forcesOut, std::move(forces))) break;
 
     const auto& xyz = stepped->particles;
-    auto out = module.newMessage(512 + (sendParticles ? xyz.size() * sizeof(float) : 0));
+    auto out = module.newMessage(512 + 160 * fluidIds.size() +
+                                 (sendParticles ? xyz.size() * sizeof(float) : 0));
     out.builder().setSimTime(time);
     out.builder().setTimeStep(dt);
-    if (module.iteration() == 0) {
-      out.builder()
-          .addObject(fluidId, msg::fluidType(), msg::ObjectOp::Add)
-          .set(msg::FluidParam::kBounds, solver.bounds())
-          .set(msg::FluidParam::kParticles, particlesId);
+    const bool split = regions.size() > 1;
+    if (split && sendParticles) regions.split(xyz);
+    for (std::size_t r = 0; r < fluidIds.size(); ++r) {
+      // One region: the object's bounds are the grid's, sent once. Regions: the bounds of their
+      // particles, sent with every copy of them (the meshes first, as a route filter wants).
+      if (module.iteration() == 0 || (split && sendParticles)) {
+        const bool add = module.iteration() == 0;
+        const msg::Aabb bounds = !split             ? solver.bounds()
+                                 : !regions.bounds.empty() ? regions.bounds[r]
+                                                           : regions.box(static_cast<int>(r));
+        if (sendParticles) out.builder().addMesh(particlesIds[r], true, split ? regions.xyz[r] : xyz, {});
+        auto object = out.builder().addObject(fluidIds[r], msg::fluidType(),
+                                              add ? msg::ObjectOp::Add : msg::ObjectOp::Update);
+        object.set(msg::FluidParam::kBounds, bounds);
+        if (add) object.set(msg::FluidParam::kParticles, particlesIds[r]);
+      } else if (sendParticles) {
+        out.builder().addMesh(particlesIds[r], true, xyz, {});
+      }
     }
-    if (sendParticles) out.builder().addMesh(particlesId, true, xyz, {});
     if (!module.put(objectsOut, std::move(out))) break;
 
     if (stats.is_open()) {

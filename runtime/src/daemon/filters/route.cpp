@@ -1,7 +1,9 @@
 // route: dynamic routing by bounding volume. Each receiver k publishes its volume of interest
 // on interest{k}; out{k} gets only the object chunks of objects whose bounds meet it, the full
 // current state of an object when it enters the volume, and the resources such objects refer
-// to, once (then their updates).
+// to, once, then their updates while it holds an object that refers to them (a receiver whose
+// objects all left stops getting a dynamic resource's updates, and gets its newest copy if one
+// comes back: a dynamic resource such as a fluid region's particles costs only the tiles that see it).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -307,9 +309,15 @@ class RouteFilter final : public Filter {
         case msg::ChunkKind::Resource: {
           const auto bytes = chunk.bytes();
           resources_[id].assign(bytes.begin(), bytes.end());
+          const auto resource = chunk.asResource();
+          const bool dynamic = resource && resource->dynamic();
           for (auto& receiver : receivers_) {
             if (receiver.resources.count(id) != 0) {
-              receiver.actions.push_back({Action::Chunk, index});  // an update of one it has
+              if (!dynamic || holdsReferrer(receiver, id)) {
+                receiver.actions.push_back({Action::Chunk, index});  // an update of one it has
+              } else {
+                receiver.resources.erase(id);  // no longer needed; resent on re-entry
+              }
             } else if (receiver.wanted.erase(id) != 0 && holdsReferrer(receiver, id)) {
               receiver.resources.insert(id);
               receiver.actions.push_back({Action::Chunk, index});
