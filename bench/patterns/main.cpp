@@ -241,9 +241,13 @@ void replaceAll(std::string& text, const std::string& from, const std::string& t
   }
 }
 
-bool demoRouting(const Context& ctx, const std::string& mode, int iterations) {
+// The demo scene on examples/routed_wall's 2 x 2 wall: `scene` "demo" (direct_wall.xml,
+// routed_wall.xml) or "demo-fluid" (direct_fluid_wall.xml, routed_fluid_wall.xml).
+bool demoRouting(const Context& ctx, const std::string& scene, const std::string& mode,
+                 int iterations) {
   const fs::path folder = fs::path(VRFLOW_SOURCE_DIR) / "examples" / "routed_wall";
-  std::ifstream in(folder / (mode == "none" ? "direct_wall.xml" : "routed_wall.xml"));
+  const std::string kind = scene == "demo" ? "" : "fluid_";
+  std::ifstream in(folder / ((mode == "none" ? "direct_" : "routed_") + kind + "wall.xml"));
   if (!in) {
     std::fprintf(stderr, "vrflow-bench-patterns: cannot read the routed_wall example in %s\n",
                  folder.c_str());
@@ -252,16 +256,15 @@ bool demoRouting(const Context& ctx, const std::string& mode, int iterations) {
   std::stringstream text;
   text << in.rdbuf();
   std::string xml = text.str();
-  replaceAll(xml, "\"../paper_scene/scene.json\"",
-             "\"" + (folder.parent_path() / "paper_scene" / "scene.json").string() + "\"");
+  replaceAll(xml, "\"../paper_scene/", "\"" + (folder.parent_path() / "paper_scene").string() + "/");
   replaceAll(xml, param("width", "480"), param("width", "96"));
   replaceAll(xml, param("height", "270"), param("height", "54"));
-  const std::string frames = (ctx.work / ("frames-" + mode)).string();
-  for (const char* dir : {"routed-wall", "direct-wall"}) {
+  const std::string frames = (ctx.work / ("frames-" + scene + "-" + mode)).string();
+  for (const char* dir : {"routed-wall", "direct-wall", "routed-fluid-wall", "direct-fluid-wall"}) {
     replaceAll(xml, param("output-dir", dir),
                param("output-dir", frames) + param("format", "png") + param("supersample", "1"));
   }
-  const std::string name = "demo-routing-" + mode + "-" + std::to_string(iterations);
+  const std::string name = scene + "-routing-" + mode + "-" + std::to_string(iterations);
   const fs::path app = ctx.work / (name + ".xml");
   std::ofstream(app) << xml;
   const fs::path reportFile = ctx.work / (name + ".json");
@@ -291,8 +294,8 @@ bool demoRouting(const Context& ctx, const std::string& mode, int iterations) {
   for (const double b : tiles) total += b;
   std::printf(
       "{\"pattern\":\"routing\",\"mode\":\"%s\",\"viewers\":4,\"bytes_per_iteration\":%.0f,"
-      "\"scene\":\"demo\",\"tiles\":[%.0f,%.0f,%.0f,%.0f]}\n",
-      mode.c_str(), total / iterations, tiles[0] / iterations, tiles[1] / iterations,
+      "\"scene\":\"%s\",\"tiles\":[%.0f,%.0f,%.0f,%.0f]}\n",
+      mode.c_str(), total / iterations, scene.c_str(), tiles[0] / iterations, tiles[1] / iterations,
       tiles[2] / iterations, tiles[3] / iterations);
   std::fflush(stdout);
   return true;
@@ -365,7 +368,13 @@ int main(int argc, char** argv) {
     for (const char* mode : {"none", "dynamic"}) ok = routing(oneHost, mode, bodies, iterations) && ok;
     if (fs::exists(ctx.bin / "vrflow-viewer")) {
       for (const char* mode : {"none", "dynamic"})
-        ok = demoRouting(oneHost, mode, demoIterations) && ok;
+        ok = demoRouting(oneHost, "demo", mode, demoIterations) && ok;
+      if (fs::exists(ctx.bin / "vrflow-fluid") &&
+          fs::exists(fs::path(VRFLOW_SOURCE_DIR) / "examples" / "routed_wall" /
+                     "routed_fluid_wall.xml")) {
+        for (const char* mode : {"none", "dynamic"})
+          ok = demoRouting(oneHost, "demo-fluid", mode, demoIterations) && ok;
+      }
     } else {
       std::fprintf(stderr,
                    "vrflow-bench-patterns: no vrflow-viewer beside this program (node "

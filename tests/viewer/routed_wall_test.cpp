@@ -36,7 +36,7 @@ std::string smallApplication(const std::string& name, const std::string& frames)
   replaceAll(app, "<param name=\"width\" value=\"480\"/>", "<param name=\"width\" value=\"96\"/>");
   replaceAll(app, "<param name=\"height\" value=\"270\"/>",
              "<param name=\"height\" value=\"54\"/>");
-  for (const char* dir : {"routed-wall", "direct-wall"}) {
+  for (const char* dir : {"routed-wall", "direct-wall", "routed-fluid-wall", "direct-fluid-wall"}) {
     replaceAll(app, "<param name=\"output-dir\" value=\"" + std::string(dir) + "\"/>",
                "<param name=\"output-dir\" value=\"" + frames +
                    "\"/><param name=\"format\" value=\"png\"/><param name=\"supersample\" "
@@ -60,14 +60,14 @@ struct WallRun {
 
 // Runs `app` (or the file `existing`, whose relative paths resolve beside it) in dir/name.
 WallRun runIn(const TempDir& dir, const std::string& name, const std::string& app,
-              const std::string& existing = "") {
+              const std::string& existing = "", int iterations = kIterations) {
   const auto folder = dir.file(name);
   fs::create_directories(folder);
   const auto file = existing.empty() ? dir.write(name + ".xml", app) : existing;
   const auto result = vrflow::testing::runCommand(
       {"/bin/sh", "-c",
        "cd '" + folder + "' && exec '" + vrflow::testing::binDir() + "/vrflow' run '" + file +
-           "' -n " + std::to_string(kIterations) + " --no-progress --report report.json"},
+           "' -n " + std::to_string(iterations) + " --no-progress --report report.json"},
       120);
   EXPECT_EQ(result.exitCode, 0) << result.err;
   WallRun run;
@@ -179,6 +179,55 @@ TEST(RoutedWall, EachTileGetsFewerBytesAndDrawsTheSameFramesAndTheSimulationIsUn
   EXPECT_EQ(digests, simulationDigests(demo.report));
   EXPECT_EQ(withRoute.bodiesState, demo.bodiesState);
   EXPECT_EQ(withRoute.netState, demo.netState);
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+}
+
+// The demo scene with its fluid seen from above (routed_fluid_wall.xml, direct_fluid_wall.xml):
+// the liquid's particles are most of the bytes, and as 4 x 1 x 4 regions whose seams fall on
+// the tiles' (x = 1.25, z = 0), each tile receives about a quarter of them.
+TEST(RoutedWall, WithTheFluidEachTileGetsAtLeast3xFewerBytesTheSameFramesAndTheSameSimulation) {
+  constexpr int kFluidIterations = 20;
+  TempDir dir;
+  const std::string routed = smallApplication("routed_fluid_wall.xml", dir.file("routed/frames"));
+  const std::string directApp =
+      smallApplication("direct_fluid_wall.xml", dir.file("direct/frames"));
+  ASSERT_EQ(modulesOf(smallApplication("routed_fluid_wall.xml", "FRAMES")),
+            modulesOf(smallApplication("direct_fluid_wall.xml", "FRAMES")));
+  const WallRun withRoute = runIn(dir, "routed", routed, "", kFluidIterations);
+  const WallRun direct = runIn(dir, "direct", directApp, "", kFluidIterations);
+  ASSERT_EQ(withRoute.report["status"], "ok");
+  ASSERT_EQ(direct.report["status"], "ok");
+  const auto routedBytes = bytesToTiles(withRoute.report);
+  const auto directBytes = bytesToTiles(direct.report);
+  ASSERT_EQ(routedBytes.size(), 4u);
+  ASSERT_EQ(directBytes.size(), 4u);
+  for (const auto& [tile, bytes] : routedBytes) {
+    std::printf("%s: %.0f bytes/iteration routed, %.0f direct (%.2fx less)\n", tile.c_str(),
+                bytes / kFluidIterations, directBytes.at(tile) / kFluidIterations,
+                directBytes.at(tile) / bytes);
+    EXPECT_GT(directBytes.at(tile), 3.0 * bytes) << tile;
+  }
+  // The same pictures: a particle region a tile is not sent lies outside its view.
+  int identical = 0;
+  for (int k = 0; k < 4; ++k) {
+    const std::string tile = "tile" + std::to_string(k);
+    EXPECT_EQ(framesOf(dir.file("routed/frames"), tile), std::size_t{kFluidIterations}) << tile;
+    for (int i = 0; i < kFluidIterations; ++i) {
+      char name[64];
+      std::snprintf(name, sizeof name, "/frames/%s_%06d.png", tile.c_str(), i);
+      const auto routedFrame = vrflow::testing::readFile(dir.file("routed") + name);
+      if (!routedFrame.empty() &&
+          routedFrame == vrflow::testing::readFile(dir.file("direct") + name)) {
+        ++identical;
+      }
+    }
+  }
+  EXPECT_EQ(identical, 4 * kFluidIterations) << "frames differ between routed and direct tiles";
+  const auto digests = simulationDigests(withRoute.report);
+  EXPECT_TRUE(digests.contains("water.fluid") && digests.contains("water.forces"));
+  EXPECT_EQ(digests, simulationDigests(direct.report));
+  EXPECT_EQ(withRoute.bodiesState, direct.bodiesState);
+  EXPECT_EQ(withRoute.netState, direct.netState);
   EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
 }
 
