@@ -208,6 +208,34 @@ TEST(Catalog, EnumParameterNeedsChoices) {
       << status.error().message;
 }
 
+// mpi-ranks names the int parameter that gives a module's MPI ranks (vrflow then starts it
+// through mpirun); naming anything else is an error at the attribute.
+TEST(Catalog, MpiRanksNamesAnIntParameter) {
+  Catalog catalog;
+  ASSERT_TRUE(catalog
+                  .addPackageString("<package name=\"p\">\n  <module type=\"m\" executable=\"x\" "
+                                    "mpi-ranks=\"blocks\">\n    <param name=\"blocks\" "
+                                    "type=\"int\" default=\"1\" min=\"1\"/>\n  </module>\n</package>\n",
+                                    "pkg.xml")
+                  .ok());
+  const auto* type = catalog.findModule("p", "m");
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->mpiRanksParam, "blocks");
+  for (const char* param : {"<param name=\"blocks\" type=\"float\"/>", ""}) {
+    Catalog bad;
+    const Status status = bad.addPackageString(
+        std::string("<package name=\"q\">\n  <module type=\"m\" executable=\"x\" "
+                    "mpi-ranks=\"blocks\">\n    ") +
+            param + "\n  </module>\n</package>\n",
+        "bad.xml");
+    ASSERT_FALSE(status.ok());
+    EXPECT_EQ(status.error().message.rfind("bad.xml:2:", 0), 0u) << status.error().message;
+    EXPECT_NE(status.error().message.find("mpi-ranks names 'blocks', which is not an int parameter"),
+              std::string::npos)
+        << status.error().message;
+  }
+}
+
 TEST(Catalog, SamePackageFromAnotherFileIsAnError) {
   Catalog catalog;
   ASSERT_TRUE(catalog.addPackageFile(packagesDir() + "/core/vrflow-package.xml").ok());

@@ -1,6 +1,11 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cctype>
+#include <filesystem>
 #include <cstdio>
 #include <cstdlib>  // unsetenv
 #include <map>
@@ -110,12 +115,49 @@ TEST(FluidModule, LightBoxFloatsThroughTheAnimatorInteractorCycle) {
 // (block-Jacobi preconditioner, sums at block borders), and a particle that crosses a cell
 // border in one run and not the other changes the cell classification discretely, so the paths
 // drift apart slowly: the stated tolerance is 1e-3 m (2 % of a cell) after 100 iterations.
-TEST(FluidModule, TwoBlocksSpawnedByTheModuleFollowTheSerialPath) {
+// Waits up to 5 s while an `orted` is a child of this process (an orphan handed to this test,
+// which is a subreaper), and reaps it.
+void waitForOrtedToExit() {
+  for (int round = 0; round < 100; ++round) {
+    bool any = false;
+    for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
+      const auto name = entry.path().filename().string();
+      if (name.empty() || !std::isdigit(static_cast<unsigned char>(name[0]))) continue;
+      const auto stat = readLines(entry.path().string() + "/stat");
+      const auto close = stat.empty() ? std::string::npos : stat[0].rfind(')');
+      if (close == std::string::npos) continue;
+      std::istringstream rest(stat[0].substr(close + 2));
+      char state = 0;
+      int parent = 0;
+      rest >> state >> parent;
+      if (parent != getpid() || stat[0].find("(orted)") == std::string::npos) continue;
+      if (state == 'Z') {
+        waitpid(std::stoi(name), nullptr, 0);  // it exited: reap it
+      } else {
+        any = true;
+      }
+    }
+    if (!any) return;
+    usleep(50000);
+  }
+}
+
+// Two blocks, started both ways: by vrflow through mpirun (the manifest's mpi-ranks="blocks";
+// VRFLOW_MPIRUN names a wrapper that logs its arguments and runs the real mpirun), and, with
+// VRFLOW_MPIRUN=none, by the module itself through MPI_Comm_spawn.
+TEST(FluidModule, TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath) {
   // Spawned ranks are another MPI job: Open MPI's shared-memory BTL does not connect jobs, so
   // they talk over TCP loopback; leave the BTL choice to Open MPI.
   unsetenv("OMPI_MCA_btl");
+  TempDir wrapperDir;
+  const auto log = wrapperDir.file("mpirun.log");
+  const auto wrapper =
+      wrapperDir.write("mpirun", "#!/bin/sh\necho \"$@\" >> '" + log + "'\nexec mpirun \"$@\"\n");
+  ASSERT_EQ(chmod(wrapper.c_str(), 0755), 0);
   std::vector<double> finalY;
-  for (int blocks : {1, 2}) {
+  for (const char* launcher : {"serial", wrapper.c_str(), "none"}) {
+    const int blocks = std::string(launcher) == "serial" ? 1 : 2;
+    setenv("VRFLOW_MPIRUN", launcher, 1);
     TempDir dir;
     const std::string box = R"(    <module id="box" package="fluidtest" type="box" host="local">
       <param name="trajectory" value=")" +
@@ -130,14 +172,42 @@ TEST(FluidModule, TwoBlocksSpawnedByTheModuleFollowTheSerialPath) {
                                   "    <connection from=\"box.objects\" to=\"water.objects\"/>\n"
                                   "    <connection from=\"water.forces\" to=\"box.events\"/>\n"));
     const auto result = runVrflow({"run", app, "--iterations", "100", "--no-progress"}, 180);
-    ASSERT_EQ(result.exitCode, 0) << blocks << " blocks: " << result.err;
+    unsetenv("VRFLOW_MPIRUN");
+    ASSERT_EQ(result.exitCode, 0) << launcher << ": " << result.err;
     const auto rows = readCsv(dir.file("box.csv"), false);
     ASSERT_GE(rows.size(), 100u);
     finalY.push_back(rows[99][1]);
   }
-  std::printf("box y after 100 iterations: 1 block %.9f, 2 blocks %.9f\n", finalY[0], finalY[1]);
+  // The wrapper ran once: for the mpirun case only, with 2 ranks of the fluid module.
+  const auto calls = readLines(log);
+  ASSERT_EQ(calls.size(), 1u);
+  EXPECT_NE(calls[0].find("-np 2"), std::string::npos) << calls[0];
+  EXPECT_NE(calls[0].find("vrflow-fluid"), std::string::npos) << calls[0];
+  std::printf("box y after 100 iterations: 1 block %.9f, 2 blocks via mpirun %.9f, spawned %.9f\n",
+              finalY[0], finalY[1], finalY[2]);
   EXPECT_NEAR(finalY[1], finalY[0], 1e-3);
+  EXPECT_NEAR(finalY[2], finalY[0], 1e-3);
+  EXPECT_EQ(finalY[1], finalY[2]) << "the same ranks and partition, however started";
   EXPECT_GT(std::abs(finalY[0] - 0.5), 0.01);  // it moved: the comparison is not of a box at rest
+  // The spawn path's singleton starts its own Open MPI daemon (orted), which exits on its own
+  // a moment after the module (it watches a pipe); the mpirun path leaves nothing.
+  waitForOrtedToExit();
+  const auto left = leftoverProcesses();
+  EXPECT_TRUE(left.empty()) << left.front();
+}
+
+// A module of several ranks whose launcher cannot be run: one clear error, nothing left behind.
+TEST(FluidModule, MissingMpirunIsAClearError) {
+  TempDir dir;
+  setenv("VRFLOW_MPIRUN", "/nonexistent/mpirun", 1);
+  const auto app = dir.write(
+      "blocks.xml", application(fluidModule("      <param name=\"blocks\" value=\"2\"/>\n"), ""));
+  const auto result = runVrflow({"run", app, "--iterations", "5", "--no-progress"}, 60);
+  unsetenv("VRFLOW_MPIRUN");
+  EXPECT_NE(result.exitCode, 0);
+  EXPECT_NE(result.err.find("mpirun"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("water"), std::string::npos) << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
 }
 
 // With the rigid package's own animator and gravity field: a 0.3 m box of density 500 floats

@@ -1,6 +1,7 @@
 #include "blocks.hpp"
 
 #include <mpi.h>
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -174,17 +175,26 @@ Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, in
   MPI_Init(&argc, &argv);
   MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   auto impl = std::make_unique<Impl>();
-  MPI_Comm inter;
-  char workerFlag[] = "--block-worker";
-  char* args[] = {workerFlag, nullptr};
-  std::vector<int> codes(static_cast<std::size_t>(blocks - 1));
-  const int rc = MPI_Comm_spawn(executable, args, blocks - 1, MPI_INFO_NULL, 0, MPI_COMM_SELF,
-                                &inter, codes.data());
-  if (rc != MPI_SUCCESS) {
-    MPI_Finalize();
-    return makeError(std::string("fluid: MPI_Comm_spawn of ") + executable + " failed");
+  if (mpirunRank() >= 0) {  // started by vrflow through mpirun: the workers are already there
+    int size = 0;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (size != blocks) {
+      MPI_Abort(MPI_COMM_WORLD, 2);  // the runtime starts exactly `blocks` ranks
+    }
+    MPI_Comm_dup(MPI_COMM_WORLD, &impl->world);
+  } else {
+    MPI_Comm inter;
+    char workerFlag[] = "--block-worker";
+    char* args[] = {workerFlag, nullptr};
+    std::vector<int> codes(static_cast<std::size_t>(blocks - 1));
+    const int rc = MPI_Comm_spawn(executable, args, blocks - 1, MPI_INFO_NULL, 0, MPI_COMM_SELF,
+                                  &inter, codes.data());
+    if (rc != MPI_SUCCESS) {
+      MPI_Finalize();
+      return makeError(std::string("fluid: MPI_Comm_spawn of ") + executable + " failed");
+    }
+    MPI_Intercomm_merge(inter, 0, &impl->world);
   }
-  MPI_Intercomm_merge(inter, 0, &impl->world);
   Setup setup{settings, fill};
   MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, impl->world);
   impl->comm = std::make_unique<MpiBlockComm>(impl->world);
@@ -217,18 +227,10 @@ void BlockGroup::stop() {
   MPI_Finalize();
 }
 
-int runBlockWorker(int argc, char** argv) {
-  prepareMpi();
-  MPI_Init(&argc, &argv);
-  MPI_Comm parent = MPI_COMM_NULL;
-  MPI_Comm_get_parent(&parent);
-  if (parent == MPI_COMM_NULL) {
-    std::fprintf(stderr, "vrflow-fluid --block-worker: not started by a fluid module\n");
-    MPI_Finalize();
-    return 2;
-  }
-  MPI_Comm world;
-  MPI_Intercomm_merge(parent, 1, &world);
+namespace {
+
+// A worker's life on `world` (rank 0 is the module): the setup, then steps until told to stop.
+int workerLoop(MPI_Comm world) {
   Setup setup;
   MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, world);
   MpiBlockComm comm(world);
@@ -249,6 +251,41 @@ int runBlockWorker(int argc, char** argv) {
   }
   MPI_Finalize();
   return 0;
+}
+
+}  // namespace
+
+int runBlockWorker(int argc, char** argv) {
+  prepareMpi();
+  MPI_Init(&argc, &argv);
+  MPI_Comm parent = MPI_COMM_NULL;
+  MPI_Comm_get_parent(&parent);
+  if (parent == MPI_COMM_NULL) {
+    std::fprintf(stderr, "vrflow-fluid --block-worker: not started by a fluid module\n");
+    MPI_Finalize();
+    return 2;
+  }
+  MPI_Comm world;
+  MPI_Intercomm_merge(parent, 1, &world);
+  return workerLoop(world);
+}
+
+int mpirunRank() {
+  if (std::getenv("VRFLOW_MPI_RANKS") == nullptr) return -1;
+  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK"}) {
+    if (const char* rank = std::getenv(name)) return std::atoi(rank);
+  }
+  return -1;
+}
+
+int runRankWorker(int argc, char** argv) {
+  // Die with rank 0's launcher as the module does; never touch the run's shared memory.
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  prepareMpi();
+  MPI_Init(&argc, &argv);
+  MPI_Comm world;
+  MPI_Comm_dup(MPI_COMM_WORLD, &world);
+  return workerLoop(world);
 }
 
 }  // namespace vrflow::fluid

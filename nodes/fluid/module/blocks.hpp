@@ -5,13 +5,17 @@
 
 #include "vrflow/fluid/solver.hpp"
 
-// The fluid module as several MPI blocks. The module process (started by vrflow like any module,
-// holding the run's shared memory) initialises MPI as a singleton and spawns `blocks - 1` copies
-// of its own executable with `--block-worker` (MPI_Comm_spawn); together they form one
-// communicator, rank 0 being the module. Each iteration rank 0 broadcasts the step (dt, bodies,
-// what to report) and every rank steps its slab; forces and particles come back to rank 0 through
-// the solver's collective calls. mpirun is not used: it would close the shared-memory descriptor
-// that a module inherits from vrflow.
+// The fluid module as several MPI blocks, rank 0 being the module vrflow talks to. Two ways to
+// start them:
+// - through mpirun (the usual one): the manifest's `mpi-ranks="blocks"` makes vrflow start the
+//   module as `mpirun -np blocks vrflow-fluid`; rank 0 joins the run (it opens the run's shared
+//   memory by VRFLOW_SEGMENT_PATH, since mpirun closes inherited descriptors), the other ranks
+//   run as workers on MPI_COMM_WORLD;
+// - without mpirun (VRFLOW_MPIRUN=none, or no Open MPI launcher): the module, started by vrflow
+//   like any other, initialises MPI as a singleton and spawns `blocks - 1` copies of its own
+//   executable with `--block-worker` (MPI_Comm_spawn); together they form one communicator.
+// Each iteration rank 0 broadcasts the step (dt, bodies, what to report) and every rank steps its
+// slab; forces and particles come back to rank 0 through the solver's collective calls.
 
 namespace vrflow::fluid {
 
@@ -59,5 +63,12 @@ class BlockGroup {
 
 /// A worker's main (the executable run with --block-worker).
 int runBlockWorker(int argc, char** argv);
+
+/// This process's rank when vrflow started the module through mpirun (VRFLOW_MPI_RANKS set),
+/// else -1.
+int mpirunRank();
+
+/// The main of ranks 1 ... N-1 of a module started through mpirun.
+int runRankWorker(int argc, char** argv);
 
 }  // namespace vrflow::fluid

@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "--block-worker") {
     return fluid::runBlockWorker(argc, argv);
   }
+  if (fluid::mpirunRank() > 0) return fluid::runRankWorker(argc, argv);  // blocks via mpirun
   Module module;
   auto& objectsIn = module.addInput("objects");
   auto& forcesOut = module.addOutput("forces");

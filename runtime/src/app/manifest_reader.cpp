@@ -104,7 +104,7 @@ std::string resolveExecutable(const std::string& executable, const std::string& 
 
 ModuleType readModuleType(const ReadContext& context, const pugi::xml_node& node,
                           const std::string& package) {
-  const ElementReader reader(context, node, {"type", "executable", "kind"});
+  const ElementReader reader(context, node, {"type", "executable", "kind", "mpi-ranks"});
   ModuleType type;
   type.package = package;
   type.type = reader.required("type");
@@ -145,6 +145,15 @@ ModuleType readModuleType(const ReadContext& context, const pugi::xml_node& node
                  }
                  type.ports.push_back(port);
                });
+  type.mpiRanksParam = reader.text("mpi-ranks");
+  if (!type.mpiRanksParam.empty()) {
+    const ParamSpec* param = type.findParam(type.mpiRanksParam);
+    if (param == nullptr || param->type != ParamType::Int) {
+      context.error(context.source.element(node).attribute("mpi-ranks"),
+                    "mpi-ranks names '" + type.mpiRanksParam + "', which is not an int " +
+                        "parameter of '" + type.type + "'");
+    }
+  }
   addImplicitPorts(type);
   return type;
 }

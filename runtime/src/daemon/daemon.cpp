@@ -4,6 +4,7 @@
 #include <atomic>
 #include <bit>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -195,6 +196,9 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
           found->second = (base / path).lexically_normal().string();
         }
       }
+    }
+    if (!type->mpiRanksParam.empty()) {  // validated as an int parameter in range
+      modules.back().mpiRanks = std::max(1, std::atoi(values[type->mpiRanksParam].c_str()));
     }
     std::string text;
     for (const auto& [name, value] : values) text += name + "=" + value + "\n";

@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -192,12 +193,24 @@ OutputPort& Module::addOutput(std::string name) {
 Status Module::init() {
   Impl& m = *impl_;
   const char* fdText = std::getenv("VRFLOW_SEGMENT_FD");
+  // A module started through mpirun (which closes inherited descriptors) opens the runtime's
+  // descriptor by its /proc path instead.
+  const char* pathText = std::getenv("VRFLOW_SEGMENT_PATH");
   const char* indexText = std::getenv("VRFLOW_MODULE_INDEX");
-  if (fdText == nullptr || indexText == nullptr) {
+  if ((fdText == nullptr && pathText == nullptr) || indexText == nullptr) {
     return makeError("this program is a vrflow module: start it through an application "
                      "(`vrflow run APP.xml`), not by hand");
   }
-  const int fd = std::atoi(fdText);
+  int fd = -1;
+  if (fdText != nullptr) {
+    fd = std::atoi(fdText);
+  } else {
+    fd = open(pathText, O_RDWR | O_CLOEXEC);
+    if (fd < 0) {
+      return makeError(std::string("cannot join the run: cannot open ") + pathText + ": " +
+                       std::strerror(errno));
+    }
+  }
   const long index = std::atol(indexText);
   auto segment = ipc::Segment::attach(fd);
   if (!segment) return makeError("cannot join the run: " + segment.error().message);

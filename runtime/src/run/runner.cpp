@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -351,10 +352,14 @@ RunOutcome Supervisor::run() {
   children_.resize(daemon_.modules().size());
   for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
     const auto& module = daemon_.modules()[i];
-    auto pid = spawnModule(module.executable, {}, fd,
-                           {"VRFLOW_SEGMENT_FD=" + std::to_string(fd),
-                            "VRFLOW_MODULE_INDEX=" + std::to_string(module.slotIndex),
-                            "VRFLOW_MODULE_ID=" + module.id, "VRFLOW_HOST=" + module.host});
+    std::vector<std::string> environment{
+        "VRFLOW_SEGMENT_FD=" + std::to_string(fd),
+        "VRFLOW_MODULE_INDEX=" + std::to_string(module.slotIndex), "VRFLOW_MODULE_ID=" + module.id,
+        "VRFLOW_HOST=" + module.host};
+    const char* mpirun = std::getenv("VRFLOW_MPIRUN");
+    const bool viaMpirun = module.mpiRanks > 1 && !(mpirun != nullptr && std::string(mpirun) == "none");
+    auto pid = viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, fd, environment)
+                         : spawnModule(module.executable, {}, fd, environment);
     if (!pid) {
       outcome = {kExitRunFailed, "failed", "module '" + module.id + "': " + pid.error().message};
       break;

@@ -74,6 +74,44 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
   return pid;
 }
 
+Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segmentFd,
+                             const std::vector<std::string>& extraEnvironment) {
+  const char* launcher = std::getenv("VRFLOW_MPIRUN");
+  const std::string mpirun = launcher != nullptr && *launcher != '\0' ? launcher : "mpirun";
+  std::vector<std::string> environment;
+  for (const auto& e : extraEnvironment) {
+    if (e.rfind("VRFLOW_SEGMENT_FD=", 0) != 0) environment.push_back(e);
+  }
+  environment.push_back("VRFLOW_SEGMENT_PATH=/proc/" + std::to_string(getpid()) + "/fd/" +
+                        std::to_string(segmentFd));
+  environment.push_back("VRFLOW_MPI_RANKS=" + std::to_string(ranks));
+  // More ranks than cores is allowed; ranks that wait yield the core. Root (containers, CI)
+  // must be allowed explicitly.
+  // CMA single copies need ptrace rights that containers often withhold: copy through the
+  // shared-memory transport's buffers instead.
+  std::vector<std::string> args{"-np", std::to_string(ranks), "--oversubscribe",
+                                "--mca", "mpi_yield_when_idle", "1",
+                                "--mca", "btl_vader_single_copy_mechanism", "none"};
+  if (geteuid() == 0) {
+    environment.push_back("OMPI_ALLOW_RUN_AS_ROOT=1");
+    environment.push_back("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1");
+  }
+  for (const auto& e : environment) {
+    if (e.rfind("VRFLOW_", 0) == 0) {
+      args.push_back("-x");
+      args.push_back(e.substr(0, e.find('=')));
+    }
+  }
+  args.push_back(executable);
+  auto pid = spawnModule(mpirun, args, -1, environment);
+  if (!pid) {
+    return makeError(pid.error().message + " (a module of " + std::to_string(ranks) +
+                     " MPI ranks is started through mpirun: install Open MPI, or set "
+                     "VRFLOW_MPIRUN)");
+  }
+  return pid;
+}
+
 std::string describeWaitStatus(int status) {
   if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
   if (WIFSIGNALED(status)) {

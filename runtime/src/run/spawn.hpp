@@ -15,6 +15,16 @@ namespace vrflow::run {
 Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::string>& args,
                           int inheritFd, const std::vector<std::string>& extraEnvironment);
 
+/// Starts `executable` as `ranks` MPI ranks of one job through Open MPI's `mpirun` (the
+/// environment variable VRFLOW_MPIRUN names another launcher; found on PATH otherwise), as
+/// spawnModule does for one process: the returned pid is mpirun's, in its own process group,
+/// killed if the runtime dies. mpirun closes inherited descriptors, so the ranks get the
+/// segment as VRFLOW_SEGMENT_PATH=/proc/<runtime pid>/fd/<fd> instead (rank 0 opens it and
+/// joins as the module; the others are its workers), and VRFLOW_MPI_RANKS=ranks. Every
+/// VRFLOW_* variable of `extraEnvironment` is exported to the ranks (`-x`).
+Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segmentFd,
+                             const std::vector<std::string>& extraEnvironment);
+
 /// "exited with status 3" / "was killed by signal 11 (Segmentation fault)".
 std::string describeWaitStatus(int status);
 

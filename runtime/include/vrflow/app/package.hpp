@@ -54,6 +54,10 @@ struct ModuleType {
   std::string type;
   std::string executable;  ///< absolute when found next to the manifest, else as written
   ModuleKind kind = ModuleKind::Other;
+  /// Empty, or the name of an int parameter: when a module's value of it is N > 1, the runtime
+  /// starts the module as N MPI ranks through `mpirun` (rank 0 is the module vrflow talks to;
+  /// the others are its workers). Manifest attribute `mpi-ranks`.
+  std::string mpiRanksParam;
   std::string doc;
   std::vector<PortSpec> ports;  ///< declared ports, then beginIt and endIt
   std::vector<ParamSpec> params;

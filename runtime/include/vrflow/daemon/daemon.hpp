@@ -43,6 +43,8 @@ struct ModuleProcess {
   std::string host;
   std::string executable;
   int slotIndex = 0;
+  /// Above 1: started as this many MPI ranks through mpirun (app::ModuleType::mpiRanksParam).
+  int mpiRanks = 1;
 };
 
 /// Counters of one connection, for the run report.
