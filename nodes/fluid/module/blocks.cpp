@@ -61,6 +61,7 @@ struct Reader {
 std::vector<char> encodeStep(const BlockStep& s) {
   Writer w;
   w.put(static_cast<std::uint8_t>(s.stop));
+  w.put(static_cast<std::uint8_t>(s.queryOnly));
   w.put(s.dt);
   w.put(static_cast<std::uint8_t>(s.gatherParticles));
   w.put(static_cast<std::uint8_t>(s.stats));
@@ -72,6 +73,9 @@ std::vector<char> encodeStep(const BlockStep& s) {
     w.put(b.linearVelocity);
     w.put(b.angularVelocity);
     w.put(b.mass);
+    // Kinematic bodies (mass 0) must stay kinematic on every block: a worker that took one for
+    // a dynamic body of mass 0 would refuse the step alone and leave rank 0 waiting.
+    w.put(static_cast<std::uint8_t>(b.kinematic));
     w.putBytes(msg::encodeShape(b.shape));
   }
   w.put(static_cast<std::uint64_t>(s.points.size()));
@@ -82,6 +86,7 @@ std::vector<char> encodeStep(const BlockStep& s) {
 bool decodeStep(const std::vector<char>& bytes, BlockStep& s) {
   Reader r{bytes};
   s.stop = r.get<std::uint8_t>() != 0;
+  s.queryOnly = r.get<std::uint8_t>() != 0;
   s.dt = r.get<double>();
   s.gatherParticles = r.get<std::uint8_t>() != 0;
   s.stats = r.get<std::uint8_t>() != 0;
@@ -95,6 +100,7 @@ bool decodeStep(const std::vector<char>& bytes, BlockStep& s) {
     b.linearVelocity = r.get<msg::Vec3>();
     b.angularVelocity = r.get<msg::Vec3>();
     b.mass = r.get<double>();
+    b.kinematic = r.get<std::uint8_t>() != 0;
     auto shape = msg::decodeShape(r.getBytes());
     if (!shape) return false;
     b.shape = std::move(*shape);
@@ -134,10 +140,12 @@ struct Setup {
 }  // namespace
 
 Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& s) {
-  auto forces = solver.step(s.dt, s.bodies, s.points);
-  if (!forces) return forces.error();
   BlockResult out;
-  out.forces = std::move(*forces);
+  if (!s.queryOnly) {
+    auto forces = solver.step(s.dt, s.bodies, s.points);
+    if (!forces) return forces.error();
+    out.forces = std::move(*forces);
+  }
   if (s.gatherParticles) out.particles = solver.gatherParticlePositions();
   if (s.stats) {
     out.volume = solver.liquidVolume();
