@@ -18,7 +18,9 @@ namespace {
 
 using nlohmann::json;
 
-json readJson(const std::string& path) { return json::parse(readFile(path)); }
+json readJson(const std::string& path) {
+  return json::parse(readFile(path));
+}
 
 // Processes the runs left behind, as one line for a failure message.
 std::string leftovers() {
@@ -64,9 +66,10 @@ TEST(DamBreakExample, KeepsItsVolumeWithinTwoPercentOverAThousandSteps) {
   ASSERT_EQ(all.size(), 1000u);
   double swing = 0.0;
   for (const double x : all) swing = std::max(swing, std::abs(x / v0 - 1.0));
-  std::printf("dam break: volume %.5f -> %.5f m^3 (%+.2f %%) after 1000 steps, largest swing "
-              "%.2f %%\n",
-              v0, v, 100.0 * (v / v0 - 1.0), 100.0 * swing);
+  std::printf(
+      "dam break: volume %.5f -> %.5f m^3 (%+.2f %%) after 1000 steps, largest swing "
+      "%.2f %%\n",
+      v0, v, 100.0 * (v / v0 - 1.0), 100.0 * swing);
   EXPECT_NEAR(v / v0, 1.0, 0.02);
   // The column broke: the liquid spread over the tank, lower than it started, and came to rest.
   const double cx = fluid["centroid"][0].get<double>(), cy = fluid["centroid"][1].get<double>();
@@ -109,8 +112,8 @@ TEST(DamBreakExample, TwoBlocksAgreeWithOneWithKinematicBodiesInTheTank) {
   json fluid[2], bodies[2];
   for (int run = 0; run < 2; ++run) {
     TempDir dir;
-    const auto app = exampleForTest("dam_break", "dam_break.xml",
-                                    {{"water.blocks", std::to_string(run + 1)}});
+    const auto app =
+        exampleForTest("dam_break", "dam_break.xml", {{"water.blocks", std::to_string(run + 1)}});
     const auto result = runApp(dir, app, 100, 120);
     ASSERT_EQ(result.exitCode, 0) << run + 1 << " blocks: " << result.err;
     fluid[run] = readJson(dir.file("dam_break-fluid.json"));
@@ -128,12 +131,13 @@ TEST(DamBreakExample, TwoBlocksAgreeWithOneWithKinematicBodiesInTheTank) {
   double crateGap = 0.0;
   ASSERT_EQ(bodies[0]["bodies"].size(), bodies[1]["bodies"].size());
   for (std::size_t b = 0; b < bodies[0]["bodies"].size(); ++b) {
-    crateGap = std::max(crateGap, distance(bodies[0]["bodies"][b]["position"],
-                                           bodies[1]["bodies"][b]["position"]));
+    crateGap = std::max(
+        crateGap, distance(bodies[0]["bodies"][b]["position"], bodies[1]["bodies"][b]["position"]));
   }
-  std::printf("dam break, 100 steps, 2 blocks vs 1: volume %+.4f %%, centroid %.2e m, crates "
-              "%.2e m\n",
-              100.0 * (v2 / v1 - 1.0), centroidGap, crateGap);
+  std::printf(
+      "dam break, 100 steps, 2 blocks vs 1: volume %+.4f %%, centroid %.2e m, crates "
+      "%.2e m\n",
+      100.0 * (v2 / v1 - 1.0), centroidGap, crateGap);
   EXPECT_NEAR(v2 / v1, 1.0, 0.005);
   EXPECT_LT(centroidGap, 0.002);
   EXPECT_LT(crateGap, 0.01);
@@ -157,10 +161,11 @@ TEST(BuoyancyExample, LightBoxFloatsHalfSubmergedAndHeavyBoxRestsOnTheFloor) {
   const auto& heavy = bodies["bodies"][6];
   const double level = fluid["level"].get<double>();
   const double submerged = fluid["bodies"][5]["submerged"].get<double>();
-  std::printf("buoyancy after 400 steps: level %.3f m, light box %.3f..%.3f m, submerged %.3f, "
-              "heavy box bottom %.4f m\n",
-              level, light["boundsMin"][1].get<double>(), light["boundsMax"][1].get<double>(),
-              submerged, heavy["boundsMin"][1].get<double>());
+  std::printf(
+      "buoyancy after 400 steps: level %.3f m, light box %.3f..%.3f m, submerged %.3f, "
+      "heavy box bottom %.4f m\n",
+      level, light["boundsMin"][1].get<double>(), light["boundsMax"][1].get<double>(), submerged,
+      heavy["boundsMin"][1].get<double>());
   EXPECT_NEAR(submerged, 0.5, 0.15);
   EXPECT_LT(std::abs(light["linearVelocity"][1].get<double>()), 0.05) << "settled";
   // Upright: a flat box of half the water's density is stable on its broad face (a 0.5 x 0.3 m

@@ -60,9 +60,10 @@ TEST(PaperSceneFluid, SixtyIterationsKeepBodiesInTheWorldTheLiquidInItsPoolAndDr
   EXPECT_EQ(fluid["steps"].get<int>(), kIterations);
   EXPECT_EQ(fluid["particles"].get<int>(), 32 * 14 * 32 * 8) << "the pool as filled";
   const double v0 = fluid["initialVolume"].get<double>(), v = fluid["volume"].get<double>();
-  std::printf("paper scene with fluid, %d iterations: volume %.4f -> %.4f m^3, level %.3f m, "
-              "fastest particle %.2f m/s\n",
-              kIterations, v0, v, fluid["level"].get<double>(), fluid["maxSpeed"].get<double>());
+  std::printf(
+      "paper scene with fluid, %d iterations: volume %.4f -> %.4f m^3, level %.3f m, "
+      "fastest particle %.2f m/s\n",
+      kIterations, v0, v, fluid["level"].get<double>(), fluid["maxSpeed"].get<double>());
   EXPECT_NEAR(v / v0, 1.0, 0.02);
   EXPECT_NEAR(fluid["level"].get<double>(), 0.875, 0.06);
   EXPECT_LT(fluid["maxSpeed"].get<double>(), 5.0);

@@ -14,13 +14,13 @@ namespace vrflow::fluid {
 
 /// Everything the state file reports; filled by the module at the end of the run.
 struct FinalState {
-  double time = 0.0;            ///< simulated seconds
-  unsigned long long steps = 0;  ///< steps taken
-  FluidSettings settings;       ///< grid, for the surface level's columns
-  double initialVolume = 0.0;   ///< liquidVolume() before the first step (m^3)
-  double volume = 0.0;          ///< liquidVolume() at the end (m^3)
-  double maxSpeed = 0.0;        ///< largest particle speed at the end (m/s)
-  std::vector<float> particles;  ///< every particle's xyz at the end
+  double time = 0.0;              ///< simulated seconds
+  unsigned long long steps = 0;   ///< steps taken
+  FluidSettings settings;         ///< grid, for the surface level's columns
+  double initialVolume = 0.0;     ///< liquidVolume() before the first step (m^3)
+  double volume = 0.0;            ///< liquidVolume() at the end (m^3)
+  double maxSpeed = 0.0;          ///< largest particle speed at the end (m/s)
+  std::vector<float> particles;   ///< every particle's xyz at the end
   std::vector<RigidBody> bodies;  ///< the bodies of the last step
   std::vector<BodyForce> forces;  ///< their forces of the last step (same order, then nodes)
 };
