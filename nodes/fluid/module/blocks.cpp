@@ -253,7 +253,12 @@ int runBlockWorker(int argc, char** argv) {
       MPI_Abort(world, 3);
     }
     if (s.stop) break;
-    if (!stepBlock(*solver, s)) break;  // rank 0 fails the same way and reports it
+    // Rank 0 normally fails the same way and reports it; say it here too, in case this block
+    // failed alone (rank 0 would then wait for it in a collective call).
+    if (auto stepped = stepBlock(*solver, s); !stepped) {
+      std::fprintf(stderr, "vrflow-fluid --block-worker: %s\n", stepped.error().message.c_str());
+      break;
+    }
   }
   MPI_Finalize();
   return 0;
