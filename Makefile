@@ -47,12 +47,12 @@ demo: build
 	    || echo "could not install $$missing: the demo writes PNG frames instead of a video"; \
 	fi
 	@rm -rf out/demo && mkdir -p out/demo
-	cd out/demo && $(abspath $(BUILD))/bin/vrflow run $(CURDIR)/examples/paper_scene/paper_scene.xml \
+	cd out/demo && $(abspath $(BUILD))/bin/vrflow run $(CURDIR)/examples/paper_scene/paper_scene_fluid.xml \
 	  --iterations 300 --no-progress --report report.json
 	@cd out/demo && if [ -f demo.mp4 ]; then \
 	  ffmpeg -loglevel error -y -sseof -0.2 -i demo.mp4 -frames:v 1 -update 1 frame.png; \
 	else cp "$$(ls demo_*.png | tail -1)" frame.png; fi
-	@QT_QPA_PLATFORM=offscreen $(BUILD)/bin/vrflow-editor examples/paper_scene/paper_scene.xml \
+	@QT_QPA_PLATFORM=offscreen $(BUILD)/bin/vrflow-editor examples/paper_scene/paper_scene_fluid.xml \
 	  --screenshot out/demo/editor.png >/dev/null 2>&1 || echo "(no editor screenshot)"
 	@echo "demo results in out/demo/: $$(cd out/demo && ls demo.mp4 2>/dev/null || echo PNG frames), frame.png, editor.png, report.json"
 

@@ -62,6 +62,7 @@ struct Reader {
 std::vector<char> encodeStep(const BlockStep& s) {
   Writer w;
   w.put(static_cast<std::uint8_t>(s.stop));
+  w.put(static_cast<std::uint8_t>(s.queryOnly));
   w.put(s.dt);
   w.put(static_cast<std::uint8_t>(s.gatherParticles));
   w.put(static_cast<std::uint8_t>(s.stats));
@@ -73,6 +74,9 @@ std::vector<char> encodeStep(const BlockStep& s) {
     w.put(b.linearVelocity);
     w.put(b.angularVelocity);
     w.put(b.mass);
+    // Kinematic bodies (mass 0) must stay kinematic on every block: a worker that took one for
+    // a dynamic body of mass 0 would refuse the step alone and leave rank 0 waiting.
+    w.put(static_cast<std::uint8_t>(b.kinematic));
     w.putBytes(msg::encodeShape(b.shape));
   }
   w.put(static_cast<std::uint64_t>(s.points.size()));
@@ -83,6 +87,7 @@ std::vector<char> encodeStep(const BlockStep& s) {
 bool decodeStep(const std::vector<char>& bytes, BlockStep& s) {
   Reader r{bytes};
   s.stop = r.get<std::uint8_t>() != 0;
+  s.queryOnly = r.get<std::uint8_t>() != 0;
   s.dt = r.get<double>();
   s.gatherParticles = r.get<std::uint8_t>() != 0;
   s.stats = r.get<std::uint8_t>() != 0;
@@ -96,6 +101,7 @@ bool decodeStep(const std::vector<char>& bytes, BlockStep& s) {
     b.linearVelocity = r.get<msg::Vec3>();
     b.angularVelocity = r.get<msg::Vec3>();
     b.mass = r.get<double>();
+    b.kinematic = r.get<std::uint8_t>() != 0;
     auto shape = msg::decodeShape(r.getBytes());
     if (!shape) return false;
     b.shape = std::move(*shape);
@@ -135,10 +141,12 @@ struct Setup {
 }  // namespace
 
 Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& s) {
-  auto forces = solver.step(s.dt, s.bodies, s.points);
-  if (!forces) return forces.error();
   BlockResult out;
-  out.forces = std::move(*forces);
+  if (!s.queryOnly) {
+    auto forces = solver.step(s.dt, s.bodies, s.points);
+    if (!forces) return forces.error();
+    out.forces = std::move(*forces);
+  }
   if (s.gatherParticles) out.particles = solver.gatherParticlePositions();
   if (s.stats) {
     out.volume = solver.liquidVolume();
@@ -247,7 +255,12 @@ int workerLoop(MPI_Comm world) {
       MPI_Abort(world, 3);
     }
     if (s.stop) break;
-    if (!stepBlock(*solver, s)) break;  // rank 0 fails the same way and reports it
+    // Rank 0 normally fails the same way and reports it; say it here too, in case this block
+    // failed alone (rank 0 would then wait for it in a collective call).
+    if (auto stepped = stepBlock(*solver, s); !stepped) {
+      std::fprintf(stderr, "vrflow-fluid --block-worker: %s\n", stepped.error().message.c_str());
+      break;
+    }
   }
   MPI_Finalize();
   return 0;

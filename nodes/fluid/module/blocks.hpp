@@ -22,6 +22,7 @@ namespace vrflow::fluid {
 /// What rank 0 asks of every block for one iteration.
 struct BlockStep {
   bool stop = false;
+  bool queryOnly = false;  ///< no step: only the queries below (the final state)
   double dt = 0.0;
   std::vector<RigidBody> bodies;
   std::vector<PointMass> points;

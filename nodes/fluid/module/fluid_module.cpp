@@ -15,6 +15,7 @@
 #include <string>
 
 #include "blocks.hpp"
+#include "final_state.hpp"
 #include "node_forces.hpp"
 #include "vrflow/fluid/solver.hpp"
 #include "vrflow/message/builtin_types.hpp"
@@ -176,6 +177,19 @@ int main(int argc, char** argv) {
              "max_particle_speed,bodies\n";
   }
 
+  // The final state needs the volume before the first step; a query-only step is collective.
+  const std::string statePath = module.param("state-file");
+  fluid::FinalState finalState;
+  finalState.settings = s;
+  if (!statePath.empty()) {
+    fluid::BlockStep query;
+    query.queryOnly = true;
+    query.stats = true;
+    auto queried = group ? group->step(query) : fluid::stepBlock(solver, query);
+    if (!queried) return fail(queried.error().message);
+    finalState.initialVolume = queried->volume;
+  }
+
   fluid::World world(nodeRadius);
   regions.grid = solver.bounds();
   std::vector<std::uint64_t> fluidIds, particlesIds;
@@ -212,6 +226,11 @@ int main(int argc, char** argv) {
     auto stepped = group ? group->step(request) : fluid::stepBlock(solver, request);
     if (!stepped) return fail(stepped.error().message);
     time += dt;
+    if (!statePath.empty()) {
+      finalState.bodies = bodies;
+      finalState.forces = stepped->forces;
+      ++finalState.steps;
+    }
 
     auto forces = module.newMessage(256 + 128 * bodies.size());
     forces.builder().setSimTime(time);
@@ -262,6 +281,22 @@ int main(int argc, char** argv) {
       stats << module.iteration() << ',' << time << ',' << st.cgIterations << ',' << st.cgResidual
             << ',' << st.fluidCells << ',' << st.bodyCells << ',' << stepped->volume << ','
             << stepped->maxSpeed << ',' << bodies.size() << '\n';
+    }
+  }
+  if (!statePath.empty()) {
+    fluid::BlockStep query;
+    query.queryOnly = true;
+    query.stats = true;
+    query.gatherParticles = true;
+    auto queried = group ? group->step(query) : fluid::stepBlock(solver, query);
+    if (!queried) return fail(queried.error().message);
+    finalState.time = time;
+    finalState.volume = queried->volume;
+    finalState.maxSpeed = queried->maxSpeed;
+    finalState.particles = std::move(queried->particles);
+    if (auto status = fluid::writeFinalState(statePath, finalState); !status) {
+      if (group) group->stop();
+      return fail(status.error().message);
     }
   }
   if (group) group->stop();
