@@ -115,9 +115,9 @@ TEST(FluidModule, LightBoxFloatsThroughTheAnimatorInteractorCycle) {
 // (block-Jacobi preconditioner, sums at block borders), and a particle that crosses a cell
 // border in one run and not the other changes the cell classification discretely, so the paths
 // drift apart slowly: the stated tolerance is 1e-3 m (2 % of a cell) after 100 iterations.
-// Waits up to 5 s while an `orted` is a child of this process (an orphan handed to this test,
-// which is a subreaper), and reaps it.
-void waitForOrtedToExit() {
+// Waits up to 5 s while an `orted` or a `vrflow-fluid` is a child of this process (an orphan
+// handed to this test, which is a subreaper), and reaps them.
+void waitForMpiOrphansToExit() {
   for (int round = 0; round < 100; ++round) {
     bool any = false;
     for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
@@ -130,7 +130,10 @@ void waitForOrtedToExit() {
       char state = 0;
       int parent = 0;
       rest >> state >> parent;
-      if (parent != getpid() || stat[0].find("(orted)") == std::string::npos) continue;
+      if (parent != getpid() || (stat[0].find("(orted)") == std::string::npos &&
+                                 stat[0].find("(vrflow-fluid)") == std::string::npos)) {
+        continue;
+      }
       if (state == 'Z') {
         waitpid(std::stoi(name), nullptr, 0);  // it exited: reap it
       } else {
@@ -177,6 +180,10 @@ TEST(FluidModule, TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath) {
     const auto rows = readCsv(dir.file("box.csv"), false);
     ASSERT_GE(rows.size(), 100u);
     finalY.push_back(rows[99][1]);
+    if (std::string(launcher) != "none") {  // mpirun and its ranks are gone with the run
+      const auto left = leftoverProcesses();
+      EXPECT_TRUE(left.empty()) << launcher << ": " << left.front();
+    }
   }
   // The wrapper ran once: for the mpirun case only, with 2 ranks of the fluid module.
   const auto calls = readLines(log);
@@ -189,9 +196,9 @@ TEST(FluidModule, TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath) {
   EXPECT_NEAR(finalY[2], finalY[0], 1e-3);
   EXPECT_EQ(finalY[1], finalY[2]) << "the same ranks and partition, however started";
   EXPECT_GT(std::abs(finalY[0] - 0.5), 0.01);  // it moved: the comparison is not of a box at rest
-  // The spawn path's singleton starts its own Open MPI daemon (orted), which exits on its own
-  // a moment after the module (it watches a pipe); the mpirun path leaves nothing.
-  waitForOrtedToExit();
+  // The spawn path's singleton starts its own Open MPI daemon (orted), which exits on its own a
+  // moment after the module (it watches a pipe), as may the spawned workers: wait for them.
+  waitForMpiOrphansToExit();
   const auto left = leftoverProcesses();
   EXPECT_TRUE(left.empty()) << left.front();
 }
