@@ -228,6 +228,14 @@ TEST(RoutedWall, WithTheFluidEachTileGetsAtLeast3xFewerBytesTheSameFramesAndTheS
   EXPECT_EQ(digests, simulationDigests(direct.report));
   EXPECT_EQ(withRoute.bodiesState, direct.bodiesState);
   EXPECT_EQ(withRoute.netState, direct.netState);
+  // ... and the same as the demo scene's own (paper_scene_fluid.xml: one viewer, no pacing, its
+  // particles as one object): the regions change how the particles travel, not the physics.
+  const WallRun demo = runIn(
+      dir, "demo", "", vrflow::testing::sourceDir() + "/examples/paper_scene/paper_scene_fluid.xml",
+      kFluidIterations);
+  EXPECT_EQ(withRoute.bodiesState, demo.bodiesState);
+  EXPECT_EQ(withRoute.netState, demo.netState);
+  EXPECT_EQ(digests.at("water.forces"), simulationDigests(demo.report).at("water.forces"));
   EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
 }
 
