@@ -1,5 +1,6 @@
 #include "pressure.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
@@ -9,132 +10,157 @@ namespace {
 constexpr double kTau = 0.97;    // modified incomplete Cholesky blend (Bridson)
 constexpr double kSigma = 0.25;  // safety: fall back to the diagonal when the pivot collapses
 
+using Row = PcgWorkspace::Row;
+
 struct Slab {
   int k0 = 0, k1 = 0;
   std::size_t c0 = 0, c1 = 0;
 };
 
-double localDot(const std::vector<double>& a, const std::vector<double>& b, const Slab& s) {
-  double sum = 0.0;
-  for (std::size_t c = s.c0; c < s.c1; ++c) sum += a[c] * b[c];
-  return sum;
+// The rows of the slab holding unknowns (cells with a diagonal), with their first and last
+// unknown: every loop below runs over these only (air above a tank's surface is skipped).
+void findRows(const Grid& g, const PressureSystem& A, const Slab& slab, std::vector<Row>& rows) {
+  rows.clear();
+  for (int k = slab.k0; k < slab.k1; ++k) {
+    for (int j = 0; j < g.ny; ++j) {
+      const std::size_t c = g.cell(0, j, k);
+      int i0 = -1, i1 = -1;
+      for (int i = 0; i < g.nx; ++i) {
+        if (A.diag[c + static_cast<std::size_t>(i)] == 0.0) continue;
+        if (i0 < 0) i0 = i;
+        i1 = i;
+      }
+      if (i0 >= 0) rows.push_back({c + static_cast<std::size_t>(i0), j, k, i0, i1});
+    }
+  }
 }
 
-double dot(const std::vector<double>& a, const std::vector<double>& b, const Slab& s,
-           BlockComm* comm) {
-  const double local = localDot(a, b, s);
+double sumOver(BlockComm* comm, double local) {
   return comm ? comm->sum(local) : local;
 }
 
-// q = A s on the slab; s must hold valid halo planes k0 - 1 and k1.
-void multiply(const Grid& g, const PressureSystem& A, const std::vector<double>& s,
-              std::vector<double>& q, const Slab& slab) {
-  const std::size_t sx = 1, sy = static_cast<std::size_t>(g.nx),
-                    sz = static_cast<std::size_t>(g.nx) * g.ny;
-  for (int k = slab.k0; k < slab.k1; ++k) {
-    for (int j = 0; j < g.ny; ++j) {
-      std::size_t c = g.cell(0, j, k);
-      for (int i = 0; i < g.nx; ++i, ++c) {
-        if (A.diag[c] == 0.0) {
-          q[c] = 0.0;
-          continue;
-        }
-        double v = A.diag[c] * s[c];
-        if (i + 1 < g.nx) v += A.ax[c] * s[c + sx];
-        if (i > 0) v += A.ax[c - sx] * s[c - sx];
-        if (j + 1 < g.ny) v += A.ay[c] * s[c + sy];
-        if (j > 0) v += A.ay[c - sy] * s[c - sy];
-        if (k + 1 < g.nz) v += A.az[c] * s[c + sz];
-        if (k > 0) v += A.az[c - sz] * s[c - sz];
-        q[c] = v;
+// q = A s on the unknowns, returning the local part of s.q; s must hold valid halo planes
+// k0 - 1 and k1.
+double multiply(const Grid& g, const PressureSystem& A, const double* s, double* q,
+                const std::vector<Row>& rows) {
+  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
+  const double* diag = A.diag.data();
+  const double* ax = A.ax.data();
+  const double* ay = A.ay.data();
+  const double* az = A.az.data();
+  double sq = 0.0;
+  for (const Row& row : rows) {
+    const bool jLo = row.j > 0, jHi = row.j + 1 < g.ny, kLo = row.k > 0, kHi = row.k + 1 < g.nz;
+    std::size_t c = row.c;
+    for (int i = row.i0; i <= row.i1; ++i, ++c) {
+      if (diag[c] == 0.0) {
+        q[c] = 0.0;
+        continue;
       }
+      double v = diag[c] * s[c];
+      if (i + 1 < g.nx) v += ax[c] * s[c + 1];
+      if (i > 0) v += ax[c - 1] * s[c - 1];
+      if (jHi) v += ay[c] * s[c + sy];
+      if (jLo) v += ay[c - sy] * s[c - sy];
+      if (kHi) v += az[c] * s[c + sz];
+      if (kLo) v += az[c - sz] * s[c - sz];
+      q[c] = v;
+      sq += s[c] * v;
     }
   }
+  return sq;
 }
 
-// MIC(0) of the slab's own block of A: couplings that leave the slab are dropped.
+// MIC(0) of the slab's own block of A (couplings that leave the slab are dropped), stored as
+// the pivots pc and the off-diagonals times their row's pivot.
 void buildPreconditioner(const Grid& g, const PressureSystem& A, const Slab& slab,
-                         std::vector<double>& pc, std::vector<double>& azLocal) {
-  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * g.ny;
-  azLocal.assign(A.az.size(), 0.0);
-  for (int k = slab.k0; k + 1 < slab.k1; ++k) {
-    const std::size_t c0 = g.cell(0, 0, k);
-    for (std::size_t c = c0; c < c0 + sz; ++c) azLocal[c] = A.az[c];
-  }
-  for (int k = slab.k0; k < slab.k1; ++k) {
-    for (int j = 0; j < g.ny; ++j) {
-      std::size_t c = g.cell(0, j, k);
-      for (int i = 0; i < g.nx; ++i, ++c) {
-        if (A.diag[c] == 0.0) {
-          pc[c] = 0.0;
-          continue;
-        }
-        double e = A.diag[c];
-        if (i > 0) {
-          const std::size_t n = c - 1;
-          const double a = A.ax[n] * pc[n];
-          e -= a * a + kTau * A.ax[n] * (A.ay[n] + azLocal[n]) * pc[n] * pc[n];
-        }
-        if (j > 0) {
-          const std::size_t n = c - sy;
-          const double a = A.ay[n] * pc[n];
-          e -= a * a + kTau * A.ay[n] * (A.ax[n] + azLocal[n]) * pc[n] * pc[n];
-        }
-        if (k > slab.k0) {
-          const std::size_t n = c - sz;
-          const double a = azLocal[n] * pc[n];
-          e -= a * a + kTau * azLocal[n] * (A.ax[n] + A.ay[n]) * pc[n] * pc[n];
-        }
-        if (e < kSigma * A.diag[c]) e = A.diag[c];
-        pc[c] = 1.0 / std::sqrt(e);
+                         PcgWorkspace& w) {
+  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
+  double* pc = w.pc.data();
+  for (const Row& row : w.rows) {
+    const bool kIn = row.k + 1 < slab.k1;  // the z coupling stays inside the slab
+    std::size_t c = row.c;
+    for (int i = row.i0; i <= row.i1; ++i, ++c) {
+      if (A.diag[c] == 0.0) continue;
+      double e = A.diag[c];
+      if (i > 0) {
+        const std::size_t n = c - 1;
+        const double a = A.ax[n] * pc[n];
+        const double azn = kIn ? A.az[n] : 0.0;
+        e -= a * a + kTau * A.ax[n] * (A.ay[n] + azn) * pc[n] * pc[n];
       }
+      if (row.j > 0) {
+        const std::size_t n = c - sy;
+        const double a = A.ay[n] * pc[n];
+        const double azn = kIn ? A.az[n] : 0.0;
+        e -= a * a + kTau * A.ay[n] * (A.ax[n] + azn) * pc[n] * pc[n];
+      }
+      if (row.k > slab.k0) {
+        const std::size_t n = c - sz;
+        const double a = A.az[n] * pc[n];
+        e -= a * a + kTau * A.az[n] * (A.ax[n] + A.ay[n]) * pc[n] * pc[n];
+      }
+      if (e < kSigma * A.diag[c]) e = A.diag[c];
+      pc[c] = 1.0 / std::sqrt(e);
+      w.axpc[c] = A.ax[c] * pc[c];
+      w.aypc[c] = A.ay[c] * pc[c];
+      w.azpc[c] = kIn ? A.az[c] * pc[c] : 0.0;
     }
   }
 }
 
-// z = M^-1 r with M the MIC(0) factor L L^T; `t` is scratch.
-void applyPreconditioner(const Grid& g, const PressureSystem& A, const std::vector<double>& az,
-                         const std::vector<double>& pc, const std::vector<double>& r,
-                         std::vector<double>& t, std::vector<double>& z, const Slab& slab) {
-  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * g.ny;
-  for (int k = slab.k0; k < slab.k1; ++k) {
-    for (int j = 0; j < g.ny; ++j) {
-      std::size_t c = g.cell(0, j, k);
-      for (int i = 0; i < g.nx; ++i, ++c) {
-        if (A.diag[c] == 0.0) {
-          t[c] = 0.0;
-          continue;
-        }
-        double v = r[c];
-        if (i > 0) v -= A.ax[c - 1] * pc[c - 1] * t[c - 1];
-        if (j > 0) v -= A.ay[c - sy] * pc[c - sy] * t[c - sy];
-        if (k > slab.k0) v -= az[c - sz] * pc[c - sz] * t[c - sz];
-        t[c] = v * pc[c];
+// z = M^-1 r with M the MIC(0) factor L L^T; returns the local part of r.z.
+double applyPreconditioner(const Grid& g, const PcgWorkspace& w, const double* r, double* t,
+                           double* z) {
+  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
+  const double* pc = w.pc.data();
+  const double* axpc = w.axpc.data();
+  const double* aypc = w.aypc.data();
+  const double* azpc = w.azpc.data();
+  // Rows that have no row below or behind them in the list read zeros there (t and z are zero
+  // off the unknowns, and the couplings of cells outside the slab are zero).
+  for (const Row& row : w.rows) {
+    std::size_t c = row.c;
+    for (int i = row.i0; i <= row.i1; ++i, ++c) {
+      if (pc[c] == 0.0) {
+        t[c] = 0.0;
+        continue;
       }
+      double v = r[c];
+      if (i > 0) v -= axpc[c - 1] * t[c - 1];
+      if (row.j > 0) v -= aypc[c - sy] * t[c - sy];
+      if (c >= sz) v -= azpc[c - sz] * t[c - sz];
+      t[c] = v * pc[c];
     }
   }
-  for (int k = slab.k1 - 1; k >= slab.k0; --k) {
-    for (int j = g.ny - 1; j >= 0; --j) {
-      std::size_t c = g.cell(g.nx - 1, j, k);
-      for (int i = g.nx - 1; i >= 0; --i, --c) {
-        if (A.diag[c] == 0.0) {
-          z[c] = 0.0;
-          continue;
-        }
-        double v = t[c];
-        if (i + 1 < g.nx) v -= A.ax[c] * pc[c] * z[c + 1];
-        if (j + 1 < g.ny) v -= A.ay[c] * pc[c] * z[c + sy];
-        if (k + 1 < slab.k1) v -= az[c] * pc[c] * z[c + sz];
-        z[c] = v * pc[c];
+  double rz = 0.0;
+  for (auto it = w.rows.rbegin(); it != w.rows.rend(); ++it) {
+    const Row& row = *it;
+    const bool jHi = row.j + 1 < g.ny;
+    std::size_t c = row.c + static_cast<std::size_t>(row.i1 - row.i0);
+    for (int i = row.i1; i >= row.i0; --i, --c) {
+      if (pc[c] == 0.0) {
+        z[c] = 0.0;
+        continue;
       }
+      double v = t[c];
+      if (i + 1 < g.nx) v -= axpc[c] * z[c + 1];
+      if (jHi) v -= aypc[c] * z[c + sy];
+      v -= azpc[c] * z[c + sz];
+      z[c] = v * pc[c];
     }
   }
+  for (const Row& row : w.rows) {
+    for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) rz += r[c] * z[c];
+  }
+  return rz;
 }
 
 }  // namespace
 
 PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vector<double>& b,
-                         std::vector<double>& p, double tol, int maxIterations, BlockComm* comm) {
+                         std::vector<double>& p, double tol, int maxIterations, BlockComm* comm,
+                         PcgWorkspace& w, bool warmStart) {
   const std::size_t n = g.cells();
   const int planeSize = g.nx * g.ny;
   Slab slab;
@@ -143,44 +169,89 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
   } else {
     slab.k1 = g.nz;
   }
-  slab.c0 = static_cast<std::size_t>(slab.k0) * planeSize;
-  slab.c1 = static_cast<std::size_t>(slab.k1) * planeSize;
-  const std::uint64_t slabCells = slab.c1 - slab.c0;
-  // Arrays streamed per iteration: product 6, two updates 6, preconditioner 12, dot 2,
-  // direction update 3 (doubles).
+  slab.c0 = static_cast<std::size_t>(slab.k0) * static_cast<std::size_t>(planeSize);
+  slab.c1 = static_cast<std::size_t>(slab.k1) * static_cast<std::size_t>(planeSize);
+  // Arrays streamed per iteration over the cells of the rows holding unknowns: product 6, two
+  // updates 6, preconditioner 12, dot 2, direction update 3 (doubles).
   constexpr std::uint64_t kArraysPerIteration = 29;
 
   PcgOutcome out;
-  p.assign(n, 0.0);
-  std::vector<double> r(b), z(n, 0.0), s(n, 0.0), q(n, 0.0), t(n, 0.0), pc(n, 0.0), azLocal;
-  const double bNorm = std::sqrt(dot(r, r, slab, comm));
-  if (bNorm == 0.0) return out;
-  buildPreconditioner(g, A, slab, pc, azLocal);
-  applyPreconditioner(g, A, azLocal, pc, r, t, z, slab);
-  for (std::size_t c = slab.c0; c < slab.c1; ++c) s[c] = z[c];
-  double rho = dot(r, z, slab, comm);
+  // Vectors are zero off the unknowns, with one plane of margin beyond the slab (the sweeps
+  // read z one plane above the slab, where the couplings are zero).
+  for (auto* v : {&w.r, &w.z, &w.s, &w.q, &w.t, &w.pc, &w.axpc, &w.aypc, &w.azpc}) {
+    v->assign(n + static_cast<std::size_t>(planeSize), 0.0);
+  }
+  findRows(g, A, slab, w.rows);
+  std::uint64_t activeCells = 0;
+  for (const Row& row : w.rows) activeCells += static_cast<std::uint64_t>(row.i1 - row.i0 + 1);
+  if (!warmStart) {
+    p.assign(n, 0.0);
+  } else {
+    p.resize(n, 0.0);
+    for (std::size_t c = 0; c < n; ++c) {
+      if (A.diag[c] == 0.0) p[c] = 0.0;
+    }
+  }
+  double* r = w.r.data();
+  double* z = w.z.data();
+  double* s = w.s.data();
+  double* q = w.q.data();
+  double* pp = p.data();
+  double bb = 0.0;
+  for (const Row& row : w.rows) {
+    for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
+      r[c] = b[c];
+      bb += b[c] * b[c];
+    }
+  }
+  const double bNorm = std::sqrt(sumOver(comm, bb));
+  if (bNorm == 0.0) {
+    std::fill(p.begin(), p.end(), 0.0);
+    return out;
+  }
+  if (warmStart) {
+    // r = b - A p0.
+    if (comm) comm->exchangeHalo(p, planeSize, g.nz, slab.k0, slab.k1, 1);
+    multiply(g, A, pp, q, w.rows);
+    for (const Row& row : w.rows) {
+      for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
+        r[c] -= q[c];
+      }
+    }
+  }
+  buildPreconditioner(g, A, slab, w);
+  double rho = sumOver(comm, applyPreconditioner(g, w, r, w.t.data(), z));
+  for (const Row& row : w.rows) {
+    for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
+      s[c] = z[c];
+    }
+  }
   double rNorm = bNorm;
   for (int it = 1; it <= maxIterations; ++it) {
-    if (comm) comm->exchangeHalo(s, planeSize, g.nz, slab.k0, slab.k1, 1);
-    multiply(g, A, s, q, slab);
-    const double sq = dot(s, q, slab, comm);
+    if (comm) comm->exchangeHalo(w.s, planeSize, g.nz, slab.k0, slab.k1, 1);
+    const double sq = sumOver(comm, multiply(g, A, s, q, w.rows));
     if (sq <= 0.0) break;  // breakdown: no descent left (round-off at convergence)
     const double alpha = rho / sq;
     double rr = 0.0;
-    for (std::size_t c = slab.c0; c < slab.c1; ++c) {
-      p[c] += alpha * s[c];
-      r[c] -= alpha * q[c];
-      rr += r[c] * r[c];
+    for (const Row& row : w.rows) {
+      for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
+        pp[c] += alpha * s[c];
+        r[c] -= alpha * q[c];
+        rr += r[c] * r[c];
+      }
     }
-    rNorm = std::sqrt(comm ? comm->sum(rr) : rr);
+    rNorm = std::sqrt(sumOver(comm, rr));
     out.iterations = it;
-    out.bytesTouched += kArraysPerIteration * 8 * slabCells;
+    out.bytesTouched += kArraysPerIteration * 8 * activeCells;
     if (rNorm <= tol * bNorm) break;
-    applyPreconditioner(g, A, azLocal, pc, r, t, z, slab);
-    const double rhoNew = dot(r, z, slab, comm);
+    const double rhoNew = sumOver(comm, applyPreconditioner(g, w, r, w.t.data(), z));
     const double beta = rhoNew / rho;
     rho = rhoNew;
-    for (std::size_t c = slab.c0; c < slab.c1; ++c) s[c] = z[c] + beta * s[c];
+    for (const Row& row : w.rows) {
+      for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
+        s[c] = z[c] + beta * s[c];
+      }
+    }
   }
   out.residual = rNorm / bNorm;
   out.converged = out.residual <= tol;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -21,6 +22,18 @@ struct PressureSystem {
   std::vector<double> az;    ///< with (i,j,k+1)
 };
 
+/// Scratch vectors of the CG, kept between steps so a step allocates nothing.
+struct PcgWorkspace {
+  std::vector<double> r, z, s, q, t, pc;
+  std::vector<double> axpc, aypc, azpc;  ///< off-diagonals times the pivot of their row
+  /// Rows (j, k) of the slab holding unknowns: first cell index, first and last i.
+  struct Row {
+    std::size_t c;
+    int j, k, i0, i1;
+  };
+  std::vector<Row> rows;
+};
+
 struct PcgOutcome {
   int iterations = 0;
   double residual = 0.0;
@@ -28,10 +41,13 @@ struct PcgOutcome {
   std::uint64_t bytesTouched = 0;
 };
 
-/// Solves A p = b to |r| <= tol |b| (2-norms over the whole grid). `p` starts at zero. With
-/// `comm`, only this block's slab of `p` is computed; the caller gathers it.
+/// Solves A p = b to |r| <= tol |b| (2-norms over the whole grid). With `warmStart`, `p` on
+/// the unknown cells is the first guess (the last step's pressure), else it starts at zero;
+/// `p` is zero on every other cell on return. With `comm`, only this block's slab of `p` is
+/// computed; the caller gathers it.
 PcgOutcome solvePressure(const Grid& grid, const PressureSystem& system,
                          const std::vector<double>& b, std::vector<double>& p, double tol,
-                         int maxIterations, BlockComm* comm);
+                         int maxIterations, BlockComm* comm, PcgWorkspace& work,
+                         bool warmStart);
 
 }  // namespace vrflow::fluid::detail

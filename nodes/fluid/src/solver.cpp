@@ -8,6 +8,7 @@
 #include "bodies.hpp"
 #include "grid.hpp"
 #include "pressure.hpp"
+#include "transfer.hpp"
 #include "vrflow/fluid/block_comm.hpp"
 
 namespace vrflow::fluid {
@@ -29,7 +30,8 @@ struct FluidSolver::Impl {
   std::vector<double> pos;  // xyz per particle (this block's)
   std::vector<double> vel;
   std::vector<float> posOut;
-  std::vector<double> u[3], uOld[3], weight[3];
+  std::vector<double> u[3], uOld[3];
+  std::vector<double> acc[3];  // particle-to-grid sums: (weighted velocity, weight) per face
   std::vector<unsigned char> valid[3];
   std::vector<int> faceBody[3];
   std::vector<int> cellBody;
@@ -42,6 +44,7 @@ struct FluidSolver::Impl {
   // full puts the surface at the face (0.5); a body cell's surface is taken at its face (0.5).
   std::vector<double> theta;
   detail::PressureSystem system;
+  detail::PcgWorkspace pcg;
   std::vector<double> rhs, pressure;
   StepStats stats;
   double maxDiv = 0.0;
@@ -96,60 +99,6 @@ struct FluidSolver::Impl {
     msg::Vec3 x{grid.ox + (i + 0.5) * h, grid.oy + (j + 0.5) * h, grid.oz + (k + 0.5) * h};
     x[static_cast<std::size_t>(a)] -= 0.5 * h;
     return x;
-  }
-
-  // Trilinear stencil of component a at world point x: first face index and fractions.
-  struct Stencil {
-    std::size_t base;
-    std::size_t sy, sz;
-    double f[3];
-  };
-  // Per dimension, the clamped cell coordinate of a point on the face lattice (the component
-  // along that dimension) and on the centre lattice (the two others): shared by the 3 stencils.
-  struct Coords {
-    int faceBase[3], centreBase[3];
-    double faceFrac[3], centreFrac[3];
-  };
-  Coords coords(const double* x) const {
-    Coords c{};
-    const double o[3] = {grid.ox, grid.oy, grid.oz};
-    const int n[3] = {grid.nx, grid.ny, grid.nz};
-    for (int d = 0; d < 3; ++d) {
-      for (int face = 0; face < 2; ++face) {
-        double v = (x[d] - o[d]) * invH - (face ? 0.0 : 0.5);
-        const int hi = n[d] - (face ? 0 : 1);
-        v = std::clamp(v, 0.0, static_cast<double>(hi));
-        int b = static_cast<int>(v);
-        if (b >= hi) b = hi - 1;
-        (face ? c.faceBase : c.centreBase)[d] = b;
-        (face ? c.faceFrac : c.centreFrac)[d] = v - b;
-      }
-    }
-    return c;
-  }
-  Stencil stencil(int a, const Coords& c) const {
-    Stencil s{};
-    int b[3];
-    for (int d = 0; d < 3; ++d) {
-      b[d] = d == a ? c.faceBase[d] : c.centreBase[d];
-      s.f[d] = d == a ? c.faceFrac[d] : c.centreFrac[d];
-    }
-    s.sy = static_cast<std::size_t>(grid.fdim(a, 0));
-    s.sz = s.sy * static_cast<std::size_t>(grid.fdim(a, 1));
-    s.base = grid.face(a, b[0], b[1], b[2]);
-    return s;
-  }
-
-  static double gather(const std::vector<double>& field, const Stencil& s) {
-    const double fx = s.f[0], fy = s.f[1], fz = s.f[2];
-    const double* p = field.data() + s.base;
-    const double c00 = p[0] + fx * (p[1] - p[0]);
-    const double c10 = p[s.sy] + fx * (p[s.sy + 1] - p[s.sy]);
-    const double c01 = p[s.sz] + fx * (p[s.sz + 1] - p[s.sz]);
-    const double c11 = p[s.sz + s.sy] + fx * (p[s.sz + s.sy + 1] - p[s.sz + s.sy]);
-    const double c0 = c00 + fy * (c10 - c00);
-    const double c1 = c01 + fy * (c11 - c01);
-    return c0 + fz * (c1 - c0);
   }
 
   void clampToDomain(double* x) const {
@@ -345,38 +294,25 @@ struct FluidSolver::Impl {
   }
 
   void particlesToGrid() {
-    for (int a = 0; a < 3; ++a) {
-      std::fill(u[a].begin(), u[a].end(), 0.0);
-      std::fill(weight[a].begin(), weight[a].end(), 0.0);
-    }
+    for (int a = 0; a < 3; ++a) std::fill(acc[a].begin(), acc[a].end(), 0.0);
+    const detail::Lattice lattice(grid);
+    double* sums[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
     const std::size_t n = pos.size() / 3;
-    for (std::size_t p = 0; p < n; ++p) {
-      const Coords c = coords(&pos[3 * p]);
-      for (int a = 0; a < 3; ++a) {
-        const Stencil s = stencil(a, c);
-        const double va = vel[3 * p + a];
-        for (int dk = 0; dk < 2; ++dk) {
-          const double wz = dk ? s.f[2] : 1 - s.f[2];
-          for (int dj = 0; dj < 2; ++dj) {
-            const double wyz = wz * (dj ? s.f[1] : 1 - s.f[1]);
-            const std::size_t row = s.base + dk * s.sz + dj * s.sy;
-            const double w0 = wyz * (1 - s.f[0]), w1 = wyz * s.f[0];
-            u[a][row] += w0 * va;
-            weight[a][row] += w0;
-            u[a][row + 1] += w1 * va;
-            weight[a][row + 1] += w1;
-          }
-        }
-      }
+    const double* x = pos.data();
+    const double* v = vel.data();
+    for (std::size_t p = 0; p < n; ++p, x += 3, v += 3) {
+      detail::Located c;
+      detail::locate(lattice, x, c);
+      for (int a = 0; a < 3; ++a) detail::splat(sums[a], detail::stencilOf(lattice, a, c), v[a]);
     }
     for (int a = 0; a < 3; ++a) {
-      if (comm) {
-        comm->addHalo(u[a], planeSize(a), grid.fdim(a, 2), k0, k1);
-        comm->addHalo(weight[a], planeSize(a), grid.fdim(a, 2), k0, k1);
-      }
+      if (comm) comm->addHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1);
+      std::fill(u[a].begin(), u[a].end(), 0.0);
+      const double* in = acc[a].data();
       forOwnFaces(a, [&](std::size_t f, int, int, int) {
-        if (weight[a][f] > 1e-9) {
-          u[a][f] /= weight[a][f];
+        const double w = in[2 * f + 1];
+        if (w > 1e-9) {
+          u[a][f] = in[2 * f] / w;
           valid[a][f] = 1;
         } else {
           u[a][f] = 0.0;
@@ -496,7 +432,7 @@ struct FluidSolver::Impl {
     exchangeCells(A.az);  // the product needs the lower block's couplings to this block
     const auto start = std::chrono::steady_clock::now();
     const auto outcome = detail::solvePressure(grid, A, rhs, pressure, settings.cgTolerance,
-                                               settings.cgMaxIterations, comm);
+                                               settings.cgMaxIterations, comm, pcg, false);
     stats.pressureSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     exchangeCells(pressure);
@@ -580,24 +516,29 @@ struct FluidSolver::Impl {
       exchange(u[a], a, kHaloForParticles);
       exchange(uOld[a], a, kHaloForParticles);
     }
-    const double flip = settings.flipRatio;
+    const detail::Lattice lattice(grid);
+    const double* un[3] = {u[0].data(), u[1].data(), u[2].data()};
+    const double* uo[3] = {uOld[0].data(), uOld[1].data(), uOld[2].data()};
+    const double flip = settings.flipRatio, pic = 1.0 - flip;
+    const double halfDt = 0.5 * dt;
     const std::size_t n = pos.size() / 3;
     for (std::size_t p = 0; p < n; ++p) {
       double* x = &pos[3 * p];
       double* v = &vel[3 * p];
-      double un[3];
-      const Coords c = coords(x);
+      double vn[3];
+      detail::Located c;
+      detail::locate(lattice, x, c);
       for (int a = 0; a < 3; ++a) {
-        const Stencil s = stencil(a, c);
-        un[a] = gather(u[a], s);
-        const double uo = gather(uOld[a], s);
-        v[a] = flip * (v[a] + un[a] - uo) + (1.0 - flip) * un[a];
+        const detail::Stencil s = detail::stencilOf(lattice, a, c);
+        vn[a] = detail::gather(un[a], s);
+        const double vo = detail::gather(uo[a], s);
+        v[a] = flip * (v[a] + vn[a] - vo) + pic * vn[a];
       }
       // Midpoint (RK2) through the divergence-free grid velocity.
-      double mid[3] = {x[0] + 0.5 * dt * un[0], x[1] + 0.5 * dt * un[1], x[2] + 0.5 * dt * un[2]};
+      double mid[3] = {x[0] + halfDt * vn[0], x[1] + halfDt * vn[1], x[2] + halfDt * vn[2]};
       clampToDomain(mid);
-      const Coords cm = coords(mid);
-      for (int a = 0; a < 3; ++a) x[a] += dt * gather(u[a], stencil(a, cm));
+      detail::locate(lattice, mid, c);
+      for (int a = 0; a < 3; ++a) x[a] += dt * detail::gather(un[a], detail::stencilOf(lattice, a, c));
       clampToDomain(x);
     }
   }
@@ -630,7 +571,7 @@ Result<std::unique_ptr<FluidSolver>> FluidSolver::create(const FluidSettings& se
   for (int a = 0; a < 3; ++a) {
     impl->u[a].assign(g.faces(a), 0.0);
     impl->uOld[a].assign(g.faces(a), 0.0);
-    impl->weight[a].assign(g.faces(a), 0.0);
+    impl->acc[a].assign(2 * g.faces(a), 0.0);
     impl->valid[a].assign(g.faces(a), 0);
     impl->faceBody[a].assign(g.faces(a), -1);
   }

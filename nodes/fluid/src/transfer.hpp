@@ -1,0 +1,118 @@
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+
+#include "grid.hpp"
+
+// Trilinear stencils between particles and the staggered grid, written for the particle loops:
+// one locate() per point gives, per dimension, the clamped cell coordinate and fraction on the
+// face lattice (the component along that dimension) and on the centre lattice (the two others);
+// the three components' stencils share them.
+
+namespace vrflow::fluid::detail {
+
+/// The grid's geometry as the particle loops use it (strides per velocity component).
+struct Lattice {
+  double origin[3] = {0, 0, 0};
+  double invH = 1.0;
+  int n[3] = {0, 0, 0};
+  std::size_t sy[3] = {0, 0, 0};  ///< stride of j in component a's face array
+  std::size_t sz[3] = {0, 0, 0};  ///< stride of k
+
+  explicit Lattice(const Grid& g) {
+    origin[0] = g.ox;
+    origin[1] = g.oy;
+    origin[2] = g.oz;
+    invH = 1.0 / g.h;
+    n[0] = g.nx;
+    n[1] = g.ny;
+    n[2] = g.nz;
+    for (int a = 0; a < 3; ++a) {
+      sy[a] = static_cast<std::size_t>(g.fdim(a, 0));
+      sz[a] = sy[a] * static_cast<std::size_t>(g.fdim(a, 1));
+    }
+  }
+};
+
+/// Where a point falls: per dimension, base index and fraction on both lattices.
+struct Located {
+  int faceBase[3], centreBase[3];
+  double faceFrac[3], centreFrac[3];
+};
+
+inline void locate(const Lattice& l, const double* x, Located& c) {
+  for (int d = 0; d < 3; ++d) {
+    const double g = (x[d] - l.origin[d]) * l.invH;
+    {
+      const int hi = l.n[d];
+      const double v = std::clamp(g - 0.0, 0.0, static_cast<double>(hi));
+      int b = static_cast<int>(v);
+      if (b >= hi) b = hi - 1;
+      c.faceBase[d] = b;
+      c.faceFrac[d] = v - b;
+    }
+    {
+      const int hi = l.n[d] - 1;
+      const double v = std::clamp(g - 0.5, 0.0, static_cast<double>(hi));
+      int b = static_cast<int>(v);
+      if (b >= hi) b = hi - 1;
+      c.centreBase[d] = b;
+      c.centreFrac[d] = v - b;
+    }
+  }
+}
+
+/// Component a's stencil: first face index and the three fractions.
+struct Stencil {
+  std::size_t base, sy, sz;
+  double fx, fy, fz;
+};
+
+inline Stencil stencilOf(const Lattice& l, int a, const Located& c) {
+  const int bx = a == 0 ? c.faceBase[0] : c.centreBase[0];
+  const int by = a == 1 ? c.faceBase[1] : c.centreBase[1];
+  const int bz = a == 2 ? c.faceBase[2] : c.centreBase[2];
+  Stencil s;
+  s.sy = l.sy[a];
+  s.sz = l.sz[a];
+  s.base = static_cast<std::size_t>(bz) * s.sz + static_cast<std::size_t>(by) * s.sy +
+           static_cast<std::size_t>(bx);
+  s.fx = a == 0 ? c.faceFrac[0] : c.centreFrac[0];
+  s.fy = a == 1 ? c.faceFrac[1] : c.centreFrac[1];
+  s.fz = a == 2 ? c.faceFrac[2] : c.centreFrac[2];
+  return s;
+}
+
+/// Trilinear interpolation of a face field (x, then y, then z).
+inline double gather(const double* field, const Stencil& s) {
+  const double fx = s.fx, fy = s.fy, fz = s.fz;
+  const double* p = field + s.base;
+  const double c00 = p[0] + fx * (p[1] - p[0]);
+  const double c10 = p[s.sy] + fx * (p[s.sy + 1] - p[s.sy]);
+  const double c01 = p[s.sz] + fx * (p[s.sz + 1] - p[s.sz]);
+  const double c11 = p[s.sz + s.sy] + fx * (p[s.sz + s.sy + 1] - p[s.sz + s.sy]);
+  const double c0 = c00 + fy * (c10 - c00);
+  const double c1 = c01 + fy * (c11 - c01);
+  return c0 + fz * (c1 - c0);
+}
+
+/// Adds a particle's velocity component `va` and its weights to `acc`, which holds (sum of
+/// weighted velocities, sum of weights) per face, interleaved so both share a cache line.
+inline void splat(double* acc, const Stencil& s, double va) {
+  for (int dk = 0; dk < 2; ++dk) {
+    const double wz = dk ? s.fz : 1 - s.fz;
+    for (int dj = 0; dj < 2; ++dj) {
+      const double wyz = wz * (dj ? s.fy : 1 - s.fy);
+      double* row = acc + 2 * (s.base + static_cast<std::size_t>(dk) * s.sz +
+                               static_cast<std::size_t>(dj) * s.sy);
+      const double w0 = wyz * (1 - s.fx), w1 = wyz * s.fx;
+      row[0] += w0 * va;
+      row[1] += w0;
+      row[2] += w1 * va;
+      row[3] += w1;
+    }
+  }
+}
+
+}  // namespace vrflow::fluid::detail
