@@ -126,10 +126,11 @@ double applyPreconditioner(const Grid& g, const PcgWorkspace& w, const double* r
         t[c] = 0.0;
         continue;
       }
+      // The neighbour along x last: it is the one just computed (the recurrence's latency).
       double v = r[c];
-      if (i > 0) v -= axpc[c - 1] * t[c - 1];
       if (row.j > 0) v -= aypc[c - sy] * t[c - sy];
       if (c >= sz) v -= azpc[c - sz] * t[c - sz];
+      if (i > 0) v -= axpc[c - 1] * t[c - 1];
       t[c] = v * pc[c];
     }
   }
@@ -144,14 +145,12 @@ double applyPreconditioner(const Grid& g, const PcgWorkspace& w, const double* r
         continue;
       }
       double v = t[c];
-      if (i + 1 < g.nx) v -= axpc[c] * z[c + 1];
       if (jHi) v -= aypc[c] * z[c + sy];
       v -= azpc[c] * z[c + sz];
+      if (i + 1 < g.nx) v -= axpc[c] * z[c + 1];
       z[c] = v * pc[c];
+      rz += r[c] * z[c];
     }
-  }
-  for (const Row& row : w.rows) {
-    for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) rz += r[c] * z[c];
   }
   return rz;
 }
@@ -160,7 +159,7 @@ double applyPreconditioner(const Grid& g, const PcgWorkspace& w, const double* r
 
 PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vector<double>& b,
                          std::vector<double>& p, double tol, int maxIterations, BlockComm* comm,
-                         PcgWorkspace& w, bool warmStart) {
+                         PcgWorkspace& w) {
   const std::size_t n = g.cells();
   const int planeSize = g.nx * g.ny;
   Slab slab;
@@ -176,22 +175,19 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
   constexpr std::uint64_t kArraysPerIteration = 29;
 
   PcgOutcome out;
-  // Vectors are zero off the unknowns, with one plane of margin beyond the slab (the sweeps
-  // read z one plane above the slab, where the couplings are zero).
+  // Vectors are zero off the unknowns, with one plane of margin on each side of the slab (the
+  // sweeps read there, where the couplings are zero; the product reads the exchanged halo).
+  const std::size_t ps = static_cast<std::size_t>(planeSize);
+  const std::size_t zeroFrom = slab.c0 >= ps ? slab.c0 - ps : 0, zeroTo = slab.c1 + ps;
   for (auto* v : {&w.r, &w.z, &w.s, &w.q, &w.t, &w.pc, &w.axpc, &w.aypc, &w.azpc}) {
-    v->assign(n + static_cast<std::size_t>(planeSize), 0.0);
+    v->resize(n + ps);
+    std::fill(v->begin() + static_cast<std::ptrdiff_t>(zeroFrom),
+              v->begin() + static_cast<std::ptrdiff_t>(zeroTo), 0.0);
   }
   findRows(g, A, slab, w.rows);
   std::uint64_t activeCells = 0;
   for (const Row& row : w.rows) activeCells += static_cast<std::uint64_t>(row.i1 - row.i0 + 1);
-  if (!warmStart) {
-    p.assign(n, 0.0);
-  } else {
-    p.resize(n, 0.0);
-    for (std::size_t c = 0; c < n; ++c) {
-      if (A.diag[c] == 0.0) p[c] = 0.0;
-    }
-  }
+  p.assign(n, 0.0);
   double* r = w.r.data();
   double* z = w.z.data();
   double* s = w.s.data();
@@ -205,20 +201,7 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
     }
   }
   const double bNorm = std::sqrt(sumOver(comm, bb));
-  if (bNorm == 0.0) {
-    std::fill(p.begin(), p.end(), 0.0);
-    return out;
-  }
-  if (warmStart) {
-    // r = b - A p0.
-    if (comm) comm->exchangeHalo(p, planeSize, g.nz, slab.k0, slab.k1, 1);
-    multiply(g, A, pp, q, w.rows);
-    for (const Row& row : w.rows) {
-      for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
-        r[c] -= q[c];
-      }
-    }
-  }
+  if (bNorm == 0.0) return out;
   buildPreconditioner(g, A, slab, w);
   double rho = sumOver(comm, applyPreconditioner(g, w, r, w.t.data(), z));
   for (const Row& row : w.rows) {

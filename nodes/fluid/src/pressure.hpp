@@ -41,13 +41,12 @@ struct PcgOutcome {
   std::uint64_t bytesTouched = 0;
 };
 
-/// Solves A p = b to |r| <= tol |b| (2-norms over the whole grid). With `warmStart`, `p` on
-/// the unknown cells is the first guess (the last step's pressure), else it starts at zero;
-/// `p` is zero on every other cell on return. With `comm`, only this block's slab of `p` is
-/// computed; the caller gathers it.
+/// Solves A p = b to |r| <= tol |b| (2-norms over the whole grid). `p` starts at zero (the last
+/// step's pressure as a first guess measured no better: the right-hand side is dominated by
+/// what the particle transfer and volume control ask anew each step). With `comm`, only this
+/// block's slab of `p` is computed; the caller gathers it.
 PcgOutcome solvePressure(const Grid& grid, const PressureSystem& system,
                          const std::vector<double>& b, std::vector<double>& p, double tol,
-                         int maxIterations, BlockComm* comm, PcgWorkspace& work,
-                         bool warmStart);
+                         int maxIterations, BlockComm* comm, PcgWorkspace& work);
 
 }  // namespace vrflow::fluid::detail

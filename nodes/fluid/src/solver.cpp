@@ -138,10 +138,21 @@ struct FluidSolver::Impl {
   }
 
   void zeroWalls(std::vector<double>* field) const {
-    for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
-        if (onWall(a, i, j, k)) field[a][f] = 0.0;
-      });
+    for (int k = k0; k < k1; ++k) {
+      for (int j = 0; j < grid.ny; ++j) {
+        field[0][grid.face(0, 0, j, k)] = 0.0;
+        field[0][grid.face(0, grid.nx, j, k)] = 0.0;
+      }
+      for (int i = 0; i < grid.nx; ++i) {
+        field[1][grid.face(1, i, 0, k)] = 0.0;
+        field[1][grid.face(1, i, grid.ny, k)] = 0.0;
+      }
+    }
+    const std::size_t ps = static_cast<std::size_t>(planeSize(2));
+    for (int k : {0, grid.nz}) {
+      if (k < k0 || k >= kEnd(2)) continue;
+      std::fill_n(field[2].begin() + static_cast<std::ptrdiff_t>(k * ps),
+                  static_cast<std::ptrdiff_t>(ps), 0.0);
     }
   }
 
@@ -177,10 +188,13 @@ struct FluidSolver::Impl {
 
   // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
   // and an order that does not depend on history.
+  std::vector<std::uint32_t> sortCell;
+  std::vector<std::size_t> sortStart;
+  std::vector<double> posScratch, velScratch;
   void sortParticles() {
     const std::size_t n = pos.size() / 3;
     particlesInCell.assign(grid.cells(), 0);
-    std::vector<std::uint32_t> cellOfParticle(n);
+    sortCell.resize(n);
     for (std::size_t p = 0; p < n; ++p) {
       int i, j, k;
       cellOf(&pos[3 * p], i, j, k);
@@ -188,21 +202,24 @@ struct FluidSolver::Impl {
       j = std::clamp(j, 0, grid.ny - 1);
       k = std::clamp(k, 0, grid.nz - 1);
       const auto c = static_cast<std::uint32_t>(grid.cell(i, j, k));
-      cellOfParticle[p] = c;
+      sortCell[p] = c;
       ++particlesInCell[c];
     }
-    std::vector<std::size_t> start(grid.cells() + 1, 0);
-    for (std::size_t c = 0; c < grid.cells(); ++c) start[c + 1] = start[c] + particlesInCell[c];
-    std::vector<double> p2(pos.size()), v2(vel.size());
+    sortStart.assign(grid.cells() + 1, 0);
+    for (std::size_t c = 0; c < grid.cells(); ++c) {
+      sortStart[c + 1] = sortStart[c] + static_cast<std::size_t>(particlesInCell[c]);
+    }
+    posScratch.resize(pos.size());
+    velScratch.resize(vel.size());
     for (std::size_t p = 0; p < n; ++p) {
-      const std::size_t to = start[cellOfParticle[p]]++;
+      const std::size_t to = sortStart[sortCell[p]]++;
       for (int d = 0; d < 3; ++d) {
-        p2[3 * to + d] = pos[3 * p + d];
-        v2[3 * to + d] = vel[3 * p + d];
+        posScratch[3 * to + d] = pos[3 * p + d];
+        velScratch[3 * to + d] = vel[3 * p + d];
       }
     }
-    pos.swap(p2);
-    vel.swap(v2);
+    pos.swap(posScratch);
+    vel.swap(velScratch);
   }
 
   // Only particles in cells that some body's bounds touch are tested against the bodies.
@@ -294,7 +311,13 @@ struct FluidSolver::Impl {
   }
 
   void particlesToGrid() {
-    for (int a = 0; a < 3; ++a) std::fill(acc[a].begin(), acc[a].end(), 0.0);
+    // This block's particles reach face planes k0 - 1 to k1.
+    for (int a = 0; a < 3; ++a) {
+      const std::size_t ps = 2 * static_cast<std::size_t>(planeSize(a));
+      const auto from = static_cast<std::ptrdiff_t>(ps * static_cast<std::size_t>(std::max(0, k0 - 1)));
+      const auto to = static_cast<std::ptrdiff_t>(ps * static_cast<std::size_t>(std::min(grid.fdim(a, 2), k1 + 1)));
+      std::fill(acc[a].begin() + from, acc[a].begin() + to, 0.0);
+    }
     const detail::Lattice lattice(grid);
     double* sums[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
     const std::size_t n = pos.size() / 3;
@@ -322,58 +345,106 @@ struct FluidSolver::Impl {
     }
   }
 
-  // Fills faces without a value from the mean of valid neighbours, `layers` rings deep.
+  // Fills faces without a value from the mean of valid neighbours, `layers` rings deep. Only
+  // rows (j, k) with a valid face in them or next to them can gain values; the others (deep in
+  // air) are skipped.
+  std::vector<unsigned char> rowState;  // per row: bit 0 some face valid, bit 1 every face valid
+  std::vector<std::size_t> filled;
   void extrapolate(std::vector<double>* field, int layers) {
     for (int a = 0; a < 3; ++a) {
       const int dx = grid.fdim(a, 0), dy = grid.fdim(a, 1), dz = grid.fdim(a, 2);
-      const std::size_t sy = static_cast<std::size_t>(dx), sz = sy * dy;
-      std::vector<unsigned char> next;
+      const std::size_t sy = static_cast<std::size_t>(dx), sz = sy * static_cast<std::size_t>(dy);
+      const int ke = kEnd(a);
       for (int layer = 0; layer < layers; ++layer) {
         exchange(field[a], a, 1);
         exchangeBytes(valid[a], planeSize(a), dz);
-        next = valid[a];
-        forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
-          if (valid[a][f]) return;
-          double total = 0.0;
-          int count = 0;
-          auto take = [&](std::size_t g) {
-            if (valid[a][g]) {
-              total += field[a][g];
-              ++count;
-            }
-          };
-          if (i > 0) take(f - 1);
-          if (i + 1 < dx) take(f + 1);
-          if (j > 0) take(f - sy);
-          if (j + 1 < dy) take(f + sy);
-          if (k > 0) take(f - sz);
-          if (k + 1 < dz) take(f + sz);
-          if (count > 0) {
-            field[a][f] = total / count;
-            next[f] = 1;
+        double* value = field[a].data();
+        unsigned char* ok = valid[a].data();
+        const int kLo = std::max(0, k0 - 1), kHi = std::min(dz, ke + 1);
+        rowState.assign(static_cast<std::size_t>(dy) * static_cast<std::size_t>(dz), 0);
+        for (int k = kLo; k < kHi; ++k) {
+          for (int j = 0; j < dy; ++j) {
+            const unsigned char* row = ok + grid.face(a, 0, j, k);
+            int count = 0;
+            for (int i = 0; i < dx; ++i) count += row[i];
+            rowState[static_cast<std::size_t>(k) * dy + j] =
+                static_cast<unsigned char>((count > 0 ? 1 : 0) | (count == dx ? 2 : 0));
           }
-        });
-        valid[a].swap(next);
+        }
+        filled.clear();
+        for (int k = k0; k < ke; ++k) {
+          for (int j = 0; j < dy; ++j) {
+            const std::size_t r = static_cast<std::size_t>(k) * dy + j;
+            if (rowState[r] & 2) continue;  // nothing to fill
+            const bool near = (rowState[r] & 1) || (j > 0 && (rowState[r - 1] & 1)) ||
+                              (j + 1 < dy && (rowState[r + 1] & 1)) ||
+                              (k > 0 && (rowState[r - dy] & 1)) ||
+                              (k + 1 < dz && (rowState[r + dy] & 1));
+            if (!near) continue;
+            std::size_t f = grid.face(a, 0, j, k);
+            for (int i = 0; i < dx; ++i, ++f) {
+              if (ok[f]) continue;
+              double total = 0.0;
+              int count = 0;
+              auto take = [&](std::size_t g) {
+                if (ok[g]) {
+                  total += value[g];
+                  ++count;
+                }
+              };
+              if (i > 0) take(f - 1);
+              if (i + 1 < dx) take(f + 1);
+              if (j > 0) take(f - sy);
+              if (j + 1 < dy) take(f + sy);
+              if (k > 0) take(f - sz);
+              if (k + 1 < dz) take(f + sz);
+              if (count > 0) {
+                value[f] = total / count;
+                filled.push_back(f);
+              }
+            }
+          }
+        }
+        for (const std::size_t f : filled) ok[f] = 1;
       }
     }
   }
 
   // Rigid motion on the faces of bodies (and of kinematic bodies' cells); `kinematicOnly`
-  // re-imposes it on kinematic bodies after gravity (a moving wall does not fall).
+  // re-imposes it on kinematic bodies after gravity (a moving wall does not fall). Only the
+  // faces in each body's bounds (one cell wider) can be affected; a face in several bodies'
+  // bounds gets the same value each time.
   void enforceBodies(const std::vector<PreparedBody>& bodies, bool kinematicOnly = false) {
-    for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
-        int b = faceBody[a][f];
-        if (b < 0 && !onWall(a, i, j, k)) {  // the faces of a kinematic body's cells too
-          const std::size_t hi = grid.cell(i, j, k), lo = hi - stride(a);
-          if (kind[hi] == detail::kSolid) b = cellBody[hi];
-          if (kind[lo] == detail::kSolid) b = cellBody[lo];
+    const double o[3] = {grid.ox, grid.oy, grid.oz};
+    for (const auto& box : bodies) {
+      if (kinematicOnly && !box.kinematic) continue;
+      for (int a = 0; a < 3; ++a) {
+        int lo[3], hi[3];
+        for (int d = 0; d < 3; ++d) {
+          lo[d] = std::max(0, static_cast<int>(std::floor((box.bounds.min[d] - o[d]) * invH)) - 1);
+          hi[d] = std::min(grid.fdim(a, d) - 1,
+                           static_cast<int>(std::ceil((box.bounds.max[d] - o[d]) * invH)) + 1);
         }
-        if (b < 0) return;
-        if (kinematicOnly && !bodies[static_cast<std::size_t>(b)].kinematic) return;
-        u[a][f] = detail::rigidVelocity(bodies[static_cast<std::size_t>(b)],
-                                        facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
-      });
+        lo[2] = std::max(lo[2], k0);
+        hi[2] = std::min(hi[2], kEnd(a) - 1);
+        for (int k = lo[2]; k <= hi[2]; ++k) {
+          for (int j = lo[1]; j <= hi[1]; ++j) {
+            for (int i = lo[0]; i <= hi[0]; ++i) {
+              const std::size_t f = grid.face(a, i, j, k);
+              int b = faceBody[a][f];
+              if (b < 0 && !onWall(a, i, j, k)) {  // the faces of a kinematic body's cells too
+                const std::size_t hiCell = grid.cell(i, j, k), loCell = hiCell - stride(a);
+                if (kind[hiCell] == detail::kSolid) b = cellBody[hiCell];
+                if (kind[loCell] == detail::kSolid) b = cellBody[loCell];
+              }
+              if (b < 0) continue;
+              const auto& body = bodies[static_cast<std::size_t>(b)];
+              if (kinematicOnly && !body.kinematic) continue;
+              u[a][f] = detail::rigidVelocity(body, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
+            }
+          }
+        }
+      }
     }
   }
 
@@ -432,7 +503,7 @@ struct FluidSolver::Impl {
     exchangeCells(A.az);  // the product needs the lower block's couplings to this block
     const auto start = std::chrono::steady_clock::now();
     const auto outcome = detail::solvePressure(grid, A, rhs, pressure, settings.cgTolerance,
-                                               settings.cgMaxIterations, comm, pcg, false);
+                                               settings.cgMaxIterations, comm, pcg);
     stats.pressureSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     exchangeCells(pressure);
@@ -516,9 +587,24 @@ struct FluidSolver::Impl {
       exchange(u[a], a, kHaloForParticles);
       exchange(uOld[a], a, kHaloForParticles);
     }
+    // (new velocity, change) per face, interleaved: the FLIP update needs both at the same
+    // stencil, and the pairs interpolate together. Only the planes this block's particles can
+    // sample are filled.
+    for (int a = 0; a < 3; ++a) {
+      const std::size_t ps = static_cast<std::size_t>(planeSize(a));
+      const int planes = grid.fdim(a, 2);
+      const std::size_t from = ps * static_cast<std::size_t>(std::max(0, k0 - kHaloForParticles));
+      const std::size_t to = ps * static_cast<std::size_t>(std::min(planes, kEnd(a) + kHaloForParticles));
+      double* out = acc[a].data();
+      const double* un = u[a].data();
+      const double* uo = uOld[a].data();
+      for (std::size_t f = from; f < to; ++f) {
+        out[2 * f] = un[f];
+        out[2 * f + 1] = un[f] - uo[f];
+      }
+    }
     const detail::Lattice lattice(grid);
-    const double* un[3] = {u[0].data(), u[1].data(), u[2].data()};
-    const double* uo[3] = {uOld[0].data(), uOld[1].data(), uOld[2].data()};
+    const double* pairs[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
     const double flip = settings.flipRatio, pic = 1.0 - flip;
     const double halfDt = 0.5 * dt;
     const std::size_t n = pos.size() / 3;
@@ -529,16 +615,17 @@ struct FluidSolver::Impl {
       detail::Located c;
       detail::locate(lattice, x, c);
       for (int a = 0; a < 3; ++a) {
-        const detail::Stencil s = detail::stencilOf(lattice, a, c);
-        vn[a] = detail::gather(un[a], s);
-        const double vo = detail::gather(uo[a], s);
-        v[a] = flip * (v[a] + vn[a] - vo) + pic * vn[a];
+        const detail::Pair g = detail::gatherPair(pairs[a], detail::stencilOf(lattice, a, c));
+        vn[a] = g[0];
+        v[a] = flip * (v[a] + g[1]) + pic * g[0];
       }
       // Midpoint (RK2) through the divergence-free grid velocity.
       double mid[3] = {x[0] + halfDt * vn[0], x[1] + halfDt * vn[1], x[2] + halfDt * vn[2]};
       clampToDomain(mid);
       detail::locate(lattice, mid, c);
-      for (int a = 0; a < 3; ++a) x[a] += dt * detail::gather(un[a], detail::stencilOf(lattice, a, c));
+      for (int a = 0; a < 3; ++a) {
+        x[a] += dt * detail::gatherPair(pairs[a], detail::stencilOf(lattice, a, c))[0];
+      }
       clampToDomain(x);
     }
   }
