@@ -45,29 +45,34 @@ void MpiBlockComm::exchangeHalo(std::vector<double>& field, int planeSize, int p
   const int upper = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
   const int d = std::min(depth, k1 - k0);
   const std::size_t ps = static_cast<std::size_t>(planeSize);
-  buffer_.resize(static_cast<std::size_t>(depth) * ps);
-  MPI_Status status;
+  const std::size_t half = static_cast<std::size_t>(depth) * ps;
+  buffer_.resize(2 * half);
+  double* fromBelow = buffer_.data();
+  double* fromAbove = buffer_.data() + half;
+  // Both directions at once (one wait instead of two in a row): my top planes go up and the
+  // lower block's land below k0; my bottom planes go down and the upper block's land from k1.
+  MPI_Request requests[4];
+  MPI_Irecv(fromBelow, depth * planeSize, MPI_DOUBLE, lower, kTagUp, comm_, &requests[0]);
+  MPI_Irecv(fromAbove, depth * planeSize, MPI_DOUBLE, upper, kTagDown, comm_, &requests[1]);
+  MPI_Isend(field.data() + static_cast<std::size_t>(k1 - d) * ps, d * planeSize, MPI_DOUBLE, upper,
+            kTagUp, comm_, &requests[2]);
+  MPI_Isend(field.data() + static_cast<std::size_t>(k0) * ps, d * planeSize, MPI_DOUBLE, lower,
+            kTagDown, comm_, &requests[3]);
+  MPI_Status statuses[4];
+  MPI_Waitall(4, requests, statuses);
   int count = 0;
-  // My top planes go up; the lower block's top planes land below k0.
-  MPI_Sendrecv(field.data() + static_cast<std::size_t>(k1 - d) * ps, d * planeSize, MPI_DOUBLE,
-               upper, kTagUp, buffer_.data(), depth * planeSize, MPI_DOUBLE, lower, kTagUp, comm_,
-               &status);
   if (lower != MPI_PROC_NULL) {
-    MPI_Get_count(&status, MPI_DOUBLE, &count);
+    MPI_Get_count(&statuses[0], MPI_DOUBLE, &count);
     const int planes = count / planeSize;
     const int first = std::max(0, k0 - planes);
-    std::copy(buffer_.begin() + static_cast<std::ptrdiff_t>((first - (k0 - planes)) * ps),
-              buffer_.begin() + static_cast<std::ptrdiff_t>(planes * ps),
+    std::copy(fromBelow + static_cast<std::ptrdiff_t>((first - (k0 - planes)) * ps),
+              fromBelow + static_cast<std::ptrdiff_t>(planes * ps),
               field.begin() + static_cast<std::ptrdiff_t>(first * ps));
   }
-  // My bottom planes go down; the upper block's bottom planes land from k1 up.
-  MPI_Sendrecv(field.data() + static_cast<std::size_t>(k0) * ps, d * planeSize, MPI_DOUBLE, lower,
-               kTagDown, buffer_.data(), depth * planeSize, MPI_DOUBLE, upper, kTagDown, comm_,
-               &status);
   if (upper != MPI_PROC_NULL) {
-    MPI_Get_count(&status, MPI_DOUBLE, &count);
+    MPI_Get_count(&statuses[1], MPI_DOUBLE, &count);
     const int planes = std::min(count / planeSize, planeCount - k1);
-    std::copy(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(planes * ps),
+    std::copy(fromAbove, fromAbove + static_cast<std::ptrdiff_t>(planes * ps),
               field.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(k1) * ps));
   }
 }

@@ -91,6 +91,31 @@ struct FluidSolver::Impl {
       }
     }
   }
+  // A face field and its validity flags in one halo exchange (depth 1): both travel as
+  // (value, flag) pairs; only the planes sent and received are packed.
+  std::vector<double> haloScratch;
+  void exchangeWithValidity(std::vector<double>& field, std::vector<unsigned char>& flags, int a) {
+    if (!comm) return;
+    const std::size_t ps = static_cast<std::size_t>(planeSize(a));
+    const int planes = grid.fdim(a, 2);
+    haloScratch.resize(2 * field.size());
+    // The received planes start as they are, so a plane no neighbour sends stays unchanged.
+    for (int k : {k0 - 1, k0, k1 - 1, k1}) {
+      if (k < 0 || k >= planes) continue;
+      for (std::size_t f = k * ps; f < (k + 1) * ps; ++f) {
+        haloScratch[2 * f] = field[f];
+        haloScratch[2 * f + 1] = flags[f];
+      }
+    }
+    comm->exchangeHalo(haloScratch, 2 * planeSize(a), planes, k0, k1, 1);
+    for (int k : {k0 - 1, k1}) {
+      if (k < 0 || k >= planes) continue;
+      for (std::size_t f = k * ps; f < (k + 1) * ps; ++f) {
+        field[f] = haloScratch[2 * f];
+        flags[f] = static_cast<unsigned char>(haloScratch[2 * f + 1]);
+      }
+    }
+  }
   double sum(double v) { return comm ? comm->sum(v) : v; }
   double max(double v) { return comm ? comm->max(v) : v; }
 
@@ -257,7 +282,11 @@ struct FluidSolver::Impl {
 
   void classify(const std::vector<PreparedBody>& bodies) {
     detail::rasterise(grid, bodies, cellBody, faceBody);
-    for (std::size_t c = 0; c < kind.size(); ++c) {
+    // Kinds are read one plane beyond the slab at most.
+    const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+    const std::size_t cFrom = plane * static_cast<std::size_t>(std::max(0, k0 - 1));
+    const std::size_t cTo = plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1));
+    for (std::size_t c = cFrom; c < cTo; ++c) {
       if (cellBody[c] >= 0) {
         const auto& body = bodies[static_cast<std::size_t>(cellBody[c])];
         kind[c] = body.kinematic ? detail::kSolid : detail::kBody;
@@ -267,7 +296,6 @@ struct FluidSolver::Impl {
         cellDensity[c] = settings.density;
       }
     }
-    const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
     for (std::size_t c = k0 * plane; c < k1 * plane; ++c) {
       if (particlesInCell[c] > 0 && kind[c] == detail::kAir) kind[c] = detail::kLiquid;
     }
@@ -356,8 +384,7 @@ struct FluidSolver::Impl {
       const std::size_t sy = static_cast<std::size_t>(dx), sz = sy * static_cast<std::size_t>(dy);
       const int ke = kEnd(a);
       for (int layer = 0; layer < layers; ++layer) {
-        exchange(field[a], a, 1);
-        exchangeBytes(valid[a], planeSize(a), dz);
+        exchangeWithValidity(field[a], valid[a], a);
         double* value = field[a].data();
         unsigned char* ok = valid[a].data();
         const int kLo = std::max(0, k0 - 1), kHi = std::min(dz, ke + 1);
@@ -463,11 +490,14 @@ struct FluidSolver::Impl {
   void project(double dt) {
     const std::size_t n = grid.cells();
     auto& A = system;
-    A.diag.assign(n, 0.0);
-    A.ax.assign(n, 0.0);
-    A.ay.assign(n, 0.0);
-    A.az.assign(n, 0.0);
-    rhs.assign(n, 0.0);
+    // The system is built on this block's cells and read one plane beyond them.
+    const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+    const auto cFrom = static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::max(0, k0 - 1)));
+    const auto cTo = static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1)));
+    for (auto* v : {&A.diag, &A.ax, &A.ay, &A.az, &rhs}) {
+      v->resize(n);
+      std::fill(v->begin() + cFrom, v->begin() + cTo, 0.0);
+    }
     const double h = grid.h;
     lastDt = dt;
     stats.targetDivergence = -settings.volumeCorrection * (1.0 - stats.particleDensity) / dt;
@@ -583,24 +613,20 @@ struct FluidSolver::Impl {
   }
 
   void gridToParticlesAndAdvect(double dt) {
-    for (int a = 0; a < 3; ++a) {
-      exchange(u[a], a, kHaloForParticles);
-      exchange(uOld[a], a, kHaloForParticles);
-    }
     // (new velocity, change) per face, interleaved: the FLIP update needs both at the same
-    // stencil, and the pairs interpolate together. Only the planes this block's particles can
-    // sample are filled.
+    // stencil, and the pairs interpolate together. Built on this block's faces; the planes its
+    // particles can sample beyond them come from the neighbours.
     for (int a = 0; a < 3; ++a) {
       const std::size_t ps = static_cast<std::size_t>(planeSize(a));
-      const int planes = grid.fdim(a, 2);
-      const std::size_t from = ps * static_cast<std::size_t>(std::max(0, k0 - kHaloForParticles));
-      const std::size_t to = ps * static_cast<std::size_t>(std::min(planes, kEnd(a) + kHaloForParticles));
       double* out = acc[a].data();
       const double* un = u[a].data();
       const double* uo = uOld[a].data();
-      for (std::size_t f = from; f < to; ++f) {
+      for (std::size_t f = ps * static_cast<std::size_t>(k0); f < ps * static_cast<std::size_t>(kEnd(a)); ++f) {
         out[2 * f] = un[f];
         out[2 * f + 1] = un[f] - uo[f];
+      }
+      if (comm) {
+        comm->exchangeHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1, kHaloForParticles);
       }
     }
     const detail::Lattice lattice(grid);
