@@ -10,8 +10,8 @@
 // The pressure Poisson system on the cell grid (7-point, symmetric positive definite on the
 // unknown cells) and its MIC(0)-preconditioned conjugate gradient. With a BlockComm each block
 // solves its slab of planes; the preconditioner is then MIC(0) of the block's own part of the
-// matrix (block Jacobi across blocks), so iteration counts and the last bits of the result
-// depend on the number of blocks.
+// matrix (block Jacobi across blocks, with 0.6 of the dropped couplings moved to the diagonal),
+// so iteration counts and the last bits of the result depend on the number of blocks.
 
 namespace vrflow::fluid::detail {
 
