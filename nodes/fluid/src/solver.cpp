@@ -354,7 +354,9 @@ struct FluidSolver::Impl {
     for (std::size_t p = 0; p < n; ++p, x += 3, v += 3) {
       detail::Located c;
       detail::locate(lattice, x, c);
-      for (int a = 0; a < 3; ++a) detail::splat(sums[a], detail::stencilOf(lattice, a, c), v[a]);
+      detail::splat(sums[0], detail::stencilOf(lattice, 0, c), v[0]);
+      detail::splat(sums[1], detail::stencilOf(lattice, 1, c), v[1]);
+      detail::splat(sums[2], detail::stencilOf(lattice, 2, c), v[2]);
     }
     for (int a = 0; a < 3; ++a) {
       if (comm) comm->addHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1);
@@ -633,6 +635,18 @@ struct FluidSolver::Impl {
     const double* pairs[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
     const double flip = settings.flipRatio, pic = 1.0 - flip;
     const double halfDt = 0.5 * dt;
+    // clampToDomain()'s bounds, computed once.
+    const double eps = 1e-3 * grid.h;
+    const double o[3] = {grid.ox, grid.oy, grid.oz};
+    const int cells[3] = {grid.nx, grid.ny, grid.nz};
+    double lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = o[d] + eps;
+      hi[d] = o[d] + cells[d] * grid.h - eps;
+    }
+    auto clamp = [&](double* y) {
+      for (int d = 0; d < 3; ++d) y[d] = std::min(std::max(y[d], lo[d]), hi[d]);
+    };
     const std::size_t n = pos.size() / 3;
     for (std::size_t p = 0; p < n; ++p) {
       double* x = &pos[3 * p];
@@ -640,19 +654,23 @@ struct FluidSolver::Impl {
       double vn[3];
       detail::Located c;
       detail::locate(lattice, x, c);
-      for (int a = 0; a < 3; ++a) {
-        const detail::Pair g = detail::gatherPair(pairs[a], detail::stencilOf(lattice, a, c));
-        vn[a] = g[0];
-        v[a] = flip * (v[a] + g[1]) + pic * g[0];
-      }
+      const detail::Pair g0 = detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c));
+      const detail::Pair g1 = detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c));
+      const detail::Pair g2 = detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c));
+      vn[0] = g0[0];
+      vn[1] = g1[0];
+      vn[2] = g2[0];
+      v[0] = flip * (v[0] + g0[1]) + pic * g0[0];
+      v[1] = flip * (v[1] + g1[1]) + pic * g1[0];
+      v[2] = flip * (v[2] + g2[1]) + pic * g2[0];
       // Midpoint (RK2) through the divergence-free grid velocity.
       double mid[3] = {x[0] + halfDt * vn[0], x[1] + halfDt * vn[1], x[2] + halfDt * vn[2]};
-      clampToDomain(mid);
+      clamp(mid);
       detail::locate(lattice, mid, c);
-      for (int a = 0; a < 3; ++a) {
-        x[a] += dt * detail::gatherPair(pairs[a], detail::stencilOf(lattice, a, c))[0];
-      }
-      clampToDomain(x);
+      x[0] += dt * detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c))[0];
+      x[1] += dt * detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c))[0];
+      x[2] += dt * detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c))[0];
+      clamp(x);
     }
   }
 

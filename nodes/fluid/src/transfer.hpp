@@ -41,26 +41,30 @@ struct Located {
   double faceFrac[3], centreFrac[3];
 };
 
+// One dimension of locate(): g is the point's coordinate in cells; n the cell count.
+inline void locateAxis(double g, int n, int& faceBase, double& faceFrac, int& centreBase,
+                       double& centreFrac) {
+  // min/max rather than branches: the same values as std::clamp for finite coordinates.
+  const double hiFace = static_cast<double>(n), hiCentre = static_cast<double>(n - 1);
+  const double vf = std::min(std::max(g, 0.0), hiFace);
+  int bf = static_cast<int>(vf);
+  bf = bf >= n ? n - 1 : bf;
+  faceBase = bf;
+  faceFrac = vf - bf;
+  const double vc = std::min(std::max(g - 0.5, 0.0), hiCentre);
+  int bc = static_cast<int>(vc);
+  bc = bc >= n - 1 ? n - 2 : bc;
+  centreBase = bc;
+  centreFrac = vc - bc;
+}
+
 inline void locate(const Lattice& l, const double* x, Located& c) {
-  for (int d = 0; d < 3; ++d) {
-    const double g = (x[d] - l.origin[d]) * l.invH;
-    {
-      const int hi = l.n[d];
-      const double v = std::clamp(g - 0.0, 0.0, static_cast<double>(hi));
-      int b = static_cast<int>(v);
-      if (b >= hi) b = hi - 1;
-      c.faceBase[d] = b;
-      c.faceFrac[d] = v - b;
-    }
-    {
-      const int hi = l.n[d] - 1;
-      const double v = std::clamp(g - 0.5, 0.0, static_cast<double>(hi));
-      int b = static_cast<int>(v);
-      if (b >= hi) b = hi - 1;
-      c.centreBase[d] = b;
-      c.centreFrac[d] = v - b;
-    }
-  }
+  locateAxis((x[0] - l.origin[0]) * l.invH, l.n[0], c.faceBase[0], c.faceFrac[0],
+             c.centreBase[0], c.centreFrac[0]);
+  locateAxis((x[1] - l.origin[1]) * l.invH, l.n[1], c.faceBase[1], c.faceFrac[1],
+             c.centreBase[1], c.centreFrac[1]);
+  locateAxis((x[2] - l.origin[2]) * l.invH, l.n[2], c.faceBase[2], c.faceFrac[2],
+             c.centreBase[2], c.centreFrac[2]);
 }
 
 /// Component a's stencil: first face index and the three fractions.
