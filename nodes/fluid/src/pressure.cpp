@@ -7,12 +7,12 @@
 namespace vrflow::fluid::detail {
 namespace {
 
-constexpr double kTau = 0.97;    // modified incomplete Cholesky blend (Bridson)
-constexpr double kSigma = 0.25;
+constexpr double kTau = 0.97;    // modified incomplete Cholesky blend (Bridson; 0.99: no better)
+constexpr double kSigma = 0.25;  // safety: fall back to the diagonal when the pivot collapses
 // Share of the couplings to neighbouring blocks moved to the diagonal (measured: 0.6 needs the
 // fewest iterations on the benchmark's dam breaks, 49 instead of 56 with 2 blocks on
 // 64 x 128 x 64, 28 instead of 36 on 32 x 64 x 32; 0.97 as inside a block needs more).
-constexpr double kBlockTau = 0.6;  // safety: fall back to the diagonal when the pivot collapses
+constexpr double kBlockTau = 0.6;
 
 using Row = PcgWorkspace::Row;
 
@@ -117,31 +117,48 @@ void buildPreconditioner(const Grid& g, const PressureSystem& A, const Slab& sla
   }
 }
 
-// z = M^-1 r with M the MIC(0) factor L L^T; returns the local part of r.z.
-double applyPreconditioner(const Grid& g, const PcgWorkspace& w, const double* r, double* t,
-                           double* z) {
+// The forward sweep of the preconditioner (L t = r) on one row, after an optional CG update of
+// p and r on the same cells (fused: r is read once); returns the row's part of |r|^2.
+template <bool kUpdate>
+double forwardRow(const Grid& g, const PcgWorkspace& w, const Row& row, double alpha,
+                  const double* s, const double* q, double* p, double* r, double* t) {
   const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
   const double* pc = w.pc.data();
   const double* axpc = w.axpc.data();
   const double* aypc = w.aypc.data();
   const double* azpc = w.azpc.data();
-  // Rows that have no row below or behind them in the list read zeros there (t and z are zero
-  // off the unknowns, and the couplings of cells outside the slab are zero).
-  for (const Row& row : w.rows) {
-    std::size_t c = row.c;
-    for (int i = row.i0; i <= row.i1; ++i, ++c) {
-      if (pc[c] == 0.0) {
-        t[c] = 0.0;
-        continue;
-      }
-      // The neighbour along x last: it is the one just computed (the recurrence's latency).
-      double v = r[c];
-      if (row.j > 0) v -= aypc[c - sy] * t[c - sy];
-      if (c >= sz) v -= azpc[c - sz] * t[c - sz];
-      if (i > 0) v -= axpc[c - 1] * t[c - 1];
-      t[c] = v * pc[c];
+  double rr = 0.0;
+  std::size_t c = row.c;
+  for (int i = row.i0; i <= row.i1; ++i, ++c) {
+    if constexpr (kUpdate) {
+      p[c] += alpha * s[c];
+      r[c] -= alpha * q[c];
+      rr += r[c] * r[c];
     }
+    if (pc[c] == 0.0) {
+      t[c] = 0.0;
+      continue;
+    }
+    // The neighbour along x last: it is the one just computed (the recurrence's latency).
+    // Rows with no row below or behind them read zeros there (t is zero off the unknowns, and
+    // the couplings of cells outside the slab are zero).
+    double v = r[c];
+    if (row.j > 0) v -= aypc[c - sy] * t[c - sy];
+    if (c >= sz) v -= azpc[c - sz] * t[c - sz];
+    if (i > 0) v -= axpc[c - 1] * t[c - 1];
+    t[c] = v * pc[c];
   }
+  return rr;
+}
+
+// The backward sweep (L^T z = t), completing z = M^-1 r; returns the local part of r.z.
+double backward(const Grid& g, const PcgWorkspace& w, const double* r, const double* t,
+                double* z) {
+  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
+  const double* pc = w.pc.data();
+  const double* axpc = w.axpc.data();
+  const double* aypc = w.aypc.data();
+  const double* azpc = w.azpc.data();
   double rz = 0.0;
   for (auto it = w.rows.rbegin(); it != w.rows.rend(); ++it) {
     const Row& row = *it;
@@ -178,9 +195,10 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
   }
   slab.c0 = static_cast<std::size_t>(slab.k0) * static_cast<std::size_t>(planeSize);
   slab.c1 = static_cast<std::size_t>(slab.k1) * static_cast<std::size_t>(planeSize);
-  // Arrays streamed per iteration over the cells of the rows holding unknowns: product 6, two
-  // updates 6, preconditioner 12, dot 2, direction update 3 (doubles).
-  constexpr std::uint64_t kArraysPerIteration = 29;
+  // Arrays streamed per iteration over the cells of the rows holding unknowns (doubles): product
+  // 6 (diag, 3 couplings, s, q), updates of p and r 6, forward sweep 6 (r, 3 scaled couplings,
+  // pivots, t), backward sweep with r.z 7, direction update 3.
+  constexpr std::uint64_t kArraysPerIteration = 28;
 
   PcgOutcome out;
   // Vectors are zero off the unknowns, with one plane of margin on each side of the slab (the
@@ -211,7 +229,8 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
   const double bNorm = std::sqrt(sumOver(comm, bb));
   if (bNorm == 0.0) return out;
   buildPreconditioner(g, A, slab, w);
-  double rho = sumOver(comm, applyPreconditioner(g, w, r, w.t.data(), z));
+  for (const Row& row : w.rows) forwardRow<false>(g, w, row, 0.0, s, q, pp, r, w.t.data());
+  double rho = sumOver(comm, backward(g, w, r, w.t.data(), z));
   for (const Row& row : w.rows) {
     for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
       s[c] = z[c];
@@ -224,17 +243,11 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
     const double sq = sumOver(comm, multiply(g, A, s, q, w.rows));
     if (sq <= 0.0) break;  // breakdown: no descent left (round-off at convergence)
     const double alpha = rho / sq;
-    double rr = 0.0;
-    for (const Row& row : w.rows) {
-      for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
-        pp[c] += alpha * s[c];
-        r[c] -= alpha * q[c];
-        rr += r[c] * r[c];
-      }
-    }
     // The preconditioner runs before the convergence test so that |r|^2 and r.z are summed
     // over the blocks together (one reduction instead of two; the last one is wasted).
-    const double rz = applyPreconditioner(g, w, r, w.t.data(), z);
+    double rr = 0.0;
+    for (const Row& row : w.rows) rr += forwardRow<true>(g, w, row, alpha, s, q, pp, r, w.t.data());
+    const double rz = backward(g, w, r, w.t.data(), z);
     double rhoNew = rz;
     if (comm) {
       sums[0] = rr;
