@@ -39,6 +39,11 @@ void MpiBlockComm::sum(std::vector<double>& values) {
   }
 }
 
+void MpiBlockComm::max(std::vector<double>& values) {
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MAX,
+                comm_);
+}
+
 void MpiBlockComm::exchangeHalo(std::vector<double>& field, int planeSize, int planeCount, int k0,
                                 int k1, int depth) {
   const int lower = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL;
@@ -80,30 +85,30 @@ void MpiBlockComm::exchangeHalo(std::vector<double>& field, int planeSize, int p
 void MpiBlockComm::addHalo(std::vector<double>& field, int planeSize, int planeCount, int k0,
                            int k1) {
   const std::size_t ps = static_cast<std::size_t>(planeSize);
-  buffer_.assign(ps, 0.0);
-  std::vector<double> zeros(ps, 0.0);
-  MPI_Status status;
-  // Plane k1 (contributions to the upper block's first plane) goes up; the lower block's
-  // contributions to my plane k0 arrive.
+  buffer_.assign(2 * ps, 0.0);
+  double* fromBelow = buffer_.data();
+  double* fromAbove = buffer_.data() + ps;
   const int upper = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
   const int lower = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL;
-  const double* up = (upper != MPI_PROC_NULL && k1 < planeCount)
-                         ? field.data() + static_cast<std::size_t>(k1) * ps
-                         : zeros.data();
-  MPI_Sendrecv(up, planeSize, MPI_DOUBLE, upper, kTagUp, buffer_.data(), planeSize, MPI_DOUBLE,
-               lower, kTagUp, comm_, &status);
+  // Both directions at once: plane k1 (contributions to the upper block's first plane) goes up,
+  // plane k0 - 1 goes down; the neighbours' contributions to planes k0 and k1 - 1 arrive.
+  MPI_Request requests[4];
+  MPI_Irecv(fromBelow, planeSize, MPI_DOUBLE, lower, kTagUp, comm_, &requests[0]);
+  MPI_Irecv(fromAbove, planeSize, MPI_DOUBLE, upper, kTagDown, comm_, &requests[1]);
+  const int upCount = (upper != MPI_PROC_NULL && k1 < planeCount) ? planeSize : 0;
+  const int downCount = (lower != MPI_PROC_NULL && k0 > 0) ? planeSize : 0;
+  MPI_Isend(field.data() + static_cast<std::size_t>(std::min(k1, planeCount - 1)) * ps, upCount,
+            MPI_DOUBLE, upper, kTagUp, comm_, &requests[2]);
+  MPI_Isend(field.data() + static_cast<std::size_t>(std::max(k0 - 1, 0)) * ps, downCount,
+            MPI_DOUBLE, lower, kTagDown, comm_, &requests[3]);
+  MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
+  // Lower block's first, as when the two directions ran one after the other.
   if (lower != MPI_PROC_NULL) {
-    for (std::size_t i = 0; i < ps; ++i) field[static_cast<std::size_t>(k0) * ps + i] += buffer_[i];
+    for (std::size_t i = 0; i < ps; ++i) field[static_cast<std::size_t>(k0) * ps + i] += fromBelow[i];
   }
-  const double* down = (lower != MPI_PROC_NULL && k0 > 0)
-                           ? field.data() + static_cast<std::size_t>(k0 - 1) * ps
-                           : zeros.data();
-  std::fill(buffer_.begin(), buffer_.end(), 0.0);
-  MPI_Sendrecv(down, planeSize, MPI_DOUBLE, lower, kTagDown, buffer_.data(), planeSize, MPI_DOUBLE,
-               upper, kTagDown, comm_, &status);
   if (upper != MPI_PROC_NULL) {
     for (std::size_t i = 0; i < ps; ++i) {
-      field[static_cast<std::size_t>(k1 - 1) * ps + i] += buffer_[i];
+      field[static_cast<std::size_t>(k1 - 1) * ps + i] += fromAbove[i];
     }
   }
 }

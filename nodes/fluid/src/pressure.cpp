@@ -201,14 +201,19 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
   constexpr std::uint64_t kArraysPerIteration = 28;
 
   PcgOutcome out;
-  // Vectors are zero off the unknowns, with one plane of margin on each side of the slab (the
-  // sweeps read there, where the couplings are zero; the product reads the exchanged halo).
+  // Vectors are zero off the unknowns (the sweeps and the product read neighbours there; the
+  // product's halo planes are exchanged before each use). Only the cells the last solve wrote,
+  // its rows, need clearing.
   const std::size_t ps = static_cast<std::size_t>(planeSize);
-  const std::size_t zeroFrom = slab.c0 >= ps ? slab.c0 - ps : 0, zeroTo = slab.c1 + ps;
-  for (auto* v : {&w.r, &w.z, &w.s, &w.q, &w.t, &w.pc, &w.axpc, &w.aypc, &w.azpc}) {
-    v->resize(n + ps);
-    std::fill(v->begin() + static_cast<std::ptrdiff_t>(zeroFrom),
-              v->begin() + static_cast<std::ptrdiff_t>(zeroTo), 0.0);
+  std::vector<double>* vectors[] = {&w.r, &w.z, &w.s, &w.q, &w.t, &w.pc, &w.axpc, &w.aypc, &w.azpc};
+  if (w.r.size() != n + ps) {
+    for (auto* v : vectors) v->assign(n + ps, 0.0);
+    w.rows.clear();
+  }
+  for (const Row& row : w.rows) {
+    const auto from = static_cast<std::ptrdiff_t>(row.c);
+    const auto count = static_cast<std::ptrdiff_t>(row.i1 - row.i0 + 1);
+    for (auto* v : vectors) std::fill_n(v->begin() + from, count, 0.0);
   }
   findRows(g, A, slab, w.rows);
   std::uint64_t activeCells = 0;

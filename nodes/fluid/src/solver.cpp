@@ -326,8 +326,12 @@ struct FluidSolver::Impl {
         }
       }
     }
-    total = sum(total);
-    count = sum(count);
+    if (comm) {
+      std::vector<double> both{total, count};
+      comm->sum(both);
+      total = both[0];
+      count = both[1];
+    }
     stats.particleDensity = count > 0 ? total / (count * n0) : 1.0;
     theta.assign(kind.size(), 0.5);
     for (std::size_t c = k0 * plane; c < k1 * plane; ++c) {
@@ -579,9 +583,14 @@ struct FluidSolver::Impl {
         }
       }
     }
-    maxDiv = max(worst);
-    stats.fluidCells = static_cast<int>(sum(fluid));
-    stats.bodyCells = static_cast<int>(sum(body));
+    if (comm) {
+      std::vector<double> both{fluid, body};
+      comm->sum(both);
+      fluid = both[0];
+      body = both[1];
+    }
+    stats.fluidCells = static_cast<int>(fluid);
+    stats.bodyCells = static_cast<int>(body);
     double speed = 0.0;
     for (int a = 0; a < 3; ++a) {
       forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
@@ -592,7 +601,15 @@ struct FluidSolver::Impl {
         speed = std::max(speed, std::abs(u[a][f]));
       });
     }
-    stats.maxSpeed = max(speed);
+    // Both maxima in one reduction.
+    if (comm) {
+      std::vector<double> both{worst, speed};
+      comm->max(both);
+      worst = both[0];
+      speed = both[1];
+    }
+    maxDiv = worst;
+    stats.maxSpeed = speed;
   }
 
   void markProjectedFaces() {
