@@ -120,7 +120,8 @@ int main(int argc, char** argv) {
         line["stream_copy_gbs"] = stream;
         // The CG's estimated traffic rate as a fraction of the copy's (above 1: vectors stay in
         // cache).
-        line["bandwidth_vs_stream"] = stream > 0 ? result["bandwidth_gbs"].get<double>() / stream : 0.0;
+        line["bandwidth_vs_stream"] =
+            stream > 0 ? result["bandwidth_gbs"].get<double>() / stream : 0.0;
         const double ms = result["ms_per_step"].get<double>();
         if (ranks == 1) oneRankMs = ms;
         if (ranks > 1 && oneRankMs > 0 && ms > 0) line["speedup_vs_1_rank"] = oneRankMs / ms;

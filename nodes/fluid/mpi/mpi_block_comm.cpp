@@ -104,7 +104,8 @@ void MpiBlockComm::addHalo(std::vector<double>& field, int planeSize, int planeC
   MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
   // Lower block's first, as when the two directions ran one after the other.
   if (lower != MPI_PROC_NULL) {
-    for (std::size_t i = 0; i < ps; ++i) field[static_cast<std::size_t>(k0) * ps + i] += fromBelow[i];
+    for (std::size_t i = 0; i < ps; ++i)
+      field[static_cast<std::size_t>(k0) * ps + i] += fromBelow[i];
   }
   if (upper != MPI_PROC_NULL) {
     for (std::size_t i = 0; i < ps; ++i) {

@@ -152,8 +152,7 @@ double forwardRow(const Grid& g, const PcgWorkspace& w, const Row& row, double a
 }
 
 // The backward sweep (L^T z = t), completing z = M^-1 r; returns the local part of r.z.
-double backward(const Grid& g, const PcgWorkspace& w, const double* r, const double* t,
-                double* z) {
+double backward(const Grid& g, const PcgWorkspace& w, const double* r, const double* t, double* z) {
   const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
   const double* pc = w.pc.data();
   const double* axpc = w.axpc.data();

@@ -346,8 +346,10 @@ struct FluidSolver::Impl {
     // This block's particles reach face planes k0 - 1 to k1.
     for (int a = 0; a < 3; ++a) {
       const std::size_t ps = 2 * static_cast<std::size_t>(planeSize(a));
-      const auto from = static_cast<std::ptrdiff_t>(ps * static_cast<std::size_t>(std::max(0, k0 - 1)));
-      const auto to = static_cast<std::ptrdiff_t>(ps * static_cast<std::size_t>(std::min(grid.fdim(a, 2), k1 + 1)));
+      const auto from =
+          static_cast<std::ptrdiff_t>(ps * static_cast<std::size_t>(std::max(0, k0 - 1)));
+      const auto to = static_cast<std::ptrdiff_t>(
+          ps * static_cast<std::size_t>(std::min(grid.fdim(a, 2), k1 + 1)));
       std::fill(acc[a].begin() + from, acc[a].begin() + to, 0.0);
     }
     const detail::Lattice lattice(grid);
@@ -364,7 +366,10 @@ struct FluidSolver::Impl {
     }
     for (int a = 0; a < 3; ++a) {
       if (comm) comm->addHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1);
-      std::fill(u[a].begin(), u[a].end(), 0.0);
+      // Faces of other blocks read zero (this block's are all written below).
+      const auto ps = static_cast<std::ptrdiff_t>(planeSize(a));
+      std::fill(u[a].begin(), u[a].begin() + ps * k0, 0.0);
+      std::fill(u[a].begin() + ps * kEnd(a), u[a].end(), 0.0);
       const double* in = acc[a].data();
       forOwnFaces(a, [&](std::size_t f, int, int, int) {
         const double w = in[2 * f + 1];
@@ -473,7 +478,8 @@ struct FluidSolver::Impl {
               if (b < 0) continue;
               const auto& body = bodies[static_cast<std::size_t>(b)];
               if (kinematicOnly && !body.kinematic) continue;
-              u[a][f] = detail::rigidVelocity(body, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
+              u[a][f] = detail::rigidVelocity(
+                  body, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
             }
           }
         }
@@ -498,8 +504,10 @@ struct FluidSolver::Impl {
     auto& A = system;
     // The system is built on this block's cells and read one plane beyond them.
     const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
-    const auto cFrom = static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::max(0, k0 - 1)));
-    const auto cTo = static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1)));
+    const auto cFrom =
+        static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::max(0, k0 - 1)));
+    const auto cTo =
+        static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1)));
     for (auto* v : {&A.diag, &A.ax, &A.ay, &A.az, &rhs}) {
       v->resize(n);
       std::fill(v->begin() + cFrom, v->begin() + cTo, 0.0);
@@ -640,7 +648,8 @@ struct FluidSolver::Impl {
       double* out = acc[a].data();
       const double* un = u[a].data();
       const double* uo = uOld[a].data();
-      for (std::size_t f = ps * static_cast<std::size_t>(k0); f < ps * static_cast<std::size_t>(kEnd(a)); ++f) {
+      for (std::size_t f = ps * static_cast<std::size_t>(k0);
+           f < ps * static_cast<std::size_t>(kEnd(a)); ++f) {
         out[2 * f] = un[f];
         out[2 * f + 1] = un[f] - uo[f];
       }

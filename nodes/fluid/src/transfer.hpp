@@ -42,8 +42,8 @@ struct Located {
 };
 
 // One dimension of locate(): g is the point's coordinate in cells; n the cell count.
-inline void locateAxis(double g, int n, int& faceBase, double& faceFrac, int& centreBase,
-                       double& centreFrac) {
+[[gnu::always_inline]] inline void locateAxis(double g, int n, int& faceBase, double& faceFrac,
+                                              int& centreBase, double& centreFrac) {
   // min/max rather than branches: the same values as std::clamp for finite coordinates.
   const double hiFace = static_cast<double>(n), hiCentre = static_cast<double>(n - 1);
   const double vf = std::min(std::max(g, 0.0), hiFace);
@@ -58,13 +58,13 @@ inline void locateAxis(double g, int n, int& faceBase, double& faceFrac, int& ce
   centreFrac = vc - bc;
 }
 
-inline void locate(const Lattice& l, const double* x, Located& c) {
-  locateAxis((x[0] - l.origin[0]) * l.invH, l.n[0], c.faceBase[0], c.faceFrac[0],
-             c.centreBase[0], c.centreFrac[0]);
-  locateAxis((x[1] - l.origin[1]) * l.invH, l.n[1], c.faceBase[1], c.faceFrac[1],
-             c.centreBase[1], c.centreFrac[1]);
-  locateAxis((x[2] - l.origin[2]) * l.invH, l.n[2], c.faceBase[2], c.faceFrac[2],
-             c.centreBase[2], c.centreFrac[2]);
+[[gnu::always_inline]] inline void locate(const Lattice& l, const double* x, Located& c) {
+  locateAxis((x[0] - l.origin[0]) * l.invH, l.n[0], c.faceBase[0], c.faceFrac[0], c.centreBase[0],
+             c.centreFrac[0]);
+  locateAxis((x[1] - l.origin[1]) * l.invH, l.n[1], c.faceBase[1], c.faceFrac[1], c.centreBase[1],
+             c.centreFrac[1]);
+  locateAxis((x[2] - l.origin[2]) * l.invH, l.n[2], c.faceBase[2], c.faceFrac[2], c.centreBase[2],
+             c.centreFrac[2]);
 }
 
 /// Component a's stencil: first face index and the three fractions.
