@@ -191,9 +191,11 @@ struct FluidSolver::Impl {
     for (std::size_t p = 0; p < count; ++p) {
       const int k = planeOf(&pos[3 * p]);
       if (k >= k0 && k < k1) {
-        for (int d = 0; d < 3; ++d) {
-          pos[3 * keep + d] = pos[3 * p + d];
-          vel[3 * keep + d] = vel[3 * p + d];
+        if (keep != p) {
+          for (int d = 0; d < 3; ++d) {
+            pos[3 * keep + d] = pos[3 * p + d];
+            vel[3 * keep + d] = vel[3 * p + d];
+          }
         }
         ++keep;
         continue;
@@ -217,8 +219,14 @@ struct FluidSolver::Impl {
   std::vector<std::size_t> sortStart;
   std::vector<double> posScratch, velScratch;
   void sortParticles() {
+    // This block's particles all lie in its slab (cellOf clamps as planeOf does in migrate), so
+    // only the slab's cells are counted; the others keep their zero counts.
     const std::size_t n = pos.size() / 3;
-    particlesInCell.assign(grid.cells(), 0);
+    const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+    const std::size_t c0 = plane * static_cast<std::size_t>(k0),
+                      c1 = plane * static_cast<std::size_t>(k1);
+    std::fill(particlesInCell.begin() + static_cast<std::ptrdiff_t>(c0),
+              particlesInCell.begin() + static_cast<std::ptrdiff_t>(c1), 0);
     sortCell.resize(n);
     for (std::size_t p = 0; p < n; ++p) {
       int i, j, k;
@@ -230,8 +238,9 @@ struct FluidSolver::Impl {
       sortCell[p] = c;
       ++particlesInCell[c];
     }
-    sortStart.assign(grid.cells() + 1, 0);
-    for (std::size_t c = 0; c < grid.cells(); ++c) {
+    sortStart.resize(grid.cells() + 1);
+    sortStart[c0] = 0;
+    for (std::size_t c = c0; c < c1; ++c) {
       sortStart[c + 1] = sortStart[c] + static_cast<std::size_t>(particlesInCell[c]);
     }
     posScratch.resize(pos.size());
