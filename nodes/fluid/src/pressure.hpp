@@ -25,6 +25,7 @@ struct PressureSystem {
 /// Scratch vectors of the CG, kept between steps so a step allocates nothing.
 struct PcgWorkspace {
   std::vector<double> r, z, s, q, t, pc;
+  std::vector<double> as;                ///< A s, updated instead of computed (several blocks only)
   std::vector<double> axpc, aypc, azpc;  ///< off-diagonals times the pivot of their row
   /// Rows (j, k) of the slab holding unknowns: first cell index, first and last i.
   struct Row {
