@@ -215,7 +215,19 @@ struct FluidSolver::Impl {
 
   // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
   // and an order that does not depend on history.
+  // The cell of each particle (clamped into the grid), in particle order. The advection stores
+  // it when particles do not change blocks afterwards (serial or one block), so that pushing
+  // out of bodies and sorting need not locate every particle again; `cellsKnown` says so.
   std::vector<std::uint32_t> sortCell;
+  bool cellsKnown = false;
+  std::uint32_t clampedCell(const double* x) const {
+    int i, j, k;
+    cellOf(x, i, j, k);
+    i = std::clamp(i, 0, grid.nx - 1);
+    j = std::clamp(j, 0, grid.ny - 1);
+    k = std::clamp(k, 0, grid.nz - 1);
+    return static_cast<std::uint32_t>(grid.cell(i, j, k));
+  }
   std::vector<std::size_t> sortStart;
   std::vector<double> posScratch, velScratch;
   void sortParticles() {
@@ -227,17 +239,11 @@ struct FluidSolver::Impl {
                       c1 = plane * static_cast<std::size_t>(k1);
     std::fill(particlesInCell.begin() + static_cast<std::ptrdiff_t>(c0),
               particlesInCell.begin() + static_cast<std::ptrdiff_t>(c1), 0);
-    sortCell.resize(n);
-    for (std::size_t p = 0; p < n; ++p) {
-      int i, j, k;
-      cellOf(&pos[3 * p], i, j, k);
-      i = std::clamp(i, 0, grid.nx - 1);
-      j = std::clamp(j, 0, grid.ny - 1);
-      k = std::clamp(k, 0, grid.nz - 1);
-      const auto c = static_cast<std::uint32_t>(grid.cell(i, j, k));
-      sortCell[p] = c;
-      ++particlesInCell[c];
+    if (!cellsKnown) {
+      sortCell.resize(n);
+      for (std::size_t p = 0; p < n; ++p) sortCell[p] = clampedCell(&pos[3 * p]);
     }
+    for (std::size_t p = 0; p < n; ++p) ++particlesInCell[sortCell[p]];
     sortStart.resize(grid.cells() + 1);
     sortStart[c0] = 0;
     for (std::size_t c = c0; c < c1; ++c) {
@@ -254,6 +260,7 @@ struct FluidSolver::Impl {
     }
     pos.swap(posScratch);
     vel.swap(velScratch);
+    cellsKnown = false;
   }
 
   // Only particles in cells that some body's bounds touch are tested against the bodies.
@@ -279,13 +286,18 @@ struct FluidSolver::Impl {
     const std::size_t count = pos.size() / 3;
     for (std::size_t p = 0; p < count; ++p) {
       double* x = &pos[3 * p];
-      int i, j, k;
-      if (!cellOf(x, i, j, k) || !nearBody[grid.cell(i, j, k)]) continue;
+      if (cellsKnown) {
+        if (!nearBody[sortCell[p]]) continue;
+      } else {
+        int i, j, k;
+        if (!cellOf(x, i, j, k) || !nearBody[grid.cell(i, j, k)]) continue;
+      }
       for (const auto& body : bodies) {
         if (!detail::inBounds(body.bounds, x)) continue;
         detail::pushOut(body, x, 0.25 * grid.h);
         clampToDomain(x);
       }
+      if (cellsKnown) sortCell[p] = clampedCell(x);
     }
   }
 
@@ -683,6 +695,8 @@ struct FluidSolver::Impl {
       for (int d = 0; d < 3; ++d) y[d] = std::min(std::max(y[d], lo[d]), hi[d]);
     };
     const std::size_t n = pos.size() / 3;
+    const bool storeCells = !comm || comm->size() == 1;
+    if (storeCells) sortCell.resize(n);
     for (std::size_t p = 0; p < n; ++p) {
       double* x = &pos[3 * p];
       double* v = &vel[3 * p];
@@ -706,7 +720,9 @@ struct FluidSolver::Impl {
       x[1] += dt * detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c))[0];
       x[2] += dt * detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c))[0];
       clamp(x);
+      if (storeCells) sortCell[p] = clampedCell(x);
     }
+    cellsKnown = storeCells;
   }
 
   void refreshOutput() {
@@ -817,6 +833,7 @@ Status FluidSolver::addLiquidBox(const msg::Aabb& box) {
           }
           if (!mine) continue;
           m.pos.insert(m.pos.end(), x, x + 3);
+          m.cellsKnown = false;
           m.vel.insert(m.vel.end(), 3, 0.0);
         }
       }
