@@ -142,11 +142,14 @@ double forwardRow(const Grid& g, const PcgWorkspace& w, const Row& row, double a
     // The neighbour along x last: it is the one just computed (the recurrence's latency).
     // Rows with no row below or behind them read zeros there (t is zero off the unknowns, and
     // the couplings of cells outside the slab are zero).
+    // The recurrence along x is one multiply and one subtraction: the pivot is applied to the
+    // rest and to the coupling before.
     double v = r[c];
     if (row.j > 0) v -= aypc[c - sy] * t[c - sy];
     if (c >= sz) v -= azpc[c - sz] * t[c - sz];
-    if (i > 0) v -= axpc[c - 1] * t[c - 1];
-    t[c] = v * pc[c];
+    v *= pc[c];
+    if (i > 0) v -= (pc[c] * axpc[c - 1]) * t[c - 1];
+    t[c] = v;
   }
   return rr;
 }
@@ -171,8 +174,9 @@ double backward(const Grid& g, const PcgWorkspace& w, const double* r, const dou
       double v = t[c];
       if (jHi) v -= aypc[c] * z[c + sy];
       v -= azpc[c] * z[c + sz];
-      if (i + 1 < g.nx) v -= axpc[c] * z[c + 1];
-      z[c] = v * pc[c];
+      v *= pc[c];
+      if (i + 1 < g.nx) v -= (pc[c] * axpc[c]) * z[c + 1];
+      z[c] = v;
       rz += r[c] * z[c];
     }
   }

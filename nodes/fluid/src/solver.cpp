@@ -697,25 +697,33 @@ struct FluidSolver::Impl {
     const std::size_t n = pos.size() / 3;
     const bool storeCells = !comm || comm->size() == 1;
     if (storeCells) sortCell.resize(n);
+    // Two passes (velocities and midpoints, then positions) rather than one: within a particle
+    // the second interpolation waits for the first, and a pass of short independent chains
+    // keeps more particles in flight.
+    posScratch.resize(pos.size());
+    double* midpoints = posScratch.data();
     for (std::size_t p = 0; p < n; ++p) {
-      double* x = &pos[3 * p];
+      const double* x = &pos[3 * p];
       double* v = &vel[3 * p];
-      double vn[3];
       detail::Located c;
       detail::locate(lattice, x, c);
       const detail::Pair g0 = detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c));
       const detail::Pair g1 = detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c));
       const detail::Pair g2 = detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c));
-      vn[0] = g0[0];
-      vn[1] = g1[0];
-      vn[2] = g2[0];
       v[0] = flip * (v[0] + g0[1]) + pic * g0[0];
       v[1] = flip * (v[1] + g1[1]) + pic * g1[0];
       v[2] = flip * (v[2] + g2[1]) + pic * g2[0];
       // Midpoint (RK2) through the divergence-free grid velocity.
-      double mid[3] = {x[0] + halfDt * vn[0], x[1] + halfDt * vn[1], x[2] + halfDt * vn[2]};
+      double* mid = midpoints + 3 * p;
+      mid[0] = x[0] + halfDt * g0[0];
+      mid[1] = x[1] + halfDt * g1[0];
+      mid[2] = x[2] + halfDt * g2[0];
       clamp(mid);
-      detail::locate(lattice, mid, c);
+    }
+    for (std::size_t p = 0; p < n; ++p) {
+      double* x = &pos[3 * p];
+      detail::Located c;
+      detail::locate(lattice, midpoints + 3 * p, c);
       x[0] += dt * detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c))[0];
       x[1] += dt * detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c))[0];
       x[2] += dt * detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c))[0];
