@@ -157,6 +157,39 @@ struct FluidSolver::Impl {
     }
   }
 
+  // Per cell row (j, k) of this block's planes and one beyond: whether it holds a cell that is
+  // not air (set by classify()). Faces next to air only are skipped by forFacesNearMatter().
+  std::vector<unsigned char> rowHasMatter;
+  void markRowsWithMatter() {
+    rowHasMatter.assign(static_cast<std::size_t>(grid.ny) * grid.nz, 0);
+    for (int k = std::max(0, k0 - 1); k < std::min(grid.nz, k1 + 1); ++k) {
+      for (int j = 0; j < grid.ny; ++j) {
+        const unsigned char* row = kind.data() + grid.cell(0, j, k);
+        unsigned char any = 0;
+        for (int i = 0; i < grid.nx; ++i) any |= row[i];  // kAir is 0
+        rowHasMatter[static_cast<std::size_t>(k) * grid.ny + j] = any != 0;
+      }
+    }
+  }
+  // forOwnFaces() restricted to the rows of faces with a cell that is not air on either side.
+  template <typename F>
+  void forFacesNearMatter(int a, F&& f) const {
+    const int ke = kEnd(a);
+    const int ny = grid.ny, nz = grid.nz;
+    auto busy = [&](int j, int k) {
+      return j >= 0 && j < ny && k >= 0 && k < nz &&
+             rowHasMatter[static_cast<std::size_t>(k) * ny + j];
+    };
+    for (int k = k0; k < ke; ++k) {
+      for (int j = 0; j < grid.fdim(a, 1); ++j) {
+        const bool near = busy(j, k) || (a == 1 && busy(j - 1, k)) || (a == 2 && busy(j, k - 1));
+        if (!near) continue;
+        std::size_t idx = grid.face(a, 0, j, k);
+        for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
+      }
+    }
+  }
+
   bool onWall(int a, int i, int j, int k) const {
     const int along = a == 0 ? i : a == 1 ? j : k;
     return along == 0 || along == grid.fdim(a, a) - 1;
@@ -321,6 +354,7 @@ struct FluidSolver::Impl {
       if (particlesInCell[c] > 0 && kind[c] == detail::kAir) kind[c] = detail::kLiquid;
     }
     exchangeBytes(kind, grid.nx * grid.ny, grid.nz);
+    markRowsWithMatter();
     // Volume control: each liquid cell away from the surface asks for a divergence that brings
     // its particle count back to particlesPerCell (cells next to air are partly full by nature).
     divTarget.assign(kind.size(), 0.0);
@@ -578,7 +612,7 @@ struct FluidSolver::Impl {
     stats.bytesTouched = outcome.bytesTouched;
     // Subtract the pressure gradient on every interior face next to an unknown cell.
     for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
+      forFacesNearMatter(a, [&](std::size_t f, int i, int j, int k) {
         if (onWall(a, i, j, k)) return;
         const std::size_t hi = grid.cell(i, j, k);
         const std::size_t lo = hi - stride(a);
@@ -622,7 +656,7 @@ struct FluidSolver::Impl {
     stats.bodyCells = static_cast<int>(body);
     double speed = 0.0;
     for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
+      forFacesNearMatter(a, [&](std::size_t f, int i, int j, int k) {
         if (onWall(a, i, j, k)) return;
         const std::size_t hi = grid.cell(i, j, k);
         const std::size_t lo = hi - stride(a);
@@ -643,7 +677,9 @@ struct FluidSolver::Impl {
 
   void markProjectedFaces() {
     for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
+      const auto ps = static_cast<std::ptrdiff_t>(planeSize(a));
+      std::fill(valid[a].begin() + ps * k0, valid[a].begin() + ps * kEnd(a), 0);
+      forFacesNearMatter(a, [&](std::size_t f, int i, int j, int k) {
         const int along = a == 0 ? i : a == 1 ? j : k;
         // Projected faces and the faces of kinematic bodies keep their values.
         bool touches = false;
