@@ -246,8 +246,6 @@ struct FluidSolver::Impl {
     }
   }
 
-  // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
-  // and an order that does not depend on history.
   // The cell of each particle (clamped into the grid), in particle order. The advection stores
   // it when particles do not change blocks afterwards (serial or one block), so that pushing
   // out of bodies and sorting need not locate every particle again; `cellsKnown` says so.
@@ -263,6 +261,8 @@ struct FluidSolver::Impl {
   }
   std::vector<std::size_t> sortStart;
   std::vector<double> posScratch, velScratch;
+  // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
+  // and an order that does not depend on history.
   void sortParticles() {
     // This block's particles all lie in its slab (cellOf clamps as planeOf does in migrate), so
     // only the slab's cells are counted; the others keep their zero counts.
