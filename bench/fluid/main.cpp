@@ -99,6 +99,7 @@ int main(int argc, char** argv) {
   };
   for (const Grid g : {Grid{32, 64, 32}, Grid{64, 128, 64}}) {
     for (int bodies : {0, 20}) {
+      double oneRankMs = 0.0;
       for (int ranks : {1, 2}) {
         const int n = g.nx == 32 ? steps : std::max(4, steps / 4);
         // The copy is measured right before each case, so both see the same machine load.
@@ -117,6 +118,13 @@ int main(int argc, char** argv) {
         line["pressure_ms_per_step"] = result["pressure_ms_per_step"];
         line["bandwidth_gbs"] = result["bandwidth_gbs"];
         line["stream_copy_gbs"] = stream;
+        // The CG's estimated traffic rate as a fraction of the copy's (above 1: vectors stay in
+        // cache).
+        line["bandwidth_vs_stream"] =
+            stream > 0 ? result["bandwidth_gbs"].get<double>() / stream : 0.0;
+        const double ms = result["ms_per_step"].get<double>();
+        if (ranks == 1) oneRankMs = ms;
+        if (ranks > 1 && oneRankMs > 0 && ms > 0) line["speedup_vs_1_rank"] = oneRankMs / ms;
         line["particles"] = result["particles"];
         line["steps"] = n;
         line["machine"] = where;

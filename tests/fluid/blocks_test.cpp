@@ -13,8 +13,9 @@
 //
 // One rank is the serial solver bit for bit (same code, no neighbours). With 2 and 4 blocks the
 // results differ in the last bits: particle-to-grid sums at block borders add in another order,
-// and the pressure CG's preconditioner is MIC(0) per block (block Jacobi), so it stops at the
-// 1e-6 relative residual at another iterate. Stated tolerance after 40 steps: body heights within
+// and the pressure CG's preconditioner is MIC(0) per block (block Jacobi, part of the dropped
+// couplings on the diagonal) in the Chronopoulos-Gear arrangement, so it stops at the 1e-6
+// relative residual at another iterate. Stated tolerance after 40 steps: body heights within
 // 1e-5 m, particle centroid height within 1e-5 relative, liquid volume (cells) within 0.5 %.
 namespace vrflow::testing {
 namespace {

@@ -39,35 +39,45 @@ void MpiBlockComm::sum(std::vector<double>& values) {
   }
 }
 
+void MpiBlockComm::max(std::vector<double>& values) {
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MAX,
+                comm_);
+}
+
 void MpiBlockComm::exchangeHalo(std::vector<double>& field, int planeSize, int planeCount, int k0,
                                 int k1, int depth) {
   const int lower = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL;
   const int upper = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
   const int d = std::min(depth, k1 - k0);
   const std::size_t ps = static_cast<std::size_t>(planeSize);
-  buffer_.resize(static_cast<std::size_t>(depth) * ps);
-  MPI_Status status;
+  const std::size_t half = static_cast<std::size_t>(depth) * ps;
+  buffer_.resize(2 * half);
+  double* fromBelow = buffer_.data();
+  double* fromAbove = buffer_.data() + half;
+  // Both directions at once (one wait instead of two in a row): my top planes go up and the
+  // lower block's land below k0; my bottom planes go down and the upper block's land from k1.
+  MPI_Request requests[4];
+  MPI_Irecv(fromBelow, depth * planeSize, MPI_DOUBLE, lower, kTagUp, comm_, &requests[0]);
+  MPI_Irecv(fromAbove, depth * planeSize, MPI_DOUBLE, upper, kTagDown, comm_, &requests[1]);
+  MPI_Isend(field.data() + static_cast<std::size_t>(k1 - d) * ps, d * planeSize, MPI_DOUBLE, upper,
+            kTagUp, comm_, &requests[2]);
+  MPI_Isend(field.data() + static_cast<std::size_t>(k0) * ps, d * planeSize, MPI_DOUBLE, lower,
+            kTagDown, comm_, &requests[3]);
+  MPI_Status statuses[4];
+  MPI_Waitall(4, requests, statuses);
   int count = 0;
-  // My top planes go up; the lower block's top planes land below k0.
-  MPI_Sendrecv(field.data() + static_cast<std::size_t>(k1 - d) * ps, d * planeSize, MPI_DOUBLE,
-               upper, kTagUp, buffer_.data(), depth * planeSize, MPI_DOUBLE, lower, kTagUp, comm_,
-               &status);
   if (lower != MPI_PROC_NULL) {
-    MPI_Get_count(&status, MPI_DOUBLE, &count);
+    MPI_Get_count(&statuses[0], MPI_DOUBLE, &count);
     const int planes = count / planeSize;
     const int first = std::max(0, k0 - planes);
-    std::copy(buffer_.begin() + static_cast<std::ptrdiff_t>((first - (k0 - planes)) * ps),
-              buffer_.begin() + static_cast<std::ptrdiff_t>(planes * ps),
+    std::copy(fromBelow + static_cast<std::ptrdiff_t>((first - (k0 - planes)) * ps),
+              fromBelow + static_cast<std::ptrdiff_t>(planes * ps),
               field.begin() + static_cast<std::ptrdiff_t>(first * ps));
   }
-  // My bottom planes go down; the upper block's bottom planes land from k1 up.
-  MPI_Sendrecv(field.data() + static_cast<std::size_t>(k0) * ps, d * planeSize, MPI_DOUBLE, lower,
-               kTagDown, buffer_.data(), depth * planeSize, MPI_DOUBLE, upper, kTagDown, comm_,
-               &status);
   if (upper != MPI_PROC_NULL) {
-    MPI_Get_count(&status, MPI_DOUBLE, &count);
+    MPI_Get_count(&statuses[1], MPI_DOUBLE, &count);
     const int planes = std::min(count / planeSize, planeCount - k1);
-    std::copy(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(planes * ps),
+    std::copy(fromAbove, fromAbove + static_cast<std::ptrdiff_t>(planes * ps),
               field.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(k1) * ps));
   }
 }
@@ -75,30 +85,31 @@ void MpiBlockComm::exchangeHalo(std::vector<double>& field, int planeSize, int p
 void MpiBlockComm::addHalo(std::vector<double>& field, int planeSize, int planeCount, int k0,
                            int k1) {
   const std::size_t ps = static_cast<std::size_t>(planeSize);
-  buffer_.assign(ps, 0.0);
-  std::vector<double> zeros(ps, 0.0);
-  MPI_Status status;
-  // Plane k1 (contributions to the upper block's first plane) goes up; the lower block's
-  // contributions to my plane k0 arrive.
+  buffer_.assign(2 * ps, 0.0);
+  double* fromBelow = buffer_.data();
+  double* fromAbove = buffer_.data() + ps;
   const int upper = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
   const int lower = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL;
-  const double* up = (upper != MPI_PROC_NULL && k1 < planeCount)
-                         ? field.data() + static_cast<std::size_t>(k1) * ps
-                         : zeros.data();
-  MPI_Sendrecv(up, planeSize, MPI_DOUBLE, upper, kTagUp, buffer_.data(), planeSize, MPI_DOUBLE,
-               lower, kTagUp, comm_, &status);
+  // Both directions at once: plane k1 (contributions to the upper block's first plane) goes up,
+  // plane k0 - 1 goes down; the neighbours' contributions to planes k0 and k1 - 1 arrive.
+  MPI_Request requests[4];
+  MPI_Irecv(fromBelow, planeSize, MPI_DOUBLE, lower, kTagUp, comm_, &requests[0]);
+  MPI_Irecv(fromAbove, planeSize, MPI_DOUBLE, upper, kTagDown, comm_, &requests[1]);
+  const int upCount = (upper != MPI_PROC_NULL && k1 < planeCount) ? planeSize : 0;
+  const int downCount = (lower != MPI_PROC_NULL && k0 > 0) ? planeSize : 0;
+  MPI_Isend(field.data() + static_cast<std::size_t>(std::min(k1, planeCount - 1)) * ps, upCount,
+            MPI_DOUBLE, upper, kTagUp, comm_, &requests[2]);
+  MPI_Isend(field.data() + static_cast<std::size_t>(std::max(k0 - 1, 0)) * ps, downCount,
+            MPI_DOUBLE, lower, kTagDown, comm_, &requests[3]);
+  MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
+  // Lower block's first, as when the two directions ran one after the other.
   if (lower != MPI_PROC_NULL) {
-    for (std::size_t i = 0; i < ps; ++i) field[static_cast<std::size_t>(k0) * ps + i] += buffer_[i];
+    for (std::size_t i = 0; i < ps; ++i)
+      field[static_cast<std::size_t>(k0) * ps + i] += fromBelow[i];
   }
-  const double* down = (lower != MPI_PROC_NULL && k0 > 0)
-                           ? field.data() + static_cast<std::size_t>(k0 - 1) * ps
-                           : zeros.data();
-  std::fill(buffer_.begin(), buffer_.end(), 0.0);
-  MPI_Sendrecv(down, planeSize, MPI_DOUBLE, lower, kTagDown, buffer_.data(), planeSize, MPI_DOUBLE,
-               upper, kTagDown, comm_, &status);
   if (upper != MPI_PROC_NULL) {
     for (std::size_t i = 0; i < ps; ++i) {
-      field[static_cast<std::size_t>(k1 - 1) * ps + i] += buffer_[i];
+      field[static_cast<std::size_t>(k1 - 1) * ps + i] += fromAbove[i];
     }
   }
 }

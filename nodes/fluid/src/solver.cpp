@@ -8,6 +8,7 @@
 #include "bodies.hpp"
 #include "grid.hpp"
 #include "pressure.hpp"
+#include "transfer.hpp"
 #include "vrflow/fluid/block_comm.hpp"
 
 namespace vrflow::fluid {
@@ -29,7 +30,8 @@ struct FluidSolver::Impl {
   std::vector<double> pos;  // xyz per particle (this block's)
   std::vector<double> vel;
   std::vector<float> posOut;
-  std::vector<double> u[3], uOld[3], weight[3];
+  std::vector<double> u[3], uOld[3];
+  std::vector<double> acc[3];  // particle-to-grid sums: (weighted velocity, weight) per face
   std::vector<unsigned char> valid[3];
   std::vector<int> faceBody[3];
   std::vector<int> cellBody;
@@ -42,6 +44,7 @@ struct FluidSolver::Impl {
   // full puts the surface at the face (0.5); a body cell's surface is taken at its face (0.5).
   std::vector<double> theta;
   detail::PressureSystem system;
+  detail::PcgWorkspace pcg;
   std::vector<double> rhs, pressure;
   StepStats stats;
   double maxDiv = 0.0;
@@ -88,6 +91,31 @@ struct FluidSolver::Impl {
       }
     }
   }
+  // A face field and its validity flags in one halo exchange (depth 1): both travel as
+  // (value, flag) pairs; only the planes sent and received are packed.
+  std::vector<double> haloScratch;
+  void exchangeWithValidity(std::vector<double>& field, std::vector<unsigned char>& flags, int a) {
+    if (!comm) return;
+    const std::size_t ps = static_cast<std::size_t>(planeSize(a));
+    const int planes = grid.fdim(a, 2);
+    haloScratch.resize(2 * field.size());
+    // The received planes start as they are, so a plane no neighbour sends stays unchanged.
+    for (int k : {k0 - 1, k0, k1 - 1, k1}) {
+      if (k < 0 || k >= planes) continue;
+      for (std::size_t f = k * ps; f < (k + 1) * ps; ++f) {
+        haloScratch[2 * f] = field[f];
+        haloScratch[2 * f + 1] = flags[f];
+      }
+    }
+    comm->exchangeHalo(haloScratch, 2 * planeSize(a), planes, k0, k1, 1);
+    for (int k : {k0 - 1, k1}) {
+      if (k < 0 || k >= planes) continue;
+      for (std::size_t f = k * ps; f < (k + 1) * ps; ++f) {
+        field[f] = haloScratch[2 * f];
+        flags[f] = static_cast<unsigned char>(haloScratch[2 * f + 1]);
+      }
+    }
+  }
   double sum(double v) { return comm ? comm->sum(v) : v; }
   double max(double v) { return comm ? comm->max(v) : v; }
 
@@ -96,60 +124,6 @@ struct FluidSolver::Impl {
     msg::Vec3 x{grid.ox + (i + 0.5) * h, grid.oy + (j + 0.5) * h, grid.oz + (k + 0.5) * h};
     x[static_cast<std::size_t>(a)] -= 0.5 * h;
     return x;
-  }
-
-  // Trilinear stencil of component a at world point x: first face index and fractions.
-  struct Stencil {
-    std::size_t base;
-    std::size_t sy, sz;
-    double f[3];
-  };
-  // Per dimension, the clamped cell coordinate of a point on the face lattice (the component
-  // along that dimension) and on the centre lattice (the two others): shared by the 3 stencils.
-  struct Coords {
-    int faceBase[3], centreBase[3];
-    double faceFrac[3], centreFrac[3];
-  };
-  Coords coords(const double* x) const {
-    Coords c{};
-    const double o[3] = {grid.ox, grid.oy, grid.oz};
-    const int n[3] = {grid.nx, grid.ny, grid.nz};
-    for (int d = 0; d < 3; ++d) {
-      for (int face = 0; face < 2; ++face) {
-        double v = (x[d] - o[d]) * invH - (face ? 0.0 : 0.5);
-        const int hi = n[d] - (face ? 0 : 1);
-        v = std::clamp(v, 0.0, static_cast<double>(hi));
-        int b = static_cast<int>(v);
-        if (b >= hi) b = hi - 1;
-        (face ? c.faceBase : c.centreBase)[d] = b;
-        (face ? c.faceFrac : c.centreFrac)[d] = v - b;
-      }
-    }
-    return c;
-  }
-  Stencil stencil(int a, const Coords& c) const {
-    Stencil s{};
-    int b[3];
-    for (int d = 0; d < 3; ++d) {
-      b[d] = d == a ? c.faceBase[d] : c.centreBase[d];
-      s.f[d] = d == a ? c.faceFrac[d] : c.centreFrac[d];
-    }
-    s.sy = static_cast<std::size_t>(grid.fdim(a, 0));
-    s.sz = s.sy * static_cast<std::size_t>(grid.fdim(a, 1));
-    s.base = grid.face(a, b[0], b[1], b[2]);
-    return s;
-  }
-
-  static double gather(const std::vector<double>& field, const Stencil& s) {
-    const double fx = s.f[0], fy = s.f[1], fz = s.f[2];
-    const double* p = field.data() + s.base;
-    const double c00 = p[0] + fx * (p[1] - p[0]);
-    const double c10 = p[s.sy] + fx * (p[s.sy + 1] - p[s.sy]);
-    const double c01 = p[s.sz] + fx * (p[s.sz + 1] - p[s.sz]);
-    const double c11 = p[s.sz + s.sy] + fx * (p[s.sz + s.sy + 1] - p[s.sz + s.sy]);
-    const double c0 = c00 + fy * (c10 - c00);
-    const double c1 = c01 + fy * (c11 - c01);
-    return c0 + fz * (c1 - c0);
   }
 
   void clampToDomain(double* x) const {
@@ -183,16 +157,60 @@ struct FluidSolver::Impl {
     }
   }
 
+  // Per cell row (j, k) of this block's planes and one beyond: whether it holds a cell that is
+  // not air (set by classify()). Faces next to air only are skipped by forFacesNearMatter().
+  std::vector<unsigned char> rowHasMatter;
+  void markRowsWithMatter() {
+    rowHasMatter.assign(static_cast<std::size_t>(grid.ny) * grid.nz, 0);
+    for (int k = std::max(0, k0 - 1); k < std::min(grid.nz, k1 + 1); ++k) {
+      for (int j = 0; j < grid.ny; ++j) {
+        const unsigned char* row = kind.data() + grid.cell(0, j, k);
+        unsigned char any = 0;
+        for (int i = 0; i < grid.nx; ++i) any |= row[i];  // kAir is 0
+        rowHasMatter[static_cast<std::size_t>(k) * grid.ny + j] = any != 0;
+      }
+    }
+  }
+  // forOwnFaces() restricted to the rows of faces with a cell that is not air on either side.
+  template <typename F>
+  void forFacesNearMatter(int a, F&& f) const {
+    const int ke = kEnd(a);
+    const int ny = grid.ny, nz = grid.nz;
+    auto busy = [&](int j, int k) {
+      return j >= 0 && j < ny && k >= 0 && k < nz &&
+             rowHasMatter[static_cast<std::size_t>(k) * ny + j];
+    };
+    for (int k = k0; k < ke; ++k) {
+      for (int j = 0; j < grid.fdim(a, 1); ++j) {
+        const bool near = busy(j, k) || (a == 1 && busy(j - 1, k)) || (a == 2 && busy(j, k - 1));
+        if (!near) continue;
+        std::size_t idx = grid.face(a, 0, j, k);
+        for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
+      }
+    }
+  }
+
   bool onWall(int a, int i, int j, int k) const {
     const int along = a == 0 ? i : a == 1 ? j : k;
     return along == 0 || along == grid.fdim(a, a) - 1;
   }
 
   void zeroWalls(std::vector<double>* field) const {
-    for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
-        if (onWall(a, i, j, k)) field[a][f] = 0.0;
-      });
+    for (int k = k0; k < k1; ++k) {
+      for (int j = 0; j < grid.ny; ++j) {
+        field[0][grid.face(0, 0, j, k)] = 0.0;
+        field[0][grid.face(0, grid.nx, j, k)] = 0.0;
+      }
+      for (int i = 0; i < grid.nx; ++i) {
+        field[1][grid.face(1, i, 0, k)] = 0.0;
+        field[1][grid.face(1, i, grid.ny, k)] = 0.0;
+      }
+    }
+    const std::size_t ps = static_cast<std::size_t>(planeSize(2));
+    for (int k : {0, grid.nz}) {
+      if (k < k0 || k >= kEnd(2)) continue;
+      std::fill_n(field[2].begin() + static_cast<std::ptrdiff_t>(k * ps),
+                  static_cast<std::ptrdiff_t>(ps), 0.0);
     }
   }
 
@@ -206,9 +224,11 @@ struct FluidSolver::Impl {
     for (std::size_t p = 0; p < count; ++p) {
       const int k = planeOf(&pos[3 * p]);
       if (k >= k0 && k < k1) {
-        for (int d = 0; d < 3; ++d) {
-          pos[3 * keep + d] = pos[3 * p + d];
-          vel[3 * keep + d] = vel[3 * p + d];
+        if (keep != p) {
+          for (int d = 0; d < 3; ++d) {
+            pos[3 * keep + d] = pos[3 * p + d];
+            vel[3 * keep + d] = vel[3 * p + d];
+          }
         }
         ++keep;
         continue;
@@ -226,34 +246,54 @@ struct FluidSolver::Impl {
     }
   }
 
+  // The cell of each particle (clamped into the grid), in particle order. The advection stores
+  // it when particles do not change blocks afterwards (serial or one block), so that pushing
+  // out of bodies and sorting need not locate every particle again; `cellsKnown` says so.
+  std::vector<std::uint32_t> sortCell;
+  bool cellsKnown = false;
+  std::uint32_t clampedCell(const double* x) const {
+    int i, j, k;
+    cellOf(x, i, j, k);
+    i = std::clamp(i, 0, grid.nx - 1);
+    j = std::clamp(j, 0, grid.ny - 1);
+    k = std::clamp(k, 0, grid.nz - 1);
+    return static_cast<std::uint32_t>(grid.cell(i, j, k));
+  }
+  std::vector<std::size_t> sortStart;
+  std::vector<double> posScratch, velScratch;
   // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
   // and an order that does not depend on history.
   void sortParticles() {
+    // This block's particles all lie in its slab (cellOf clamps as planeOf does in migrate), so
+    // only the slab's cells are counted; the others keep their zero counts.
     const std::size_t n = pos.size() / 3;
-    particlesInCell.assign(grid.cells(), 0);
-    std::vector<std::uint32_t> cellOfParticle(n);
-    for (std::size_t p = 0; p < n; ++p) {
-      int i, j, k;
-      cellOf(&pos[3 * p], i, j, k);
-      i = std::clamp(i, 0, grid.nx - 1);
-      j = std::clamp(j, 0, grid.ny - 1);
-      k = std::clamp(k, 0, grid.nz - 1);
-      const auto c = static_cast<std::uint32_t>(grid.cell(i, j, k));
-      cellOfParticle[p] = c;
-      ++particlesInCell[c];
+    const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+    const std::size_t c0 = plane * static_cast<std::size_t>(k0),
+                      c1 = plane * static_cast<std::size_t>(k1);
+    std::fill(particlesInCell.begin() + static_cast<std::ptrdiff_t>(c0),
+              particlesInCell.begin() + static_cast<std::ptrdiff_t>(c1), 0);
+    if (!cellsKnown) {
+      sortCell.resize(n);
+      for (std::size_t p = 0; p < n; ++p) sortCell[p] = clampedCell(&pos[3 * p]);
     }
-    std::vector<std::size_t> start(grid.cells() + 1, 0);
-    for (std::size_t c = 0; c < grid.cells(); ++c) start[c + 1] = start[c] + particlesInCell[c];
-    std::vector<double> p2(pos.size()), v2(vel.size());
+    for (std::size_t p = 0; p < n; ++p) ++particlesInCell[sortCell[p]];
+    sortStart.resize(grid.cells() + 1);
+    sortStart[c0] = 0;
+    for (std::size_t c = c0; c < c1; ++c) {
+      sortStart[c + 1] = sortStart[c] + static_cast<std::size_t>(particlesInCell[c]);
+    }
+    posScratch.resize(pos.size());
+    velScratch.resize(vel.size());
     for (std::size_t p = 0; p < n; ++p) {
-      const std::size_t to = start[cellOfParticle[p]]++;
+      const std::size_t to = sortStart[sortCell[p]]++;
       for (int d = 0; d < 3; ++d) {
-        p2[3 * to + d] = pos[3 * p + d];
-        v2[3 * to + d] = vel[3 * p + d];
+        posScratch[3 * to + d] = pos[3 * p + d];
+        velScratch[3 * to + d] = vel[3 * p + d];
       }
     }
-    pos.swap(p2);
-    vel.swap(v2);
+    pos.swap(posScratch);
+    vel.swap(velScratch);
+    cellsKnown = false;
   }
 
   // Only particles in cells that some body's bounds touch are tested against the bodies.
@@ -279,19 +319,28 @@ struct FluidSolver::Impl {
     const std::size_t count = pos.size() / 3;
     for (std::size_t p = 0; p < count; ++p) {
       double* x = &pos[3 * p];
-      int i, j, k;
-      if (!cellOf(x, i, j, k) || !nearBody[grid.cell(i, j, k)]) continue;
+      if (cellsKnown) {
+        if (!nearBody[sortCell[p]]) continue;
+      } else {
+        int i, j, k;
+        if (!cellOf(x, i, j, k) || !nearBody[grid.cell(i, j, k)]) continue;
+      }
       for (const auto& body : bodies) {
         if (!detail::inBounds(body.bounds, x)) continue;
         detail::pushOut(body, x, 0.25 * grid.h);
         clampToDomain(x);
       }
+      if (cellsKnown) sortCell[p] = clampedCell(x);
     }
   }
 
   void classify(const std::vector<PreparedBody>& bodies) {
     detail::rasterise(grid, bodies, cellBody, faceBody);
-    for (std::size_t c = 0; c < kind.size(); ++c) {
+    // Kinds are read one plane beyond the slab at most.
+    const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+    const std::size_t cFrom = plane * static_cast<std::size_t>(std::max(0, k0 - 1));
+    const std::size_t cTo = plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1));
+    for (std::size_t c = cFrom; c < cTo; ++c) {
       if (cellBody[c] >= 0) {
         const auto& body = bodies[static_cast<std::size_t>(cellBody[c])];
         kind[c] = body.kinematic ? detail::kSolid : detail::kBody;
@@ -301,11 +350,11 @@ struct FluidSolver::Impl {
         cellDensity[c] = settings.density;
       }
     }
-    const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
     for (std::size_t c = k0 * plane; c < k1 * plane; ++c) {
       if (particlesInCell[c] > 0 && kind[c] == detail::kAir) kind[c] = detail::kLiquid;
     }
     exchangeBytes(kind, grid.nx * grid.ny, grid.nz);
+    markRowsWithMatter();
     // Volume control: each liquid cell away from the surface asks for a divergence that brings
     // its particle count back to particlesPerCell (cells next to air are partly full by nature).
     divTarget.assign(kind.size(), 0.0);
@@ -332,8 +381,12 @@ struct FluidSolver::Impl {
         }
       }
     }
-    total = sum(total);
-    count = sum(count);
+    if (comm) {
+      std::vector<double> both{total, count};
+      comm->sum(both);
+      total = both[0];
+      count = both[1];
+    }
     stats.particleDensity = count > 0 ? total / (count * n0) : 1.0;
     theta.assign(kind.size(), 0.5);
     for (std::size_t c = k0 * plane; c < k1 * plane; ++c) {
@@ -345,38 +398,38 @@ struct FluidSolver::Impl {
   }
 
   void particlesToGrid() {
+    // This block's particles reach face planes k0 - 1 to k1.
     for (int a = 0; a < 3; ++a) {
-      std::fill(u[a].begin(), u[a].end(), 0.0);
-      std::fill(weight[a].begin(), weight[a].end(), 0.0);
+      const std::size_t ps = 2 * static_cast<std::size_t>(planeSize(a));
+      const auto from =
+          static_cast<std::ptrdiff_t>(ps * static_cast<std::size_t>(std::max(0, k0 - 1)));
+      const auto to = static_cast<std::ptrdiff_t>(
+          ps * static_cast<std::size_t>(std::min(grid.fdim(a, 2), k1 + 1)));
+      std::fill(acc[a].begin() + from, acc[a].begin() + to, 0.0);
     }
+    const detail::Lattice lattice(grid);
+    double* sums[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
     const std::size_t n = pos.size() / 3;
-    for (std::size_t p = 0; p < n; ++p) {
-      const Coords c = coords(&pos[3 * p]);
-      for (int a = 0; a < 3; ++a) {
-        const Stencil s = stencil(a, c);
-        const double va = vel[3 * p + a];
-        for (int dk = 0; dk < 2; ++dk) {
-          const double wz = dk ? s.f[2] : 1 - s.f[2];
-          for (int dj = 0; dj < 2; ++dj) {
-            const double wyz = wz * (dj ? s.f[1] : 1 - s.f[1]);
-            const std::size_t row = s.base + dk * s.sz + dj * s.sy;
-            const double w0 = wyz * (1 - s.f[0]), w1 = wyz * s.f[0];
-            u[a][row] += w0 * va;
-            weight[a][row] += w0;
-            u[a][row + 1] += w1 * va;
-            weight[a][row + 1] += w1;
-          }
-        }
-      }
+    const double* x = pos.data();
+    const double* v = vel.data();
+    for (std::size_t p = 0; p < n; ++p, x += 3, v += 3) {
+      detail::Located c;
+      detail::locate(lattice, x, c);
+      detail::splat(sums[0], detail::stencilOf(lattice, 0, c), v[0]);
+      detail::splat(sums[1], detail::stencilOf(lattice, 1, c), v[1]);
+      detail::splat(sums[2], detail::stencilOf(lattice, 2, c), v[2]);
     }
     for (int a = 0; a < 3; ++a) {
-      if (comm) {
-        comm->addHalo(u[a], planeSize(a), grid.fdim(a, 2), k0, k1);
-        comm->addHalo(weight[a], planeSize(a), grid.fdim(a, 2), k0, k1);
-      }
+      if (comm) comm->addHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1);
+      // Faces of other blocks read zero (this block's are all written below).
+      const auto ps = static_cast<std::ptrdiff_t>(planeSize(a));
+      std::fill(u[a].begin(), u[a].begin() + ps * k0, 0.0);
+      std::fill(u[a].begin() + ps * kEnd(a), u[a].end(), 0.0);
+      const double* in = acc[a].data();
       forOwnFaces(a, [&](std::size_t f, int, int, int) {
-        if (weight[a][f] > 1e-9) {
-          u[a][f] /= weight[a][f];
+        const double w = in[2 * f + 1];
+        if (w > 1e-9) {
+          u[a][f] = in[2 * f] / w;
           valid[a][f] = 1;
         } else {
           u[a][f] = 0.0;
@@ -386,58 +439,106 @@ struct FluidSolver::Impl {
     }
   }
 
-  // Fills faces without a value from the mean of valid neighbours, `layers` rings deep.
+  // Fills faces without a value from the mean of valid neighbours, `layers` rings deep. Only
+  // rows (j, k) with a valid face in them or next to them can gain values; the others (deep in
+  // air) are skipped.
+  std::vector<unsigned char> rowState;  // per row: bit 0 some face valid, bit 1 every face valid
+  std::vector<std::size_t> filled;
   void extrapolate(std::vector<double>* field, int layers) {
     for (int a = 0; a < 3; ++a) {
       const int dx = grid.fdim(a, 0), dy = grid.fdim(a, 1), dz = grid.fdim(a, 2);
-      const std::size_t sy = static_cast<std::size_t>(dx), sz = sy * dy;
-      std::vector<unsigned char> next;
+      const std::size_t sy = static_cast<std::size_t>(dx), sz = sy * static_cast<std::size_t>(dy);
+      const int ke = kEnd(a);
       for (int layer = 0; layer < layers; ++layer) {
-        exchange(field[a], a, 1);
-        exchangeBytes(valid[a], planeSize(a), dz);
-        next = valid[a];
-        forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
-          if (valid[a][f]) return;
-          double total = 0.0;
-          int count = 0;
-          auto take = [&](std::size_t g) {
-            if (valid[a][g]) {
-              total += field[a][g];
-              ++count;
-            }
-          };
-          if (i > 0) take(f - 1);
-          if (i + 1 < dx) take(f + 1);
-          if (j > 0) take(f - sy);
-          if (j + 1 < dy) take(f + sy);
-          if (k > 0) take(f - sz);
-          if (k + 1 < dz) take(f + sz);
-          if (count > 0) {
-            field[a][f] = total / count;
-            next[f] = 1;
+        exchangeWithValidity(field[a], valid[a], a);
+        double* value = field[a].data();
+        unsigned char* ok = valid[a].data();
+        const int kLo = std::max(0, k0 - 1), kHi = std::min(dz, ke + 1);
+        rowState.assign(static_cast<std::size_t>(dy) * static_cast<std::size_t>(dz), 0);
+        for (int k = kLo; k < kHi; ++k) {
+          for (int j = 0; j < dy; ++j) {
+            const unsigned char* row = ok + grid.face(a, 0, j, k);
+            int count = 0;
+            for (int i = 0; i < dx; ++i) count += row[i];
+            rowState[static_cast<std::size_t>(k) * dy + j] =
+                static_cast<unsigned char>((count > 0 ? 1 : 0) | (count == dx ? 2 : 0));
           }
-        });
-        valid[a].swap(next);
+        }
+        filled.clear();
+        for (int k = k0; k < ke; ++k) {
+          for (int j = 0; j < dy; ++j) {
+            const std::size_t r = static_cast<std::size_t>(k) * dy + j;
+            if (rowState[r] & 2) continue;  // nothing to fill
+            const bool near = (rowState[r] & 1) || (j > 0 && (rowState[r - 1] & 1)) ||
+                              (j + 1 < dy && (rowState[r + 1] & 1)) ||
+                              (k > 0 && (rowState[r - dy] & 1)) ||
+                              (k + 1 < dz && (rowState[r + dy] & 1));
+            if (!near) continue;
+            std::size_t f = grid.face(a, 0, j, k);
+            for (int i = 0; i < dx; ++i, ++f) {
+              if (ok[f]) continue;
+              double total = 0.0;
+              int count = 0;
+              auto take = [&](std::size_t g) {
+                if (ok[g]) {
+                  total += value[g];
+                  ++count;
+                }
+              };
+              if (i > 0) take(f - 1);
+              if (i + 1 < dx) take(f + 1);
+              if (j > 0) take(f - sy);
+              if (j + 1 < dy) take(f + sy);
+              if (k > 0) take(f - sz);
+              if (k + 1 < dz) take(f + sz);
+              if (count > 0) {
+                value[f] = total / count;
+                filled.push_back(f);
+              }
+            }
+          }
+        }
+        for (const std::size_t f : filled) ok[f] = 1;
       }
     }
   }
 
   // Rigid motion on the faces of bodies (and of kinematic bodies' cells); `kinematicOnly`
-  // re-imposes it on kinematic bodies after gravity (a moving wall does not fall).
+  // re-imposes it on kinematic bodies after gravity (a moving wall does not fall). Only the
+  // faces in each body's bounds (one cell wider) can be affected; a face in several bodies'
+  // bounds gets the same value each time.
   void enforceBodies(const std::vector<PreparedBody>& bodies, bool kinematicOnly = false) {
-    for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
-        int b = faceBody[a][f];
-        if (b < 0 && !onWall(a, i, j, k)) {  // the faces of a kinematic body's cells too
-          const std::size_t hi = grid.cell(i, j, k), lo = hi - stride(a);
-          if (kind[hi] == detail::kSolid) b = cellBody[hi];
-          if (kind[lo] == detail::kSolid) b = cellBody[lo];
+    const double o[3] = {grid.ox, grid.oy, grid.oz};
+    for (const auto& box : bodies) {
+      if (kinematicOnly && !box.kinematic) continue;
+      for (int a = 0; a < 3; ++a) {
+        int lo[3], hi[3];
+        for (int d = 0; d < 3; ++d) {
+          lo[d] = std::max(0, static_cast<int>(std::floor((box.bounds.min[d] - o[d]) * invH)) - 1);
+          hi[d] = std::min(grid.fdim(a, d) - 1,
+                           static_cast<int>(std::ceil((box.bounds.max[d] - o[d]) * invH)) + 1);
         }
-        if (b < 0) return;
-        if (kinematicOnly && !bodies[static_cast<std::size_t>(b)].kinematic) return;
-        u[a][f] = detail::rigidVelocity(bodies[static_cast<std::size_t>(b)],
-                                        facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
-      });
+        lo[2] = std::max(lo[2], k0);
+        hi[2] = std::min(hi[2], kEnd(a) - 1);
+        for (int k = lo[2]; k <= hi[2]; ++k) {
+          for (int j = lo[1]; j <= hi[1]; ++j) {
+            for (int i = lo[0]; i <= hi[0]; ++i) {
+              const std::size_t f = grid.face(a, i, j, k);
+              int b = faceBody[a][f];
+              if (b < 0 && !onWall(a, i, j, k)) {  // the faces of a kinematic body's cells too
+                const std::size_t hiCell = grid.cell(i, j, k), loCell = hiCell - stride(a);
+                if (kind[hiCell] == detail::kSolid) b = cellBody[hiCell];
+                if (kind[loCell] == detail::kSolid) b = cellBody[loCell];
+              }
+              if (b < 0) continue;
+              const auto& body = bodies[static_cast<std::size_t>(b)];
+              if (kinematicOnly && !body.kinematic) continue;
+              u[a][f] = detail::rigidVelocity(
+                  body, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
+            }
+          }
+        }
+      }
     }
   }
 
@@ -456,11 +557,16 @@ struct FluidSolver::Impl {
   void project(double dt) {
     const std::size_t n = grid.cells();
     auto& A = system;
-    A.diag.assign(n, 0.0);
-    A.ax.assign(n, 0.0);
-    A.ay.assign(n, 0.0);
-    A.az.assign(n, 0.0);
-    rhs.assign(n, 0.0);
+    // The system is built on this block's cells and read one plane beyond them.
+    const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+    const auto cFrom =
+        static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::max(0, k0 - 1)));
+    const auto cTo =
+        static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1)));
+    for (auto* v : {&A.diag, &A.ax, &A.ay, &A.az, &rhs}) {
+      v->resize(n);
+      std::fill(v->begin() + cFrom, v->begin() + cTo, 0.0);
+    }
     const double h = grid.h;
     lastDt = dt;
     stats.targetDivergence = -settings.volumeCorrection * (1.0 - stats.particleDensity) / dt;
@@ -496,7 +602,7 @@ struct FluidSolver::Impl {
     exchangeCells(A.az);  // the product needs the lower block's couplings to this block
     const auto start = std::chrono::steady_clock::now();
     const auto outcome = detail::solvePressure(grid, A, rhs, pressure, settings.cgTolerance,
-                                               settings.cgMaxIterations, comm);
+                                               settings.cgMaxIterations, comm, pcg);
     stats.pressureSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     exchangeCells(pressure);
@@ -506,7 +612,7 @@ struct FluidSolver::Impl {
     stats.bytesTouched = outcome.bytesTouched;
     // Subtract the pressure gradient on every interior face next to an unknown cell.
     for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
+      forFacesNearMatter(a, [&](std::size_t f, int i, int j, int k) {
         if (onWall(a, i, j, k)) return;
         const std::size_t hi = grid.cell(i, j, k);
         const std::size_t lo = hi - stride(a);
@@ -540,12 +646,17 @@ struct FluidSolver::Impl {
         }
       }
     }
-    maxDiv = max(worst);
-    stats.fluidCells = static_cast<int>(sum(fluid));
-    stats.bodyCells = static_cast<int>(sum(body));
+    if (comm) {
+      std::vector<double> both{fluid, body};
+      comm->sum(both);
+      fluid = both[0];
+      body = both[1];
+    }
+    stats.fluidCells = static_cast<int>(fluid);
+    stats.bodyCells = static_cast<int>(body);
     double speed = 0.0;
     for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
+      forFacesNearMatter(a, [&](std::size_t f, int i, int j, int k) {
         if (onWall(a, i, j, k)) return;
         const std::size_t hi = grid.cell(i, j, k);
         const std::size_t lo = hi - stride(a);
@@ -553,12 +664,22 @@ struct FluidSolver::Impl {
         speed = std::max(speed, std::abs(u[a][f]));
       });
     }
-    stats.maxSpeed = max(speed);
+    // Both maxima in one reduction.
+    if (comm) {
+      std::vector<double> both{worst, speed};
+      comm->max(both);
+      worst = both[0];
+      speed = both[1];
+    }
+    maxDiv = worst;
+    stats.maxSpeed = speed;
   }
 
   void markProjectedFaces() {
     for (int a = 0; a < 3; ++a) {
-      forOwnFaces(a, [&](std::size_t f, int i, int j, int k) {
+      const auto ps = static_cast<std::ptrdiff_t>(planeSize(a));
+      std::fill(valid[a].begin() + ps * k0, valid[a].begin() + ps * kEnd(a), 0);
+      forFacesNearMatter(a, [&](std::size_t f, int i, int j, int k) {
         const int along = a == 0 ? i : a == 1 ? j : k;
         // Projected faces and the faces of kinematic bodies keep their values.
         bool touches = false;
@@ -576,30 +697,76 @@ struct FluidSolver::Impl {
   }
 
   void gridToParticlesAndAdvect(double dt) {
+    // (new velocity, change) per face, interleaved: the FLIP update needs both at the same
+    // stencil, and the pairs interpolate together. Built on this block's faces; the planes its
+    // particles can sample beyond them come from the neighbours.
     for (int a = 0; a < 3; ++a) {
-      exchange(u[a], a, kHaloForParticles);
-      exchange(uOld[a], a, kHaloForParticles);
+      const std::size_t ps = static_cast<std::size_t>(planeSize(a));
+      double* out = acc[a].data();
+      const double* un = u[a].data();
+      const double* uo = uOld[a].data();
+      for (std::size_t f = ps * static_cast<std::size_t>(k0);
+           f < ps * static_cast<std::size_t>(kEnd(a)); ++f) {
+        out[2 * f] = un[f];
+        out[2 * f + 1] = un[f] - uo[f];
+      }
+      if (comm) {
+        comm->exchangeHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1, kHaloForParticles);
+      }
     }
-    const double flip = settings.flipRatio;
+    const detail::Lattice lattice(grid);
+    const double* pairs[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
+    const double flip = settings.flipRatio, pic = 1.0 - flip;
+    const double halfDt = 0.5 * dt;
+    // clampToDomain()'s bounds, computed once.
+    const double eps = 1e-3 * grid.h;
+    const double o[3] = {grid.ox, grid.oy, grid.oz};
+    const int cells[3] = {grid.nx, grid.ny, grid.nz};
+    double lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = o[d] + eps;
+      hi[d] = o[d] + cells[d] * grid.h - eps;
+    }
+    auto clamp = [&](double* y) {
+      for (int d = 0; d < 3; ++d) y[d] = std::min(std::max(y[d], lo[d]), hi[d]);
+    };
     const std::size_t n = pos.size() / 3;
+    const bool storeCells = !comm || comm->size() == 1;
+    if (storeCells) sortCell.resize(n);
+    // Two passes (velocities and midpoints, then positions) rather than one: within a particle
+    // the second interpolation waits for the first, and a pass of short independent chains
+    // keeps more particles in flight.
+    posScratch.resize(pos.size());
+    double* midpoints = posScratch.data();
+    for (std::size_t p = 0; p < n; ++p) {
+      const double* x = &pos[3 * p];
+      double* v = &vel[3 * p];
+      detail::Located c;
+      detail::locate(lattice, x, c);
+      const detail::Pair g0 = detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c));
+      const detail::Pair g1 = detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c));
+      const detail::Pair g2 = detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c));
+      v[0] = flip * (v[0] + g0[1]) + pic * g0[0];
+      v[1] = flip * (v[1] + g1[1]) + pic * g1[0];
+      v[2] = flip * (v[2] + g2[1]) + pic * g2[0];
+      // Midpoint (RK2) through the divergence-free grid velocity.
+      double* mid = midpoints + 3 * p;
+      mid[0] = x[0] + halfDt * g0[0];
+      mid[1] = x[1] + halfDt * g1[0];
+      mid[2] = x[2] + halfDt * g2[0];
+      clamp(mid);
+    }
     for (std::size_t p = 0; p < n; ++p) {
       double* x = &pos[3 * p];
-      double* v = &vel[3 * p];
-      double un[3];
-      const Coords c = coords(x);
-      for (int a = 0; a < 3; ++a) {
-        const Stencil s = stencil(a, c);
-        un[a] = gather(u[a], s);
-        const double uo = gather(uOld[a], s);
-        v[a] = flip * (v[a] + un[a] - uo) + (1.0 - flip) * un[a];
-      }
-      // Midpoint (RK2) through the divergence-free grid velocity.
-      double mid[3] = {x[0] + 0.5 * dt * un[0], x[1] + 0.5 * dt * un[1], x[2] + 0.5 * dt * un[2]};
-      clampToDomain(mid);
-      const Coords cm = coords(mid);
-      for (int a = 0; a < 3; ++a) x[a] += dt * gather(u[a], stencil(a, cm));
-      clampToDomain(x);
+      detail::Located c;
+      detail::locate(lattice, midpoints + 3 * p, c);
+      x[0] += dt * detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c))[0];
+      x[1] += dt * detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c))[0];
+      x[2] += dt * detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c))[0];
+      clamp(x);
+      if (storeCells) sortCell[p] = clampedCell(x);
     }
+    cellsKnown = storeCells;
   }
 
   void refreshOutput() {
@@ -630,7 +797,7 @@ Result<std::unique_ptr<FluidSolver>> FluidSolver::create(const FluidSettings& se
   for (int a = 0; a < 3; ++a) {
     impl->u[a].assign(g.faces(a), 0.0);
     impl->uOld[a].assign(g.faces(a), 0.0);
-    impl->weight[a].assign(g.faces(a), 0.0);
+    impl->acc[a].assign(2 * g.faces(a), 0.0);
     impl->valid[a].assign(g.faces(a), 0);
     impl->faceBody[a].assign(g.faces(a), -1);
   }
@@ -710,6 +877,7 @@ Status FluidSolver::addLiquidBox(const msg::Aabb& box) {
           }
           if (!mine) continue;
           m.pos.insert(m.pos.end(), x, x + 3);
+          m.cellsKnown = false;
           m.vel.insert(m.vel.end(), 3, 0.0);
         }
       }

@@ -23,6 +23,8 @@ class BlockComm {
   virtual double max(double value) = 0;
   /// Element-wise sum of `values` over every block, in place.
   virtual void sum(std::vector<double>& values) = 0;
+  /// Element-wise maximum of `values` over every block, in place.
+  virtual void max(std::vector<double>& values) = 0;
   /// Fills the `depth` planes on each side of this block's planes [k0, k1) of `field` (planes of
   /// `planeSize` values, `planeCount` planes) with the neighbours' values.
   virtual void exchangeHalo(std::vector<double>& field, int planeSize, int planeCount, int k0,

@@ -19,6 +19,7 @@ class MpiBlockComm final : public BlockComm {
   double sum(double value) override;
   double max(double value) override;
   void sum(std::vector<double>& values) override;
+  void max(std::vector<double>& values) override;
   void exchangeHalo(std::vector<double>& field, int planeSize, int planeCount, int k0, int k1,
                     int depth) override;
   void addHalo(std::vector<double>& field, int planeSize, int planeCount, int k0, int k1) override;
