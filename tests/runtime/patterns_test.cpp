@@ -38,6 +38,25 @@ class Patterns : public ::testing::Test {
                       90);
   }
   std::string example(const std::string& path) { return sourceDir() + "/examples/" + path; }
+  // routing/movers (with `params`, paced by the viewers) through one route filter `wall` to a
+  // routing/tile-viewer per box, v0 ... (each logging to vK.csv in the temporary folder).
+  std::string moversWall(const std::string& params, const std::vector<std::string>& boxes) {
+    std::string modules = moduleXml(
+        "scene", "routing/movers",
+        params + "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
+    std::string connections = connectXml("scene.objects", "wall.in");
+    for (std::size_t k = 0; k < boxes.size(); ++k) {
+      const std::string id = "v" + std::to_string(k);
+      modules += moduleXml(id, "routing/tile-viewer",
+                           paramXml("box", boxes[k]) + paramXml("file", dir.file(id + ".csv")));
+      connections += connectXml("wall.out" + std::to_string(k), id + ".objects") +
+                     connectXml(id + ".interest", "wall.interest" + std::to_string(k)) +
+                     connectXml(id + ".endIt", "scene.beginIt");
+    }
+    return appXml(modules,
+                  filterXml("wall", "route", paramXml("outputs", std::to_string(boxes.size()))),
+                  connections);
+  }
   nlohmann::json report(const std::string& name) {
     return nlohmann::json::parse(readFile(dir.file(name)));
   }
@@ -378,24 +397,11 @@ TEST_F(Patterns, RouteForwardsExactlyTheIntersectingObjectsAndTheirStateOnEntry)
 // Meshes sent after the bodies that use them (iteration 3) reach a viewer only if it holds such
 // a body; a delete reaches only the viewers that hold the body.
 TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
-  std::string modules =
-      moduleXml("scene", "routing/movers",
-                paramXml("count", "16") + paramXml("meshes", "8") + paramXml("iterations", "12") +
-                    paramXml("meshes-at", "3") + paramXml("delete-at", "6") +
-                    "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
-  std::string connections = connectXml("scene.objects", "wall.in");
-  const char* boxes[] = {"0 -1 -1 10 12 1", "20 -1 -1 30 12 1", "all"};
-  for (int k = 0; k < 3; ++k) {
-    const std::string id = "v" + std::to_string(k);
-    modules += moduleXml(id, "routing/tile-viewer",
-                         paramXml("box", boxes[k]) + paramXml("file", dir.file(id + ".csv")));
-    connections += connectXml("wall.out" + std::to_string(k), id + ".objects") +
-                   connectXml(id + ".interest", "wall.interest" + std::to_string(k)) +
-                   connectXml(id + ".endIt", "scene.beginIt");
-  }
   const auto result = run(dir.write(
-      "late.xml",
-      appXml(modules, filterXml("wall", "route", paramXml("outputs", "3")), connections)));
+      "late.xml", moversWall(paramXml("count", "16") + paramXml("meshes", "8") +
+                                 paramXml("iterations", "12") + paramXml("meshes-at", "3") +
+                                 paramXml("delete-at", "6"),
+                             {"0 -1 -1 10 12 1", "20 -1 -1 30 12 1", "all"})));
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto all = byIteration(dir.file("v2.csv"));
   std::string first;  // body 0: the first body added
@@ -453,25 +459,13 @@ TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
 // on re-entry the newest copy, before the body's entry; the receiver of everything gets every
 // copy.
 TEST_F(Patterns, RouteSendsDynamicResourcesOnlyWhileTheirObjectsAreInTheVolume) {
-  std::string modules = moduleXml(
-      "scene", "routing/movers",
-      paramXml("count", "1") + paramXml("meshes", "1") + paramXml("mesh-triangles", "4") +
-          paramXml("width", "4") + paramXml("dt", "0.1") + paramXml("iterations", "120") +
-          paramXml("dynamic-meshes", "true") +
-          "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
-  std::string connections = connectXml("scene.objects", "wall.in");
-  const char* boxes[] = {"0 -1 -1 1 1 1", "all"};
-  for (int k = 0; k < 2; ++k) {
-    const std::string id = "v" + std::to_string(k);
-    modules += moduleXml(id, "routing/tile-viewer",
-                         paramXml("box", boxes[k]) + paramXml("file", dir.file(id + ".csv")));
-    connections += connectXml("wall.out" + std::to_string(k), id + ".objects") +
-                   connectXml(id + ".interest", "wall.interest" + std::to_string(k)) +
-                   connectXml(id + ".endIt", "scene.beginIt");
-  }
   const auto result = run(dir.write(
       "dynamic.xml",
-      appXml(modules, filterXml("wall", "route", paramXml("outputs", "2")), connections)));
+      moversWall(paramXml("count", "1") + paramXml("meshes", "1") +
+                     paramXml("mesh-triangles", "4") + paramXml("width", "4") +
+                     paramXml("dt", "0.1") + paramXml("iterations", "120") +
+                     paramXml("dynamic-meshes", "true"),
+                 {"0 -1 -1 1 1 1", "all"})));
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto all = byIteration(dir.file("v1.csv"));
   const auto got = byIteration(dir.file("v0.csv"));
