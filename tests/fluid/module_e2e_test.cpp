@@ -203,6 +203,45 @@ TEST(FluidModule, TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath) {
   EXPECT_TRUE(left.empty()) << left.front();
 }
 
+// Under `vrflow launch` the daemon of the module's host starts its ranks: the box animator on
+// host a, the fluid as 2 ranks on host b (127.0.0.2), coupled across the TCP link; the box
+// follows the serial path as on one host, and host b's daemon ran mpirun.
+TEST(FluidModule, TwoBlocksOnAnotherHostAreStartedByThatHostsDaemon) {
+  unsetenv("OMPI_MCA_btl");
+  TempDir dir;
+  const auto log = dir.file("mpirun.log");
+  const auto wrapper =
+      dir.write("mpirun", "#!/bin/sh\necho \"$@\" >> '" + log + "'\nexec mpirun \"$@\"\n");
+  ASSERT_EQ(chmod(wrapper.c_str(), 0755), 0);
+  std::string app = application(
+      fluidModule("      <param name=\"blocks\" value=\"2\"/>\n") +
+          R"(    <module id="box" package="fluidtest" type="box" host="local">
+      <param name="trajectory" value=")" +
+          dir.file("box.csv") + R"("/>
+      <input port="events" initial-messages="1"/>
+    </module>
+)",
+      "    <connection from=\"box.objects\" to=\"water.objects\"/>\n"
+      "    <connection from=\"water.forces\" to=\"box.events\"/>\n");
+  app.replace(app.find("  </hosts>"), 0, "    <host id=\"b\" address=\"127.0.0.2\"/>\n");
+  const std::string onLocal = "type=\"fluid\" host=\"local\"";
+  app.replace(app.find(onLocal), onLocal.size(), "type=\"fluid\" host=\"b\"");
+  setenv("VRFLOW_MPIRUN", wrapper.c_str(), 1);
+  const auto result = runVrflow(
+      {"launch", dir.write("hosts.xml", app), "--backend", "local", "--iterations", "100"}, 180);
+  unsetenv("VRFLOW_MPIRUN");
+  ASSERT_EQ(result.exitCode, 0) << result.out << result.err;
+  const auto rows = readCsv(dir.file("box.csv"), false);
+  ASSERT_GE(rows.size(), 100u);
+  // The serial value of TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath (same tank and box).
+  EXPECT_NEAR(rows[99][1], 0.53162, 1e-3);
+  const auto calls = readLines(log);
+  ASSERT_EQ(calls.size(), 1u);
+  EXPECT_NE(calls[0].find("-np 2"), std::string::npos) << calls[0];
+  const auto left = leftoverProcesses();
+  EXPECT_TRUE(left.empty()) << left.front();
+}
+
 // A module of several ranks whose launcher cannot be run: one clear error, nothing left behind.
 TEST(FluidModule, MissingMpirunIsAClearError) {
   TempDir dir;
