@@ -145,6 +145,26 @@ void waitForMpiOrphansToExit() {
   }
 }
 
+// An mpirun for VRFLOW_MPIRUN in `dir`: it appends its arguments to dir/mpirun.log and runs the
+// real mpirun.
+std::string loggingMpirun(const TempDir& dir) {
+  const auto wrapper = dir.write("mpirun", "#!/bin/sh\necho \"$@\" >> '" +
+                                               dir.file("mpirun.log") + "'\nexec mpirun \"$@\"\n");
+  EXPECT_EQ(chmod(wrapper.c_str(), 0755), 0);
+  return wrapper;
+}
+
+// The test box animator in the default tank, its trajectory written to `trajectory`, first in
+// the fluid's cycle (one initial message on its events).
+std::string cycleBox(const std::string& trajectory) {
+  return R"(    <module id="box" package="fluidtest" type="box" host="local">
+      <param name="trajectory" value=")" +
+         trajectory + R"("/>
+      <input port="events" initial-messages="1"/>
+    </module>
+)";
+}
+
 // Two blocks, started both ways: by vrflow through mpirun (the manifest's mpi-ranks="blocks";
 // VRFLOW_MPIRUN names a wrapper that logs its arguments and runs the real mpirun), and, with
 // VRFLOW_MPIRUN=none, by the module itself through MPI_Comm_spawn.
@@ -154,20 +174,13 @@ TEST(FluidModule, TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath) {
   unsetenv("OMPI_MCA_btl");
   TempDir wrapperDir;
   const auto log = wrapperDir.file("mpirun.log");
-  const auto wrapper =
-      wrapperDir.write("mpirun", "#!/bin/sh\necho \"$@\" >> '" + log + "'\nexec mpirun \"$@\"\n");
-  ASSERT_EQ(chmod(wrapper.c_str(), 0755), 0);
+  const auto wrapper = loggingMpirun(wrapperDir);
   std::vector<double> finalY;
   for (const char* launcher : {"serial", wrapper.c_str(), "none"}) {
     const int blocks = std::string(launcher) == "serial" ? 1 : 2;
     setenv("VRFLOW_MPIRUN", launcher, 1);
     TempDir dir;
-    const std::string box = R"(    <module id="box" package="fluidtest" type="box" host="local">
-      <param name="trajectory" value=")" +
-                            dir.file("box.csv") + R"("/>
-      <input port="events" initial-messages="1"/>
-    </module>
-)";
+    const std::string box = cycleBox(dir.file("box.csv"));
     const auto app = dir.write(
         "blocks.xml", application(fluidModule("      <param name=\"blocks\" value=\"" +
                                               std::to_string(blocks) + "\"/>\n") +
@@ -210,17 +223,9 @@ TEST(FluidModule, TwoBlocksOnAnotherHostAreStartedByThatHostsDaemon) {
   unsetenv("OMPI_MCA_btl");
   TempDir dir;
   const auto log = dir.file("mpirun.log");
-  const auto wrapper =
-      dir.write("mpirun", "#!/bin/sh\necho \"$@\" >> '" + log + "'\nexec mpirun \"$@\"\n");
-  ASSERT_EQ(chmod(wrapper.c_str(), 0755), 0);
+  const auto wrapper = loggingMpirun(dir);
   std::string app = application(
-      fluidModule("      <param name=\"blocks\" value=\"2\"/>\n") +
-          R"(    <module id="box" package="fluidtest" type="box" host="local">
-      <param name="trajectory" value=")" +
-          dir.file("box.csv") + R"("/>
-      <input port="events" initial-messages="1"/>
-    </module>
-)",
+      fluidModule("      <param name=\"blocks\" value=\"2\"/>\n") + cycleBox(dir.file("box.csv")),
       "    <connection from=\"box.objects\" to=\"water.objects\"/>\n"
       "    <connection from=\"water.forces\" to=\"box.events\"/>\n");
   app.replace(app.find("  </hosts>"), 0, "    <host id=\"b\" address=\"127.0.0.2\"/>\n");
