@@ -1,0 +1,243 @@
+#include <algorithm>
+#include <cmath>
+
+#include "solver_impl.hpp"
+
+namespace vrflow::fluid {
+
+namespace {
+constexpr double kMinTheta = 0.2;  // keeps ghost-fluid coefficients (1 / theta) bounded
+}  // namespace
+
+void FluidSolver::Impl::exchangeBytes(std::vector<unsigned char>& bytes, int planeSizeBytes,
+                                      int planes) {
+  if (!comm) return;
+  const std::size_t ps = static_cast<std::size_t>(planeSizeBytes);
+  byteScratch.resize(bytes.size());
+  // The received planes start as they are, so a plane no neighbour sends stays unchanged.
+  for (int k : {k0 - 1, k0, k1 - 1, k1}) {
+    if (k < 0 || k >= planes) continue;
+    for (std::size_t c = k * ps; c < (k + 1) * ps; ++c) byteScratch[c] = bytes[c];
+  }
+  comm->exchangeHalo(byteScratch, planeSizeBytes, planes, k0, k1, 1);
+  for (int k : {k0 - 1, k1}) {
+    if (k < 0 || k >= planes) continue;
+    for (std::size_t c = k * ps; c < (k + 1) * ps; ++c) {
+      bytes[c] = static_cast<unsigned char>(byteScratch[c]);
+    }
+  }
+}
+
+void FluidSolver::Impl::exchangeWithValidity(std::vector<double>& field,
+                                             std::vector<unsigned char>& flags, int a) {
+  if (!comm) return;
+  const std::size_t ps = static_cast<std::size_t>(planeSize(a));
+  const int planes = grid.fdim(a, 2);
+  haloScratch.resize(2 * field.size());
+  // The received planes start as they are, so a plane no neighbour sends stays unchanged.
+  for (int k : {k0 - 1, k0, k1 - 1, k1}) {
+    if (k < 0 || k >= planes) continue;
+    for (std::size_t f = k * ps; f < (k + 1) * ps; ++f) {
+      haloScratch[2 * f] = field[f];
+      haloScratch[2 * f + 1] = flags[f];
+    }
+  }
+  comm->exchangeHalo(haloScratch, 2 * planeSize(a), planes, k0, k1, 1);
+  for (int k : {k0 - 1, k1}) {
+    if (k < 0 || k >= planes) continue;
+    for (std::size_t f = k * ps; f < (k + 1) * ps; ++f) {
+      field[f] = haloScratch[2 * f];
+      flags[f] = static_cast<unsigned char>(haloScratch[2 * f + 1]);
+    }
+  }
+}
+
+void FluidSolver::Impl::markRowsWithMatter() {
+  rowHasMatter.assign(static_cast<std::size_t>(grid.ny) * grid.nz, 0);
+  for (int k = std::max(0, k0 - 1); k < std::min(grid.nz, k1 + 1); ++k) {
+    for (int j = 0; j < grid.ny; ++j) {
+      const unsigned char* row = kind.data() + grid.cell(0, j, k);
+      unsigned char any = 0;
+      for (int i = 0; i < grid.nx; ++i) any |= row[i];  // kAir is 0
+      rowHasMatter[static_cast<std::size_t>(k) * grid.ny + j] = any != 0;
+    }
+  }
+}
+
+void FluidSolver::Impl::zeroWalls(std::vector<double>* field) const {
+  for (int k = k0; k < k1; ++k) {
+    for (int j = 0; j < grid.ny; ++j) {
+      field[0][grid.face(0, 0, j, k)] = 0.0;
+      field[0][grid.face(0, grid.nx, j, k)] = 0.0;
+    }
+    for (int i = 0; i < grid.nx; ++i) {
+      field[1][grid.face(1, i, 0, k)] = 0.0;
+      field[1][grid.face(1, i, grid.ny, k)] = 0.0;
+    }
+  }
+  const std::size_t ps = static_cast<std::size_t>(planeSize(2));
+  for (int k : {0, grid.nz}) {
+    if (k < k0 || k >= kEnd(2)) continue;
+    std::fill_n(field[2].begin() + static_cast<std::ptrdiff_t>(k * ps),
+                static_cast<std::ptrdiff_t>(ps), 0.0);
+  }
+}
+
+void FluidSolver::Impl::classify(const std::vector<PreparedBody>& bodies) {
+  detail::rasterise(grid, bodies, cellBody, faceBody);
+  // Kinds are read one plane beyond the slab at most.
+  const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+  const std::size_t cFrom = plane * static_cast<std::size_t>(std::max(0, k0 - 1));
+  const std::size_t cTo = plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1));
+  for (std::size_t c = cFrom; c < cTo; ++c) {
+    if (cellBody[c] >= 0) {
+      const auto& body = bodies[static_cast<std::size_t>(cellBody[c])];
+      kind[c] = body.kinematic ? detail::kSolid : detail::kBody;
+      cellDensity[c] = body.density;
+    } else {
+      kind[c] = detail::kAir;
+      cellDensity[c] = settings.density;
+    }
+  }
+  for (std::size_t c = k0 * plane; c < k1 * plane; ++c) {
+    if (particlesInCell[c] > 0 && kind[c] == detail::kAir) kind[c] = detail::kLiquid;
+  }
+  exchangeBytes(kind, grid.nx * grid.ny, grid.nz);
+  markRowsWithMatter();
+  // Volume control: each liquid cell away from the surface asks for a divergence that brings
+  // its particle count back to particlesPerCell (cells next to air are partly full by nature).
+  divTarget.assign(kind.size(), 0.0);
+  const double n0 = settings.particlesPerCell;
+  const std::size_t sy = static_cast<std::size_t>(grid.nx), sz = plane;
+  double total = 0, count = 0;
+  for (int k = k0; k < k1; ++k) {
+    for (int j = 0; j < grid.ny; ++j) {
+      for (int i = 0; i < grid.nx; ++i) {
+        const std::size_t c = grid.cell(i, j, k);
+        if (kind[c] != detail::kLiquid) continue;
+        if ((i > 0 && kind[c - 1] == detail::kAir) ||
+            (i + 1 < grid.nx && kind[c + 1] == detail::kAir) ||
+            (j > 0 && kind[c - sy] == detail::kAir) ||
+            (j + 1 < grid.ny && kind[c + sy] == detail::kAir) ||
+            (k > 0 && kind[c - sz] == detail::kAir) ||
+            (k + 1 < grid.nz && kind[c + sz] == detail::kAir)) {
+          continue;
+        }
+        total += particlesInCell[c];
+        count += 1;
+        const double density = std::min(2.0, particlesInCell[c] / n0);
+        divTarget[c] = -settings.volumeCorrection * (1.0 - density);
+      }
+    }
+  }
+  if (comm) {
+    std::vector<double> both{total, count};
+    comm->sum(both);
+    total = both[0];
+    count = both[1];
+  }
+  stats.particleDensity = count > 0 ? total / (count * n0) : 1.0;
+  theta.assign(kind.size(), 0.5);
+  for (std::size_t c = k0 * plane; c < k1 * plane; ++c) {
+    if (kind[c] != detail::kLiquid) continue;
+    const double full = std::min(1.0, particlesInCell[c] / n0);
+    theta[c] = std::clamp(full - 0.5, kMinTheta, 0.5);
+  }
+  exchangeCells(theta);
+}
+
+void FluidSolver::Impl::extrapolate(std::vector<double>* field, int layers) {
+  for (int a = 0; a < 3; ++a) {
+    const int dx = grid.fdim(a, 0), dy = grid.fdim(a, 1), dz = grid.fdim(a, 2);
+    const std::size_t sy = static_cast<std::size_t>(dx), sz = sy * static_cast<std::size_t>(dy);
+    const int ke = kEnd(a);
+    for (int layer = 0; layer < layers; ++layer) {
+      exchangeWithValidity(field[a], valid[a], a);
+      double* value = field[a].data();
+      unsigned char* ok = valid[a].data();
+      const int kLo = std::max(0, k0 - 1), kHi = std::min(dz, ke + 1);
+      rowState.assign(static_cast<std::size_t>(dy) * static_cast<std::size_t>(dz), 0);
+      for (int k = kLo; k < kHi; ++k) {
+        for (int j = 0; j < dy; ++j) {
+          const unsigned char* row = ok + grid.face(a, 0, j, k);
+          int count = 0;
+          for (int i = 0; i < dx; ++i) count += row[i];
+          rowState[static_cast<std::size_t>(k) * dy + j] =
+              static_cast<unsigned char>((count > 0 ? 1 : 0) | (count == dx ? 2 : 0));
+        }
+      }
+      filled.clear();
+      for (int k = k0; k < ke; ++k) {
+        for (int j = 0; j < dy; ++j) {
+          const std::size_t r = static_cast<std::size_t>(k) * dy + j;
+          if (rowState[r] & 2) continue;  // nothing to fill
+          const bool near = (rowState[r] & 1) || (j > 0 && (rowState[r - 1] & 1)) ||
+                            (j + 1 < dy && (rowState[r + 1] & 1)) ||
+                            (k > 0 && (rowState[r - dy] & 1)) ||
+                            (k + 1 < dz && (rowState[r + dy] & 1));
+          if (!near) continue;
+          std::size_t f = grid.face(a, 0, j, k);
+          for (int i = 0; i < dx; ++i, ++f) {
+            if (ok[f]) continue;
+            double total = 0.0;
+            int count = 0;
+            auto take = [&](std::size_t g) {
+              if (ok[g]) {
+                total += value[g];
+                ++count;
+              }
+            };
+            if (i > 0) take(f - 1);
+            if (i + 1 < dx) take(f + 1);
+            if (j > 0) take(f - sy);
+            if (j + 1 < dy) take(f + sy);
+            if (k > 0) take(f - sz);
+            if (k + 1 < dz) take(f + sz);
+            if (count > 0) {
+              value[f] = total / count;
+              filled.push_back(f);
+            }
+          }
+        }
+      }
+      for (const std::size_t f : filled) ok[f] = 1;
+    }
+  }
+}
+
+void FluidSolver::Impl::enforceBodies(const std::vector<PreparedBody>& bodies, bool kinematicOnly) {
+  const double o[3] = {grid.ox, grid.oy, grid.oz};
+  for (const auto& box : bodies) {
+    if (kinematicOnly && !box.kinematic) continue;
+    for (int a = 0; a < 3; ++a) {
+      int lo[3], hi[3];
+      for (int d = 0; d < 3; ++d) {
+        lo[d] = std::max(0, static_cast<int>(std::floor((box.bounds.min[d] - o[d]) * invH)) - 1);
+        hi[d] = std::min(grid.fdim(a, d) - 1,
+                         static_cast<int>(std::ceil((box.bounds.max[d] - o[d]) * invH)) + 1);
+      }
+      lo[2] = std::max(lo[2], k0);
+      hi[2] = std::min(hi[2], kEnd(a) - 1);
+      for (int k = lo[2]; k <= hi[2]; ++k) {
+        for (int j = lo[1]; j <= hi[1]; ++j) {
+          for (int i = lo[0]; i <= hi[0]; ++i) {
+            const std::size_t f = grid.face(a, i, j, k);
+            int b = faceBody[a][f];
+            if (b < 0 && !onWall(a, i, j, k)) {  // the faces of a kinematic body's cells too
+              const std::size_t hiCell = grid.cell(i, j, k), loCell = hiCell - stride(a);
+              if (kind[hiCell] == detail::kSolid) b = cellBody[hiCell];
+              if (kind[loCell] == detail::kSolid) b = cellBody[loCell];
+            }
+            if (b < 0) continue;
+            const auto& body = bodies[static_cast<std::size_t>(b)];
+            if (kinematicOnly && !body.kinematic) continue;
+            u[a][f] =
+                detail::rigidVelocity(body, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace vrflow::fluid

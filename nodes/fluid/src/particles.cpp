@@ -1,0 +1,229 @@
+#include <algorithm>
+#include <cmath>
+
+#include "solver_impl.hpp"
+#include "transfer.hpp"
+
+namespace vrflow::fluid {
+
+namespace {
+constexpr int kHaloForParticles = 3;  // planes of velocity a block's particles may sample
+constexpr int kParticleRecord = 6;    // position and velocity
+}  // namespace
+
+void FluidSolver::Impl::migrate() {
+  if (!comm) return;
+  const int n = comm->size();
+  std::vector<std::vector<double>> out(static_cast<std::size_t>(n));
+  std::size_t keep = 0;
+  const std::size_t count = pos.size() / 3;
+  for (std::size_t p = 0; p < count; ++p) {
+    const int k = planeOf(&pos[3 * p]);
+    if (k >= k0 && k < k1) {
+      if (keep != p) {
+        for (int d = 0; d < 3; ++d) {
+          pos[3 * keep + d] = pos[3 * p + d];
+          vel[3 * keep + d] = vel[3 * p + d];
+        }
+      }
+      ++keep;
+      continue;
+    }
+    auto& o = out[static_cast<std::size_t>(blockOfPlane(grid.nz, n, k))];
+    o.insert(o.end(), &pos[3 * p], &pos[3 * p] + 3);
+    o.insert(o.end(), &vel[3 * p], &vel[3 * p] + 3);
+  }
+  pos.resize(3 * keep);
+  vel.resize(3 * keep);
+  const auto in = comm->exchange(out, kParticleRecord);
+  for (std::size_t r = 0; r + kParticleRecord <= in.size(); r += kParticleRecord) {
+    pos.insert(pos.end(), &in[r], &in[r] + 3);
+    vel.insert(vel.end(), &in[r + 3], &in[r + 3] + 3);
+  }
+}
+
+void FluidSolver::Impl::sortParticles() {
+  // This block's particles all lie in its slab (cellOf clamps as planeOf does in migrate), so
+  // only the slab's cells are counted; the others keep their zero counts.
+  const std::size_t n = pos.size() / 3;
+  const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+  const std::size_t c0 = plane * static_cast<std::size_t>(k0),
+                    c1 = plane * static_cast<std::size_t>(k1);
+  std::fill(particlesInCell.begin() + static_cast<std::ptrdiff_t>(c0),
+            particlesInCell.begin() + static_cast<std::ptrdiff_t>(c1), 0);
+  if (!cellsKnown) {
+    sortCell.resize(n);
+    for (std::size_t p = 0; p < n; ++p) sortCell[p] = clampedCell(&pos[3 * p]);
+  }
+  for (std::size_t p = 0; p < n; ++p) ++particlesInCell[sortCell[p]];
+  sortStart.resize(grid.cells() + 1);
+  sortStart[c0] = 0;
+  for (std::size_t c = c0; c < c1; ++c) {
+    sortStart[c + 1] = sortStart[c] + static_cast<std::size_t>(particlesInCell[c]);
+  }
+  posScratch.resize(pos.size());
+  velScratch.resize(vel.size());
+  for (std::size_t p = 0; p < n; ++p) {
+    const std::size_t to = sortStart[sortCell[p]]++;
+    for (int d = 0; d < 3; ++d) {
+      posScratch[3 * to + d] = pos[3 * p + d];
+      velScratch[3 * to + d] = vel[3 * p + d];
+    }
+  }
+  pos.swap(posScratch);
+  vel.swap(velScratch);
+  cellsKnown = false;
+}
+
+void FluidSolver::Impl::pushParticlesOut(const std::vector<PreparedBody>& bodies) {
+  if (bodies.empty()) return;
+  nearBody.assign(grid.cells(), 0);
+  const double o[3] = {grid.ox, grid.oy, grid.oz};
+  const int n[3] = {grid.nx, grid.ny, grid.nz};
+  for (const auto& body : bodies) {
+    int lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::max(0, static_cast<int>(std::floor((body.bounds.min[d] - o[d]) * invH)) - 1);
+      hi[d] =
+          std::min(n[d] - 1, static_cast<int>(std::floor((body.bounds.max[d] - o[d]) * invH)) + 1);
+    }
+    for (int k = lo[2]; k <= hi[2]; ++k) {
+      for (int j = lo[1]; j <= hi[1]; ++j) {
+        for (int i = lo[0]; i <= hi[0]; ++i) nearBody[grid.cell(i, j, k)] = 1;
+      }
+    }
+  }
+  const std::size_t count = pos.size() / 3;
+  for (std::size_t p = 0; p < count; ++p) {
+    double* x = &pos[3 * p];
+    if (cellsKnown) {
+      if (!nearBody[sortCell[p]]) continue;
+    } else {
+      int i, j, k;
+      if (!cellOf(x, i, j, k) || !nearBody[grid.cell(i, j, k)]) continue;
+    }
+    for (const auto& body : bodies) {
+      if (!detail::inBounds(body.bounds, x)) continue;
+      detail::pushOut(body, x, 0.25 * grid.h);
+      clampToDomain(x);
+    }
+    if (cellsKnown) sortCell[p] = clampedCell(x);
+  }
+}
+
+void FluidSolver::Impl::particlesToGrid() {
+  // This block's particles reach face planes k0 - 1 to k1.
+  for (int a = 0; a < 3; ++a) {
+    const std::size_t ps = 2 * static_cast<std::size_t>(planeSize(a));
+    const auto from =
+        static_cast<std::ptrdiff_t>(ps * static_cast<std::size_t>(std::max(0, k0 - 1)));
+    const auto to = static_cast<std::ptrdiff_t>(
+        ps * static_cast<std::size_t>(std::min(grid.fdim(a, 2), k1 + 1)));
+    std::fill(acc[a].begin() + from, acc[a].begin() + to, 0.0);
+  }
+  const detail::Lattice lattice(grid);
+  double* sums[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
+  const std::size_t n = pos.size() / 3;
+  const double* x = pos.data();
+  const double* v = vel.data();
+  for (std::size_t p = 0; p < n; ++p, x += 3, v += 3) {
+    detail::Located c;
+    detail::locate(lattice, x, c);
+    detail::splat(sums[0], detail::stencilOf(lattice, 0, c), v[0]);
+    detail::splat(sums[1], detail::stencilOf(lattice, 1, c), v[1]);
+    detail::splat(sums[2], detail::stencilOf(lattice, 2, c), v[2]);
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (comm) comm->addHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1);
+    // Faces of other blocks read zero (this block's are all written below).
+    const auto ps = static_cast<std::ptrdiff_t>(planeSize(a));
+    std::fill(u[a].begin(), u[a].begin() + ps * k0, 0.0);
+    std::fill(u[a].begin() + ps * kEnd(a), u[a].end(), 0.0);
+    const double* in = acc[a].data();
+    forOwnFaces(a, [&](std::size_t f, int, int, int) {
+      const double w = in[2 * f + 1];
+      if (w > 1e-9) {
+        u[a][f] = in[2 * f] / w;
+        valid[a][f] = 1;
+      } else {
+        u[a][f] = 0.0;
+        valid[a][f] = 0;
+      }
+    });
+  }
+}
+
+void FluidSolver::Impl::gridToParticlesAndAdvect(double dt) {
+  // (new velocity, change) per face, interleaved: the FLIP update needs both at the same
+  // stencil, and the pairs interpolate together. Built on this block's faces; the planes its
+  // particles can sample beyond them come from the neighbours.
+  for (int a = 0; a < 3; ++a) {
+    const std::size_t ps = static_cast<std::size_t>(planeSize(a));
+    double* out = acc[a].data();
+    const double* un = u[a].data();
+    const double* uo = uOld[a].data();
+    for (std::size_t f = ps * static_cast<std::size_t>(k0);
+         f < ps * static_cast<std::size_t>(kEnd(a)); ++f) {
+      out[2 * f] = un[f];
+      out[2 * f + 1] = un[f] - uo[f];
+    }
+    if (comm) {
+      comm->exchangeHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1, kHaloForParticles);
+    }
+  }
+  const detail::Lattice lattice(grid);
+  const double* pairs[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
+  const double flip = settings.flipRatio, pic = 1.0 - flip;
+  const double halfDt = 0.5 * dt;
+  // clampToDomain()'s bounds, computed once.
+  const double eps = 1e-3 * grid.h;
+  const double o[3] = {grid.ox, grid.oy, grid.oz};
+  const int cells[3] = {grid.nx, grid.ny, grid.nz};
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = o[d] + eps;
+    hi[d] = o[d] + cells[d] * grid.h - eps;
+  }
+  auto clamp = [&](double* y) {
+    for (int d = 0; d < 3; ++d) y[d] = std::min(std::max(y[d], lo[d]), hi[d]);
+  };
+  const std::size_t n = pos.size() / 3;
+  const bool storeCells = !comm || comm->size() == 1;
+  if (storeCells) sortCell.resize(n);
+  // Two passes (velocities and midpoints, then positions) rather than one: within a particle
+  // the second interpolation waits for the first, and a pass of short independent chains
+  // keeps more particles in flight.
+  posScratch.resize(pos.size());
+  double* midpoints = posScratch.data();
+  for (std::size_t p = 0; p < n; ++p) {
+    const double* x = &pos[3 * p];
+    double* v = &vel[3 * p];
+    detail::Located c;
+    detail::locate(lattice, x, c);
+    const detail::Pair g0 = detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c));
+    const detail::Pair g1 = detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c));
+    const detail::Pair g2 = detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c));
+    v[0] = flip * (v[0] + g0[1]) + pic * g0[0];
+    v[1] = flip * (v[1] + g1[1]) + pic * g1[0];
+    v[2] = flip * (v[2] + g2[1]) + pic * g2[0];
+    // Midpoint (RK2) through the divergence-free grid velocity.
+    double* mid = midpoints + 3 * p;
+    mid[0] = x[0] + halfDt * g0[0];
+    mid[1] = x[1] + halfDt * g1[0];
+    mid[2] = x[2] + halfDt * g2[0];
+    clamp(mid);
+  }
+  for (std::size_t p = 0; p < n; ++p) {
+    double* x = &pos[3 * p];
+    detail::Located c;
+    detail::locate(lattice, midpoints + 3 * p, c);
+    x[0] += dt * detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c))[0];
+    x[1] += dt * detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c))[0];
+    x[2] += dt * detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c))[0];
+    clamp(x);
+    if (storeCells) sortCell[p] = clampedCell(x);
+  }
+  cellsKnown = storeCells;
+}
+
+}  // namespace vrflow::fluid
