@@ -77,10 +77,13 @@ void FluidSolver::Impl::sortParticles() {
 
 void FluidSolver::Impl::pushParticlesOut(const std::vector<PreparedBody>& bodies) {
   if (bodies.empty()) return;
-  nearBody.assign(grid.cells(), 0);
+  // Per cell, the bodies whose bounds (one cell wider) reach it, in body order: a particle is
+  // tested against those only (a net's hundreds of nodes lie over one layer of cells).
+  const std::size_t cells = grid.cells();
+  bodiesAt.assign(cells + 1, 0);
   const double o[3] = {grid.ox, grid.oy, grid.oz};
   const int n[3] = {grid.nx, grid.ny, grid.nz};
-  for (const auto& body : bodies) {
+  auto forCellsNear = [&](const PreparedBody& body, auto&& f) {
     int lo[3], hi[3];
     for (int d = 0; d < 3; ++d) {
       lo[d] = std::max(0, static_cast<int>(std::floor((body.bounds.min[d] - o[d]) * invH)) - 1);
@@ -89,23 +92,47 @@ void FluidSolver::Impl::pushParticlesOut(const std::vector<PreparedBody>& bodies
     }
     for (int k = lo[2]; k <= hi[2]; ++k) {
       for (int j = lo[1]; j <= hi[1]; ++j) {
-        for (int i = lo[0]; i <= hi[0]; ++i) nearBody[grid.cell(i, j, k)] = 1;
+        for (int i = lo[0]; i <= hi[0]; ++i) f(grid.cell(i, j, k));
       }
+    }
+  };
+  for (const auto& body : bodies) forCellsNear(body, [&](std::size_t c) { ++bodiesAt[c + 1]; });
+  for (std::size_t c = 0; c < cells; ++c) bodiesAt[c + 1] += bodiesAt[c];
+  bodyList.resize(bodiesAt[cells]);
+  {
+    std::vector<std::uint32_t>& next = bodyListFill;
+    next.assign(bodiesAt.begin(), bodiesAt.end() - 1);
+    for (std::size_t b = 0; b < bodies.size(); ++b) {
+      forCellsNear(bodies[b],
+                   [&](std::size_t c) { bodyList[next[c]++] = static_cast<std::uint32_t>(b); });
     }
   }
   const std::size_t count = pos.size() / 3;
   for (std::size_t p = 0; p < count; ++p) {
     double* x = &pos[3 * p];
+    std::size_t c;
     if (cellsKnown) {
-      if (!nearBody[sortCell[p]]) continue;
+      c = sortCell[p];
     } else {
       int i, j, k;
-      if (!cellOf(x, i, j, k) || !nearBody[grid.cell(i, j, k)]) continue;
+      if (!cellOf(x, i, j, k)) continue;
+      c = grid.cell(i, j, k);
     }
-    for (const auto& body : bodies) {
-      if (!detail::inBounds(body.bounds, x)) continue;
-      detail::pushOut(body, x, 0.25 * grid.h);
+    if (bodiesAt[c] == bodiesAt[c + 1]) continue;
+    // Every body whose bounds hold a point of cell c is on c's list. A push that carries the
+    // particle out of c ends the list: the bodies after the one that pushed are then all tested.
+    for (std::uint32_t e = bodiesAt[c]; e < bodiesAt[c + 1]; ++e) {
+      const std::size_t b = bodyList[e];
+      if (!detail::inBounds(bodies[b].bounds, x)) continue;
+      detail::pushOut(bodies[b], x, 0.25 * grid.h);
       clampToDomain(x);
+      if (clampedCell(x) == c) continue;
+      for (std::size_t rest = b + 1; rest < bodies.size(); ++rest) {
+        if (!detail::inBounds(bodies[rest].bounds, x)) continue;
+        detail::pushOut(bodies[rest], x, 0.25 * grid.h);
+        clampToDomain(x);
+      }
+      break;
     }
     if (cellsKnown) sortCell[p] = clampedCell(x);
   }

@@ -172,8 +172,9 @@ struct FluidSolver::Impl {
   // and an order that does not depend on history.
   void sortParticles();
 
-  // Only particles in cells that some body's bounds touch are tested against the bodies.
-  std::vector<unsigned char> nearBody;
+  // Pushes particles out of the bodies. Per cell (CSR: bodiesAt[c] to bodiesAt[c + 1] in
+  // bodyList), the bodies whose bounds reach it; only those are tested.
+  std::vector<std::uint32_t> bodiesAt, bodyList, bodyListFill;
   void pushParticlesOut(const std::vector<PreparedBody>& bodies);
 
   void classify(const std::vector<PreparedBody>& bodies);
