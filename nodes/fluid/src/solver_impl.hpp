@@ -103,10 +103,14 @@ struct FluidSolver::Impl {
     return i >= 0 && j >= 0 && k >= 0 && i < grid.nx && j < grid.ny && k < grid.nz;
   }
 
-  int planeOf(const double* x) const {
-    const int k = static_cast<int>(std::floor((x[2] - grid.oz) * invH));
-    return std::clamp(k, 0, grid.nz - 1);
+  // The index along one axis of the cell holding coordinate g (in cells), clamped into [0, n):
+  // the same as clamping floor(g), without the floor (truncation after max(g, 0) is floor).
+  static int clampedIndex(double g, int n) {
+    const int i = static_cast<int>(std::max(g, 0.0));
+    return i < n ? i : n - 1;
   }
+
+  int planeOf(const double* x) const { return clampedIndex((x[2] - grid.oz) * invH, grid.nz); }
 
   // Loops over this block's faces of component a (with the along-axis index).
   template <typename F>
@@ -159,11 +163,9 @@ struct FluidSolver::Impl {
   std::vector<std::uint32_t> sortCell;
   bool cellsKnown = false;
   std::uint32_t clampedCell(const double* x) const {
-    int i, j, k;
-    cellOf(x, i, j, k);
-    i = std::clamp(i, 0, grid.nx - 1);
-    j = std::clamp(j, 0, grid.ny - 1);
-    k = std::clamp(k, 0, grid.nz - 1);
+    const int i = clampedIndex((x[0] - grid.ox) * invH, grid.nx);
+    const int j = clampedIndex((x[1] - grid.oy) * invH, grid.ny);
+    const int k = clampedIndex((x[2] - grid.oz) * invH, grid.nz);
     return static_cast<std::uint32_t>(grid.cell(i, j, k));
   }
   std::vector<std::size_t> sortStart;
