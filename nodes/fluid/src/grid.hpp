@@ -6,6 +6,16 @@
 // The staggered grid's storage: cell-centred scalars, and the three face-velocity components
 // (u on x-faces: (nx+1) x ny x nz, v on y-faces, w on z-faces), all x-fastest.
 
+// The passes that take most of a step are compiled twice on x86-64 with GCC: for the baseline
+// and for x86-64-v3 (AVX2, FMA), picked when the program loads (an ifunc). Results then differ
+// between machines with and without AVX2 in the last bits (fused multiply-adds), never between
+// the blocks and the serial solver of one machine.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define VRFLOW_FLUID_HOT __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define VRFLOW_FLUID_HOT
+#endif
+
 namespace vrflow::fluid::detail {
 
 /// What a cell holds this step.

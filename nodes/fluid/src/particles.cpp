@@ -148,18 +148,7 @@ void FluidSolver::Impl::particlesToGrid() {
         ps * static_cast<std::size_t>(std::min(grid.fdim(a, 2), k1 + 1)));
     std::fill(acc[a].begin() + from, acc[a].begin() + to, 0.0);
   }
-  const detail::Lattice lattice(grid);
-  double* sums[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
-  const std::size_t n = pos.size() / 3;
-  const double* x = pos.data();
-  const double* v = vel.data();
-  for (std::size_t p = 0; p < n; ++p, x += 3, v += 3) {
-    detail::Located c;
-    detail::locate(lattice, x, c);
-    detail::splat(sums[0], detail::stencilOf(lattice, 0, c), v[0]);
-    detail::splat(sums[1], detail::stencilOf(lattice, 1, c), v[1]);
-    detail::splat(sums[2], detail::stencilOf(lattice, 2, c), v[2]);
-  }
+  splatParticles();
   for (int a = 0; a < 3; ++a) {
     if (comm) comm->addHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1);
     // Faces of other blocks read zero (this block's are all written below).
@@ -177,6 +166,21 @@ void FluidSolver::Impl::particlesToGrid() {
         valid[a][f] = 0;
       }
     });
+  }
+}
+
+VRFLOW_FLUID_HOT void FluidSolver::Impl::splatParticles() {
+  const detail::Lattice lattice(grid);
+  double* sums[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
+  const std::size_t n = pos.size() / 3;
+  const double* x = pos.data();
+  const double* v = vel.data();
+  for (std::size_t p = 0; p < n; ++p, x += 3, v += 3) {
+    detail::Located c;
+    detail::locate(lattice, x, c);
+    detail::splat(sums[0], detail::stencilOf(lattice, 0, c), v[0]);
+    detail::splat(sums[1], detail::stencilOf(lattice, 1, c), v[1]);
+    detail::splat(sums[2], detail::stencilOf(lattice, 2, c), v[2]);
   }
 }
 
@@ -198,6 +202,10 @@ void FluidSolver::Impl::gridToParticlesAndAdvect(double dt) {
       comm->exchangeHalo(acc[a], 2 * planeSize(a), grid.fdim(a, 2), k0, k1, kHaloForParticles);
     }
   }
+  sampleAndAdvectParticles(dt);
+}
+
+VRFLOW_FLUID_HOT void FluidSolver::Impl::sampleAndAdvectParticles(double dt) {
   const detail::Lattice lattice(grid);
   const double* pairs[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
   const double flip = settings.flipRatio, pic = 1.0 - flip;

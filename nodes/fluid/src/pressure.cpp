@@ -45,6 +45,7 @@ double sumOver(BlockComm* comm, double local) {
 
 // q = A s on the unknowns, returning the local part of s.q; s must hold valid halo planes
 // k0 - 1 and k1.
+VRFLOW_FLUID_HOT
 double multiply(const Grid& g, const PressureSystem& A, const double* s, double* q,
                 const std::vector<Row>& rows) {
   const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
@@ -77,6 +78,7 @@ double multiply(const Grid& g, const PressureSystem& A, const double* s, double*
 
 // MIC(0) of the slab's own block of A (couplings that leave the slab are dropped), stored as
 // the pivots pc and the off-diagonals times their row's pivot.
+VRFLOW_FLUID_HOT
 void buildPreconditioner(const Grid& g, const PressureSystem& A, const Slab& slab,
                          PcgWorkspace& w) {
   const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
@@ -120,8 +122,9 @@ void buildPreconditioner(const Grid& g, const PressureSystem& A, const Slab& sla
 // The forward sweep of the preconditioner (L t = r) on one row, after an optional CG update of
 // p and r on the same cells (fused: r is read once); returns the row's part of |r|^2.
 template <bool kUpdate>
-double forwardRow(const Grid& g, const PcgWorkspace& w, const Row& row, double alpha,
-                  const double* s, const double* q, double* p, double* r, double* t) {
+VRFLOW_FLUID_HOT double forwardRow(const Grid& g, const PcgWorkspace& w, const Row& row,
+                                   double alpha, const double* s, const double* q, double* p,
+                                   double* r, double* t) {
   const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
   const double* pc = w.pc.data();
   const double* axpc = w.axpc.data();
@@ -155,6 +158,7 @@ double forwardRow(const Grid& g, const PcgWorkspace& w, const Row& row, double a
 }
 
 // The backward sweep (L^T z = t), completing z = M^-1 r; returns the local part of r.z.
+VRFLOW_FLUID_HOT
 double backward(const Grid& g, const PcgWorkspace& w, const double* r, const double* t, double* z) {
   const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
   const double* pc = w.pc.data();

@@ -182,6 +182,10 @@ struct FluidSolver::Impl {
   void classify(const std::vector<PreparedBody>& bodies);
 
   void particlesToGrid();
+  // The particle loops of the two transfers, compiled twice (VRFLOW_FLUID_HOT in their
+  // definitions): call them only from particles.cpp, where the load-time choice is made.
+  void splatParticles();
+  void sampleAndAdvectParticles(double dt);
 
   // Fills faces without a value from the mean of valid neighbours, `layers` rings deep. Only
   // rows (j, k) with a valid face in them or next to them can gain values; the others (deep in

@@ -110,39 +110,45 @@ inline Pair loadPair(const double* p) {
   return v;
 }
 
-/// gather() of two interleaved fields at once (`pairs` holds two values per face).
+/// Four doubles processed together: one AVX register in the x86-64-v3 clones of the particle
+/// loops, two SSE2 registers in the baseline ones.
+typedef double Quad __attribute__((vector_size(32)));
+
+/// gather() of two interleaved fields at once (`pairs` holds two values per face). A face and
+/// its x neighbour are one load of four values, so the eight corners are four loads: z, then y,
+/// then x.
 inline Pair gatherPair(const double* pairs, const Stencil& s) {
-  const Pair fx = {s.fx, s.fx}, fy = {s.fy, s.fy}, fz = {s.fz, s.fz};
   const double* p = pairs + 2 * s.base;
   const std::size_t y = 2 * s.sy, z = 2 * s.sz;
-  const Pair p000 = loadPair(p), p100 = loadPair(p + 2);
-  const Pair p010 = loadPair(p + y), p110 = loadPair(p + y + 2);
-  const Pair p001 = loadPair(p + z), p101 = loadPair(p + z + 2);
-  const Pair p011 = loadPair(p + z + y), p111 = loadPair(p + z + y + 2);
-  const Pair c00 = p000 + fx * (p100 - p000);
-  const Pair c10 = p010 + fx * (p110 - p010);
-  const Pair c01 = p001 + fx * (p101 - p001);
-  const Pair c11 = p011 + fx * (p111 - p011);
-  const Pair c0 = c00 + fy * (c10 - c00);
-  const Pair c1 = c01 + fy * (c11 - c01);
-  return c0 + fz * (c1 - c0);
+  const Quad fy = {s.fy, s.fy, s.fy, s.fy}, fz = {s.fz, s.fz, s.fz, s.fz};
+  // (Loaded in place: a function returning a Quad would change the ABI without AVX.)
+  Quad r00, r10, r01, r11;
+  __builtin_memcpy(&r00, p, sizeof r00);
+  __builtin_memcpy(&r10, p + y, sizeof r10);
+  __builtin_memcpy(&r01, p + z, sizeof r01);
+  __builtin_memcpy(&r11, p + z + y, sizeof r11);
+  const Quad c0 = r00 + fz * (r01 - r00);
+  const Quad c1 = r10 + fz * (r11 - r10);
+  const Quad c = c0 + fy * (c1 - c0);  // the pair at x, then at x + 1
+  const Pair lo = {c[0], c[1]}, hi = {c[2], c[3]};
+  return lo + Pair{s.fx, s.fx} * (hi - lo);
 }
 
 /// Adds a particle's velocity component `va` and its weights to `acc`, which holds (sum of
-/// weighted velocities, sum of weights) per face, interleaved so both share a cache line.
+/// weighted velocities, sum of weights) per face, interleaved so both share a cache line: a face
+/// and its x neighbour are one read-modify-write of four values.
 inline void splat(double* acc, const Stencil& s, double va) {
+  const Quad x = Quad{1 - s.fx, 1 - s.fx, s.fx, s.fx} * Quad{va, 1.0, va, 1.0};
   for (int dk = 0; dk < 2; ++dk) {
     const double wz = dk ? s.fz : 1 - s.fz;
     for (int dj = 0; dj < 2; ++dj) {
       const double wyz = wz * (dj ? s.fy : 1 - s.fy);
       double* row = acc + 2 * (s.base + static_cast<std::size_t>(dk) * s.sz +
                                static_cast<std::size_t>(dj) * s.sy);
-      const double w0 = wyz * (1 - s.fx), w1 = wyz * s.fx;
-      const Pair v = {va, 1.0};
-      const Pair a0 = loadPair(row) + Pair{w0, w0} * v;
-      const Pair a1 = loadPair(row + 2) + Pair{w1, w1} * v;
-      __builtin_memcpy(row, &a0, sizeof a0);
-      __builtin_memcpy(row + 2, &a1, sizeof a1);
+      Quad sum;
+      __builtin_memcpy(&sum, row, sizeof sum);
+      sum += Quad{wyz, wyz, wyz, wyz} * x;
+      __builtin_memcpy(row, &sum, sizeof sum);
     }
   }
 }
