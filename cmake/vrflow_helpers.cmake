@@ -70,7 +70,7 @@ endfunction()
 # vrflow_add_test(NAME SOURCES ... DEPS ... LABELS ...): one GoogleTest executable, registered
 # with CTest test by test, with the given labels.
 function(vrflow_add_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;PREFIX" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE vrflow_warnings ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   if(NOT ARG_TIMEOUT)
@@ -78,7 +78,9 @@ function(vrflow_add_test name)
   endif()
   # Tests find the commands beside their own executable (build/bin) and the sources here.
   target_compile_definitions(${name} PRIVATE VRFLOW_TEST_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  # PREFIX names a second build of the same tests apart from the first ("PREFIX.Suite.Test").
   gtest_discover_tests(${name}
+    TEST_PREFIX "${ARG_PREFIX}"
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
     DISCOVERY_TIMEOUT 60)
 endfunction()

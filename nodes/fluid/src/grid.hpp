@@ -9,8 +9,10 @@
 // The passes that take most of a step are compiled twice on x86-64 with GCC: for the baseline
 // and for x86-64-v3 (AVX2, FMA), picked when the program loads (an ifunc). Results then differ
 // between machines with and without AVX2 in the last bits (fused multiply-adds), never between
-// the blocks and the serial solver of one machine.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+// the blocks and the serial solver of one machine. VRFLOW_FLUID_BASELINE_ONLY builds the baseline
+// alone (the tests run the solver's physics tests on it too).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(VRFLOW_FLUID_BASELINE_ONLY)
 #define VRFLOW_FLUID_HOT __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
 #define VRFLOW_FLUID_HOT
