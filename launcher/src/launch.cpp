@@ -300,6 +300,8 @@ void Launcher::appendDaemonOptions(std::vector<std::string>& argv) const {
   for (const auto& c : options_.compositeDirs) {
     argv.insert(argv.end(), {"--composites", std::filesystem::absolute(c, ec).string()});
   }
+  // Each daemon reads the file itself: the command line's parameters go with it.
+  for (const auto& s : options_.overrides) argv.insert(argv.end(), {"--set", s});
 }
 
 Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& secret) {

@@ -21,6 +21,7 @@ vrflow_add_library(app
     src/app/rates.cpp
     src/app/manifest_reader.cpp
     src/app/model.cpp
+    src/app/overrides.cpp
     src/app/package.cpp
     src/app/source_location.cpp
     src/app/source_text.cpp

@@ -12,14 +12,15 @@
 #include <optional>
 #include <set>
 
+#include "control_link.hpp"
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/expand.hpp"
 #include "vrflow/app/loader.hpp"
+#include "vrflow/app/overrides.hpp"
 #include "vrflow/app/validate.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/runner.hpp"
-#include "control_link.hpp"
 
 int main(int argc, char** argv) {
   CLI::App cli{"vrflow-daemon: serve one host of an application"};
@@ -34,6 +35,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> compositeDirs;
   cli.add_option("--composites", compositeDirs,
                  "Extra folder of composite files NAME.vrc.xml (repeatable)");
+  std::vector<std::string> overrides;
+  cli.add_option("--set", overrides,
+                 "ID.PARAM=VALUE: set a parameter of a module or filter over the file's "
+                 "(repeatable)");
   cli.add_option("--iterations,-n", options.iterations, "Stop after N iterations of every module");
   cli.add_option("--report", options.reportPath, "Write a JSON run report to FILE");
   cli.add_option("--timeout", options.timeoutSeconds, "Fail if the run lasts longer (seconds)");
@@ -75,12 +80,17 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
+  if (auto set = vrflow::app::applyOverrides(*application, overrides); !set) {
+    std::fprintf(stderr, "vrflow-daemon: %s\n", set.error().message.c_str());
+    return vrflow::run::kExitInvalid;
+  }
   auto loaded = vrflow::daemon::loadApplicationPlugins(*application, *catalog);
   problems.insert(problems.end(), loaded.begin(), loaded.end());
   auto more = vrflow::app::validate(*application, *catalog);
   problems.insert(problems.end(), more.begin(), more.end());
   vrflow::app::sortAndDeduplicate(problems);
-  for (const auto& d : problems) std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
+  for (const auto& d : problems)
+    std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
   if (vrflow::app::hasErrors(problems)) return vrflow::run::kExitInvalid;
   std::optional<vrflow::net::Secret> secret;
   if (!controlConnect.empty()) {
@@ -93,7 +103,8 @@ int main(int argc, char** argv) {
     std::memset(const_cast<char*>(text), 0, std::strlen(text));
     unsetenv("VRFLOW_RUN_SECRET");  // modules must not inherit it
     if (!parsed) {
-      std::fprintf(stderr, "vrflow-daemon: $VRFLOW_RUN_SECRET: %s\n", parsed.error().message.c_str());
+      std::fprintf(stderr, "vrflow-daemon: $VRFLOW_RUN_SECRET: %s\n",
+                   parsed.error().message.c_str());
       return vrflow::run::kExitInvalid;
     }
     secret = *parsed;
@@ -101,7 +112,8 @@ int main(int argc, char** argv) {
       const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
       const long index = rank != nullptr ? std::atol(rank) : -1;
       if (index < 0 || static_cast<std::size_t>(index) >= application->hosts.size()) {
-        std::fprintf(stderr, "vrflow-daemon: %s: no --host, and MPI rank %s names no host of the file\n",
+        std::fprintf(stderr,
+                     "vrflow-daemon: %s: no --host, and MPI rank %s names no host of the file\n",
                      file.c_str(), rank != nullptr ? rank : "(none)");
         return vrflow::run::kExitInvalid;
       }
@@ -133,7 +145,8 @@ int main(int argc, char** argv) {
       }
       auto fd = vrflow::tools::ControlLink::connectBack(controlConnect, *secret, index);
       if (!fd) {
-        std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", host.c_str(), fd.error().message.c_str());
+        std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", host.c_str(),
+                     fd.error().message.c_str());
         return vrflow::run::kExitRunFailed;
       }
       in = *fd;
@@ -156,7 +169,8 @@ int main(int argc, char** argv) {
   }
 
   // Multi-rate: the iterations of each module come from the whole network, before the split.
-  if (options.iterations > 0) options.moduleIterations = vrflow::run::moduleIterations(*application, options.iterations);
+  if (options.iterations > 0)
+    options.moduleIterations = vrflow::run::moduleIterations(*application, options.iterations);
 
   // Keep this host's share of the network.
   vrflow::app::Application local = *application;

@@ -11,6 +11,7 @@
 #include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/expand.hpp"
 #include "vrflow/app/loader.hpp"
+#include "vrflow/app/overrides.hpp"
 #include "vrflow/app/validate.hpp"
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/plugin.hpp"
@@ -22,10 +23,12 @@
 namespace {
 
 // Loads the file and expands its composites (search path: the file's folder, --composites,
-// $VRFLOW_COMPOSITE_PATH); validates the flat application when a catalog is given. Prints every
-// diagnostic; returns the flat application when there is no error.
+// $VRFLOW_COMPOSITE_PATH), applies the --set parameters, and validates the flat application when
+// a catalog is given. Prints every diagnostic; returns the flat application when there is no
+// error.
 std::optional<vrflow::app::Application> loadFlat(const std::string& file,
                                                  const std::vector<std::string>& compositeDirs,
+                                                 const std::vector<std::string>& overrides,
                                                  vrflow::app::Catalog* catalog) {
   std::vector<vrflow::app::Diagnostic> problems;
   auto application = vrflow::app::loadApplicationFile(file, &problems);
@@ -39,6 +42,10 @@ std::optional<vrflow::app::Application> loadFlat(const std::string& file,
     std::fprintf(stderr, "%s\n", flat.error().message.c_str());
     return std::nullopt;
   }
+  if (auto set = vrflow::app::applyOverrides(*flat, overrides); !set) {
+    std::fprintf(stderr, "vrflow: %s\n", set.error().message.c_str());
+    return std::nullopt;
+  }
   if (catalog != nullptr) {
     auto plugins = vrflow::daemon::loadApplicationPlugins(*flat, *catalog);
     problems.insert(problems.end(), plugins.begin(), plugins.end());
@@ -46,7 +53,8 @@ std::optional<vrflow::app::Application> loadFlat(const std::string& file,
     problems.insert(problems.end(), more.begin(), more.end());
   }
   vrflow::app::sortAndDeduplicate(problems);
-  for (const auto& d : problems) std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
+  for (const auto& d : problems)
+    std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
   if (vrflow::app::hasErrors(problems)) return std::nullopt;
   return std::move(*flat);
 }
@@ -62,6 +70,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> compositeDirs;
   cli.add_option("--composites", compositeDirs,
                  "Extra folder of composite files NAME.vrc.xml (repeatable)");
+  std::vector<std::string> overrides;
+  cli.add_option("--set", overrides,
+                 "ID.PARAM=VALUE: set a parameter of a module or filter over the file's "
+                 "(repeatable; validated as if written in the file)");
 
   auto* validate = cli.add_subcommand("validate", "Check an application file; exit 0 when valid");
   std::string validateFile;
@@ -95,25 +107,34 @@ int main(int argc, char** argv) {
                   "Write a Chrome/Perfetto trace (modules' wait/compute spans, messages as flows)");
 
 #ifdef VRFLOW_HAS_LAUNCHER
-  auto* launch = cli.add_subcommand("launch", "Run an application with one daemon per host (TCP between them)");
+  auto* launch = cli.add_subcommand(
+      "launch", "Run an application with one daemon per host (TCP between them)");
   launch->fallthrough();
   vrflow::launcher::LaunchOptions launchOptions;
   launch->add_option("APP.xml", launchOptions.appFile, "Application file")->required();
-  launch->add_option("--hosts", launchOptions.hostfile, "Hostfile: where each host runs (docs/launcher.md)");
-  launch->add_option("--backend", launchOptions.backend, "How daemons are started: local, ssh, mpirun")
+  launch->add_option("--hosts", launchOptions.hostfile,
+                     "Hostfile: where each host runs (docs/launcher.md)");
+  launch
+      ->add_option("--backend", launchOptions.backend,
+                   "How daemons are started: local, ssh, mpirun")
       ->check(CLI::IsMember({"local", "ssh", "mpirun"}));
-  launch->add_option("--iterations,-n", launchOptions.iterations, "Stop after N iterations of every module");
+  launch->add_option("--iterations,-n", launchOptions.iterations,
+                     "Stop after N iterations of every module");
   launch->add_option("--report", launchOptions.reportPath, "Write a JSON run report to FILE");
-  launch->add_option("--timeout", launchOptions.timeoutSeconds, "Fail if the run lasts longer (seconds)")
+  launch
+      ->add_option("--timeout", launchOptions.timeoutSeconds,
+                   "Fail if the run lasts longer (seconds)")
       ->check(CLI::NonNegativeNumber);
   launch->add_option("--control-address", launchOptions.controlAddress,
                      "mpirun: this machine's address as the daemons reach it (default 127.0.0.1)");
   launch->add_option("--trace", launchOptions.tracePath,
                      "Write a Chrome/Perfetto trace of every host, clocks aligned");
-  launch->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,
-                     "A host silent this long (no heartbeat) is declared lost (seconds)")
+  launch
+      ->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,
+                   "A host silent this long (no heartbeat) is declared lost (seconds)")
       ->check(CLI::PositiveNumber);
-  auto* monitorCommand = cli.add_subcommand("monitor", "Show live statistics of the running launches");
+  auto* monitorCommand =
+      cli.add_subcommand("monitor", "Show live statistics of the running launches");
   bool monitorOnce = false, monitorJson = false;
   monitorCommand->add_flag("--once", monitorOnce, "Print one snapshot and exit");
   monitorCommand->add_flag("--json", monitorJson, "Print the raw snapshots (JSON lines)");
@@ -129,7 +150,7 @@ int main(int argc, char** argv) {
   if (monitorCommand->parsed()) return vrflow::launcher::monitor(monitorOnce, monitorJson);
 #endif
   if (expand->parsed()) {
-    const auto flat = loadFlat(expandFile, compositeDirs, nullptr);
+    const auto flat = loadFlat(expandFile, compositeDirs, overrides, nullptr);
     if (!flat) return 1;
     std::fputs(vrflow::app::saveApplication(*flat).c_str(), stdout);
     return 0;
@@ -140,20 +161,21 @@ int main(int argc, char** argv) {
     return vrflow::run::kExitInvalid;
   }
   if (validate->parsed()) {
-    return loadFlat(validateFile, compositeDirs, &*catalog) ? 0 : 1;
+    return loadFlat(validateFile, compositeDirs, overrides, &*catalog) ? 0 : 1;
   }
 #ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
-    auto flat = loadFlat(launchOptions.appFile, compositeDirs, &*catalog);
+    auto flat = loadFlat(launchOptions.appFile, compositeDirs, overrides, &*catalog);
     if (!flat) return vrflow::run::kExitInvalid;
     launchOptions.packageDirs = packageDirs;
     launchOptions.compositeDirs = compositeDirs;
+    launchOptions.overrides = overrides;
     const auto outcome = vrflow::launcher::launch(*flat, launchOptions);
     if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
     return outcome.exitCode;
   }
 #endif
-  auto application = loadFlat(runFile, compositeDirs, &*catalog);
+  auto application = loadFlat(runFile, compositeDirs, overrides, &*catalog);
   if (!application) return vrflow::run::kExitInvalid;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
   options.progress = !noProgress && isatty(STDERR_FILENO) != 0;

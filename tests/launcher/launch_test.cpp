@@ -148,6 +148,31 @@ TEST(Launch, ThreeHostsGiveTheSameDigestsAsOneHost) {
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 
+TEST(Launch, SetParametersReachTheDaemonOfEveryHost) {
+  // springs runs on host b: its daemon reads the file itself, so --set must travel to it.
+  TempDir dir;
+  const std::vector<std::string> set{"--set", "springs.stiffness=90", "--set", "chain.count=5"};
+  auto one = std::vector<std::string>{"run", pipelineFile(), "-n", "60", "--no-progress",
+                                      "--report", dir.file("one.json")};
+  one.insert(one.end(), set.begin(), set.end());
+  ASSERT_EQ(runVrflow(one, 120).exitCode, 0);
+  auto three = std::vector<std::string>{"launch", threeHostsFile(), "--backend", "local", "-n",
+                                        "60", "--report", dir.file("three.json")};
+  three.insert(three.end(), set.begin(), set.end());
+  const auto launched = runVrflow(three, 120);
+  ASSERT_EQ(launched.exitCode, 0) << launched.err;
+  const auto plain = runVrflow({"launch", threeHostsFile(), "--backend", "local", "-n", "60",
+                                "--report", dir.file("plain.json")},
+                               120);
+  ASSERT_EQ(plain.exitCode, 0) << plain.err;
+  const auto a = deterministicPart(dir.file("one.json"));
+  const auto b = deterministicPart(dir.file("three.json"));
+  EXPECT_EQ(a, b) << a.dump(1) << "\n---\n" << b.dump(1);
+  EXPECT_NE(b["outputs"], deterministicPart(dir.file("plain.json"))["outputs"])
+      << "the settings changed nothing";
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
 TEST(Launch, KillingADaemonStopsEveryHostAndNamesIt) {
   TempDir dir;
   const auto result = launchAndKill("--host b", dir.file("r.json"));

@@ -75,6 +75,45 @@ TEST_F(RunTest, PipelineOfThreeModulesDeliversEveryMessageInOrder) {
   EXPECT_GT(json["connections"][0]["bytes"].get<uint64_t>(), 50u * 4096u);
 }
 
+TEST_F(RunTest, SetOverridesAParameterOfTheFileForThisRunOnly) {
+  const auto csv = dir.file("out.csv");
+  const auto file = dir.write(
+      "app.xml", app(module("src", "core/source", param("size", "4096")) +
+                         module("rec", "core/recorder", param("file", csv)),
+                     connect("src.out", "rec.in")));
+  const auto result = runVrflow({"run", file, "-n", "5", "--no-progress", "--set", "src.size=128"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto lines = readLines(csv);
+  ASSERT_EQ(lines.size(), 6u);
+  for (int i = 1; i <= 5; ++i) {
+    EXPECT_NE(lines[i].find(",128,"), std::string::npos) << lines[i];
+    EXPECT_EQ(lines[i].find(",4096,"), std::string::npos) << lines[i];
+  }
+  // The file itself is unchanged: `vrflow expand` prints what the run used.
+  EXPECT_NE(readFile(file).find("value=\"4096\""), std::string::npos);
+  const auto expanded = runVrflow({"expand", file, "--set", "src.size=128"});
+  ASSERT_EQ(expanded.exitCode, 0) << expanded.err;
+  EXPECT_NE(expanded.out.find("<param name=\"size\" value=\"128\"/>"), std::string::npos)
+      << expanded.out;
+}
+
+TEST_F(RunTest, SetWithABadValueAnUnknownModuleOrNoDotIsAClearError) {
+  const auto file = dir.write(
+      "app.xml", app(module("src", "core/source") + module("rec", "core/recorder"),
+                     connect("src.out", "rec.in")));
+  const auto bad = runVrflow({"run", file, "-n", "5", "--set", "src.size=big"});
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_NE(bad.err.find("--set src.size=big: error: parameter 'size' of module 'src'"),
+            std::string::npos)
+      << bad.err;
+  const auto unknown = runVrflow({"validate", file, "--set", "sorce.size=1"});
+  EXPECT_EQ(unknown.exitCode, 1);
+  EXPECT_NE(unknown.err.find("no module or filter 'sorce'"), std::string::npos) << unknown.err;
+  const auto malformed = runVrflow({"run", file, "--set", "size=1"});
+  EXPECT_EQ(malformed.exitCode, 2);
+  EXPECT_NE(malformed.err.find("expected ID.PARAM=VALUE"), std::string::npos) << malformed.err;
+}
+
 TEST_F(RunTest, ReportDigestsAreTheSameForTwoRuns) {
   const auto file = dir.write(
       "app.xml",

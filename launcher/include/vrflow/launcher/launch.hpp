@@ -42,6 +42,7 @@ struct LaunchOptions {
   double peerTimeoutSeconds = 3;  ///< heartbeat timeout between daemons
   double startSeconds = 30;       ///< every daemon must be linked within this
   std::vector<std::string> packageDirs, compositeDirs;
+  std::vector<std::string> overrides;  ///< `--set ID.PARAM=VALUE`, applied by every daemon
   bool progress = false;
 };
 

@@ -1,0 +1,22 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "vrflow/app/model.hpp"
+#include "vrflow/base/result.hpp"
+
+// Parameters set on the command line (`--set ID.PARAM=VALUE`) over those of the file, so that one
+// application file serves several runs (a CI matrix, a benchmark with more blocks).
+
+namespace vrflow::app {
+
+/// Sets, in order, each `ID.PARAM=VALUE` of `settings` on the module or filter ID of the
+/// expanded application (ids as `vrflow expand` prints them; PARAM is what follows the last dot
+/// of the part before '='), adding the parameter when the file does not set it. The value is
+/// checked later by validation like one written in the file; diagnostics about it name
+/// `--set ID.PARAM=VALUE` as their place. Errors: a setting without '=' or a dot, or an ID that
+/// names no module or filter.
+Status applyOverrides(Application& application, const std::vector<std::string>& settings);
+
+}  // namespace vrflow::app

@@ -1,0 +1,57 @@
+#include "vrflow/app/overrides.hpp"
+
+#include <string_view>
+
+namespace vrflow::app {
+namespace {
+
+// Sets `name` in `params` from the command line: the parameter keeps no place in the file.
+void setFromCommandLine(std::vector<Param>& params, const std::string& name,
+                        const std::string& value, const std::string& setting) {
+  Param* found = nullptr;
+  for (Param& param : params) {
+    if (param.name == name) found = &param;
+  }
+  if (found == nullptr) {
+    params.push_back(Param{});
+    found = &params.back();
+    found->name = name;
+  }
+  found->value = value;
+  found->loc = SourceLocation("--set " + setting, 0, 0);
+}
+
+}  // namespace
+
+Status applyOverrides(Application& application, const std::vector<std::string>& settings) {
+  for (const std::string& setting : settings) {
+    const auto equals = setting.find('=');
+    const std::string_view target =
+        std::string_view(setting).substr(0, equals == std::string::npos ? 0 : equals);
+    const auto dot = target.rfind('.');
+    if (equals == std::string::npos || dot == std::string_view::npos || dot == 0 ||
+        dot + 1 == target.size()) {
+      return makeError("--set '" + setting + "': expected ID.PARAM=VALUE (e.g. water.blocks=2)");
+    }
+    const std::string id(target.substr(0, dot)), name(target.substr(dot + 1));
+    const std::string value = setting.substr(equals + 1);
+    bool set = false;
+    for (Module& module : application.modules) {
+      if (module.id != id) continue;
+      setFromCommandLine(module.params, name, value, setting);
+      set = true;
+    }
+    for (Filter& filter : application.filters) {
+      if (filter.id != id) continue;
+      setFromCommandLine(filter.params, name, value, setting);
+      set = true;
+    }
+    if (!set) {
+      return makeError("--set '" + setting + "': the application has no module or filter '" + id +
+                       "'");
+    }
+  }
+  return {};
+}
+
+}  // namespace vrflow::app
