@@ -239,22 +239,25 @@ Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, in
     }
     MPI_Comm_dup(MPI_COMM_WORLD, &impl->world);
   } else {
+    // Open MPI does not tell rank 0 when a spawned worker dies: rank 0 watches them itself.
+    impl->watch = WorkerWatch::start(blocks - 1);
+    std::string workerFlag = "--block-worker", watchFlag = "--watch";
+    std::string watchName = impl->watch ? impl->watch->name() : "";
+    std::vector<char*> args{workerFlag.data()};
+    if (impl->watch) {
+      args.push_back(watchFlag.data());
+      args.push_back(watchName.data());
+    }
+    args.push_back(nullptr);
     MPI_Comm inter;
-    char workerFlag[] = "--block-worker";
-    char* args[] = {workerFlag, nullptr};
     std::vector<int> codes(static_cast<std::size_t>(blocks - 1));
-    const int rc = MPI_Comm_spawn(executable, args, blocks - 1, MPI_INFO_NULL, 0, MPI_COMM_SELF,
-                                  &inter, codes.data());
+    const int rc = MPI_Comm_spawn(executable, args.data(), blocks - 1, MPI_INFO_NULL, 0,
+                                  MPI_COMM_SELF, &inter, codes.data());
     if (rc != MPI_SUCCESS) {
       MPI_Finalize();
       return makeError(std::string("fluid: MPI_Comm_spawn of ") + executable + " failed");
     }
     MPI_Intercomm_merge(inter, 0, &impl->world);
-    // Open MPI does not tell rank 0 when a spawned worker dies: rank 0 watches them itself.
-    const int self = getpid();
-    std::vector<int> pids(static_cast<std::size_t>(blocks));
-    MPI_Gather(&self, 1, MPI_INT, pids.data(), 1, MPI_INT, 0, impl->world);
-    impl->watch = WorkerWatch::start(std::vector<pid_t>(pids.begin() + 1, pids.end()));
   }
   impl->blocks = blocks;
   Setup setup{settings, fill};
@@ -342,6 +345,12 @@ int workerLoop(MPI_Comm world) {
 
 int runBlockWorker(int argc, char** argv) {
   prepareMpi();
+  // Rank 0's watch (worker_watch.hpp) sees this process end by its connection closing.
+  int watch = -1;
+  if (argc >= 4 && std::strcmp(argv[2], "--watch") == 0) {
+    watch = WorkerWatch::join(argv[3]);
+    if (watch < 0) return 2;
+  }
   MPI_Init(&argc, &argv);
   MPI_Comm parent = MPI_COMM_NULL;
   MPI_Comm_get_parent(&parent);
@@ -352,8 +361,11 @@ int runBlockWorker(int argc, char** argv) {
   }
   MPI_Comm world;
   MPI_Intercomm_merge(parent, 1, &world);
-  const int self = getpid();  // for rank 0's watch (WorkerWatch)
-  MPI_Gather(&self, 1, MPI_INT, nullptr, 0, MPI_INT, 0, world);
+  if (watch >= 0) {
+    int rank = 0;
+    MPI_Comm_rank(world, &rank);
+    WorkerWatch::tellBlock(watch, rank);
+  }
   return workerLoop(world);
 }
 

@@ -13,7 +13,8 @@
 //   run as workers on MPI_COMM_WORLD;
 // - without mpirun (VRFLOW_MPIRUN=none, or no Open MPI launcher): the module, started by vrflow
 //   like any other, initialises MPI as a singleton and spawns `blocks - 1` copies of its own
-//   executable with `--block-worker` (MPI_Comm_spawn); together they form one communicator.
+//   executable with `--block-worker --watch NAME` (MPI_Comm_spawn; NAME: rank 0's WorkerWatch);
+//   together they form one communicator.
 // Each iteration rank 0 broadcasts the step (dt, bodies, what to report) and every rank steps its
 // slab; forces and particles come back to rank 0 through the solver's collective calls.
 // A failure ends the whole group, never leaves rank 0 waiting: blocks whose step failed agree
