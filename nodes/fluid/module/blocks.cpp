@@ -4,6 +4,7 @@
 #include <sys/prctl.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <string>
 
 #include "vrflow/fluid/mpi_block_comm.hpp"
+#include "worker_watch.hpp"
 
 namespace vrflow::fluid {
 namespace {
@@ -138,6 +140,48 @@ struct Setup {
   msg::Aabb fill;
 };
 
+// After a step failed on this block: did every block fail it? They fail together when the
+// step's input is bad (each checks the same broadcast input before any collective call); a block
+// that fails alone leaves the others inside the step's collective calls, waiting for it forever.
+// The agreement is a barrier on a communicator of its own, so it never meets a collective call
+// of the step; blocks that failed together reach it at once, the bound only ends the wait for
+// blocks that never come.
+bool everyBlockFailed(MPI_Comm failures) {
+  constexpr auto kBound = std::chrono::seconds(5);
+  MPI_Request request = MPI_REQUEST_NULL;
+  MPI_Ibarrier(failures, &request);
+  const auto end = std::chrono::steady_clock::now() + kBound;
+  for (;;) {
+    int done = 0;
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done != 0) return true;
+    if (std::chrono::steady_clock::now() >= end) return false;
+    usleep(1000);
+  }
+}
+
+// Test hook: with VRFLOW_FLUID_TEST_FAIL="BLOCK STEP", step number STEP (from 0, query-only steps
+// not counted) fails on block BLOCK alone, as a bug of one block would (BLOCK -1: on every
+// block). A block cannot fail alone otherwise (the blocks check the same input), so the tests
+// need it to reach that path.
+bool injectedFailure(int block, std::uint64_t step) {
+  const char* text = std::getenv("VRFLOW_FLUID_TEST_FAIL");
+  int failBlock = -2;
+  unsigned long long failStep = 0;
+  return text != nullptr && std::sscanf(text, "%d %llu", &failBlock, &failStep) == 2 &&
+         (failBlock == block || failBlock == -1) && failStep == step;
+}
+
+// One step on this block, or the injected failure.
+Result<BlockResult> runStep(FluidSolver& solver, const BlockStep& s, int block,
+                            std::uint64_t& steps) {
+  if (!s.queryOnly && injectedFailure(block, steps++)) {
+    return makeError("fluid: block " + std::to_string(block) +
+                     ": failure injected by VRFLOW_FLUID_TEST_FAIL");
+  }
+  return stepBlock(solver, s);
+}
+
 }  // namespace
 
 Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& s) {
@@ -157,8 +201,12 @@ Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& s) {
 
 struct BlockGroup::Impl {
   MPI_Comm world = MPI_COMM_NULL;
+  MPI_Comm failures = MPI_COMM_NULL;  ///< only for the agreement after a failed step
+  int blocks = 0;
+  std::uint64_t steps = 0;
   std::unique_ptr<MpiBlockComm> comm;
   std::unique_ptr<FluidSolver> solver;
+  std::unique_ptr<WorkerWatch> watch;  ///< spawned workers only (mpirun watches its own ranks)
   bool stopped = false;
 };
 
@@ -191,20 +239,30 @@ Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, in
     }
     MPI_Comm_dup(MPI_COMM_WORLD, &impl->world);
   } else {
+    // Open MPI does not tell rank 0 when a spawned worker dies: rank 0 watches them itself.
+    impl->watch = WorkerWatch::start(blocks - 1);
+    std::string workerFlag = "--block-worker", watchFlag = "--watch";
+    std::string watchName = impl->watch ? impl->watch->name() : "";
+    std::vector<char*> args{workerFlag.data()};
+    if (impl->watch) {
+      args.push_back(watchFlag.data());
+      args.push_back(watchName.data());
+    }
+    args.push_back(nullptr);
     MPI_Comm inter;
-    char workerFlag[] = "--block-worker";
-    char* args[] = {workerFlag, nullptr};
     std::vector<int> codes(static_cast<std::size_t>(blocks - 1));
-    const int rc = MPI_Comm_spawn(executable, args, blocks - 1, MPI_INFO_NULL, 0, MPI_COMM_SELF,
-                                  &inter, codes.data());
+    const int rc = MPI_Comm_spawn(executable, args.data(), blocks - 1, MPI_INFO_NULL, 0,
+                                  MPI_COMM_SELF, &inter, codes.data());
     if (rc != MPI_SUCCESS) {
       MPI_Finalize();
       return makeError(std::string("fluid: MPI_Comm_spawn of ") + executable + " failed");
     }
     MPI_Intercomm_merge(inter, 0, &impl->world);
   }
+  impl->blocks = blocks;
   Setup setup{settings, fill};
   MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, impl->world);
+  MPI_Comm_dup(impl->world, &impl->failures);
   impl->comm = std::make_unique<MpiBlockComm>(impl->world);
   auto created = FluidSolver::create(settings);
   if (!created) return created.error();
@@ -217,10 +275,19 @@ Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, in
 Result<BlockResult> BlockGroup::step(const BlockStep& s) {
   auto bytes = encodeStep(s);
   broadcast(bytes, impl_->world);
-  auto result = stepBlock(*impl_->solver, s);
-  if (!result && !impl_->stopped) {  // every block failed the same way and left its loop
+  auto result = runStep(*impl_->solver, s, 0, impl_->steps);
+  if (!result && !impl_->stopped) {
     impl_->stopped = true;
-    MPI_Finalize();
+    impl_->watch.reset();  // the workers that failed with this block end on their own
+    if (everyBlockFailed(impl_->failures)) {  // they left their loops: a clean end
+      MPI_Finalize();
+      return result;
+    }
+    // The workers are inside the step, waiting for this block: no MPI_Finalize. The module
+    // reports the error and exits non-zero, and Open MPI (mpirun, or the singleton's orted)
+    // ends the workers when it sees rank 0 gone.
+    return makeError(result.error().message + " (MPI block 0 of " + std::to_string(impl_->blocks) +
+                     " alone: the other blocks did not fail with it; stopping them)");
   }
   return result;
 }
@@ -228,6 +295,7 @@ Result<BlockResult> BlockGroup::step(const BlockStep& s) {
 void BlockGroup::stop() {
   if (impl_->stopped) return;
   impl_->stopped = true;
+  impl_->watch.reset();  // the workers end after the stop below
   BlockStep last;
   last.stop = true;
   auto bytes = encodeStep(last);
@@ -241,26 +309,33 @@ namespace {
 int workerLoop(MPI_Comm world) {
   Setup setup;
   MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, world);
+  MPI_Comm failures = MPI_COMM_NULL;
+  MPI_Comm_dup(world, &failures);
   MpiBlockComm comm(world);
   auto created = FluidSolver::create(setup.settings);
   if (!created) return 1;  // rank 0 made the same check and reports it
   auto solver = std::move(created.value());
   if (!solver->setBlockComm(&comm) || !solver->addLiquidBox(setup.fill)) return 1;
+  std::uint64_t steps = 0;
   for (;;) {
     std::vector<char> bytes;
     broadcast(bytes, world);
     BlockStep s;
     if (!decodeStep(bytes, s)) {
-      std::fprintf(stderr, "vrflow-fluid --block-worker: malformed step from rank 0\n");
+      std::fprintf(stderr, "vrflow-fluid: MPI block %d of %d: malformed step from rank 0\n",
+                   comm.rank(), comm.size());
       MPI_Abort(world, 3);
     }
     if (s.stop) break;
-    // Rank 0 normally fails the same way and reports it; say it here too, in case this block
-    // failed alone (rank 0 would then wait for it in a collective call).
-    if (auto stepped = stepBlock(*solver, s); !stepped) {
-      std::fprintf(stderr, "vrflow-fluid --block-worker: %s\n", stepped.error().message.c_str());
-      break;
-    }
+    auto stepped = runStep(*solver, s, comm.rank(), steps);
+    if (stepped) continue;
+    // Failed with every block: rank 0 reports it. Failed alone: the other blocks wait for this
+    // one inside the step; end the whole job, rank 0 with it, so that vrflow reports the module.
+    if (everyBlockFailed(failures)) break;
+    std::fprintf(stderr,
+                 "vrflow-fluid: MPI block %d of %d failed alone: %s; aborting every block\n",
+                 comm.rank(), comm.size(), stepped.error().message.c_str());
+    MPI_Abort(world, 1);
   }
   MPI_Finalize();
   return 0;
@@ -270,6 +345,12 @@ int workerLoop(MPI_Comm world) {
 
 int runBlockWorker(int argc, char** argv) {
   prepareMpi();
+  // Rank 0's watch (worker_watch.hpp) sees this process end by its connection closing.
+  int watch = -1;
+  if (argc >= 4 && std::strcmp(argv[2], "--watch") == 0) {
+    watch = WorkerWatch::join(argv[3]);
+    if (watch < 0) return 2;
+  }
   MPI_Init(&argc, &argv);
   MPI_Comm parent = MPI_COMM_NULL;
   MPI_Comm_get_parent(&parent);
@@ -280,6 +361,11 @@ int runBlockWorker(int argc, char** argv) {
   }
   MPI_Comm world;
   MPI_Intercomm_merge(parent, 1, &world);
+  if (watch >= 0) {
+    int rank = 0;
+    MPI_Comm_rank(world, &rank);
+    WorkerWatch::tellBlock(watch, rank);
+  }
   return workerLoop(world);
 }
 

@@ -13,9 +13,15 @@
 //   run as workers on MPI_COMM_WORLD;
 // - without mpirun (VRFLOW_MPIRUN=none, or no Open MPI launcher): the module, started by vrflow
 //   like any other, initialises MPI as a singleton and spawns `blocks - 1` copies of its own
-//   executable with `--block-worker` (MPI_Comm_spawn); together they form one communicator.
+//   executable with `--block-worker --watch NAME` (MPI_Comm_spawn; NAME: rank 0's WorkerWatch);
+//   together they form one communicator.
 // Each iteration rank 0 broadcasts the step (dt, bodies, what to report) and every rank steps its
 // slab; forces and particles come back to rank 0 through the solver's collective calls.
+// A failure ends the whole group, never leaves rank 0 waiting: blocks whose step failed agree
+// (a barrier bounded to 5 s) that they all failed it, and stop cleanly with rank 0 reporting it;
+// a block that failed alone aborts the MPI job (MPI_Abort; rank 0 returns the error and exits
+// without MPI_Finalize). A dead rank ends an mpirun job; spawned workers are watched by rank 0
+// (worker_watch.hpp), which Open MPI does not tell when one dies.
 
 namespace vrflow::fluid {
 
@@ -50,7 +56,8 @@ class BlockGroup {
                                                    const FluidSettings& settings,
                                                    const msg::Aabb& fill);
   ~BlockGroup();
-  /// Runs one step on every block (collective). After an error the workers are gone.
+  /// Runs one step on every block (collective). After an error the workers are gone or going:
+  /// return from the module with the error.
   Result<BlockResult> step(const BlockStep& step);
   /// Tells the workers to stop and finalises MPI.
   void stop();

@@ -72,6 +72,7 @@ class Supervisor {
  private:
   struct Child {
     pid_t pid = 0;
+    int mpiRanks = 0;  ///< above 1: `pid` is the mpirun that runs this many ranks
     bool alive = false;
     ModuleEnd end{"not started"};
   };
@@ -200,8 +201,12 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
       if ((!clean || !joined) && !stopping && outcome.exitCode == kExitOk) {
         outcome.exitCode = kExitRunFailed;
         outcome.status = "failed";
-        outcome.error = "module '" + module.id + "' (host " + module.host + ", pid " +
-                        std::to_string(pid) + ") " + describeWaitStatus(status) +
+        const bool mpirun = child.mpiRanks > 1;
+        outcome.error = "module '" + module.id + "' (host " + module.host + ", " +
+                        (mpirun ? std::to_string(child.mpiRanks) + " MPI ranks, mpirun pid "
+                                : std::string("pid ")) +
+                        std::to_string(pid) + ") " +
+                        (mpirun ? describeMpirunWaitStatus(status) : describeWaitStatus(status)) +
                         (joined ? "" : " before joining the run (it never called Module::init())");
       }
     }
@@ -365,6 +370,7 @@ RunOutcome Supervisor::run() {
       break;
     }
     children_[i].pid = *pid;
+    children_[i].mpiRanks = viaMpirun ? module.mpiRanks : 0;
     children_[i].alive = true;
     children_[i].end.exit = "running";
   }

@@ -112,14 +112,28 @@ Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segme
   return pid;
 }
 
+namespace {
+
+std::string signalText(int sig) {
+  const char* name = strsignal(sig);
+  return "signal " + std::to_string(sig) + " (" + (name ? name : "?") + ")";
+}
+
+}  // namespace
+
 std::string describeWaitStatus(int status) {
   if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
-  if (WIFSIGNALED(status)) {
-    const int sig = WTERMSIG(status);
-    const char* name = strsignal(sig);
-    return "was killed by signal " + std::to_string(sig) + " (" + (name ? name : "?") + ")";
-  }
+  if (WIFSIGNALED(status)) return "was killed by " + signalText(WTERMSIG(status));
   return "ended with wait status " + std::to_string(status);
+}
+
+std::string describeMpirunWaitStatus(int status) {
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 0;
+  if (code > 128 && code - 128 < NSIG) {  // Open MPI's odls: exit code = WTERMSIG + 128
+    return describeWaitStatus(status) + " (an MPI rank was killed by " + signalText(code - 128) +
+           ")";
+  }
+  return describeWaitStatus(status);
 }
 
 }  // namespace vrflow::run

@@ -28,4 +28,8 @@ Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segme
 /// "exited with status 3" / "was killed by signal 11 (Segmentation fault)".
 std::string describeWaitStatus(int status);
 
+/// describeWaitStatus of an mpirun, which exits with 128 + N when one of its ranks was killed by
+/// signal N: "exited with status 137 (an MPI rank was killed by signal 9 (Killed))".
+std::string describeMpirunWaitStatus(int status);
+
 }  // namespace vrflow::run
