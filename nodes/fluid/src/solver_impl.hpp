@@ -181,6 +181,13 @@ struct FluidSolver::Impl {
 
   void classify(const std::vector<PreparedBody>& bodies);
 
+  // Per body: 1 when one of its cells shares a face with a liquid cell, else 0 (doubles, for the
+  // reduction over blocks). A body out of the liquid is in air: its cells are classified as air
+  // (p = 0), so that pressure cannot reach it through the cells of another body it touches (a
+  // net's node lying on the water, a floating box under it), and it gets no force.
+  std::vector<double> inLiquid;
+  void dryBodiesOutOfLiquid(std::size_t bodyCount);
+
   void particlesToGrid();
   // The particle loops of the two transfers, compiled twice (VRFLOW_FLUID_HOT in their
   // definitions): call them only from particles.cpp, where the load-time choice is made.
@@ -194,10 +201,10 @@ struct FluidSolver::Impl {
   std::vector<std::size_t> filled;
   void extrapolate(std::vector<double>* field, int layers);
 
-  // Rigid motion on the faces of bodies (and of kinematic bodies' cells); `kinematicOnly`
-  // re-imposes it on kinematic bodies after gravity (a moving wall does not fall). Only the
-  // faces in each body's bounds (one cell wider) can be affected; a face in several bodies'
-  // bounds gets the same value each time.
+  // Rigid motion on the faces of bodies, of kinematic bodies' cells and between a body's cell
+  // and air; `kinematicOnly` re-imposes it on kinematic bodies after gravity (a moving wall does
+  // not fall). Only the faces in each body's bounds (one cell wider) can be affected; a face in
+  // several bodies' bounds gets the same value each time.
   void enforceBodies(const std::vector<PreparedBody>& bodies, bool kinematicOnly = false);
 
   bool unknown(std::size_t c) const {

@@ -48,6 +48,8 @@ struct PointMass {
 
 /// What the liquid did to one body over the step: apply `force` and `torque` (about the centre
 /// of mass `point`) for `duration` seconds. Gravity is not included: the animator adds its own.
+/// A body none of whose cells shares a face with a liquid cell is in air (p = 0 around it): its
+/// force and torque are zero, whatever bodies it touches.
 struct BodyForce {
   std::uint64_t id = 0;
   std::uint32_t index = 0;  ///< node index for point masses, 0 for rigid bodies
@@ -64,7 +66,7 @@ struct StepStats {
   double cgResidual = 0.0;  ///< final |r| / |b| (0 when b = 0)
   bool cgConverged = true;
   int fluidCells = 0;              ///< cells holding liquid particles
-  int bodyCells = 0;               ///< cells inside bodies
+  int bodyCells = 0;               ///< cells inside bodies that touch the liquid (unknowns)
   double maxSpeed = 0.0;           ///< largest face velocity magnitude after projection
   std::uint64_t bytesTouched = 0;  ///< estimate of this block's memory traffic in the pressure CG
   double pressureSeconds = 0.0;    ///< wall time of the pressure CG (for bandwidth estimates)
