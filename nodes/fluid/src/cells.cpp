@@ -150,12 +150,16 @@ void FluidSolver::Impl::classify(const std::vector<PreparedBody>& bodies) {
 void FluidSolver::Impl::dryBodiesOutOfLiquid(std::size_t bodyCount) {
   inLiquid.assign(bodyCount, 0.0);
   const int dims[3] = {grid.nx, grid.ny, grid.nz};
-  // From each of this block's liquid cells to the body cells beside it (kinds and cellBody are
-  // known one plane beyond the slab).
+  // Body cells of this block holding particles (outside the shape, inside the cell), and from
+  // each of its liquid cells the body cells beside it (kinds and cellBody are known one plane
+  // beyond the slab).
   for (int k = k0; k < k1; ++k) {
     for (int j = 0; j < grid.ny; ++j) {
       for (int i = 0; i < grid.nx; ++i) {
         const std::size_t c = grid.cell(i, j, k);
+        if (kind[c] == detail::kBody && particlesInCell[c] > 0) {
+          inLiquid[static_cast<std::size_t>(cellBody[c])] = 1.0;
+        }
         if (kind[c] != detail::kLiquid) continue;
         const int idx[3] = {i, j, k};
         for (int a = 0; a < 3; ++a) {

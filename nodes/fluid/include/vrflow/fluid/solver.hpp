@@ -48,8 +48,8 @@ struct PointMass {
 
 /// What the liquid did to one body over the step: apply `force` and `torque` (about the centre
 /// of mass `point`) for `duration` seconds. Gravity is not included: the animator adds its own.
-/// A body none of whose cells shares a face with a liquid cell is in air (p = 0 around it): its
-/// force and torque are zero, whatever bodies it touches.
+/// A body none of whose cells holds particles or shares a face with a liquid cell is in air
+/// (p = 0 around it): its force and torque are zero, whatever bodies it touches.
 struct BodyForce {
   std::uint64_t id = 0;
   std::uint32_t index = 0;  ///< node index for point masses, 0 for rigid bodies
