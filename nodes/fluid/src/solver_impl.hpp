@@ -182,9 +182,10 @@ struct FluidSolver::Impl {
   void classify(const std::vector<PreparedBody>& bodies);
 
   // Per body: 1 when one of its cells holds particles or shares a face with a liquid cell, else
-  // 0 (doubles, for the reduction over blocks). A body out of the liquid is in air: its cells are classified as air
-  // (p = 0), so that pressure cannot reach it through the cells of another body it touches (a
-  // net's node lying on the water, a floating box under it), and it gets no force.
+  // 0 (doubles, for the reduction over blocks). A body out of the liquid is in air: its cells
+  // are classified as air (p = 0), so that pressure cannot reach it through the cells of another
+  // body it touches (a net's node lying on the water, a floating box under it), and it gets no
+  // force.
   std::vector<double> inLiquid;
   void dryBodiesOutOfLiquid(std::size_t bodyCount);
 
