@@ -146,7 +146,13 @@ void waitForOrphansToEnd(double seconds) {
   while (std::chrono::steady_clock::now() < end) {
     while (waitpid(-1, nullptr, WNOHANG) > 0) {
     }
-    if (descendantsOf(getpid()).empty()) return;
+    // Zombies are not descendants here: one that ended since the reaping above is reaped now,
+    // or leftoverProcesses() would count it.
+    if (descendantsOf(getpid()).empty()) {
+      while (waitpid(-1, nullptr, WNOHANG) > 0) {
+      }
+      return;
+    }
     usleep(50000);
   }
 }
