@@ -235,19 +235,52 @@ std::optional<run::RunOutcome> ControlLink::poll() {
   return std::nullopt;
 }
 
-void ControlLink::drain(const run::RunOutcome& outcome) {
+std::vector<std::string> ControlLink::drain(const run::RunOutcome& outcome) {
   send("finished " + std::to_string(outcome.exitCode) + " " + outcome.status + " " + outcome.error);
+  std::vector<std::string> warnings;
   // Keep routing (messages for the other hosts) until the launcher says every host is done.
   while (!stopped_) {
     const std::string line = next(0.05);
     if (line == "quit") {
-      transport_->finish(2.0);
+      warnings = settle();
+      if (!stopped_) transport_->finish(2.0);
       break;
     }
     if (line == "stop" || line == "eof") stopped_ = true;
   }
   if (stopped_) transport_->finish(0.5);  // say bye, so that peers do not log a lost link
   transport_->stop();
+  return warnings;
+}
+
+std::vector<std::string> ControlLink::settle() {
+  // Every host's modules have ended, but their last messages may still be on the way: a peer
+  // says "finished" as soon as its modules exit, and what they sent last crosses the link
+  // after. Wait until each connection is closed by its sender and what came before the close
+  // is routed here, so that the report counts every message sent, as on one host.
+  constexpr double kSettleSeconds = 10;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::string> open;
+  while (true) {
+    open = transport_->settle(0.05);
+    if (open.empty() || !transport_->fatalError().empty()) break;
+    const std::string line = next(0);
+    if (line == "stop" || line == "eof") {
+      stopped_ = true;
+      return {};
+    }
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >
+        kSettleSeconds) {
+      break;
+    }
+  }
+  if (open.empty()) return {};
+  std::string names;
+  for (const auto& c : open) names += (names.empty() ? "" : ", ") + c;
+  const auto fatal = transport_->fatalError();
+  return {"connection(s) crossing hosts not closed after every host finished (" + names +
+          "): " + (fatal.empty() ? "still open after 10 s" : fatal) +
+          "; the report may miss their last messages"};
 }
 
 void ControlLink::trace(const std::string& json) { send("trace " + json); }

@@ -35,7 +35,7 @@ class ControlLink final : public run::HostLink {
   void configure(daemon::DaemonOptions& options) override;
   Status ready() override;
   std::optional<run::RunOutcome> poll() override;
-  void drain(const run::RunOutcome& outcome) override;
+  std::vector<std::string> drain(const run::RunOutcome& outcome) override;
   void report(const std::string& json) override;
   void trace(const std::string& json) override;
   void stats(const std::string& json) override;
@@ -47,6 +47,9 @@ class ControlLink final : public run::HostLink {
   /// (negative: forever); empty on timeout.
   std::string next(double seconds);
   void readLoop();
+  /// After "quit": waits until the connections crossing hosts are over (or a stop comes);
+  /// returns a warning for those still open.
+  std::vector<std::string> settle();
 
   int in_, out_;
   int selfIndex_ = 0;

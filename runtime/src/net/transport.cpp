@@ -323,6 +323,7 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       }
       std::lock_guard lock(mutex);
       it->second->closedByPeer = true;
+      changed.notify_all();  // settle() waits on it
       return {};
     }
     case FrameType::Credit: {
@@ -638,6 +639,7 @@ class RemoteSink final : public daemon::Sink {
       std::lock_guard lock(t_->mutex);
       if (c_->sentClose) return;
       c_->sentClose = true;
+      t_->changed.notify_all();  // settle() waits on it
       auto it = t_->linkOfPeer.find(c_->remote.peer);
       if (it == t_->linkOfPeer.end()) return;
       t_->queueControl(*it->second, FrameType::Close, c_->remote.channel, nullptr, 0);
@@ -729,6 +731,7 @@ std::size_t Transport::receive(uint32_t channel, daemon::Sink& sink, bool& close
     }
     c.creditsToSend += static_cast<uint32_t>(moved);
     closed = c.closedByPeer && c.inbox.empty();
+    if (closed) t.changed.notify_all();  // settle() waits on it
   }
   if (moved > 0) t.wake();
   return moved;
@@ -750,6 +753,24 @@ std::vector<LinkStats> Transport::linkStats() const {
     }
   }
   return stats;
+}
+
+std::vector<std::string> Transport::settle(double seconds) {
+  Impl& t = *impl_;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  std::unique_lock lock(t.mutex);
+  while (true) {
+    std::vector<std::string> open;
+    for (const auto& [channel, c] : t.channels) {
+      const bool over = c->remote.outgoing ? c->sentClose : c->closedByPeer && c->inbox.empty();
+      if (!over) {
+        open.push_back(app::toString(c->remote.connection.from) + " -> " +
+                       app::toString(c->remote.connection.to));
+      }
+    }
+    if (open.empty() || !t.fatal.empty() || t.stopped.load()) return open;
+    if (t.changed.wait_until(lock, deadline) == std::cv_status::timeout) return open;
+  }
 }
 
 void Transport::finish(double seconds) {
