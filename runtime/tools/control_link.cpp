@@ -102,7 +102,7 @@ Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application&
     }
   }
   link->send("listening " + std::to_string(link->transport_->port()));
-  link->reader_ = std::thread([raw = link.get()] { raw->readLoop(); });
+  std::thread([fd = in, inbox = link->inbox_] { readLoop(fd, inbox); }).detach();
   return link;
 }
 
@@ -138,32 +138,33 @@ Result<int> ControlLink::connectBack(const std::string& address, const net::Secr
 
 ControlLink::~ControlLink() {
   if (transport_) transport_->stop();
-  // The reader ends at end of input: the launcher closes our stdin when the run is over.
-  if (reader_.joinable()) reader_.detach();
+  // The reader ends at end of input (the launcher closes our stdin when the run is over); it
+  // holds the inbox, not this object.
 }
 
-void ControlLink::readLoop() {
+void ControlLink::readLoop(int fd, const std::shared_ptr<Inbox>& inbox) {
   std::string line;
-  while (readLine(in_, line)) {
-    std::lock_guard lock(mutex_);
-    lines_.push_back(line);
-    changed_.notify_all();
+  while (readLine(fd, line)) {
+    std::lock_guard lock(inbox->mutex);
+    inbox->lines.push_back(line);
+    inbox->changed.notify_all();
   }
-  std::lock_guard lock(mutex_);
-  lines_.push_back("eof");
-  changed_.notify_all();
+  std::lock_guard lock(inbox->mutex);
+  inbox->lines.push_back("eof");
+  inbox->changed.notify_all();
 }
 
 std::string ControlLink::next(double seconds) {
-  std::unique_lock lock(mutex_);
+  Inbox& inbox = *inbox_;
+  std::unique_lock lock(inbox.mutex);
   if (seconds < 0) {
-    changed_.wait(lock, [&] { return !lines_.empty(); });
-  } else if (!changed_.wait_for(lock, std::chrono::duration<double>(seconds),
-                                [&] { return !lines_.empty(); })) {
+    inbox.changed.wait(lock, [&] { return !inbox.lines.empty(); });
+  } else if (!inbox.changed.wait_for(lock, std::chrono::duration<double>(seconds),
+                                     [&] { return !inbox.lines.empty(); })) {
     return {};
   }
-  std::string line = lines_.front();
-  if (line != "eof") lines_.pop_front();  // end of input stays visible
+  std::string line = inbox.lines.front();
+  if (line != "eof") inbox.lines.pop_front();  // end of input stays visible
   return line;
 }
 

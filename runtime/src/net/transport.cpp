@@ -170,6 +170,9 @@ struct Transport::Impl {
     item.headBytes = kFrameHeaderBytes + bytes;
     link.out.push_back(std::move(item));
   }
+  ~Impl() {
+    if (wakeFd >= 0) close(wakeFd);
+  }
   void newLink(int fd, bool connector, int peer);
   void loop();
   void readFrom(Link& link);
@@ -614,6 +617,7 @@ class RemoteSink final : public daemon::Sink {
     c_->credits.fetch_sub(1);
     {
       std::lock_guard lock(t_->mutex);
+      if (t_->stopped.load()) return;  // stop() has dropped what links held
       auto it = t_->linkOfPeer.find(c_->remote.peer);
       if (it == t_->linkOfPeer.end()) return;  // the link is gone: the run is failing already
       OutItem item;
@@ -637,7 +641,7 @@ class RemoteSink final : public daemon::Sink {
     if (t_->stopped.load()) return;
     {
       std::lock_guard lock(t_->mutex);
-      if (c_->sentClose) return;
+      if (c_->sentClose || t_->stopped.load()) return;
       c_->sentClose = true;
       t_->changed.notify_all();  // settle() waits on it
       auto it = t_->linkOfPeer.find(c_->remote.peer);
@@ -723,6 +727,7 @@ std::size_t Transport::receive(uint32_t channel, daemon::Sink& sink, bool& close
   std::deque<daemon::MessageRef> taken;
   {
     std::lock_guard lock(t.mutex);
+    if (t.stopped.load()) return 0;
     Channel& c = *t.channels.at(channel);
     while (!c.inbox.empty() && sink.hasSpace()) {
       sink.push(std::move(c.inbox.front()));
@@ -799,6 +804,10 @@ void Transport::stop() {
     t.wake();
     t.thread.join();
   }
+  // Under the lock: a routing thread that has just seen `stopped` false (in a sink's push or
+  // close, or in receive()) holds it while it touches a link or an inbox, and looks again once
+  // it has it.
+  std::lock_guard lock(t.mutex);
   for (auto& link : t.links) {
     if (link->pendingHandle != 0 && t.segment != nullptr) t.segment->release(link->pendingHandle);
     link->pendingHandle = 0;
@@ -808,8 +817,8 @@ void Transport::stop() {
   }
   for (auto& [channel, c] : t.channels) c->inbox.clear();
   if (t.listenFd >= 0) close(t.listenFd);
-  if (t.wakeFd >= 0) close(t.wakeFd);
-  t.listenFd = t.wakeFd = -1;
+  t.listenFd = -1;
+  // The eventfd stays open until the Transport goes (~Impl): a routing thread may still ring it.
 }
 
 }  // namespace vrflow::net
