@@ -202,7 +202,7 @@ TEST(Launch, MessagesStillCrossingHostsAtTheEndAreCountedOnABusyCpu) {
     const auto got = deterministicPart(dir.file("three.json"));
     ASSERT_EQ(expected, got) << "launch " << i << ":\n"
                              << expected.dump(1) << "\n---\n"
-                             << got.dump(1);
+                             << got.dump(1) << "\n" << three.err;
   }
   EXPECT_TRUE(leftoverProcesses().empty());
 }
