@@ -278,6 +278,11 @@ void Launcher::pump(int timeoutMs) {
       }
       if (!d.finished) {
         failWith({run::kExitRunFailed, "failed", d.name() + " " + d.exitText}, true);
+      } else if (d.report.empty()) {
+        // Without its share the merged report would silently lack this host's modules.
+        failWith({run::kExitRunFailed, "failed",
+                  d.name() + " " + d.exitText + " after its modules finished, without its report"},
+                 true);
       }
       if (d.toDaemon >= 0) close(d.toDaemon);
       d.toDaemon = -1;

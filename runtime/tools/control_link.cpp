@@ -102,7 +102,7 @@ Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application&
     }
   }
   link->send("listening " + std::to_string(link->transport_->port()));
-  link->reader_ = std::thread([raw = link.get()] { raw->readLoop(); });
+  std::thread([fd = in, inbox = link->inbox_] { readLoop(fd, inbox); }).detach();
   return link;
 }
 
@@ -138,32 +138,33 @@ Result<int> ControlLink::connectBack(const std::string& address, const net::Secr
 
 ControlLink::~ControlLink() {
   if (transport_) transport_->stop();
-  // The reader ends at end of input: the launcher closes our stdin when the run is over.
-  if (reader_.joinable()) reader_.detach();
+  // The reader ends at end of input (the launcher closes our stdin when the run is over); it
+  // holds the inbox, not this object.
 }
 
-void ControlLink::readLoop() {
+void ControlLink::readLoop(int fd, const std::shared_ptr<Inbox>& inbox) {
   std::string line;
-  while (readLine(in_, line)) {
-    std::lock_guard lock(mutex_);
-    lines_.push_back(line);
-    changed_.notify_all();
+  while (readLine(fd, line)) {
+    std::lock_guard lock(inbox->mutex);
+    inbox->lines.push_back(line);
+    inbox->changed.notify_all();
   }
-  std::lock_guard lock(mutex_);
-  lines_.push_back("eof");
-  changed_.notify_all();
+  std::lock_guard lock(inbox->mutex);
+  inbox->lines.push_back("eof");
+  inbox->changed.notify_all();
 }
 
 std::string ControlLink::next(double seconds) {
-  std::unique_lock lock(mutex_);
+  Inbox& inbox = *inbox_;
+  std::unique_lock lock(inbox.mutex);
   if (seconds < 0) {
-    changed_.wait(lock, [&] { return !lines_.empty(); });
-  } else if (!changed_.wait_for(lock, std::chrono::duration<double>(seconds),
-                                [&] { return !lines_.empty(); })) {
+    inbox.changed.wait(lock, [&] { return !inbox.lines.empty(); });
+  } else if (!inbox.changed.wait_for(lock, std::chrono::duration<double>(seconds),
+                                     [&] { return !inbox.lines.empty(); })) {
     return {};
   }
-  std::string line = lines_.front();
-  if (line != "eof") lines_.pop_front();  // end of input stays visible
+  std::string line = inbox.lines.front();
+  if (line != "eof") inbox.lines.pop_front();  // end of input stays visible
   return line;
 }
 
@@ -235,19 +236,52 @@ std::optional<run::RunOutcome> ControlLink::poll() {
   return std::nullopt;
 }
 
-void ControlLink::drain(const run::RunOutcome& outcome) {
+std::vector<std::string> ControlLink::drain(const run::RunOutcome& outcome) {
   send("finished " + std::to_string(outcome.exitCode) + " " + outcome.status + " " + outcome.error);
+  std::vector<std::string> warnings;
   // Keep routing (messages for the other hosts) until the launcher says every host is done.
   while (!stopped_) {
     const std::string line = next(0.05);
     if (line == "quit") {
-      transport_->finish(2.0);
+      warnings = settle();
+      if (!stopped_) transport_->finish(2.0);
       break;
     }
     if (line == "stop" || line == "eof") stopped_ = true;
   }
   if (stopped_) transport_->finish(0.5);  // say bye, so that peers do not log a lost link
   transport_->stop();
+  return warnings;
+}
+
+std::vector<std::string> ControlLink::settle() {
+  // Every host's modules have ended, but their last messages may still be on the way: a peer
+  // says "finished" as soon as its modules exit, and what they sent last crosses the link
+  // after. Wait until each connection is closed by its sender and what came before the close
+  // is routed here, so that the report counts every message sent, as on one host.
+  constexpr double kSettleSeconds = 10;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::string> open;
+  while (true) {
+    open = transport_->settle(0.05);
+    if (open.empty() || !transport_->fatalError().empty()) break;
+    const std::string line = next(0);
+    if (line == "stop" || line == "eof") {
+      stopped_ = true;
+      return {};
+    }
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >
+        kSettleSeconds) {
+      break;
+    }
+  }
+  if (open.empty()) return {};
+  std::string names;
+  for (const auto& c : open) names += (names.empty() ? "" : ", ") + c;
+  const auto fatal = transport_->fatalError();
+  return {"connection(s) crossing hosts not closed after every host finished (" + names +
+          "): " + (fatal.empty() ? "still open after 10 s" : fatal) +
+          "; the report may miss their last messages"};
 }
 
 void ControlLink::trace(const std::string& json) { send("trace " + json); }

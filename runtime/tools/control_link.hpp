@@ -35,7 +35,7 @@ class ControlLink final : public run::HostLink {
   void configure(daemon::DaemonOptions& options) override;
   Status ready() override;
   std::optional<run::RunOutcome> poll() override;
-  void drain(const run::RunOutcome& outcome) override;
+  std::vector<std::string> drain(const run::RunOutcome& outcome) override;
   void report(const std::string& json) override;
   void trace(const std::string& json) override;
   void stats(const std::string& json) override;
@@ -46,7 +46,9 @@ class ControlLink final : public run::HostLink {
   /// The next command from the launcher ("eof" when it went away); waits up to `seconds`
   /// (negative: forever); empty on timeout.
   std::string next(double seconds);
-  void readLoop();
+  /// After "quit": waits until the connections crossing hosts are over (or a stop comes);
+  /// returns a warning for those still open.
+  std::vector<std::string> settle();
 
   int in_, out_;
   int selfIndex_ = 0;
@@ -55,10 +57,15 @@ class ControlLink final : public run::HostLink {
   std::unique_ptr<net::Transport> transport_;
   std::vector<net::RemoteConnection> remote_;
   std::vector<uint32_t> localChannels_;
-  std::thread reader_;
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::deque<std::string> lines_;
+  /// The launcher's lines, shared with the thread that reads them: it blocks in read() until
+  /// the launcher closes the channel, which may come after this object is gone.
+  struct Inbox {
+    std::mutex mutex;
+    std::condition_variable changed;
+    std::deque<std::string> lines;
+  };
+  std::shared_ptr<Inbox> inbox_ = std::make_shared<Inbox>();
+  static void readLoop(int fd, const std::shared_ptr<Inbox>& inbox);
 };
 
 }  // namespace vrflow::tools

@@ -157,7 +157,9 @@ TEST_F(PatternsOnThreeHosts, DynamicRoutingSendsEachTileTheSameAsOnOneHost) {
   // Same chunks to each tile: the bytes on every connection into a tile are those of one host.
   const auto bytesInto = [](const TempDir& dir, const std::string& report) {
     std::map<std::string, uint64_t> bytes;
-    for (const auto& c : nlohmann::json::parse(readFile(dir.file(report)))["connections"]) {
+    // The parsed report outlives the loop (a range over a member of a temporary would not).
+    const auto parsed = nlohmann::json::parse(readFile(dir.file(report)));
+    for (const auto& c : parsed["connections"]) {
       bytes[c["from"].get<std::string>() + "->" + c["to"].get<std::string>()] = c["bytes"].get<uint64_t>();
     }
     return bytes;
@@ -246,7 +248,8 @@ TEST_F(PatternsOnThreeHosts, GreedySamplingNeverBlocksTheWriterAcrossHosts) {
   EXPECT_EQ(iterations.at("fast"), 2000);
   EXPECT_LT(iterations.at("slow"), 2000);
   EXPECT_GE(iterations.at("slow"), 1);
-  for (const auto& c : nlohmann::json::parse(readFile(three.file("three.json")))["connections"]) {
+  const auto report = nlohmann::json::parse(readFile(three.file("three.json")));
+  for (const auto& c : report["connections"]) {
     EXPECT_EQ(c["stayed_full"], false) << c["from"];
   }
   const auto counters = recordedCounters(three.file("sampled.csv"));

@@ -170,6 +170,9 @@ struct Transport::Impl {
     item.headBytes = kFrameHeaderBytes + bytes;
     link.out.push_back(std::move(item));
   }
+  ~Impl() {
+    if (wakeFd >= 0) close(wakeFd);
+  }
   void newLink(int fd, bool connector, int peer);
   void loop();
   void readFrom(Link& link);
@@ -323,6 +326,7 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       }
       std::lock_guard lock(mutex);
       it->second->closedByPeer = true;
+      changed.notify_all();  // settle() waits on it
       return {};
     }
     case FrameType::Credit: {
@@ -613,6 +617,7 @@ class RemoteSink final : public daemon::Sink {
     c_->credits.fetch_sub(1);
     {
       std::lock_guard lock(t_->mutex);
+      if (t_->stopped.load()) return;  // stop() has dropped what links held
       auto it = t_->linkOfPeer.find(c_->remote.peer);
       if (it == t_->linkOfPeer.end()) return;  // the link is gone: the run is failing already
       OutItem item;
@@ -636,8 +641,9 @@ class RemoteSink final : public daemon::Sink {
     if (t_->stopped.load()) return;
     {
       std::lock_guard lock(t_->mutex);
-      if (c_->sentClose) return;
+      if (c_->sentClose || t_->stopped.load()) return;
       c_->sentClose = true;
+      t_->changed.notify_all();  // settle() waits on it
       auto it = t_->linkOfPeer.find(c_->remote.peer);
       if (it == t_->linkOfPeer.end()) return;
       t_->queueControl(*it->second, FrameType::Close, c_->remote.channel, nullptr, 0);
@@ -721,6 +727,7 @@ std::size_t Transport::receive(uint32_t channel, daemon::Sink& sink, bool& close
   std::deque<daemon::MessageRef> taken;
   {
     std::lock_guard lock(t.mutex);
+    if (t.stopped.load()) return 0;
     Channel& c = *t.channels.at(channel);
     while (!c.inbox.empty() && sink.hasSpace()) {
       sink.push(std::move(c.inbox.front()));
@@ -729,6 +736,7 @@ std::size_t Transport::receive(uint32_t channel, daemon::Sink& sink, bool& close
     }
     c.creditsToSend += static_cast<uint32_t>(moved);
     closed = c.closedByPeer && c.inbox.empty();
+    if (closed) t.changed.notify_all();  // settle() waits on it
   }
   if (moved > 0) t.wake();
   return moved;
@@ -750,6 +758,24 @@ std::vector<LinkStats> Transport::linkStats() const {
     }
   }
   return stats;
+}
+
+std::vector<std::string> Transport::settle(double seconds) {
+  Impl& t = *impl_;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  std::unique_lock lock(t.mutex);
+  while (true) {
+    std::vector<std::string> open;
+    for (const auto& [channel, c] : t.channels) {
+      const bool over = c->remote.outgoing ? c->sentClose : c->closedByPeer && c->inbox.empty();
+      if (!over) {
+        open.push_back(app::toString(c->remote.connection.from) + " -> " +
+                       app::toString(c->remote.connection.to));
+      }
+    }
+    if (open.empty() || !t.fatal.empty() || t.stopped.load()) return open;
+    if (t.changed.wait_until(lock, deadline) == std::cv_status::timeout) return open;
+  }
 }
 
 void Transport::finish(double seconds) {
@@ -778,6 +804,10 @@ void Transport::stop() {
     t.wake();
     t.thread.join();
   }
+  // Under the lock: a routing thread that has just seen `stopped` false (in a sink's push or
+  // close, or in receive()) holds it while it touches a link or an inbox, and looks again once
+  // it has it.
+  std::lock_guard lock(t.mutex);
   for (auto& link : t.links) {
     if (link->pendingHandle != 0 && t.segment != nullptr) t.segment->release(link->pendingHandle);
     link->pendingHandle = 0;
@@ -787,8 +817,8 @@ void Transport::stop() {
   }
   for (auto& [channel, c] : t.channels) c->inbox.clear();
   if (t.listenFd >= 0) close(t.listenFd);
-  if (t.wakeFd >= 0) close(t.wakeFd);
-  t.listenFd = t.wakeFd = -1;
+  t.listenFd = -1;
+  // The eventfd stays open until the Transport goes (~Impl): a routing thread may still ring it.
 }
 
 }  // namespace vrflow::net

@@ -491,7 +491,8 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
     }
   }
   if (outcome.exitCode == kExitOk) outcome = supervisor.run();
-  if (options.hostLink != nullptr) options.hostLink->drain(outcome);
+  std::vector<std::string> drainWarnings;
+  if (options.hostLink != nullptr) drainWarnings = options.hostLink->drain(outcome);
   (*daemon)->shutdown();
   supervisor.drainTraces();
   for (std::size_t i = 0; i < (*daemon)->modules().size(); ++i) {
@@ -517,6 +518,7 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
     }
   }
   std::vector<std::string> warnings = (*daemon)->takeWarnings();
+  warnings.insert(warnings.end(), drainWarnings.begin(), drainWarnings.end());
   if (options.hostLink != nullptr) {
     options.hostLink->report(reportJson(application, **daemon, supervisor.ends(), outcome, options,
                                         secondsSince(start), warnings));

@@ -99,6 +99,11 @@ class Transport {
   std::size_t receive(uint32_t channel, daemon::Sink& sink, bool& closed);
   /// The first failure of an established link (peer lost, malformed frame), or empty.
   std::string fatalError() const;
+  /// Waits up to `seconds` until every connection crossing this host's boundary is over: each
+  /// outgoing one closed here (after its last message), each incoming one closed by its peer
+  /// with every message it sent taken by receive(). Returns early on a link failure
+  /// (fatalError()). Returns the connections not over yet ("FROM -> TO"), none when all are.
+  std::vector<std::string> settle(double seconds);
   /// Flushes what is queued, says goodbye to every peer, and waits up to `seconds` for theirs.
   void finish(double seconds);
   /// Stops the I/O thread, closes every socket and drops every held message.

@@ -64,8 +64,9 @@ class HostLink {
   virtual Status ready() = 0;
   /// Every supervisor tick: an outcome ends the run (a peer lost, a stop from the launcher).
   virtual std::optional<RunOutcome> poll() = 0;
-  /// After this host's modules ended: keeps routing until every host is done.
-  virtual void drain(const RunOutcome& outcome) = 0;
+  /// After this host's modules ended: keeps routing until every host is done and every
+  /// connection crossing hosts is over. Returns warnings for the report.
+  virtual std::vector<std::string> drain(const RunOutcome& outcome) = 0;
   /// This host's share of the run report (JSON text).
   virtual void report(const std::string& json) = 0;
   /// This host's trace events (run::hostTraceToJson), when the run is traced.
