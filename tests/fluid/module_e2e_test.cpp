@@ -311,12 +311,16 @@ TEST(FluidModule, BoxOfTheRigidPackageFloats) {
 // particle-regions 2 1 1: the particles leave as two fluid objects, the halves x < 0.4 m and
 // x >= 0.4 m of the grid, each with its own particles and their bounds, so that a route filter
 // sends the tile-viewer that sees only x <= 0.3 m the left half, every iteration, and the one
-// that sees everything both halves, which together hold every particle.
+// that sees everything both halves, which together hold every particle. A viewer's volume
+// reaches the route only after its first message (`route` does not wait for it), so the first
+// iterations may reach a viewer empty; one-message connections keep that lag to a few
+// iterations whatever the machine's load.
 TEST(FluidModule, ParticleRegionsLetARouteFilterSendEachViewerOnlyWhatItSees) {
   TempDir dir;
   std::string modules = fluidModule("      <param name=\"particle-regions\" value=\"2 1 1\"/>\n");
   const char* boxes[] = {"0 -1 -1 0.3 2 2", "all"};
-  std::string connections = "    <connection from=\"water.fluid\" to=\"wall.in\"/>\n";
+  std::string connections =
+      "    <connection from=\"water.fluid\" to=\"wall.in\" capacity=\"1\"/>\n";
   for (int k = 0; k < 2; ++k) {
     const std::string id = "v" + std::to_string(k);
     modules += "    <module id=\"" + id + "\" package=\"routing\" type=\"tile-viewer\" host=\"local\">\n" +
@@ -324,15 +328,15 @@ TEST(FluidModule, ParticleRegionsLetARouteFilterSendEachViewerOnlyWhatItSees) {
                "      <param name=\"file\" value=\"" + dir.file(id + ".csv") + "\"/>\n" +
                "    </module>\n";
     connections += "    <connection from=\"wall.out" + std::to_string(k) + "\" to=\"" + id +
-                   ".objects\"/>\n    <connection from=\"" + id + ".interest\" to=\"wall.interest" +
-                   std::to_string(k) + "\"/>\n";
+                   ".objects\" capacity=\"1\"/>\n    <connection from=\"" + id +
+                   ".interest\" to=\"wall.interest" + std::to_string(k) + "\"/>\n";
   }
   std::string app = application(modules, connections);
   app.replace(app.find("  <connections>"), 0,
               "  <filters>\n    <filter id=\"wall\" type=\"route\" host=\"local\">\n"
               "      <param name=\"outputs\" value=\"2\"/>\n    </filter>\n  </filters>\n");
   const auto result = runVrflow({"--packages", binDir() + "/../share/vrflow/example-packages",
-                                 "run", dir.write("regions.xml", app), "--iterations", "12",
+                                 "run", dir.write("regions.xml", app), "--iterations", "40",
                                  "--no-progress"},
                                 120);
   ASSERT_EQ(result.exitCode, 0) << result.err;
@@ -350,9 +354,11 @@ TEST(FluidModule, ParticleRegionsLetARouteFilterSendEachViewerOnlyWhatItSees) {
   };
   const auto left = meshes(readLines(dir.file("v0.csv")));
   const auto all = meshes(readLines(dir.file("v1.csv")));
-  ASSERT_GE(all.size(), 10u);
+  ASSERT_GE(all.size(), 30u);
+  ASSERT_GE(left.size(), 30u);
   long total = -1;
   for (const auto& [it, regions] : all) {
+    if (left.find(it) == left.end() && it < 10) continue;  // before the left tile's volume
     ASSERT_EQ(regions.size(), 2u) << "both halves, iteration " << it;
     long sum = 0;
     for (const auto& [id, count] : regions) {

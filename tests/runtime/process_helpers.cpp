@@ -126,6 +126,10 @@ std::vector<std::string> leftoverProcesses() {
         int ppid;
         rest >> state >> ppid;
         if (ppid != getpid()) continue;
+        if (state == 'Z') {  // it ended since waitpid() above: the next round reaps it
+          any = true;
+          continue;
+        }
         std::ifstream cmd("/proc/" + std::string(entry->d_name) + "/cmdline");
         std::string text;
         std::getline(cmd, text, '\0');
