@@ -73,17 +73,8 @@ std::string environValue(pid_t pid, const std::string& variable) {
 // Every live process under `root` (children, their children, ...).
 std::vector<pid_t> descendantsOf(pid_t root) {
   std::multimap<pid_t, pid_t> children;
-  for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
-    const auto name = entry.path().filename().string();
-    if (name.empty() || !std::isdigit(static_cast<unsigned char>(name[0]))) continue;
-    const auto stat = readLines(entry.path().string() + "/stat");
-    const auto close = stat.empty() ? std::string::npos : stat[0].rfind(')');
-    if (close == std::string::npos) continue;
-    std::istringstream rest(stat[0].substr(close + 2));
-    char state = 0;
-    pid_t parent = 0;
-    rest >> state >> parent;
-    if (state != 'Z') children.emplace(parent, static_cast<pid_t>(std::stoi(name)));
+  for (const ProcessInfo& process : processTable()) {
+    if (process.state != 'Z') children.emplace(process.parent, process.pid);
   }
   std::vector<pid_t> found{root};
   for (std::size_t i = 0; i < found.size(); ++i) {

@@ -120,22 +120,13 @@ TEST(FluidModule, LightBoxFloatsThroughTheAnimatorInteractorCycle) {
 void waitForMpiOrphansToExit() {
   for (int round = 0; round < 100; ++round) {
     bool any = false;
-    for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
-      const auto name = entry.path().filename().string();
-      if (name.empty() || !std::isdigit(static_cast<unsigned char>(name[0]))) continue;
-      const auto stat = readLines(entry.path().string() + "/stat");
-      const auto close = stat.empty() ? std::string::npos : stat[0].rfind(')');
-      if (close == std::string::npos) continue;
-      std::istringstream rest(stat[0].substr(close + 2));
-      char state = 0;
-      int parent = 0;
-      rest >> state >> parent;
-      if (parent != getpid() || (stat[0].find("(orted)") == std::string::npos &&
-                                 stat[0].find("(vrflow-fluid)") == std::string::npos)) {
+    for (const ProcessInfo& process : processTable()) {
+      if (process.parent != getpid() ||
+          (process.name != "orted" && process.name != "vrflow-fluid")) {
         continue;
       }
-      if (state == 'Z') {
-        waitpid(std::stoi(name), nullptr, 0);  // it exited: reap it
+      if (process.state == 'Z') {
+        waitpid(process.pid, nullptr, 0);  // it exited: reap it
       } else {
         any = true;
       }

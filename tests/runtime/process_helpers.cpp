@@ -90,8 +90,7 @@ CommandResult runCommand(const std::vector<std::string>& argv, double timeoutSec
 
 CommandResult runVrflow(std::vector<std::string> args, double timeoutSeconds,
                         double signalAfterSeconds, int signal) {
-  std::vector<std::string> argv{binDir() + "/vrflow", "--packages",
-                                binDir() + "/../test-packages"};
+  std::vector<std::string> argv{binDir() + "/vrflow", "--packages", binDir() + "/../test-packages"};
   argv.insert(argv.end(), args.begin(), args.end());
   return runCommand(argv, timeoutSeconds, signalAfterSeconds, signal);
 }
@@ -111,39 +110,47 @@ std::vector<std::string> leftoverProcesses() {
     }
     if (pid == 0 && ++rounds < 500) {
       // A child is still running: find and kill it.
-      DIR* proc = opendir("/proc");
       bool any = false;
-      while (dirent* entry = proc ? readdir(proc) : nullptr) {
-        const int child = std::atoi(entry->d_name);
-        if (child <= 0) continue;
-        std::ifstream stat("/proc/" + std::string(entry->d_name) + "/stat");
-        std::string line;
-        std::getline(stat, line);
-        const auto close = line.rfind(')');
-        if (close == std::string::npos) continue;
-        std::istringstream rest(line.substr(close + 2));
-        char state;
-        int ppid;
-        rest >> state >> ppid;
-        if (ppid != getpid()) continue;
-        if (state == 'Z') {  // it ended since waitpid() above: the next round reaps it
-          any = true;
-          continue;
-        }
-        std::ifstream cmd("/proc/" + std::string(entry->d_name) + "/cmdline");
+      for (const ProcessInfo& process : processTable()) {
+        if (process.parent != getpid()) continue;
+        any = true;
+        if (process.state == 'Z')
+          continue;  // it ended since waitpid() above: the next round reaps it
+        std::ifstream cmd("/proc/" + std::to_string(process.pid) + "/cmdline");
         std::string text;
         std::getline(cmd, text, '\0');
         left.push_back(text);
-        kill(child, SIGKILL);
-        any = true;
+        kill(process.pid, SIGKILL);
       }
-      if (proc) closedir(proc);
       if (!any) usleep(10000);
       continue;
     }
     break;  // ECHILD: no children at all
   }
   return left;
+}
+
+std::vector<ProcessInfo> processTable() {
+  std::vector<ProcessInfo> table;
+  DIR* proc = opendir("/proc");
+  while (dirent* entry = proc ? readdir(proc) : nullptr) {
+    const pid_t pid = std::atoi(entry->d_name);
+    if (pid <= 0) continue;
+    std::ifstream stat("/proc/" + std::string(entry->d_name) + "/stat");
+    std::string line;
+    std::getline(stat, line);
+    // "pid (name) state ppid ...": the name may hold spaces and parentheses.
+    const auto open = line.find('('), close = line.rfind(')');
+    if (open == std::string::npos || close == std::string::npos || close < open) continue;
+    ProcessInfo process;
+    process.pid = pid;
+    process.name = line.substr(open + 1, close - open - 1);
+    std::istringstream rest(line.substr(close + 2));
+    rest >> process.state >> process.parent;
+    if (rest) table.push_back(std::move(process));
+  }
+  if (proc) closedir(proc);
+  return table;
 }
 
 std::vector<std::string> vrflowShmEntries() {

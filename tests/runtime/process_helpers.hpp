@@ -1,5 +1,7 @@
 #pragma once
 
+#include <sys/types.h>
+
 #include <string>
 #include <vector>
 
@@ -23,6 +25,17 @@ CommandResult runVrflow(std::vector<std::string> args, double timeoutSeconds = 6
 /// Processes left behind by the commands this test ran (reparented to this process, which is a
 /// child subreaper), killed and reaped; their command lines are returned.
 std::vector<std::string> leftoverProcesses();
+
+/// One process as /proc/PID/stat shows it.
+struct ProcessInfo {
+  pid_t pid = 0;
+  pid_t parent = 0;
+  char state = 0;    ///< 'R', 'S', 'Z' (ended, not yet reaped), ...
+  std::string name;  ///< the command name (comm), without its parentheses
+};
+
+/// Every process of the machine, from /proc (those that end while it reads are left out).
+std::vector<ProcessInfo> processTable();
 
 /// Entries of /dev/shm whose name mentions vrflow.
 std::vector<std::string> vrflowShmEntries();
