@@ -90,3 +90,10 @@ endfunction()
 function(vrflow_install_package name manifest)
   configure_file(${manifest} ${PROJECT_BINARY_DIR}/share/vrflow/packages/${name}/vrflow-package.xml COPYONLY)
 endfunction()
+
+# vrflow_install_composite(FILE): puts a composite a node package ships (NAME.vrc.xml) where the
+# `vrflow` command and the editor find it (<build>/share/vrflow/composites/, searched last).
+function(vrflow_install_composite file)
+  get_filename_component(name ${file} NAME)
+  configure_file(${file} ${PROJECT_BINARY_DIR}/share/vrflow/composites/${name} COPYONLY)
+endfunction()

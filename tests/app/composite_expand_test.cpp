@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include "composite_support.hpp"
@@ -284,13 +285,17 @@ TEST(CompositeExpansion, ApplicationWithoutInstancesExpandsToItself) {
   EXPECT_EQ(connectionTexts(*flat), connectionTexts(*app));
 }
 
-TEST(CompositeExpansion, DefaultSourcesSearchTheApplicationsFolderThenTheEnvironment) {
+TEST(CompositeExpansion, DefaultSourcesSearchTheApplicationsFolderThenTheEnvironmentThenPackages) {
   Application app;
   app.file = "/some/where/app.xml";
   ::setenv("VRFLOW_COMPOSITE_PATH", "/a::/b", 1);
   const CompositeSources sources = defaultCompositeSources(app, {"/extra"});
   ::unsetenv("VRFLOW_COMPOSITE_PATH");
-  EXPECT_EQ(sources.searchPath, (Strings{"/some/where", "/extra", "/a", "/b"}));
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  const std::string share =
+      (std::filesystem::path(self).parent_path().parent_path() / "share/vrflow/composites")
+          .string();
+  EXPECT_EQ(sources.searchPath, (Strings{"/some/where", "/extra", "/a", "/b", share}));
 }
 
 TEST(CompositeExpansion, ValidateExpandsAnApplicationFileThatUsesComposites) {

@@ -4,6 +4,7 @@
 #include <sys/prctl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
@@ -385,6 +386,173 @@ int runRankWorker(int argc, char** argv) {
   MPI_Comm world;
   MPI_Comm_dup(MPI_COMM_WORLD, &world);
   return workerLoop(world);
+}
+
+struct JobBlock::Impl {
+  std::string job;
+  MPI_Comm world = MPI_COMM_NULL;
+  MPI_Comm failures = MPI_COMM_NULL;  ///< only for the agreement after a failed step
+  int rank = 0;
+  int size = 1;
+  std::uint64_t steps = 0;
+  std::unique_ptr<MpiBlockComm> comm;
+  std::unique_ptr<FluidSolver> solver;
+  bool stopped = false;
+};
+
+JobBlock::JobBlock(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+JobBlock::~JobBlock() {
+  if (impl_->stopped) return;
+  // The module is ending on an error of its own (it printed it) without the others: they may be
+  // inside a collective call waiting for this block, where MPI_Finalize would wait for them.
+  if (impl_->size > 1) MPI_Abort(impl_->world, 1);
+  stop();
+}
+int JobBlock::rank() const {
+  return impl_->rank;
+}
+int JobBlock::size() const {
+  return impl_->size;
+}
+FluidSolver& JobBlock::solver() {
+  return *impl_->solver;
+}
+
+Result<std::unique_ptr<JobBlock>> JobBlock::start(const std::string& job,
+                                                  const FluidSettings& settings,
+                                                  const msg::Aabb& fill) {
+  prepareMpi();
+  int argc = 0;
+  char** argv = nullptr;
+  MPI_Init(&argc, &argv);
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  auto impl = std::make_unique<Impl>();
+  impl->job = job;
+  MPI_Comm_dup(MPI_COMM_WORLD, &impl->world);
+  MPI_Comm_dup(MPI_COMM_WORLD, &impl->failures);
+  MPI_Comm_rank(impl->world, &impl->rank);
+  MPI_Comm_size(impl->world, &impl->size);
+  // Every block checks the same settings (the job's modules share them through their composite),
+  // so they fail together here; the rest of the job then ends with MPI_Finalize.
+  auto fail = [&](const std::string& message) -> Result<std::unique_ptr<JobBlock>> {
+    MPI_Finalize();
+    return makeError(message);
+  };
+  if (impl->size > settings.nz) {
+    return fail("fluid: MPI job '" + job + "' has " + std::to_string(impl->size) +
+                " modules for a grid of " + std::to_string(settings.nz) +
+                " z-planes: each block needs at least one plane");
+  }
+  impl->comm = std::make_unique<MpiBlockComm>(impl->world);
+  auto created = FluidSolver::create(settings);
+  if (!created) return fail(created.error().message);
+  impl->solver = std::move(created.value());
+  if (auto status = impl->solver->setBlockComm(impl->comm.get()); !status) {
+    return fail(status.error().message);
+  }
+  impl->solver->setLocalBodies(true);
+  if (auto status = impl->solver->addLiquidBox(fill); !status) return fail(status.error().message);
+  return std::unique_ptr<JobBlock>(new JobBlock(std::move(impl)));
+}
+
+msg::Aabb JobBlock::slab(int marginCells) const {
+  const auto& s = impl_->solver->settings();
+  int k0 = 0, k1 = 0;
+  slabOf(s.nz, impl_->rank, impl_->size, k0, k1);
+  const double margin = marginCells * s.cellSize;
+  msg::Aabb box = impl_->solver->bounds();
+  box.min[2] = s.origin[2] + k0 * s.cellSize;
+  box.max[2] = s.origin[2] + k1 * s.cellSize;
+  for (std::size_t a = 0; a < 3; ++a) {
+    box.min[a] -= margin;
+    box.max[a] += margin;
+  }
+  return box;
+}
+
+bool JobBlock::agree(bool mine) {
+  int all = mine ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &all, 1, MPI_INT, MPI_MIN, impl_->world);
+  return all != 0;
+}
+
+bool JobBlock::fromFirst(bool value) {
+  int v = value ? 1 : 0;
+  MPI_Bcast(&v, 1, MPI_INT, 0, impl_->world);
+  return v != 0;
+}
+
+Result<BlockResult> JobBlock::step(const BlockStep& s) {
+  auto result = runStep(*impl_->solver, s, impl_->rank, impl_->steps);
+  if (result || impl_->stopped) return result;
+  impl_->stopped = true;
+  if (everyBlockFailed(impl_->failures)) {  // every block reports it and ends cleanly
+    MPI_Finalize();
+    return result;
+  }
+  std::fprintf(stderr, "vrflow-fluid: MPI block %d of %d (job '%s') failed alone: %s; aborting the job\n",
+               impl_->rank, impl_->size, impl_->job.c_str(), result.error().message.c_str());
+  MPI_Abort(impl_->world, 1);
+  return result;  // not reached
+}
+
+void JobBlock::gatherBodies(std::vector<RigidBody>& bodies, std::vector<BodyForce>& forces) {
+  // Each block sends the bodies it reports, with their forces; block 0 sorts them by id.
+  BlockStep mine;
+  std::vector<BodyForce> mineForces;
+  for (std::size_t b = 0; b < bodies.size() && b < forces.size(); ++b) {
+    if (!forces[b].reported) continue;
+    mine.bodies.push_back(bodies[b]);
+    mineForces.push_back(forces[b]);
+  }
+  Writer w;
+  w.bytes = encodeStep(mine);
+  for (const auto& f : mineForces) w.put(f);
+  const int count = static_cast<int>(w.bytes.size());
+  std::vector<int> counts(static_cast<std::size_t>(impl_->size)), offsets(counts.size());
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, impl_->world);
+  std::vector<char> all;
+  if (impl_->rank == 0) {
+    int total = 0;
+    for (std::size_t r = 0; r < counts.size(); ++r) {
+      offsets[r] = total;
+      total += counts[r];
+    }
+    all.resize(static_cast<std::size_t>(total));
+  }
+  MPI_Gatherv(w.bytes.data(), count, MPI_CHAR, all.data(), counts.data(), offsets.data(),
+              MPI_CHAR, 0, impl_->world);
+  bodies.clear();
+  forces.clear();
+  if (impl_->rank != 0) return;
+  std::vector<std::pair<RigidBody, BodyForce>> merged;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    const std::vector<char> part(all.begin() + offsets[r], all.begin() + offsets[r] + counts[r]);
+    BlockStep theirs;
+    if (!decodeStep(part, theirs)) continue;  // same process image: cannot happen
+    // The forces follow the encoded step: read them from its end.
+    const std::size_t forceBytes = theirs.bodies.size() * sizeof(BodyForce);
+    if (part.size() < forceBytes) continue;
+    const char* p = part.data() + part.size() - forceBytes;
+    for (auto& body : theirs.bodies) {
+      BodyForce f;
+      std::memcpy(&f, p, sizeof f);
+      p += sizeof f;
+      merged.emplace_back(std::move(body), f);
+    }
+  }
+  std::sort(merged.begin(), merged.end(),
+            [](const auto& a, const auto& b) { return a.first.id < b.first.id; });
+  for (auto& [body, force] : merged) {
+    bodies.push_back(std::move(body));
+    forces.push_back(force);
+  }
+}
+
+void JobBlock::stop() {
+  if (impl_->stopped) return;
+  impl_->stopped = true;
+  MPI_Finalize();
 }
 
 }  // namespace vrflow::fluid

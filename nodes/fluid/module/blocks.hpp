@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "vrflow/fluid/solver.hpp"
@@ -66,6 +67,46 @@ class BlockGroup {
  private:
   struct Impl;
   explicit BlockGroup(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One block of an MPI job of fluid modules: every module of the job (the same `job` parameter;
+/// the manifest's `mpi-job="job"` makes vrflow start them as one mpirun, one rank each) is a
+/// module with its own ports, fed the objects near its slab (by a route filter, say) and sending
+/// its own forces and particles; a gather filter joins them. Ranks are peers: no rank drives
+/// the others. The same failure handling as BlockGroup: blocks failing together end cleanly,
+/// a block failing alone aborts the job.
+class JobBlock {
+ public:
+  /// Initialises MPI (a job of one module runs as an MPI singleton), builds this rank's block of
+  /// the solver with local bodies (FluidSolver::setLocalBodies) and fills it.
+  static Result<std::unique_ptr<JobBlock>> start(const std::string& job,
+                                                 const FluidSettings& settings,
+                                                 const msg::Aabb& fill);
+  ~JobBlock();
+  int rank() const;
+  int size() const;
+  FluidSolver& solver();
+  /// This block's slab of z-planes with the grid's extent along x and y, widened by
+  /// `marginCells` cells on every side (kLocalBodyMargin: the box it needs the objects of).
+  msg::Aabb slab(int marginCells) const;
+  /// Whether every block goes on (collective): false on any block stops them all together.
+  bool agree(bool mine);
+  /// Block 0's `value`, on every block (collective).
+  bool fromFirst(bool value);
+  /// Runs one step on this block. A failure on every block returns the error on each; a block
+  /// that fails alone aborts the job (MPI_Abort) after printing its error.
+  Result<BlockResult> step(const BlockStep& step);
+  /// The rigid bodies and their forces over every block, each body once (from the block that
+  /// reports it), in id order on block 0; `bodies` and `forces` are this block's (forces: the
+  /// step's, bodies first). Collective; other blocks get nothing.
+  void gatherBodies(std::vector<RigidBody>& bodies, std::vector<BodyForce>& forces);
+  /// Finalises MPI (every block together, after `agree` said stop).
+  void stop();
+
+ private:
+  struct Impl;
+  explicit JobBlock(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

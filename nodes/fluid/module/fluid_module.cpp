@@ -112,6 +112,7 @@ int main(int argc, char** argv) {
   auto& objectsIn = module.addInput("objects");
   auto& forcesOut = module.addOutput("forces");
   auto& objectsOut = module.addOutput("fluid");
+  auto& interestOut = module.addOutput("interest");
   if (auto status = module.init(); !status) {
     std::fprintf(stderr, "vrflow-fluid: %s\n", status.error().message.c_str());
     return 2;
@@ -152,12 +153,22 @@ int main(int argc, char** argv) {
   }
 
   const auto blocks = module.paramInt("blocks", 1);
+  const std::string job = module.param("job", "");
+  if (!job.empty() && blocks > 1) {
+    return fail("blocks = " + std::to_string(blocks) + " with job = '" + job +
+                "': a module of an MPI job is one block of it (leave blocks at 1)");
+  }
 
   if (auto status = fluid::validateSettings(s); !status) return fail(status.error().message);
   if (auto status = fluid::validateTimeStep(s, dt); !status) return fail(status.error().message);
   std::unique_ptr<fluid::FluidSolver> serial;
   std::unique_ptr<fluid::BlockGroup> group;
-  if (blocks <= 1) {
+  std::unique_ptr<fluid::JobBlock> jobBlock;
+  if (!job.empty()) {
+    auto started = fluid::JobBlock::start(job, s, fill);
+    if (!started) return fail(started.error().message);
+    jobBlock = std::move(started.value());
+  } else if (blocks <= 1) {
     auto created = fluid::FluidSolver::create(s);
     if (!created) return fail(created.error().message);
     serial = std::move(created.value());
@@ -167,10 +178,21 @@ int main(int argc, char** argv) {
     if (!started) return fail(started.error().message);
     group = std::move(started.value());
   }
-  fluid::FluidSolver& solver = serial ? *serial : group->solver();
+  fluid::FluidSolver& solver = serial ? *serial : group ? group->solver() : jobBlock->solver();
+  auto stepBlocks = [&](const fluid::BlockStep& request) {
+    return group ? group->step(request)
+           : jobBlock ? jobBlock->step(request)
+                      : fluid::stepBlock(solver, request);
+  };
+  // The blocks of a job make the collective queries together: block 0's file parameters decide.
+  const bool first = !jobBlock || jobBlock->rank() == 0;
+  const std::string statsPath = module.param("stats");
+  const std::string statePath = module.param("state-file");
+  const bool withStats = jobBlock ? jobBlock->fromFirst(!statsPath.empty()) : !statsPath.empty();
+  const bool withState = jobBlock ? jobBlock->fromFirst(!statePath.empty()) : !statePath.empty();
 
   std::ofstream stats;
-  if (const auto path = module.param("stats"); !path.empty()) {
+  if (const auto& path = statsPath; first && withStats) {
     stats.open(path, std::ios::trunc);
     if (!stats) return fail("cannot write the stats file " + path);
     stats << "iteration,time,cg_iterations,cg_residual,fluid_cells,body_cells,volume,"
@@ -178,20 +200,23 @@ int main(int argc, char** argv) {
   }
 
   // The final state needs the volume before the first step; a query-only step is collective.
-  const std::string statePath = module.param("state-file");
   fluid::FinalState finalState;
   finalState.settings = s;
-  if (!statePath.empty()) {
+  if (withState) {
     fluid::BlockStep query;
     query.queryOnly = true;
     query.stats = true;
-    auto queried = group ? group->step(query) : fluid::stepBlock(solver, query);
+    auto queried = stepBlocks(query);
     if (!queried) return fail(queried.error().message);
     finalState.initialVolume = queried->volume;
   }
 
   fluid::World world(nodeRadius);
   regions.grid = solver.bounds();
+  // A block of a job couples the objects near its slab only, and says so on `interest` (for a
+  // route filter); its particles are its own, its fluid object's bounds its slab.
+  const msg::Aabb near = jobBlock ? jobBlock->slab(fluid::kLocalBodyMargin) : msg::Aabb{};
+  const msg::Aabb ownBounds = jobBlock ? jobBlock->slab(0) : solver.bounds();
   std::vector<std::uint64_t> fluidIds, particlesIds;
   for (int r = 0; r < regions.size(); ++r) {
     fluidIds.push_back(module.newId());
@@ -199,15 +224,21 @@ int main(int argc, char** argv) {
   }
   bool warnedUncoupled = false;
   double time = 0.0;
-  while (module.wait()) {
+  bool ending = false;
+  for (;;) {
+    // The blocks of a job stop together: one that stopped waiting would leave the others in the
+    // step's collective calls.
+    bool go = !ending && module.wait();
+    if (jobBlock) go = jobBlock->agree(go);
+    if (!go) break;
     if (objectsIn.connected()) {
       const Message& in = module.get(objectsIn);
       if (in.valid()) {
         if (auto status = world.apply(in.view()); !status) return fail(status.error().message);
       }
     }
-    const auto bodies = world.rigidBodies();
-    const auto points = world.pointMasses();
+    const auto bodies = world.rigidBodies(jobBlock ? &near : nullptr);
+    const auto points = world.pointMasses(jobBlock ? &near : nullptr);
     if (!warnedUncoupled && module.iteration() >= 2) {
       for (const auto& line : world.uncoupled()) {
         std::fprintf(stderr, "vrflow-fluid: not coupled: %s\n", line.c_str());
@@ -221,12 +252,12 @@ int main(int argc, char** argv) {
     request.dt = dt;
     request.bodies = bodies;
     request.points = points;
-    request.gatherParticles = sendParticles;
-    request.stats = stats.is_open();
-    auto stepped = group ? group->step(request) : fluid::stepBlock(solver, request);
+    request.gatherParticles = sendParticles && !jobBlock;
+    request.stats = withStats;
+    auto stepped = stepBlocks(request);
     if (!stepped) return fail(stepped.error().message);
     time += dt;
-    if (!statePath.empty()) {
+    if (withState) {
       finalState.bodies = bodies;
       finalState.forces = stepped->forces;
       ++finalState.steps;
@@ -238,19 +269,28 @@ int main(int argc, char** argv) {
     // The step returns the bodies' forces first, then the nodes'.
     for (std::size_t b = 0; b < bodies.size() && b < stepped->forces.size(); ++b) {
       const auto& f = stepped->forces[b];
-      if (f.cells > 0 && !bodies[b].kinematic) {
+      if (f.cells > 0 && !bodies[b].kinematic && f.reported) {
         forces.builder().addForce(f.id, {f.force, f.torque, f.point, f.duration});
       }
     }
-    if (!points.empty() && stepped->forces.size() >= bodies.size()) {
-      const std::vector<fluid::BodyForce> nodeForces(
-          stepped->forces.begin() + static_cast<std::ptrdiff_t>(bodies.size()),
-          stepped->forces.end());
-      fluid::addNodeForceEvents(forces.builder(), points, nodeForces);
+    if (!points.empty() && stepped->forces.size() >= bodies.size() + points.size()) {
+      // A net is held whole by a block, so its nodes are reported by the same one.
+      std::vector<fluid::PointMass> reportedPoints;
+      std::vector<fluid::BodyForce> nodeForces;
+      for (std::size_t p = 0; p < points.size(); ++p) {
+        const auto& f = stepped->forces[bodies.size() + p];
+        if (!f.reported) continue;
+        reportedPoints.push_back(points[p]);
+        nodeForces.push_back(f);
+      }
+      fluid::addNodeForceEvents(forces.builder(), reportedPoints, nodeForces);
     }
-    if (!module.put(forcesOut, std::move(forces))) break;
+    if (!module.put(forcesOut, std::move(forces))) {
+      ending = true;
+      continue;
+    }
 
-    const auto& xyz = stepped->particles;
+    const auto& xyz = jobBlock ? solver.particlePositions() : stepped->particles;
     auto out = module.newMessage(512 + 160 * fluidIds.size() +
                                  (sendParticles ? xyz.size() * sizeof(float) : 0));
     out.builder().setSimTime(time);
@@ -262,7 +302,7 @@ int main(int argc, char** argv) {
       // particles, sent with every copy of them (the meshes first, as a route filter wants).
       if (module.iteration() == 0 || (split && sendParticles)) {
         const bool add = module.iteration() == 0;
-        const msg::Aabb bounds = !split             ? solver.bounds()
+        const msg::Aabb bounds = !split             ? ownBounds
                                  : !regions.bounds.empty() ? regions.bounds[r]
                                                            : regions.box(static_cast<int>(r));
         if (sendParticles) out.builder().addMesh(particlesIds[r], true, split ? regions.xyz[r] : xyz, {});
@@ -274,7 +314,22 @@ int main(int argc, char** argv) {
         out.builder().addMesh(particlesIds[r], true, xyz, {});
       }
     }
-    if (!module.put(objectsOut, std::move(out))) break;
+    if (!module.put(objectsOut, std::move(out))) {
+      ending = true;
+      continue;
+    }
+    if (jobBlock && module.iteration() == 0 && interestOut.connected()) {
+      char text[160];
+      std::snprintf(text, sizeof text, "%.17g %.17g %.17g %.17g %.17g %.17g", near.min[0],
+                    near.min[1], near.min[2], near.max[0], near.max[1], near.max[2]);
+      auto volume = module.newMessage();
+      volume.builder().setStampsOnly(true);
+      volume.builder().addStringStamp("interest", text);
+      if (!module.put(interestOut, std::move(volume))) {
+        ending = true;
+        continue;
+      }
+    }
 
     if (stats.is_open()) {
       const auto& st = solver.lastStats();
@@ -283,22 +338,26 @@ int main(int argc, char** argv) {
             << stepped->maxSpeed << ',' << bodies.size() << '\n';
     }
   }
-  if (!statePath.empty()) {
+  if (withState) {
     fluid::BlockStep query;
     query.queryOnly = true;
     query.stats = true;
     query.gatherParticles = true;
-    auto queried = group ? group->step(query) : fluid::stepBlock(solver, query);
+    auto queried = stepBlocks(query);
     if (!queried) return fail(queried.error().message);
+    if (jobBlock) jobBlock->gatherBodies(finalState.bodies, finalState.forces);
     finalState.time = time;
     finalState.volume = queried->volume;
     finalState.maxSpeed = queried->maxSpeed;
     finalState.particles = std::move(queried->particles);
-    if (auto status = fluid::writeFinalState(statePath, finalState); !status) {
-      if (group) group->stop();
-      return fail(status.error().message);
+    if (first) {
+      if (auto status = fluid::writeFinalState(statePath, finalState); !status) {
+        if (group) group->stop();
+        return fail(status.error().message);
+      }
     }
   }
   if (group) group->stop();
+  if (jobBlock) jobBlock->stop();
   return module.exitStatus();
 }

@@ -11,6 +11,15 @@ std::vector<double> toVector(const msg::PackedArray<double>& array) {
   return out;
 }
 
+// Closed boxes meet when they overlap or touch on every axis; unknown bounds meet everything.
+bool meets(const std::optional<msg::Aabb>& bounds, const msg::Aabb* near) {
+  if (near == nullptr || !bounds) return true;
+  for (std::size_t a = 0; a < 3; ++a) {
+    if (bounds->min[a] > near->max[a] || near->min[a] > bounds->max[a]) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 Status World::apply(const msg::MessageView& message) {
@@ -48,6 +57,7 @@ Status World::apply(const msg::MessageView& message) {
       if (auto v = object->vec3(msg::RigidParam::kAngularVelocity)) rigid.body.angularVelocity = *v;
       if (auto m = object->scalar(msg::RigidParam::kMass)) rigid.body.mass = *m;
       if (auto s = object->idParam(msg::RigidParam::kShape)) rigid.shapeId = *s;
+      if (auto b = object->aabb(msg::RigidParam::kBounds)) rigid.bounds = *b;
     } else if (object->typeId() == netId) {
       if (object->op() == msg::ObjectOp::Delete) {
         nets_.erase(object->id());
@@ -59,14 +69,16 @@ Status World::apply(const msg::MessageView& message) {
       if (auto a = object->doubleArray(msg::MassSpringParam::kVelocities))
         net.velocities = toVector(*a);
       if (auto a = object->doubleArray(msg::MassSpringParam::kMasses)) net.masses = toVector(*a);
+      if (auto b = object->aabb(msg::MassSpringParam::kBounds)) net.bounds = *b;
     }
   }
   return {};
 }
 
-std::vector<RigidBody> World::rigidBodies() const {
+std::vector<RigidBody> World::rigidBodies(const msg::Aabb* near) const {
   std::vector<RigidBody> out;
   for (const auto& [id, rigid] : rigids_) {
+    if (!meets(rigid.bounds, near)) continue;
     const auto shape = shapes_.find(rigid.shapeId);
     if (shape == shapes_.end()) continue;
     out.push_back(rigid.body);
@@ -77,10 +89,11 @@ std::vector<RigidBody> World::rigidBodies() const {
   return out;
 }
 
-std::vector<PointMass> World::pointMasses() const {
+std::vector<PointMass> World::pointMasses(const msg::Aabb* near) const {
   std::vector<PointMass> out;
   if (nodeRadius_ <= 0.0) return out;
   for (const auto& [id, net] : nets_) {
+    if (!meets(net.bounds, near)) continue;
     const std::size_t n = net.positions.size() / 3;
     for (std::size_t i = 0; i < n; ++i) {
       PointMass p;

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,9 +24,12 @@ class World {
   Status apply(const msg::MessageView& message);
 
   /// Rigid bodies whose shape has arrived, in id order (deterministic); mass 0 means kinematic.
-  std::vector<RigidBody> rigidBodies() const;
-  /// Mass-spring nodes (empty when nodeRadius is 0), in net id then node order.
-  std::vector<PointMass> pointMasses() const;
+  /// With `near`, only those whose latest bounds meet it (closed boxes, as a route filter
+  /// judges) or whose bounds never came.
+  std::vector<RigidBody> rigidBodies(const msg::Aabb* near = nullptr) const;
+  /// Mass-spring nodes (empty when nodeRadius is 0), in net id then node order; with `near`,
+  /// every node of the nets whose bounds meet it (or never came).
+  std::vector<PointMass> pointMasses(const msg::Aabb* near = nullptr) const;
   /// Rigid objects seen without their shape (not coupled yet), for the log.
   std::vector<std::string> uncoupled() const;
 
@@ -33,9 +37,11 @@ class World {
   struct Rigid {
     RigidBody body;
     std::uint64_t shapeId = 0;
+    std::optional<msg::Aabb> bounds;
   };
   struct Net {
     std::vector<double> positions, velocities, masses;
+    std::optional<msg::Aabb> bounds;
   };
   double nodeRadius_;
   std::map<std::uint64_t, Rigid> rigids_;

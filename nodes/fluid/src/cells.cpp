@@ -173,9 +173,9 @@ void FluidSolver::Impl::dryBodiesOutOfLiquid(std::size_t bodyCount) {
       }
     }
   }
-  if (comm && bodyCount > 0) comm->max(inLiquid);
-  // Every block rasterised every body, so each turns the same cells to air in its planes and
-  // the plane beyond them.
+  combineBodies(inLiquid, 1, true);
+  // Every block rasterised every body that reaches its planes and the plane beyond them, so
+  // each turns the same cells to air there.
   const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
   const std::size_t cFrom = plane * static_cast<std::size_t>(std::max(0, k0 - 1));
   const std::size_t cTo = plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1));

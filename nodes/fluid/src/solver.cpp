@@ -61,6 +61,77 @@ Status FluidSolver::setBlockComm(BlockComm* comm) {
   return {};
 }
 
+void FluidSolver::setLocalBodies(bool local) {
+  impl_->localBodies = local;
+}
+
+void FluidSolver::Impl::uniteBodies(const std::vector<PreparedBody>& bodies) {
+  unionKeys.clear();
+  unionHolder.clear();
+  unionOfBody.clear();
+  if (!comm || !localBodies) return;
+  // Every block sends its list to every block as records (rank, id high, id low, index): whole
+  // numbers below 2^32, exact in doubles.
+  constexpr int kRecord = 4;
+  std::vector<double> mine;
+  mine.reserve(bodies.size() * kRecord);
+  for (const auto& body : bodies) {
+    mine.push_back(comm->rank());
+    mine.push_back(static_cast<double>(body.id >> 32));
+    mine.push_back(static_cast<double>(body.id & 0xffffffffu));
+    mine.push_back(body.index);
+  }
+  const std::vector<std::vector<double>> outgoing(static_cast<std::size_t>(comm->size()), mine);
+  const auto all = comm->exchange(outgoing, kRecord);
+  struct Held {
+    std::pair<std::uint64_t, std::uint32_t> key;
+    int rank;
+  };
+  std::vector<Held> held;
+  held.reserve(all.size() / kRecord);
+  for (std::size_t r = 0; r + kRecord <= all.size(); r += kRecord) {
+    const auto id = (static_cast<std::uint64_t>(all[r + 1]) << 32) |
+                    static_cast<std::uint64_t>(all[r + 2]);
+    held.push_back({{id, static_cast<std::uint32_t>(all[r + 3])}, static_cast<int>(all[r])});
+  }
+  std::sort(held.begin(), held.end(), [](const Held& a, const Held& b) {
+    return a.key != b.key ? a.key < b.key : a.rank < b.rank;
+  });
+  for (const auto& h : held) {
+    if (!unionKeys.empty() && unionKeys.back() == h.key) continue;  // a higher block holds it too
+    unionKeys.push_back(h.key);
+    unionHolder.push_back(h.rank);
+  }
+  for (const auto& body : bodies) {
+    const std::pair<std::uint64_t, std::uint32_t> key{body.id, body.index};
+    unionOfBody.push_back(static_cast<std::size_t>(
+        std::lower_bound(unionKeys.begin(), unionKeys.end(), key) - unionKeys.begin()));
+  }
+}
+
+void FluidSolver::Impl::combineBodies(std::vector<double>& values, std::size_t width,
+                                      bool maximum) {
+  if (!comm) return;
+  if (!localBodies) {  // every block holds the same list
+    if (values.empty()) return;
+    maximum ? comm->max(values) : comm->sum(values);
+    return;
+  }
+  if (unionKeys.empty()) return;  // no block holds a body
+  // A block that does not hold a body adds 0 (or its maximum 0), as a block holding it with no
+  // face in its planes would: the same bits as when every block holds every body.
+  unionScratch.assign(unionKeys.size() * width, 0.0);
+  for (std::size_t b = 0; b < unionOfBody.size(); ++b) {
+    std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(b * width), width,
+                unionScratch.begin() + static_cast<std::ptrdiff_t>(unionOfBody[b] * width));
+  }
+  maximum ? comm->max(unionScratch) : comm->sum(unionScratch);
+  for (std::size_t b = 0; b < unionOfBody.size(); ++b) {
+    std::copy_n(unionScratch.begin() + static_cast<std::ptrdiff_t>(unionOfBody[b] * width), width,
+                values.begin() + static_cast<std::ptrdiff_t>(b * width));
+  }
+}
+
 Status FluidSolver::addLiquidBox(const msg::Aabb& box) {
   auto& m = *impl_;
   for (int d = 0; d < 3; ++d) {
@@ -137,6 +208,7 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
     prepared.push_back(std::move(*p));
   }
 
+  m.uniteBodies(prepared);
   m.pushParticlesOut(prepared);
   m.migrate();
   m.sortParticles();
@@ -163,11 +235,14 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
     detail::bodyForceSums(m.grid, prepared[b], static_cast<int>(b), m.faceBody, m.u, m.uOld,
                           m.settings.gravity, dt, m.k0, kEnd, &sums[b * detail::kBodySums]);
   }
-  if (m.comm && !sums.empty()) m.comm->sum(sums);
+  m.combineBodies(sums, detail::kBodySums, false);
   std::vector<BodyForce> forces;
   forces.reserve(prepared.size());
   for (std::size_t b = 0; b < prepared.size(); ++b) {
     forces.push_back(detail::finishBodyForce(prepared[b], &sums[b * detail::kBodySums], dt));
+    if (m.localBodies && m.comm) {
+      forces.back().reported = m.unionHolder[m.unionOfBody[b]] == m.comm->rank();
+    }
     // A body in air: the faces it shares with a wet body's cells changed, but not for it.
     if (!prepared[b].kinematic && m.inLiquid[b] == 0.0) {
       forces.back().force = {};

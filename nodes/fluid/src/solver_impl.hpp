@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "bodies.hpp"
@@ -50,6 +51,18 @@ struct FluidSolver::Impl {
   double maxDiv = 0.0;
   double lastDt = 1.0;
   BlockComm* comm = nullptr;
+  // Blocks holding their own body lists (setLocalBodies): the union of every block's bodies,
+  // keyed (id, index) in order, the lowest block holding each, and where each body of this
+  // block's list sits in the union.
+  bool localBodies = false;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> unionKeys;
+  std::vector<int> unionHolder;
+  std::vector<std::size_t> unionOfBody;
+  void uniteBodies(const std::vector<PreparedBody>& bodies);
+  // Per-body values (`width` per body, in the order of this block's list) combined over every
+  // block: summed, or the maximum taken. Collective whenever there is a block link.
+  std::vector<double> unionScratch;
+  void combineBodies(std::vector<double>& values, std::size_t width, bool maximum);
   std::uint64_t rng = 1;
 
   double nextJitter() {  // splitmix64 -> [-0.5, 0.5)

@@ -295,6 +295,14 @@ CompositeSources defaultCompositeSources(const Application& app,
       rest = colon == std::string_view::npos ? std::string_view() : rest.substr(colon + 1);
     }
   }
+  // Composites that node packages ship (the fluid's fluid_blocks), beside their manifests:
+  // <folder of this executable>/../share/vrflow/composites, in the build tree and installs alike.
+  std::error_code error;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    sources.searchPath.push_back(
+        (self.parent_path().parent_path() / "share/vrflow/composites").string());
+  }
   return sources;
 }
 

@@ -58,7 +58,14 @@ struct BodyForce {
   msg::Vec3 point{};
   double duration = 0.0;
   int cells = 0;  ///< grid faces the body covered (0: too small or outside: no force)
+  /// False when another block reports this body (blocks holding their own body lists,
+  /// setLocalBodies): every block holding it computed the same force, the lowest one reports it.
+  bool reported = true;
 };
+
+/// How far beyond its slab, in cells, a block with local bodies must hold the bodies (its
+/// rasterisation reaches one plane beyond; the second is a margin).
+inline constexpr int kLocalBodyMargin = 2;
 
 /// Numbers about the last step, for tests and benchmarks.
 struct StepStats {
@@ -99,6 +106,13 @@ class FluidSolver {
   /// particles in them, and every step, addLiquidBox and query below becomes collective (every
   /// block calls it). Call before addLiquidBox; nullptr (the default) is the serial solver.
   Status setBlockComm(BlockComm* comm);
+
+  /// With a block link: each block's step gets only the bodies and points near its slab (those
+  /// whose bounds meet its planes widened by kLocalBodyMargin cells), so blocks hold different
+  /// lists. Per-body sums are then combined by id over every block's list (the union, in id
+  /// order), and each body's force is marked `reported` on the lowest block holding it. A block
+  /// must hold every body that reaches its planes; the others it may hold or not.
+  void setLocalBodies(bool local);
 
   const FluidSettings& settings() const;
   const StepStats& lastStats() const;
