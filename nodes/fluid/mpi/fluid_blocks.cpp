@@ -3,7 +3,9 @@
 // and floor as contacts) from the forces the blocks return. Prints one JSON line on rank 0: the
 // scene, timing, pressure-solve numbers and what the blocks agree on (volume, particle centroid,
 // body heights, a digest of the particle positions). `--serial` runs the library without a
-// BlockComm (on one rank) to compare with `mpirun -np 1`.
+// BlockComm (on one rank) to compare with `mpirun -np 1`. `--local-bodies` gives each block only
+// the boxes near its slab (FluidSolver::setLocalBodies, as the fluid's job modules do) and sums
+// the reported forces over the ranks to integrate every box on every rank.
 #include <mpi.h>
 
 #include <algorithm>
@@ -32,6 +34,7 @@ struct Options {
   int maxParticles = 200000;
   double dt = 0.005;
   bool serial = false;
+  bool localBodies = false;
 };
 
 bool parse(int argc, char** argv, Options& o) {
@@ -44,7 +47,9 @@ bool parse(int argc, char** argv, Options& o) {
       return end && *end == '\0' && std::isfinite(v);
     };
     double v = 0;
-    if (a == "--serial") {
+    if (a == "--local-bodies") {
+      o.localBodies = true;
+    } else if (a == "--serial") {
       o.serial = true;
     } else if (a == "--nx" || a == "--ny" || a == "--nz" || a == "--steps" || a == "--bodies" ||
                a == "--warmup" || a == "--max-particles") {
@@ -136,7 +141,7 @@ int main(int argc, char** argv) {
     if (rank == 0) {
       std::fprintf(stderr,
                    "usage: vrflow-fluid-blocks [--nx N --ny N --nz N --h M --dt S --steps N "
-                   "--warmup N --bodies N --max-particles N --serial]\n");
+                   "--warmup N --bodies N --max-particles N --serial --local-bodies]\n");
     }
     MPI_Finalize();
     return 2;
@@ -162,6 +167,7 @@ int main(int argc, char** argv) {
   auto solver = std::move(created.value());
   fluid::MpiBlockComm comm(MPI_COMM_WORLD);
   if (!o.serial) {
+    solver->setLocalBodies(o.localBodies);
     if (auto status = solver->setBlockComm(&comm); !status) {
       if (rank == 0)
         std::fprintf(stderr, "vrflow-fluid-blocks: %s\n", status.error().message.c_str());
@@ -185,7 +191,17 @@ int main(int argc, char** argv) {
   int timedSteps = 0;
   for (int step = 0; step < o.steps; ++step) {
     std::vector<fluid::RigidBody> bodies;
-    for (const auto& b : boxes) bodies.push_back(b.body);
+    std::vector<std::size_t> held;  // the boxes this block was given
+    int k0 = 0, k1 = s.nz;
+    if (!o.serial) fluid::slabOf(s.nz, rank, size, k0, k1);
+    const double zLo = tank.min[2] + (k0 - fluid::kLocalBodyMargin) * s.cellSize;
+    const double zHi = tank.min[2] + (k1 + fluid::kLocalBodyMargin) * s.cellSize;
+    for (std::size_t b = 0; b < boxes.size(); ++b) {
+      const double z = boxes[b].body.position[2], half = boxes[b].half;
+      if (o.localBodies && (z + half < zLo || z - half > zHi)) continue;
+      bodies.push_back(boxes[b].body);
+      held.push_back(b);
+    }
     MPI_Barrier(MPI_COMM_WORLD);
     const double t0 = MPI_Wtime(), c0 = cpuSeconds();
     auto forces = solver->step(o.dt, bodies);
@@ -198,8 +214,25 @@ int main(int argc, char** argv) {
       MPI_Finalize();
       return 1;
     }
+    // Every box's force on every rank: with local bodies, from the rank that reports it (the
+    // others add zeros, so the sum is that force's bits).
+    std::vector<fluid::BodyForce> all(boxes.size());
+    for (std::size_t i = 0; i < held.size(); ++i) {
+      if ((*forces)[i].reported) all[held[i]] = (*forces)[i];
+    }
+    if (o.localBodies) {
+      std::vector<double> sums(boxes.size() * 3);
+      for (std::size_t b = 0; b < boxes.size(); ++b) {
+        for (int a = 0; a < 3; ++a) sums[3 * b + a] = all[b].force[a];
+      }
+      MPI_Allreduce(MPI_IN_PLACE, sums.data(), static_cast<int>(sums.size()), MPI_DOUBLE, MPI_SUM,
+                    MPI_COMM_WORLD);
+      for (std::size_t b = 0; b < boxes.size(); ++b) {
+        for (int a = 0; a < 3; ++a) all[b].force[a] = sums[3 * b + a];
+      }
+    }
     for (std::size_t b = 0; b < boxes.size(); ++b)
-      integrate(boxes[b], (*forces)[b], o.dt, s.gravity, tank);
+      integrate(boxes[b], all[b], o.dt, s.gravity, tank);
     const auto& st = solver->lastStats();
     if (step >= o.warmup) {
       timed += t1 - t0;
