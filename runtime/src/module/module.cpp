@@ -295,6 +295,12 @@ bool Module::wait() {
     m.finish();
     return false;
   }
+  // Waiting on an input sees a stop request; a module without connected inputs sees it here
+  // (or it would run until killed).
+  if (m.waitOrder.empty() && m.stopRequested()) {
+    m.finish();
+    return false;
+  }
   const uint64_t waitStart = nowNs();
   for (const int portSlot : m.waitOrder) {
     auto& port = m.slot->ports[portSlot];
