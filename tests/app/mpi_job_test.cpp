@@ -75,13 +75,14 @@ TEST(MpiJob, ModulesOfOneTypeWithTheSameValueAreOneJobRankedInModuleOrder) {
   EXPECT_EQ(jobs[2].modules, (std::vector<std::size_t>{4}));
   EXPECT_EQ(jobs[3].name, "shared");
   EXPECT_EQ(jobs[3].modules, (std::vector<std::size_t>{5}));
-  EXPECT_TRUE(check(R"(<application>
+  const std::vector<Diagnostic> found = check(R"(<application>
   <modules>
     <module id="b0" package="par" type="block"><param name="job" value="water"/></module>
     <module id="b1" package="par" type="block"><param name="job" value="water"/></module>
   </modules>
 </application>
-)").empty());
+)");
+  EXPECT_TRUE(found.empty()) << formatDiagnostics(found);
 }
 
 TEST(MpiJob, AJobOnTwoHostsIsAnErrorAtTheModuleOnTheOtherHost) {
