@@ -100,10 +100,11 @@ TEST(MpiJob, AJobOnTwoHostsIsAnErrorAtTheModuleOnTheOtherHost) {
   </modules>
 </application>
 )");
-  EXPECT_ONLY_ERROR_AT(found, 8, 48,
-                       "module 'b1' is on another host than the rest of MPI job 'water' "
-                       "(par/block; b0, b2 on host 'a'; b1, b3 on host 'b'): the modules of one "
-                       "MPI job must be on one host (MPI jobs across hosts are not supported yet)");
+  EXPECT_ONLY_ERROR_AT(
+      found, 8, 48,
+      "module 'b1' is on host 'b' but MPI job 'water' (par/block) began on host 'a' "
+      "(b0, b2 on host 'a'; b1, b3 on host 'b'): the modules of one MPI job "
+      "must be on one host (MPI jobs across hosts are not supported yet)");
 }
 
 TEST(MpiJob, AModuleOfAJobCannotAlsoStartRanksOfItsOwn) {

@@ -35,8 +35,9 @@ void checkOneHost(Validation& v, const MpiJob& job) {
     const Module& module = v.app.modules[m];
     if (effectiveHost(v.app, module.host) == first) continue;
     v.error(module.loc.attribute("host"),
-            "module '" + module.id + "' is on another host than the rest of MPI job '" + job.name +
-                "' (" + job.package + "/" + job.type + "; " + modulesByHost(v, job) +
+            "module '" + module.id + "' is on host '" + effectiveHost(v.app, module.host) +
+                "' but MPI job '" + job.name + "' (" + job.package + "/" + job.type +
+                ") began on host '" + first + "' (" + modulesByHost(v, job) +
                 "): the modules of one MPI job must be on one host (MPI jobs across hosts are "
                 "not supported yet)");
     return;  // one error per job
