@@ -272,5 +272,39 @@ TEST_F(MpiJobRun, ARankThatDiesEndsTheRunNamingTheJob) {
   EXPECT_EQ(report["modules"][4]["exit"], exit);
 }
 
+// A process of an MPI job finds its module by its MPI rank: without a rank, or with one the
+// job's indices do not cover, it refuses to join, saying why (before touching the run).
+TEST(MpiJobModule, ARankWithoutItsEntryInTheJobCannotJoin) {
+  const std::string relay = binDir() + "/vrflow-core-relay";
+  setenv("VRFLOW_SEGMENT_PATH", "/nonexistent", 1);
+  setenv("VRFLOW_MPI_JOB", "water", 1);
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"",
+       "is a module of MPI job 'water' (VRFLOW_MODULE_INDICES=4,7) but has no MPI rank "
+       "(neither OMPI_COMM_WORLD_RANK nor PMIX_RANK is set)"},
+      {"2",
+       "MPI rank 2 (OMPI_COMM_WORLD_RANK) is not a rank of MPI job 'water', which has 2 "
+       "module(s) (VRFLOW_MODULE_INDICES=4,7)"},
+      {"x", "MPI rank x (OMPI_COMM_WORLD_RANK) is not a rank"}};
+  for (const auto& [rank, expected] : cases) {
+    setenv("VRFLOW_MODULE_INDICES", "4,7", 1);
+    if (!rank.empty()) setenv("OMPI_COMM_WORLD_RANK", rank.c_str(), 1);
+    const auto result = runCommand({relay}, 30);
+    unsetenv("OMPI_COMM_WORLD_RANK");
+    EXPECT_NE(result.exitCode, 0) << rank;
+    EXPECT_NE(result.err.find("cannot join the run: "), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find(expected), std::string::npos) << result.err;
+  }
+  setenv("VRFLOW_MODULE_INDICES", "4,,7", 1);
+  setenv("OMPI_COMM_WORLD_RANK", "0", 1);
+  const auto malformed = runCommand({relay}, 30);
+  EXPECT_NE(malformed.err.find("malformed VRFLOW_MODULE_INDICES '4,,7'"), std::string::npos)
+      << malformed.err;
+  for (const char* name :
+       {"VRFLOW_SEGMENT_PATH", "VRFLOW_MPI_JOB", "VRFLOW_MODULE_INDICES", "OMPI_COMM_WORLD_RANK"}) {
+    unsetenv(name);
+  }
+}
+
 }  // namespace
 }  // namespace vrflow::testing
