@@ -242,6 +242,26 @@ TEST_F(MpiJobRun, WithoutMpirunAJobOfTwoModulesFailsAtStartNamingIt) {
   EXPECT_FALSE(std::ifstream(dir.file("b0.csv")).good()) << "a recorder was started";
 }
 
+// A launcher that cannot be run: one error naming the job and the launcher; the modules
+// already started (the recorders, first in the file) are stopped.
+TEST_F(MpiJobRun, AMissingMpirunIsAClearErrorNamingTheJob) {
+  const auto file = dir.write(
+      "missing.xml",
+      application(kOneHost,
+                  recorder("b0", dir.file("b0.csv")) + recorder("b1", dir.file("b1.csv")) +
+                      rankModule("b0", "water") + rankModule("b1", "water"),
+                  recorded("b0") + recorded("b1")));
+  setenv("VRFLOW_MPIRUN", "/nonexistent/mpirun", 1);
+  const auto result = runVrflow({"run", file, "--iterations", "5", "--no-progress"}, 60);
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("MPI job 'water' (modules b0, b1; host local): cannot start "
+                            "'/nonexistent/mpirun'"),
+            std::string::npos)
+      << result.err;
+  EXPECT_NE(result.err.find("an MPI job of 2 modules is started through mpirun"), std::string::npos)
+      << result.err;
+}
+
 // A rank that dies (SIGKILL at its iteration 3) ends its mpirun, which ends the job's other
 // modules and the run: one error naming the job, long before --timeout would end the run.
 TEST_F(MpiJobRun, ARankThatDiesEndsTheRunNamingTheJob) {
