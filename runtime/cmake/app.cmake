@@ -21,6 +21,7 @@ vrflow_add_library(app
     src/app/rates.cpp
     src/app/manifest_reader.cpp
     src/app/model.cpp
+    src/app/mpi_job.cpp
     src/app/overrides.cpp
     src/app/package.cpp
     src/app/source_location.cpp
@@ -30,6 +31,7 @@ vrflow_add_library(app
     src/app/validate.cpp
     src/app/validate_connections.cpp
     src/app/validate_cycles.cpp
+    src/app/validate_mpi_jobs.cpp
     src/app/xml_out.cpp
   PUBLIC_DEPS vrflow::base
   PRIVATE_DEPS pugixml::pugixml)

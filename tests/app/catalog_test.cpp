@@ -236,6 +236,36 @@ TEST(Catalog, MpiRanksNamesAnIntParameter) {
   }
 }
 
+// mpi-job names the string parameter whose value groups modules into one MPI job; naming
+// anything else is an error at the attribute.
+TEST(Catalog, MpiJobNamesAStringParameter) {
+  Catalog catalog;
+  ASSERT_TRUE(catalog
+                  .addPackageString("<package name=\"p\">\n  <module type=\"m\" executable=\"x\" "
+                                    "mpi-job=\"job\">\n    <param name=\"job\" "
+                                    "type=\"string\"/>\n  </module>\n</package>\n",
+                                    "pkg.xml")
+                  .ok());
+  const auto* type = catalog.findModule("p", "m");
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->mpiJobParam, "job");
+  EXPECT_EQ(type->mpiRanksParam, "");
+  for (const char* param : {"<param name=\"job\" type=\"int\"/>", ""}) {
+    Catalog bad;
+    const Status status = bad.addPackageString(
+        std::string("<package name=\"q\">\n  <module type=\"m\" executable=\"x\" "
+                    "mpi-job=\"job\">\n    ") +
+            param + "\n  </module>\n</package>\n",
+        "bad.xml");
+    ASSERT_FALSE(status.ok());
+    EXPECT_EQ(status.error().message.rfind("bad.xml:2:", 0), 0u) << status.error().message;
+    EXPECT_NE(status.error().message.find("mpi-job names 'job', which is not a string parameter "
+                                          "of 'm'"),
+              std::string::npos)
+        << status.error().message;
+  }
+}
+
 TEST(Catalog, SamePackageFromAnotherFileIsAnError) {
   Catalog catalog;
   ASSERT_TRUE(catalog.addPackageFile(packagesDir() + "/core/vrflow-package.xml").ok());

@@ -245,7 +245,7 @@ TEST(CompositeErrors, AProblemRepeatedByEveryIterationIsReportedOnce) {
   const std::vector<Diagnostic> found = checkComposed(oneInstance(R"(
       <modules><repeat var="i" count="5000"><module id="m${j}" package="core" type="relay"/></repeat></modules>)"));
   EXPECT_ONLY_ERROR_AT(found, 4, 53,
-                       "attribute 'id' of <module>: unknown name 'j' in '${j}' (known: i)");
+                       "attribute 'id' of <module>: unknown name 'j' in '${j}' (known: i, instance)");
 }
 
 TEST(CompositeErrors, IdsInsideACompositeMustNotHoldTheSeparator) {
@@ -258,6 +258,19 @@ TEST(CompositeErrors, RepeatVariableMayNotHideAParameter) {
   EXPECT_ONLY_ERROR_AT(checkComposed(oneInstance(R"(<param name="i" default="1"/>
       <modules><repeat var="i" count="2"><module id="r${i}" package="core" type="relay"/></repeat></modules>)")),
                        4, 24, "repeat variable 'i' hides a parameter");
+}
+
+// `instance` is the built-in ${instance} (the id of the instance being expanded): neither a
+// parameter nor a repeat variable may take that name.
+TEST(CompositeErrors, InstanceIsAReservedName) {
+  EXPECT_ONLY_ERROR_AT(checkComposed(oneInstance(R"(<param name="instance" default="x"/>
+      <modules><module id="r" package="core" type="relay"/></modules>)")),
+                       3, 32,
+                       "parameter name 'instance' is reserved: ${instance} is the id of the "
+                       "instance being expanded; choose another name");
+  EXPECT_ONLY_ERROR_AT(checkComposed(oneInstance(R"(
+      <modules><repeat var="instance" count="2"><module id="r${instance}" package="core" type="relay"/></repeat></modules>)")),
+                       4, 24, "repeat variable 'instance' is reserved");
 }
 
 TEST(CompositeErrors, StructuralProblemsOfACompositeAreFoundWhenLoading) {

@@ -129,6 +129,46 @@ TEST(CompositeExpansion, NestedCompositesPrefixEveryLevelAndResolvePortsThroughE
   EXPECT_EQ(deepest->loc.file, testing::compositeDir() + "/relay_pair.vrc.xml");
 }
 
+// ${instance} is the full id of the instance being expanded: unique per instance at every
+// level, which is what an MPI job name needs (one job per instance of a parallel module).
+TEST(CompositeExpansion, InstanceIsTheFullIdOfTheInstanceBeingExpanded) {
+  const Application flat = expandOrFail(R"(<application>
+  <composites>
+    <composite name="block">
+      <param name="tag" default="none"/>
+      <modules>
+        <module id="s" package="core" type="source">
+          <param name="label" value="${instance}/${tag}"/>
+        </module>
+      </modules>
+    </composite>
+    <composite name="outer">
+      <modules>
+        <module id="own" package="core" type="source"><param name="label" value="${instance}"/></module>
+      </modules>
+      <instances>
+        <instance id="water" composite="block"><param name="tag" value="${instance}"/></instance>
+      </instances>
+    </composite>
+  </composites>
+  <instances>
+    <instance id="water" composite="block"/>
+    <instance id="o" composite="outer"/>
+    <instance id="p" composite="outer"/>
+  </instances>
+</application>
+)");
+  std::map<std::string, std::string> labels;
+  for (const Module& module : flat.modules) {
+    labels[module.id] = paramString(module.params, "label", "?");
+  }
+  EXPECT_EQ(labels, (std::map<std::string, std::string>{{"water:s", "water/none"},
+                                                        {"o:own", "o"},
+                                                        {"o:water:s", "o:water/o"},
+                                                        {"p:own", "p"},
+                                                        {"p:water:s", "p:water/p"}}));
+}
+
 TEST(CompositeExpansion, NodesWithoutAHostRunOnTheHostOfTheirInstance) {
   const Application flat =
       expandOrFail(testing::readFile(testing::compositeDir() + "/composites_in_file.xml"));
@@ -259,7 +299,7 @@ TEST(CompositeExpansion, SubstitutionFollowsTheDocumentedGrammar) {
 TEST(CompositeExpansion, SubstitutionErrorsSayWhatIsWrong) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"${x +}", "an operand is missing"},
-      {"${y}", "unknown name 'y' in '${y}' (known: word, x)"},
+      {"${y}", "unknown name 'y' in '${y}' (known: instance, word, x)"},
       {"${y + 1}", "unknown name 'y'"},
       {"${word + 1}", "'word' is 'hello', not an integer"},
       {"${x / (x - 7)}", "division by zero"},

@@ -82,6 +82,11 @@ TemplateElement readTemplate(const ReadContext& context, const pugi::xml_node& n
       reader.errorAt("var", "repeat variable '" + var +
                                 "' must be a name: a letter or '_', then letters, digits, '_'");
     }
+    if (var == kInstanceTemplateName) {
+      reader.errorAt("var", "repeat variable '" + var +
+                                "' is reserved: ${instance} is the id of the instance being "
+                                "expanded; choose another name");
+    }
     if (repeatDepth >= kMaxRepeatDepth) {
       context.error(reader.loc(),
                     "<repeat> is nested more than " + std::to_string(kMaxRepeatDepth) + " deep");
@@ -114,6 +119,11 @@ CompositeParam readCompositeParam(const ReadContext& context, const pugi::xml_no
   if (!param.name.empty() && !isTemplateName(param.name)) {
     reader.errorAt("name", "parameter name '" + param.name +
                                "' must be a name: a letter or '_', then letters, digits, '_'");
+  }
+  if (param.name == kInstanceTemplateName) {
+    reader.errorAt("name", "parameter name '" + param.name +
+                               "' is reserved: ${instance} is the id of the instance being "
+                               "expanded; choose another name");
   }
   if (reader.has("default")) param.defaultValue = reader.text("default");
   param.min = readBound(reader, "min");

@@ -200,6 +200,7 @@ bool Expander::bindParams(const Composite& composite, const std::vector<Param>& 
     }
     scope[param.name] = value;
   }
+  scope[std::string(kInstanceTemplateName)] = instance;
   return bound;
 }
 

@@ -117,7 +117,9 @@ void Expander::walk(const std::vector<TemplateElement>& elements, Frame& frame,
 void Expander::walkRepeat(const TemplateElement& repeat, Frame& frame,
                           const std::function<void(const TemplateElement&)>& visit) {
   const std::string* var = repeat.find("var");
-  if (var == nullptr || !isTemplateName(*var)) return;  // reported when loading
+  if (var == nullptr || !isTemplateName(*var) || *var == kInstanceTemplateName) {
+    return;  // reported when loading
+  }
   const SourceLocation loc = located(repeat.loc, frame);
   const std::optional<long long> count = integerAttribute(repeat, "count", frame);
   std::optional<long long> start = 0;

@@ -104,7 +104,7 @@ std::string resolveExecutable(const std::string& executable, const std::string& 
 
 ModuleType readModuleType(const ReadContext& context, const pugi::xml_node& node,
                           const std::string& package) {
-  const ElementReader reader(context, node, {"type", "executable", "kind", "mpi-ranks"});
+  const ElementReader reader(context, node, {"type", "executable", "kind", "mpi-ranks", "mpi-job"});
   ModuleType type;
   type.package = package;
   type.type = reader.required("type");
@@ -151,6 +151,15 @@ ModuleType readModuleType(const ReadContext& context, const pugi::xml_node& node
     if (param == nullptr || param->type != ParamType::Int) {
       context.error(context.source.element(node).attribute("mpi-ranks"),
                     "mpi-ranks names '" + type.mpiRanksParam + "', which is not an int " +
+                        "parameter of '" + type.type + "'");
+    }
+  }
+  type.mpiJobParam = reader.text("mpi-job");
+  if (!type.mpiJobParam.empty()) {
+    const ParamSpec* param = type.findParam(type.mpiJobParam);
+    if (param == nullptr || param->type != ParamType::String) {
+      context.error(context.source.element(node).attribute("mpi-job"),
+                    "mpi-job names '" + type.mpiJobParam + "', which is not a string " +
                         "parameter of '" + type.type + "'");
     }
   }

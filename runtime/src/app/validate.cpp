@@ -235,6 +235,7 @@ std::vector<Diagnostic> validate(const Application& app, const Catalog& catalog)
     detail::checkNodes(validation);
     detail::checkConnections(validation);
     detail::checkCycles(validation);
+    detail::checkMpiJobs(validation);
     sortAndDeduplicate(validation.diagnostics);
     return std::move(validation.diagnostics);
   } catch (const std::exception& e) {

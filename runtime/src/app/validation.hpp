@@ -61,5 +61,7 @@ void checkNodes(Validation& validation);
 void checkConnections(Validation& validation);
 /// Cycles that no initial message starts.
 void checkCycles(Validation& validation);
+/// MPI jobs of several modules: all on one host, none that also starts ranks of its own.
+void checkMpiJobs(Validation& validation);
 
 }  // namespace vrflow::app::detail

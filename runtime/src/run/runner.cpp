@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -19,6 +21,8 @@
 #include "report.hpp"
 #include "spawn.hpp"
 #include "vrflow/app/graph.hpp"
+#include "vrflow/app/mpi_job.hpp"
+#include "vrflow/base/assert.hpp"
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/message/ids.hpp"
@@ -63,9 +67,10 @@ std::string sourcesOf(const app::Application& application, const std::string& mo
 
 class Supervisor {
  public:
+  /// `jobs`: the MPI jobs of `application` (app::mpiJobs); those of several modules start as
+  /// one mpirun each.
   Supervisor(const app::Application& application, const RunOptions& options,
-             daemon::Daemon& daemon)
-      : application_(application), options_(options), daemon_(daemon) {}
+             daemon::Daemon& daemon, std::vector<app::MpiJob> jobs);
 
   RunOutcome run();
 
@@ -73,9 +78,14 @@ class Supervisor {
   struct Child {
     pid_t pid = 0;
     int mpiRanks = 0;  ///< above 1: `pid` is the mpirun that runs this many ranks
+    int job = -1;      ///< index in jobs_: `pid` is the mpirun of that job, shared by its modules
     bool alive = false;
     ModuleEnd end{"not started"};
   };
+  std::string jobLabel(const app::MpiJob& job, pid_t mpirun) const;
+  std::optional<std::string> jobsWithoutMpirun() const;
+  bool startJob(std::size_t jobIndex, int segmentFd, std::vector<std::string> environment,
+                RunOutcome& outcome);
   void reap(RunOutcome& outcome, bool stopping);
   void stopAll();
   std::size_t liveCount() const;
@@ -119,8 +129,12 @@ class Supervisor {
       m["compute_ns"] = slot.computeNs.load();
       m["wait_ns"] = slot.waitNs.load();
       uint64_t cpuNs = 0, rss = 0;
+      // A module of an MPI job is its rank's process (it wrote its pid when it joined), not
+      // the mpirun it shares with the job's other modules.
+      const int32_t own = slot.pid.load();
+      const pid_t pid = children_[i].job >= 0 && own > 0 ? own : children_[i].pid;
       if (children_[i].alive) {
-        std::FILE* stat = std::fopen(("/proc/" + std::to_string(children_[i].pid) + "/stat").c_str(), "r");
+        std::FILE* stat = std::fopen(("/proc/" + std::to_string(pid) + "/stat").c_str(), "r");
         if (stat != nullptr) {
           char text[1024] = {};
           const std::size_t n = std::fread(text, 1, sizeof text - 1, stat);
@@ -133,7 +147,7 @@ class Supervisor {
             cpuNs = (utime + stime) * (1'000'000'000ull / static_cast<unsigned long>(ticks));
           }
         }
-        std::FILE* statm = std::fopen(("/proc/" + std::to_string(children_[i].pid) + "/statm").c_str(), "r");
+        std::FILE* statm = std::fopen(("/proc/" + std::to_string(pid) + "/statm").c_str(), "r");
         if (statm != nullptr) {
           unsigned long size = 0, resident = 0;
           if (std::fscanf(statm, "%lu %lu", &size, &resident) == 2) rss = resident * static_cast<unsigned long>(page);
@@ -161,6 +175,8 @@ class Supervisor {
   const app::Application& application_;
   const RunOptions& options_;
   daemon::Daemon& daemon_;
+  std::vector<app::MpiJob> jobs_;  ///< only those of several modules
+  std::vector<int> jobOf_;         ///< per module: its index in jobs_, or -1
   std::vector<Child> children_;
   Clock::time_point start_ = Clock::now();
   uint64_t lastIterationSum_ = 0;
@@ -177,6 +193,62 @@ class Supervisor {
   }
 };
 
+Supervisor::Supervisor(const app::Application& application, const RunOptions& options,
+                       daemon::Daemon& daemon, std::vector<app::MpiJob> jobs)
+    : application_(application), options_(options), daemon_(daemon) {
+  // Modules and slots follow the application's module order (Daemon::create).
+  VRFLOW_ASSERT(daemon_.modules().size() == application_.modules.size(),
+                "one daemon module per application module");
+  jobOf_.assign(daemon_.modules().size(), -1);
+  for (auto& job : jobs) {
+    if (job.modules.size() < 2) continue;  // one module: a plain process (MPI singleton)
+    for (const std::size_t m : job.modules) jobOf_[m] = static_cast<int>(jobs_.size());
+    jobs_.push_back(std::move(job));
+  }
+}
+
+// "MPI job 'water' (modules water:b0, water:b1; host local; mpirun pid 42)".
+std::string Supervisor::jobLabel(const app::MpiJob& job, pid_t mpirun) const {
+  const auto& first = daemon_.modules()[job.modules.front()];
+  return "MPI job '" + job.name + "' (modules " + job.moduleIds(application_) + "; host " +
+         first.host + (mpirun > 0 ? "; mpirun pid " + std::to_string(mpirun) : "") + ")";
+}
+
+// With VRFLOW_MPIRUN=none no job of several modules can start (its modules are the ranks of
+// one mpirun): the reason, before anything starts.
+std::optional<std::string> Supervisor::jobsWithoutMpirun() const {
+  const char* mpirun = std::getenv("VRFLOW_MPIRUN");
+  if (jobs_.empty() || mpirun == nullptr || std::string(mpirun) != "none") return std::nullopt;
+  const app::MpiJob& job = jobs_.front();
+  return jobLabel(job, 0) + " cannot start: VRFLOW_MPIRUN=none, but its " +
+         std::to_string(job.modules.size()) +
+         " modules run as the ranks of one mpirun (unset VRFLOW_MPIRUN, or give each module a "
+         "job of its own)";
+}
+
+// Starts every module of jobs_[jobIndex] as one mpirun; false (and `outcome` says why) when it
+// cannot start.
+bool Supervisor::startJob(std::size_t jobIndex, int segmentFd,
+                          std::vector<std::string> environment, RunOutcome& outcome) {
+  const app::MpiJob& job = jobs_[jobIndex];
+  std::vector<int> slots;
+  for (const std::size_t m : job.modules) slots.push_back(daemon_.modules()[m].slotIndex);
+  environment.push_back("VRFLOW_MPI_JOB=" + job.name);
+  const auto& first = daemon_.modules()[job.modules.front()];
+  auto pid = spawnMpiJob(first.executable, slots, segmentFd, environment);
+  if (!pid) {
+    outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + pid.error().message};
+    return false;
+  }
+  for (const std::size_t m : job.modules) {
+    children_[m].pid = *pid;
+    children_[m].job = static_cast<int>(jobIndex);
+    children_[m].alive = true;
+    children_[m].end.exit = "running";
+  }
+  return true;
+}
+
 std::size_t Supervisor::liveCount() const {
   std::size_t n = 0;
   for (const auto& c : children_) n += c.alive ? 1 : 0;
@@ -187,6 +259,10 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
   int status = 0;
   pid_t pid = 0;
   while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
+    // One process: a module, or the mpirun of an MPI job that all its modules share.
+    std::string notJoined;  // the first module that never joined, if any
+    int job = -1;
+    std::size_t first = children_.size();
     for (std::size_t i = 0; i < children_.size(); ++i) {
       Child& child = children_[i];
       if (child.pid != pid || !child.alive) continue;
@@ -195,21 +271,37 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
                                          : "signal " + std::to_string(WTERMSIG(status));
       daemon_.moduleEnded(static_cast<int>(i));
       const auto& module = daemon_.modules()[i];
-      const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-      const bool joined = daemon_.slot(module.slotIndex).state.load() !=
-                          static_cast<uint32_t>(ipc::ModuleState::Starting);
-      if ((!clean || !joined) && !stopping && outcome.exitCode == kExitOk) {
-        outcome.exitCode = kExitRunFailed;
-        outcome.status = "failed";
-        const bool mpirun = child.mpiRanks > 1;
-        outcome.error = "module '" + module.id + "' (host " + module.host + ", " +
-                        (mpirun ? std::to_string(child.mpiRanks) + " MPI ranks, mpirun pid "
-                                : std::string("pid ")) +
-                        std::to_string(pid) + ") " +
-                        (mpirun ? describeMpirunWaitStatus(status) : describeWaitStatus(status)) +
-                        (joined ? "" : " before joining the run (it never called Module::init())");
+      if (notJoined.empty() && daemon_.slot(module.slotIndex).state.load() ==
+                                   static_cast<uint32_t>(ipc::ModuleState::Starting)) {
+        notJoined = module.id;
       }
+      if (first == children_.size()) first = i;
+      job = child.job;
     }
+    if (first == children_.size()) continue;  // not a process of this run
+    const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    if ((clean && notJoined.empty()) || stopping || outcome.exitCode != kExitOk) continue;
+    outcome.exitCode = kExitRunFailed;
+    outcome.status = "failed";
+    if (job >= 0) {
+      outcome.error = jobLabel(jobs_[static_cast<std::size_t>(job)], pid) + " " +
+                      describeMpirunWaitStatus(status) +
+                      (notJoined.empty() ? ""
+                                         : " before module '" + notJoined +
+                                               "' joined the run (it never called "
+                                               "Module::init())");
+      continue;
+    }
+    const Child& child = children_[first];
+    const auto& module = daemon_.modules()[first];
+    const bool mpirun = child.mpiRanks > 1;
+    outcome.error = "module '" + module.id + "' (host " + module.host + ", " +
+                    (mpirun ? std::to_string(child.mpiRanks) + " MPI ranks, mpirun pid "
+                            : std::string("pid ")) +
+                    std::to_string(pid) + ") " +
+                    (mpirun ? describeMpirunWaitStatus(status) : describeWaitStatus(status)) +
+                    (notJoined.empty() ? ""
+                                       : " before joining the run (it never called Module::init())");
   }
 }
 
@@ -243,9 +335,13 @@ bool Supervisor::notJoined(std::string& detail) {
                                   static_cast<uint32_t>(ipc::ModuleState::Starting)) {
       char text[64];
       std::snprintf(text, sizeof text, "%g s", options_.joinSeconds);
-      detail = "module '" + module.id + "' (host " + module.host + ", pid " +
-               std::to_string(children_[i].pid) + ") did not join the run within " + text +
-               " (it never called Module::init())";
+      const int job = children_[i].job;
+      const std::string process =
+          job < 0 ? "pid " + std::to_string(children_[i].pid)
+                  : "a rank of MPI job '" + jobs_[static_cast<std::size_t>(job)].name +
+                        "', mpirun pid " + std::to_string(children_[i].pid);
+      detail = "module '" + module.id + "' (host " + module.host + ", " + process +
+               ") did not join the run within " + text + " (it never called Module::init())";
       return true;
     }
   }
@@ -330,8 +426,14 @@ void Supervisor::stopAll() {
   }
   for (int round = 0; round < 2 && liveCount() > 0; ++round) {
     const int sig = round == 0 ? SIGTERM : SIGKILL;
+    std::vector<pid_t> signalled;  // the modules of an MPI job share one mpirun
     for (auto& child : children_) {
-      if (child.alive) kill(-child.pid, sig);  // its whole process group: wrappers too
+      if (!child.alive ||
+          std::find(signalled.begin(), signalled.end(), child.pid) != signalled.end()) {
+        continue;
+      }
+      kill(-child.pid, sig);  // its whole process group: wrappers too
+      signalled.push_back(child.pid);
     }
     const auto end = Clock::now() + std::chrono::seconds(1);
     while (liveCount() > 0 && (round == 1 || Clock::now() < end)) {
@@ -350,17 +452,23 @@ RunOutcome Supervisor::run() {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGCHLD);
+  if (auto refused = jobsWithoutMpirun()) return {kExitRunFailed, "failed", *refused};
   if (auto status = daemon_.start(); !status) {
     return {kExitRunFailed, "failed", status.error().message};
   }
   const int fd = daemon_.segment().fd();
   children_.resize(daemon_.modules().size());
   for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
+    if (children_[i].alive) continue;  // started with its MPI job
     const auto& module = daemon_.modules()[i];
     std::vector<std::string> environment{
         "VRFLOW_SEGMENT_FD=" + std::to_string(fd),
         "VRFLOW_MODULE_INDEX=" + std::to_string(module.slotIndex), "VRFLOW_MODULE_ID=" + module.id,
         "VRFLOW_HOST=" + module.host};
+    if (jobOf_[i] >= 0) {
+      if (!startJob(static_cast<std::size_t>(jobOf_[i]), fd, environment, outcome)) break;
+      continue;
+    }
     const char* mpirun = std::getenv("VRFLOW_MPIRUN");
     const bool viaMpirun = module.mpiRanks > 1 && !(mpirun != nullptr && std::string(mpirun) == "none");
     auto pid = viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, fd, environment)
@@ -483,7 +591,7 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
     return {kExitRunFailed, "failed", daemon.error().message};
   }
   const auto start = Clock::now();
-  Supervisor supervisor(application, options, **daemon);
+  Supervisor supervisor(application, options, **daemon, app::mpiJobs(application, catalog));
   RunOutcome outcome;
   if (options.hostLink != nullptr) {
     if (auto status = options.hostLink->ready(); !status) {

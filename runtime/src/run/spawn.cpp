@@ -74,8 +74,13 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
   return pid;
 }
 
-Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segmentFd,
-                             const std::vector<std::string>& extraEnvironment) {
+namespace {
+
+// Starts `executable` as `ranks` ranks of one job through mpirun (VRFLOW_MPIRUN names another
+// launcher), with `extraEnvironment` exported to every rank (VRFLOW_SEGMENT_FD replaced by
+// VRFLOW_SEGMENT_PATH: mpirun closes inherited descriptors).
+Result<pid_t> spawnMpirun(const std::string& executable, int ranks, int segmentFd,
+                          const std::vector<std::string>& extraEnvironment) {
   const char* launcher = std::getenv("VRFLOW_MPIRUN");
   const std::string mpirun = launcher != nullptr && *launcher != '\0' ? launcher : "mpirun";
   std::vector<std::string> environment;
@@ -84,7 +89,6 @@ Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segme
   }
   environment.push_back("VRFLOW_SEGMENT_PATH=/proc/" + std::to_string(getpid()) + "/fd/" +
                         std::to_string(segmentFd));
-  environment.push_back("VRFLOW_MPI_RANKS=" + std::to_string(ranks));
   // More ranks than cores is allowed; ranks that wait yield the core. Root (containers, CI)
   // must be allowed explicitly.
   // CMA single copies need ptrace rights that containers often withhold: copy through the
@@ -103,10 +107,43 @@ Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segme
     }
   }
   args.push_back(executable);
-  auto pid = spawnModule(mpirun, args, -1, environment);
+  return spawnModule(mpirun, args, -1, environment);
+}
+
+}  // namespace
+
+Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segmentFd,
+                             const std::vector<std::string>& extraEnvironment) {
+  std::vector<std::string> environment = extraEnvironment;
+  environment.push_back("VRFLOW_MPI_RANKS=" + std::to_string(ranks));
+  auto pid = spawnMpirun(executable, ranks, segmentFd, environment);
   if (!pid) {
     return makeError(pid.error().message + " (a module of " + std::to_string(ranks) +
                      " MPI ranks is started through mpirun: install Open MPI, or set "
+                     "VRFLOW_MPIRUN)");
+  }
+  return pid;
+}
+
+Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>& slotIndices,
+                          int segmentFd, const std::vector<std::string>& extraEnvironment) {
+  std::string indices;
+  for (const int index : slotIndices) {
+    indices += (indices.empty() ? "" : ",") + std::to_string(index);
+  }
+  std::vector<std::string> environment;
+  for (const auto& e : extraEnvironment) {
+    // One process per module: the modules' own index and id would name rank 0's to every rank.
+    if (e.rfind("VRFLOW_MODULE_INDEX=", 0) != 0 && e.rfind("VRFLOW_MODULE_ID=", 0) != 0) {
+      environment.push_back(e);
+    }
+  }
+  environment.push_back("VRFLOW_MODULE_INDICES=" + indices);
+  const int ranks = static_cast<int>(slotIndices.size());
+  auto pid = spawnMpirun(executable, ranks, segmentFd, environment);
+  if (!pid) {
+    return makeError(pid.error().message + " (an MPI job of " + std::to_string(ranks) +
+                     " modules is started through mpirun: install Open MPI, or set "
                      "VRFLOW_MPIRUN)");
   }
   return pid;

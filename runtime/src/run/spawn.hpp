@@ -25,6 +25,15 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
 Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segmentFd,
                              const std::vector<std::string>& extraEnvironment);
 
+/// Starts the modules of one MPI job (app::MpiJob), one per rank, as one `mpirun -np N` of
+/// `executable` with N = slotIndices.size(), the options, launcher and segment path of
+/// spawnMpiModule(). Rank r joins the run as the module of slot slotIndices[r]: the ranks get
+/// VRFLOW_MODULE_INDICES="i0,i1,..." (Module::init() takes the entry of its rank, from
+/// OMPI_COMM_WORLD_RANK or PMIX_RANK) instead of VRFLOW_MODULE_INDEX and VRFLOW_MODULE_ID, and
+/// no VRFLOW_MPI_RANKS (every rank is a module, none a worker).
+Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>& slotIndices,
+                          int segmentFd, const std::vector<std::string>& extraEnvironment);
+
 /// "exited with status 3" / "was killed by signal 11 (Segmentation fault)".
 std::string describeWaitStatus(int status);
 

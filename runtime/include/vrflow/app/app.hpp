@@ -9,6 +9,7 @@
 #include "vrflow/app/graph.hpp"           // IWYU pragma: export
 #include "vrflow/app/loader.hpp"          // IWYU pragma: export
 #include "vrflow/app/model.hpp"           // IWYU pragma: export
+#include "vrflow/app/mpi_job.hpp"         // IWYU pragma: export
 #include "vrflow/app/package.hpp"         // IWYU pragma: export
 #include "vrflow/app/validate.hpp"        // IWYU pragma: export
 #include "vrflow/app/writer.hpp"          // IWYU pragma: export

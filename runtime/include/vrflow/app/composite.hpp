@@ -71,6 +71,11 @@ inline constexpr std::string_view kCompositeFileSuffix = ".vrc.xml";
 /// '.').
 inline constexpr char kInstanceSeparator = ':';
 
+/// The built-in template name: inside a composite's body, `${instance}` is the full id of the
+/// instance being expanded (`water`, or `outer:water` when nested). A composite parameter or a
+/// `<repeat>` variable cannot take this name.
+inline constexpr std::string_view kInstanceTemplateName = "instance";
+
 /// The declared parameter `name`, or nullptr.
 const CompositeParam* findCompositeParam(const Composite& composite, std::string_view name);
 /// The port called `name` among `ports` (a composite's inputs or outputs), or nullptr.

@@ -58,6 +58,11 @@ struct ModuleType {
   /// starts the module as N MPI ranks through `mpirun` (rank 0 is the module vrflow talks to;
   /// the others are its workers). Manifest attribute `mpi-ranks`.
   std::string mpiRanksParam;
+  /// Empty, or the name of a string parameter: modules of this type whose value of it is the
+  /// same non-empty text form one MPI job named by it, one module per rank (rank r is the r-th
+  /// of them in the application's module order; see mpi_job.hpp). The runtime starts a job of
+  /// N >= 2 modules as one `mpirun -np N`. Manifest attribute `mpi-job`.
+  std::string mpiJobParam;
   std::string doc;
   std::vector<PortSpec> ports;  ///< declared ports, then beginIt and endIt
   std::vector<ParamSpec> params;
