@@ -218,8 +218,9 @@ TEST(DamBreakExample, OneFluidModulePerBlockEqualsTheFluidsOwnBlocks) {
   EXPECT_EQ(fluid[1]["centroid"], fluid[0]["centroid"]);
   EXPECT_EQ(fluid[1]["maxSpeed"], fluid[0]["maxSpeed"]);
   ASSERT_EQ(fluid[1]["bodies"].size(), fluid[0]["bodies"].size());
+  // Bodies in id order; the ids themselves differ (other modules take other id ranges).
   for (std::size_t b = 0; b < fluid[0]["bodies"].size(); ++b) {
-    EXPECT_EQ(fluid[1]["bodies"][b]["id"], fluid[0]["bodies"][b]["id"]);
+    EXPECT_EQ(fluid[1]["bodies"][b]["position"], fluid[0]["bodies"][b]["position"]) << b;
     EXPECT_EQ(fluid[1]["bodies"][b]["force"], fluid[0]["bodies"][b]["force"]) << b;
     EXPECT_EQ(fluid[1]["bodies"][b]["torque"], fluid[0]["bodies"][b]["torque"]) << b;
     EXPECT_EQ(fluid[1]["bodies"][b]["faces"], fluid[0]["bodies"][b]["faces"]) << b;

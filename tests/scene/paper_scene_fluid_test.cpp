@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "../fluid/example_apps.hpp"
 #include "process_helpers.hpp"
 #include "vrflow/massspring/net.hpp"
 
@@ -96,6 +97,35 @@ TEST(PaperSceneFluid, SixtyIterationsKeepBodiesInTheWorldTheLiquidInItsPoolAndDr
     if (entry.path().extension() == ".mp4" && entry.file_size() > 0) video = true;
   }
   EXPECT_TRUE(video || frames == static_cast<std::size_t>(kIterations)) << frames << " frames";
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+// paper_scene_fluid_blocks.xml: the same scene with the liquid as one fluid module per MPI block
+// (composite fluid_blocks: a route filter feeding each block the bodies and the net near its
+// slab, gather filters joining forces and particles). It computes what the fluid's own two
+// blocks compute: after 60 iterations the bodies' and the net's final states are the same
+// bytes, and so are the liquid's particle count, volume, centroid and level.
+TEST(PaperSceneFluid, OneFluidModulePerBlockGivesTheSceneOfTheFluidsOwnTwoBlocks) {
+  const char* files[2] = {"paper_scene_fluid.xml", "paper_scene_fluid_blocks.xml"};
+  const char* fluidStates[2] = {"fluid-final.json", "fluid-blocks-final.json"};
+  std::string bodies[2], net[2];
+  nlohmann::json fluid[2];
+  for (int run = 0; run < 2; ++run) {
+    TempDir dir;
+    const auto app = exampleForTest("paper_scene", files[run],
+                                    run == 0 ? ParamOverrides{{"water.blocks", "2"}} : ParamOverrides{});
+    const auto result = runApp(dir, app, kIterations, 200);
+    ASSERT_EQ(result.exitCode, 0) << files[run] << ": " << result.err;
+    bodies[run] = readFile(dir.file("bodies-final.json"));
+    net[run] = readFile(dir.file("net-final.txt"));
+    fluid[run] = nlohmann::json::parse(readFile(dir.file(fluidStates[run])));
+  }
+  EXPECT_FALSE(bodies[0].empty());
+  EXPECT_EQ(bodies[1], bodies[0]);
+  EXPECT_EQ(net[1], net[0]);
+  for (const char* key : {"particles", "volume", "centroid", "level", "maxSpeed"}) {
+    EXPECT_EQ(fluid[1][key], fluid[0][key]) << key;
+  }
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 

@@ -422,6 +422,11 @@ Result<std::unique_ptr<JobBlock>> JobBlock::start(const std::string& job,
                                                   const FluidSettings& settings,
                                                   const msg::Aabb& fill) {
   prepareMpi();
+  // A job of one module is started as a plain process: an MPI singleton, which needs no
+  // Open MPI daemon of its own (one would outlive the module for a moment).
+  if (std::getenv("OMPI_COMM_WORLD_RANK") == nullptr && std::getenv("PMIX_RANK") == nullptr) {
+    setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
+  }
   int argc = 0;
   char** argv = nullptr;
   MPI_Init(&argc, &argv);
