@@ -5,7 +5,6 @@
 
 #include <cstdlib>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "process_helpers.hpp"
 
@@ -16,11 +15,7 @@ namespace {
 // source module, then x, y, z = MPI rank, MPI size, sum of the ranks.
 std::vector<std::string> recordedPoints(const std::string& path) {
   std::vector<std::string> rows;
-  const auto lines = readLines(path);
-  for (std::size_t i = 1; i < lines.size(); ++i) {
-    std::vector<std::string> cells;
-    std::stringstream in(lines[i]);
-    for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
+  for (const auto& cells : readCsvRows(path)) {
     if (cells.size() < 9 || cells[4] != "object") continue;
     rows.push_back(cells[1] + " " + cells[6] + " " + cells[7] + " " + cells[8]);
   }

@@ -12,7 +12,6 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "process_helpers.hpp"
 
@@ -56,11 +55,7 @@ struct Seen {
 // The rows of a core/recorder CSV: iteration,source,source_iteration,sim_time,kind,id,x,y,z.
 std::vector<Seen> readRecording(const std::string& path) {
   std::vector<Seen> rows;
-  const auto lines = readLines(path);
-  for (std::size_t i = 1; i < lines.size(); ++i) {
-    std::vector<std::string> cells;
-    std::stringstream in(lines[i]);
-    for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
+  for (const auto& cells : readCsvRows(path)) {
     if (cells.size() < 9 || cells[4] != "object") continue;
     rows.push_back({cells[1], std::stoi(cells[6]), std::stoi(cells[7]), std::stoi(cells[8])});
   }

@@ -193,4 +193,16 @@ std::vector<std::string> readLines(const std::string& path) {
   return lines;
 }
 
+std::vector<std::vector<std::string>> readCsvRows(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  const auto lines = readLines(path);
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    std::vector<std::string> cells;
+    std::stringstream in(lines[i]);
+    for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
+    rows.push_back(std::move(cells));
+  }
+  return rows;
+}
+
 }  // namespace vrflow::testing

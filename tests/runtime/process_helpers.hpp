@@ -58,6 +58,8 @@ class TempDir {
 
 std::string readFile(const std::string& path);
 std::vector<std::string> readLines(const std::string& path);
+/// The rows of a CSV file after its header line, split at commas (no quoting).
+std::vector<std::vector<std::string>> readCsvRows(const std::string& path);
 std::string binDir();
 std::string sourceDir();
 
