@@ -26,14 +26,46 @@ namespace {
 constexpr double kTimeoutSeconds = 300;  // the run's --timeout: a hang would reach it
 constexpr double kBoundSeconds = 60;     // how long the test waits before calling it a hang
 
-// A small tank in 2 blocks (4 z-planes each), with its stats written to `stats` every iteration.
-std::string twoBlockTank(const std::string& stats) {
-  return R"(<?xml version="1.0" encoding="UTF-8"?>
+// A small tank in 2 blocks (4 z-planes each), with its stats written to `stats` every iteration:
+// the module's own blocks, or (`asJob`) two modules of one MPI job (the composite fluid_blocks).
+std::string twoBlockTank(const std::string& stats, bool asJob = false) {
+  const std::string header = R"(<?xml version="1.0" encoding="UTF-8"?>
 <application name="fluid-block-failure" version="1">
   <hosts>
     <host id="local" address="127.0.0.1"/>
   </hosts>
-  <modules>
+)";
+  if (asJob) {
+    // The composite's objects input feeds a route filter, which must be connected: a box floats.
+    return header + R"(  <modules>
+    <module id="box" package="fluidtest" type="box" host="local">
+      <param name="half" value="0.15"/>
+      <param name="start" value="0.4 0.45 0.4"/>
+      <param name="trajectory" value=")" +
+           stats + R"(.box.csv"/>
+      <input port="events" initial-messages="1"/>
+    </module>
+  </modules>
+  <instances>
+    <instance id="water" composite="fluid_blocks" host="local">
+      <param name="nx" value="8"/>
+      <param name="ny" value="8"/>
+      <param name="nz" value="8"/>
+      <param name="cell_size" value="0.1"/>
+      <param name="fill_max" value="0.8 0.4 0.8"/>
+      <param name="blocks" value="2"/>
+      <param name="stats" value=")" +
+           stats + R"("/>
+    </instance>
+  </instances>
+  <connections>
+    <connection from="box.objects" to="water.objects"/>
+    <connection from="water.forces" to="box.events"/>
+  </connections>
+</application>
+)";
+  }
+  return header + R"(  <modules>
     <module id="water" package="fluid" type="fluid" host="local">
       <param name="nx" value="8"/>
       <param name="ny" value="8"/>
@@ -45,10 +77,13 @@ std::string twoBlockTank(const std::string& stats) {
          stats + R"("/>
     </module>
   </modules>
-  <connections>
-  </connections>
 </application>
 )";
+}
+
+// What vrflow calls the fluid when it reports its end.
+std::string fluidName(bool asJob) {
+  return asJob ? "MPI job 'water' (modules water:block0, water:block1" : "module 'water'";
 }
 
 std::string readProcFile(pid_t pid, const char* name) {
@@ -175,15 +210,15 @@ pid_t startRun(const std::string& app, const std::string& errPath) {
   return pid;
 }
 
-// Runs the two-block tank with `launcher` as VRFLOW_MPIRUN, kills the worker block with SIGKILL
-// once the run steps (or as soon as the worker is there, `whileStarting`), and checks the end;
-// returns vrflow's stderr.
-std::string killWorkerBlock(const char* launcher, bool whileStarting = false) {
+// Runs the two-block tank with `launcher` as VRFLOW_MPIRUN, kills the worker block (rank 1) with
+// SIGKILL once the run steps (or as soon as the worker is there, `whileStarting`), and checks
+// the end; returns vrflow's stderr.
+std::string killWorkerBlock(const char* launcher, bool whileStarting = false, bool asJob = false) {
   unsetenv("OMPI_MCA_btl");  // spawned ranks talk over TCP: leave the choice to Open MPI
   setenv("VRFLOW_MPIRUN", launcher, 1);
   TempDir dir;
   const auto stats = dir.file("stats.csv");
-  const auto app = dir.write("tank.xml", twoBlockTank(stats));
+  const auto app = dir.write("tank.xml", twoBlockTank(stats, asJob));
   const auto before = shmNow();
   const pid_t vrflow = startRun(app, dir.file("err.txt"));
   unsetenv("VRFLOW_MPIRUN");
@@ -221,7 +256,7 @@ std::string killWorkerBlock(const char* launcher, bool whileStarting = false) {
   if (!status) return giveUp("vrflow still runs 60 s after its worker block was killed (hang)");
   const auto err = readFile(dir.file("err.txt"));
   EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 1) << launcher << ": " << err;
-  EXPECT_NE(err.find("module 'water'"), std::string::npos) << launcher << ": " << err;
+  EXPECT_NE(err.find(fluidName(asJob)), std::string::npos) << launcher << ": " << err;
   EXPECT_EQ(err.find("timed out"), std::string::npos) << launcher << ": " << err;
   waitForOrphansToEnd(10);
   const auto left = leftoverProcesses();
@@ -253,10 +288,11 @@ TEST(FluidModule, SpawnedWorkerBlockKilledWhileStartingEndsTheRunPromptly) {
 
 // A block cannot fail alone unless it has a bug (the blocks check the same input): the failure
 // is injected (VRFLOW_FLUID_TEST_FAIL="BLOCK STEP", read by the module's blocks only).
-CommandResult runWithInjectedFailure(const char* launcher, const char* failure) {
+CommandResult runWithInjectedFailure(const char* launcher, const char* failure,
+                                     bool asJob = false) {
   unsetenv("OMPI_MCA_btl");
   TempDir dir;
-  const auto app = dir.write("tank.xml", twoBlockTank(dir.file("stats.csv")));
+  const auto app = dir.write("tank.xml", twoBlockTank(dir.file("stats.csv"), asJob));
   setenv("VRFLOW_MPIRUN", launcher, 1);
   setenv("VRFLOW_FLUID_TEST_FAIL", failure, 1);
   // Past kBoundSeconds runCommand kills vrflow (exit code 128 + 9): a hang.
@@ -265,7 +301,8 @@ CommandResult runWithInjectedFailure(const char* launcher, const char* failure) 
   unsetenv("VRFLOW_FLUID_TEST_FAIL");
   unsetenv("VRFLOW_MPIRUN");
   EXPECT_EQ(result.exitCode, 1) << launcher << " (137: hung, killed by the test): " << result.err;
-  EXPECT_NE(result.err.find("module 'water'"), std::string::npos) << launcher << ": " << result.err;
+  EXPECT_NE(result.err.find(asJob ? "water:block" : "module 'water'"), std::string::npos)
+      << launcher << ": " << result.err;
   EXPECT_NE(result.err.find("failure injected"), std::string::npos)
       << launcher << ": " << result.err;
   waitForOrphansToEnd(10);
@@ -291,6 +328,28 @@ TEST(FluidModule, StepFailingOnEveryBlockIsReportedByTheModuleAlone) {
     EXPECT_EQ(result.err.find("alone"), std::string::npos) << launcher << ": " << result.err;
     EXPECT_EQ(result.err.find("MPI_ABORT"), std::string::npos) << launcher << ": " << result.err;
   }
+}
+
+// The same with the fluid as two modules of one MPI job (fluid_blocks): the blocks are peers,
+// mpirun is the job's one process, and vrflow names the job.
+TEST(FluidBlocksJob, ABlockKilledEndsTheRunPromptlyNamingTheJob) {
+  const auto err = killWorkerBlock("mpirun", false, true);
+  EXPECT_NE(err.find("an MPI rank was killed by signal 9"), std::string::npos) << err;
+}
+
+TEST(FluidBlocksJob, ABlockWhoseStepFailsAloneAbortsTheJobPromptly) {
+  const auto result = runWithInjectedFailure("mpirun", "1 10", true);
+  EXPECT_NE(result.err.find("MPI block 1 of 2 (job 'water') failed alone"), std::string::npos)
+      << result.err;
+  EXPECT_NE(result.err.find(fluidName(true)), std::string::npos) << result.err;
+}
+
+TEST(FluidBlocksJob, AStepFailingOnEveryBlockEndsTheRunWithoutAnAbort) {
+  const auto result = runWithInjectedFailure("mpirun", "-1 10", true);
+  EXPECT_NE(result.err.find("vrflow-fluid: fluid: block 0: failure injected"), std::string::npos)
+      << result.err;
+  EXPECT_EQ(result.err.find("alone"), std::string::npos) << result.err;
+  EXPECT_EQ(result.err.find("MPI_ABORT"), std::string::npos) << result.err;
 }
 
 }  // namespace
