@@ -74,6 +74,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return vrflow::run::kExitInvalid;
   }
+  vrflow::app::applyInstanceOverrides(*application, overrides);  // as `vrflow` does
   application = vrflow::app::expandComposites(
       *application, vrflow::app::defaultCompositeSources(*application, compositeDirs), &problems);
   if (!application) {

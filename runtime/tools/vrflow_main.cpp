@@ -36,13 +36,16 @@ std::optional<vrflow::app::Application> loadFlat(const std::string& file,
     std::fprintf(stderr, "%s\n", application.error().message.c_str());
     return std::nullopt;
   }
+  // Settings of the file's own composite instances change what the expansion makes.
+  std::vector<std::string> moduleSettings = overrides;
+  vrflow::app::applyInstanceOverrides(*application, moduleSettings);
   const auto sources = vrflow::app::defaultCompositeSources(*application, compositeDirs);
   auto flat = vrflow::app::expandComposites(*application, sources, &problems);
   if (!flat) {
     std::fprintf(stderr, "%s\n", flat.error().message.c_str());
     return std::nullopt;
   }
-  if (auto set = vrflow::app::applyOverrides(*flat, overrides); !set) {
+  if (auto set = vrflow::app::applyOverrides(*flat, moduleSettings); !set) {
     std::fprintf(stderr, "vrflow: %s\n", set.error().message.c_str());
     return std::nullopt;
   }

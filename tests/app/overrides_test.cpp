@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"
+#include "vrflow/app/expand.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/validate.hpp"
 
@@ -82,7 +83,61 @@ TEST(Overrides, MalformedSettingsAndUnknownIdsAreRefusedByName) {
   const auto status = applyOverrides(app, {"src.count=1", "nope.count=1"});
   ASSERT_FALSE(status.ok());
   EXPECT_EQ(status.error().message,
-            "--set 'nope.count=1': the application has no module or filter 'nope'");
+            "--set 'nope.count=1': the application has no module, filter or instance 'nope'");
+}
+
+// An instance of the file's own composite `sinks` (n sinks behind a broadcast).
+constexpr std::string_view kInstanceApp = R"(<application name="y" version="1">
+  <hosts><host id="h" address="127.0.0.1"/></hosts>
+  <composites>
+    <composite name="sinks">
+      <param name="n" default="2" min="1" max="8"/>
+      <input name="in" to="fan.in"/>
+      <modules>
+        <repeat var="i" count="${n}"><module id="s${i}" package="core" type="sink"/></repeat>
+      </modules>
+      <filters><filter id="fan" type="broadcast"/></filters>
+      <connections>
+        <repeat var="i" count="${n}"><connection from="fan.out" to="s${i}.in"/></repeat>
+      </connections>
+    </composite>
+  </composites>
+  <modules>
+    <module id="src" package="core" type="source" host="h"/>
+  </modules>
+  <instances>
+    <instance id="many" composite="sinks" host="h"/>
+  </instances>
+  <connections>
+    <connection from="src.out" to="many.in"/>
+  </connections>
+</application>
+)";
+
+TEST(Overrides, AnInstanceOfTheFileIsSetBeforeExpansionTheRestAfter) {
+  auto app = loadApplicationString(kInstanceApp, "app.xml", nullptr);
+  ASSERT_TRUE(app.ok()) << app.error().message;
+  std::vector<std::string> settings{"many.n=5", "src.count=4"};
+  applyInstanceOverrides(*app, settings);
+  EXPECT_EQ(settings, std::vector<std::string>{"src.count=4"}) << "left for after expansion";
+  auto flat = expandComposites(*app, CompositeSources{}, nullptr);
+  ASSERT_TRUE(flat.ok()) << flat.error().message;
+  ASSERT_TRUE(applyOverrides(*flat, settings).ok());
+  EXPECT_EQ(flat->modules.size(), 6u) << "src and 5 sinks";
+  const auto problems = validate(*flat, testing::testCatalog());
+  EXPECT_TRUE(problems.empty()) << formatDiagnostics(problems);
+}
+
+TEST(Overrides, ABadInstanceValueIsReportedAtTheSetting) {
+  auto app = loadApplicationString(kInstanceApp, "app.xml", nullptr);
+  ASSERT_TRUE(app.ok()) << app.error().message;
+  std::vector<std::string> settings{"many.n=9"};
+  applyInstanceOverrides(*app, settings);
+  std::vector<Diagnostic> problems;
+  auto flat = expandComposites(*app, CompositeSources{}, &problems);
+  ASSERT_TRUE(hasErrors(problems)) << "n above its max";
+  const std::string text = formatDiagnostics(problems);
+  EXPECT_NE(text.find("--set many.n=9"), std::string::npos) << text;
 }
 
 }  // namespace

@@ -63,13 +63,13 @@ std::string exampleForTest(const std::string& folder, const std::string& file,
 }
 
 CommandResult runApp(const TempDir& dir, const std::string& app, int iterations,
-                     double timeoutSeconds) {
+                     double timeoutSeconds, const std::string& extraArgs) {
   const auto file = dir.write("app.xml", app);
   return runCommand({"/bin/sh", "-c",
                      "cd '" + dir.path() + "' && exec '" + binDir() + "/vrflow' run '" + file +
                          "' -n " + std::to_string(iterations) + " --timeout " +
                          std::to_string(static_cast<int>(timeoutSeconds * 0.8)) +
-                         " --no-progress --report report.json"},
+                         " --no-progress --report report.json " + extraArgs},
                     timeoutSeconds);
 }
 

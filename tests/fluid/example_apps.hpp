@@ -19,9 +19,10 @@ using ParamOverrides = std::map<std::string, std::string>;
 std::string exampleForTest(const std::string& folder, const std::string& file,
                            const ParamOverrides& overrides, bool keepViewer = false);
 
-/// Writes `app` into `dir` and runs it there for `iterations` (report in report.json); vrflow
-/// itself stops a run that outlasts 80 % of the timeout (a hang fails cleanly).
+/// Writes `app` into `dir` and runs it there for `iterations` (report in report.json), with
+/// `extraArgs` (e.g. "--set water.blocks=4") on the command line; vrflow itself stops a run that
+/// outlasts 80 % of the timeout (a hang fails cleanly).
 CommandResult runApp(const TempDir& dir, const std::string& app, int iterations,
-                     double timeoutSeconds = 240);
+                     double timeoutSeconds = 240, const std::string& extraArgs = "");
 
 }  // namespace vrflow::testing

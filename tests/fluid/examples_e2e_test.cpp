@@ -183,30 +183,35 @@ TEST(DamBreakExample, TwoBlocksAgreeWithOneWithKinematicBodiesInTheTank) {
 // near it, combines per-body sums with the others by id, and the lowest block holding a body
 // reports its force; that is the same arithmetic as the fluid's own blocks (every block holding
 // every body), so after 100 steps the two agree bit for bit: particles, volume, centroid, every
-// body's position, and the forces of the last step.
-TEST(DamBreakExample, OneFluidModulePerBlockEqualsTheFluidsOwnBlocks) {
+// body's position, and the forces of the last step. With 2 blocks as shipped, and with 4 set on
+// the command line (`--set water.blocks=4` sets the composite instance's parameter).
+void expectOneModulePerBlockEqualsOwnBlocks(int blockCount) {
+  const std::string blocks = std::to_string(blockCount);
   json fluid[2], bodies[2];
   for (int run = 0; run < 2; ++run) {
     TempDir dir;
-    const auto app = run == 0 ? exampleForTest("dam_break", "dam_break.xml", {{"water.blocks", "2"}})
-                              : exampleForTest("dam_break", "dam_break_blocks.xml", {});
-    const auto result = runApp(dir, app, 100, 120);
-    ASSERT_EQ(result.exitCode, 0) << (run == 0 ? "blocks = 2" : "fluid_blocks") << ": " << result.err;
+    const auto app = run == 0
+                         ? exampleForTest("dam_break", "dam_break.xml", {{"water.blocks", blocks}})
+                         : exampleForTest("dam_break", "dam_break_blocks.xml", {});
+    const auto result =
+        runApp(dir, app, 100, 120, run == 0 ? "" : "--set water.blocks=" + blocks);
+    ASSERT_EQ(result.exitCode, 0) << (run == 0 ? "blocks = " : "fluid_blocks ") << blocks << ": "
+                                  << result.err;
     const std::string prefix = run == 0 ? "dam_break" : "dam_break_blocks";
     fluid[run] = readJson(dir.file(prefix + "-fluid.json"));
     bodies[run] = readJson(dir.file(prefix + "-bodies.json"));
     if (run == 1) {
       // Two fluid modules ran, each with its own ports: the report lists both.
       const auto report = readJson(dir.file("report.json"));
-      int blocks = 0;
+      int modules = 0;
       for (const auto& module : report["modules"]) {
         const std::string id = module["id"].get<std::string>();
         if (id.rfind("water:block", 0) == 0) {
-          ++blocks;
+          ++modules;
           EXPECT_EQ(module["iterations"].get<int>(), 100) << id;
         }
       }
-      EXPECT_EQ(blocks, 2) << report.dump();
+      EXPECT_EQ(modules, blockCount) << report.dump();
     }
     EXPECT_TRUE(runningChildrenGone(5.0)) << "a process of the run outlived it by 5 s";
     for (const auto& line : leftoverProcesses()) {
@@ -231,6 +236,14 @@ TEST(DamBreakExample, OneFluidModulePerBlockEqualsTheFluidsOwnBlocks) {
   }
   // The comparison is of a moving scene: the column has started to break.
   EXPECT_GT(fluid[0]["centroid"][0].get<double>(), 0.4);
+}
+
+TEST(DamBreakExample, OneFluidModulePerBlockEqualsTheFluidsOwnBlocks) {
+  expectOneModulePerBlockEqualsOwnBlocks(2);
+}
+
+TEST(DamBreakExample, FourFluidModulesEqualTheFluidsOwnFourBlocks) {
+  expectOneModulePerBlockEqualsOwnBlocks(4);
 }
 
 // A flat box of density 500 settles with about half its height under water; a cube of density

@@ -19,4 +19,11 @@ namespace vrflow::app {
 /// names no module or filter.
 Status applyOverrides(Application& application, const std::vector<std::string>& settings);
 
+/// Before composite expansion: sets each `ID.PARAM=VALUE` of `settings` whose ID names an
+/// instance of the application itself (not one inside a composite) on that instance, so that
+/// `--set water.blocks=4` changes what a composite makes; such settings are removed from
+/// `settings`, the others are left for applyOverrides on the expanded application. The value is
+/// checked by the expansion like one written in the file (its place: `--set ...`).
+void applyInstanceOverrides(Application& application, std::vector<std::string>& settings);
+
 }  // namespace vrflow::app
