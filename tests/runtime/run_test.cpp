@@ -108,7 +108,8 @@ TEST_F(RunTest, SetWithABadValueAnUnknownModuleOrNoDotIsAClearError) {
       << bad.err;
   const auto unknown = runVrflow({"validate", file, "--set", "sorce.size=1"});
   EXPECT_EQ(unknown.exitCode, 1);
-  EXPECT_NE(unknown.err.find("no module or filter 'sorce'"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("no module, filter or instance 'sorce'"), std::string::npos)
+      << unknown.err;
   const auto malformed = runVrflow({"run", file, "--set", "size=1"});
   EXPECT_EQ(malformed.exitCode, 2);
   EXPECT_NE(malformed.err.find("expected ID.PARAM=VALUE"), std::string::npos) << malformed.err;

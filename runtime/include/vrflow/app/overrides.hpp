@@ -16,7 +16,7 @@ namespace vrflow::app {
 /// of the part before '='), adding the parameter when the file does not set it. The value is
 /// checked later by validation like one written in the file; diagnostics about it name
 /// `--set ID.PARAM=VALUE` as their place. Errors: a setting without '=' or a dot, or an ID that
-/// names no module or filter.
+/// names no module or filter (nor an instance: applyInstanceOverrides takes those first).
 Status applyOverrides(Application& application, const std::vector<std::string>& settings);
 
 /// Before composite expansion: sets each `ID.PARAM=VALUE` of `settings` whose ID names an
