@@ -29,54 +29,48 @@ constexpr double kBoundSeconds = 60;     // how long the test waits before calli
 // A small tank in 2 blocks (4 z-planes each), with its stats written to `stats` every iteration:
 // the module's own blocks, or (`asJob`) two modules of one MPI job (the composite fluid_blocks).
 std::string twoBlockTank(const std::string& stats, bool asJob = false) {
+  // The tank's parameters; a composite spells '-' as '_'.
+  const std::string dash = asJob ? "_" : "-";
+  const std::string params = R"(      <param name="nx" value="8"/>
+      <param name="ny" value="8"/>
+      <param name="nz" value="8"/>
+      <param name="cell)" + dash + R"(size" value="0.1"/>
+      <param name="fill)" + dash + R"(max" value="0.8 0.4 0.8"/>
+      <param name="blocks" value="2"/>
+      <param name="stats" value=")" + stats + R"("/>
+)";
   const std::string header = R"(<?xml version="1.0" encoding="UTF-8"?>
 <application name="fluid-block-failure" version="1">
   <hosts>
     <host id="local" address="127.0.0.1"/>
   </hosts>
 )";
-  if (asJob) {
-    // The composite's objects input feeds a route filter, which must be connected: a box floats.
+  if (!asJob) {
     return header + R"(  <modules>
+    <module id="water" package="fluid" type="fluid" host="local">
+)" + params + R"(    </module>
+  </modules>
+</application>
+)";
+  }
+  // The composite's objects input feeds a route filter, which must be connected: a box floats.
+  return header + R"(  <modules>
     <module id="box" package="fluidtest" type="box" host="local">
       <param name="half" value="0.15"/>
       <param name="start" value="0.4 0.45 0.4"/>
       <param name="trajectory" value=")" +
-           stats + R"(.box.csv"/>
+         stats + R"(.box.csv"/>
       <input port="events" initial-messages="1"/>
     </module>
   </modules>
   <instances>
     <instance id="water" composite="fluid_blocks" host="local">
-      <param name="nx" value="8"/>
-      <param name="ny" value="8"/>
-      <param name="nz" value="8"/>
-      <param name="cell_size" value="0.1"/>
-      <param name="fill_max" value="0.8 0.4 0.8"/>
-      <param name="blocks" value="2"/>
-      <param name="stats" value=")" +
-           stats + R"("/>
-    </instance>
+)" + params + R"(    </instance>
   </instances>
   <connections>
     <connection from="box.objects" to="water.objects"/>
     <connection from="water.forces" to="box.events"/>
   </connections>
-</application>
-)";
-  }
-  return header + R"(  <modules>
-    <module id="water" package="fluid" type="fluid" host="local">
-      <param name="nx" value="8"/>
-      <param name="ny" value="8"/>
-      <param name="nz" value="8"/>
-      <param name="cell-size" value="0.1"/>
-      <param name="fill-max" value="0.8 0.4 0.8"/>
-      <param name="blocks" value="2"/>
-      <param name="stats" value=")" +
-         stats + R"("/>
-    </module>
-  </modules>
 </application>
 )";
 }
