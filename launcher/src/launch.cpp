@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "vrflow/base/executable_dir.hpp"
 #include "vrflow/launcher/launch.hpp"
 #include "vrflow/net/transport.hpp"
 #include "vrflow/run/trace.hpp"
@@ -407,9 +408,7 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
 }
 
 Status Launcher::start() {
-  std::error_code ec;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  const std::string daemonPath = (self.parent_path() / "vrflow-daemon").string();
+  const std::string daemonPath = (executableDir() / "vrflow-daemon").string();
   const bool ssh = options_.backend == "ssh";
   std::vector<HostEntry> entries;
   if (ssh && options_.hostfile.empty()) {
@@ -446,6 +445,7 @@ Status Launcher::start() {
       }
       if (entry->address.empty()) d.bind = host.address;
     }
+    std::error_code ec;
     const std::string appFile = std::filesystem::absolute(options_.appFile, ec).string();
     std::vector<std::string> argv{entry != nullptr && !entry->daemon.empty() ? entry->daemon : daemonPath,
                                   appFile, "--host", host.id, "--control", "--bind", d.bind};

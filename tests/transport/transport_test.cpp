@@ -8,6 +8,8 @@
 
 #include <cstring>
 #include <future>
+#include <memory>
+#include <optional>
 #include <thread>
 
 #include "daemon/graph.hpp"
@@ -73,22 +75,43 @@ class Collect final : public daemon::Sink {
   std::vector<daemon::MessageRef> messages;
 };
 
-TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
+// Transports a (127.0.0.1) and b (127.0.0.2), each with a segment of `segmentBytes`, sharing
+// connection 0 (a sends, b receives), authenticated and linked to each other.
+struct LinkedPair {
+  std::unique_ptr<Transport> a, b;
+  std::optional<ipc::Segment> segA, segB;
+};
+
+::testing::AssertionResult link(LinkedPair& pair, std::size_t segmentBytes) {
   const Secret secret = newSecret();
   auto a = Transport::listen(optionsFor(0, secret));
   auto b = Transport::listen(optionsFor(1, secret));
-  ASSERT_TRUE(a.ok() && b.ok());
-  auto segA = ipc::Segment::create(16 << 20, 0x7f000001);
-  auto segB = ipc::Segment::create(16 << 20, 0x7f000002);
-  ASSERT_TRUE(segA.ok() && segB.ok());
-  (*a)->attachSegment(*segA);
-  (*b)->attachSegment(*segB);
-  (*a)->addConnection(channel0(true));
-  (*b)->addConnection(channel0(false));
-  const std::vector<PeerAddress> peers{{0, "127.0.0.1", (*a)->port()}, {1, "127.0.0.2", (*b)->port()}};
-  auto linkB = std::async(std::launch::async, [&] { return (*b)->connectPeers(peers); });
-  ASSERT_TRUE((*a)->connectPeers(peers).ok());
-  ASSERT_TRUE(linkB.get().ok());
+  if (!a.ok() || !b.ok()) return ::testing::AssertionFailure() << "listen failed";
+  auto segA = ipc::Segment::create(segmentBytes, 0x7f000001);
+  auto segB = ipc::Segment::create(segmentBytes, 0x7f000002);
+  if (!segA.ok() || !segB.ok()) return ::testing::AssertionFailure() << "no segment";
+  pair.a = std::move(*a);
+  pair.b = std::move(*b);
+  pair.segA.emplace(std::move(*segA));
+  pair.segB.emplace(std::move(*segB));
+  pair.a->attachSegment(*pair.segA);
+  pair.b->attachSegment(*pair.segB);
+  pair.a->addConnection(channel0(true));
+  pair.b->addConnection(channel0(false));
+  const std::vector<PeerAddress> peers{{0, "127.0.0.1", pair.a->port()},
+                                       {1, "127.0.0.2", pair.b->port()}};
+  auto linkB = std::async(std::launch::async, [&] { return pair.b->connectPeers(peers); });
+  const bool linkedA = pair.a->connectPeers(peers).ok();
+  if (!linkB.get().ok() || !linkedA) return ::testing::AssertionFailure() << "not linked";
+  return ::testing::AssertionSuccess();
+}
+
+TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
+  LinkedPair pair;
+  ASSERT_TRUE(link(pair, 16 << 20));
+  auto& a = pair.a;
+  auto& b = pair.b;
+  auto& segA = pair.segA;
 
   msg::Stamps stamps;
   stamps.iteration = 42;
@@ -96,7 +119,7 @@ TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
   const uint64_t handle = segA->allocate(bytes.size());
   std::memcpy(segA->payload(handle), bytes.data(), bytes.size());
   segA->block(handle).used = bytes.size();
-  auto sink = (*a)->makeSink(0);
+  auto sink = a->makeSink(0);
   ASSERT_TRUE(sink->hasSpace());
   sink->push(daemon::MessageRef(&*segA, handle));
   sink->close();
@@ -104,7 +127,7 @@ TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
   Collect received;
   bool closed = false;
   for (int i = 0; i < 1000 && !closed; ++i) {
-    (*b)->receive(0, received, closed);
+    b->receive(0, received, closed);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   ASSERT_TRUE(closed);
@@ -112,85 +135,64 @@ TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
   auto view = received.messages[0].view();
   ASSERT_TRUE(view.ok());
   EXPECT_EQ(view->stamps().iteration, 42u);
-  EXPECT_EQ((*b)->fatalError(), "");
+  EXPECT_EQ(b->fatalError(), "");
   received.messages.clear();
-  (*a)->finish(2);
-  (*b)->finish(2);
-  (*a)->stop();
-  (*b)->stop();
+  a->finish(2);
+  b->finish(2);
+  a->stop();
+  b->stop();
 }
 
 TEST(Transport, SettleWaitsUntilWhatCameBeforeThePeersCloseIsRouted) {
-  const Secret secret = newSecret();
-  auto a = Transport::listen(optionsFor(0, secret));
-  auto b = Transport::listen(optionsFor(1, secret));
-  ASSERT_TRUE(a.ok() && b.ok());
-  auto segA = ipc::Segment::create(16 << 20, 0x7f000001);
-  auto segB = ipc::Segment::create(16 << 20, 0x7f000002);
-  ASSERT_TRUE(segA.ok() && segB.ok());
-  (*a)->attachSegment(*segA);
-  (*b)->attachSegment(*segB);
-  (*a)->addConnection(channel0(true));
-  (*b)->addConnection(channel0(false));
-  const std::vector<PeerAddress> peers{{0, "127.0.0.1", (*a)->port()},
-                                       {1, "127.0.0.2", (*b)->port()}};
-  auto linkB = std::async(std::launch::async, [&] { return (*b)->connectPeers(peers); });
-  ASSERT_TRUE((*a)->connectPeers(peers).ok());
-  ASSERT_TRUE(linkB.get().ok());
+  LinkedPair pair;
+  ASSERT_TRUE(link(pair, 16 << 20));
+  auto& a = pair.a;
+  auto& b = pair.b;
+  auto& segA = pair.segA;
   const std::vector<std::string> open{"p.out -> q.in"};
-  EXPECT_EQ((*a)->settle(0), open);
-  EXPECT_EQ((*b)->settle(0), open);
+  EXPECT_EQ(a->settle(0), open);
+  EXPECT_EQ(b->settle(0), open);
 
   const auto bytes = msg::makeEmptyMessage(msg::Stamps{});
   const uint64_t handle = segA->allocate(bytes.size());
   std::memcpy(segA->payload(handle), bytes.data(), bytes.size());
   segA->block(handle).used = bytes.size();
-  auto sink = (*a)->makeSink(0);
+  auto sink = a->makeSink(0);
   sink->push(daemon::MessageRef(&*segA, handle));
   sink->close();
-  EXPECT_TRUE((*a)->settle(0).empty()) << "the sender closed its side";
+  EXPECT_TRUE(a->settle(0).empty()) << "the sender closed its side";
   // The message and the close arrive, but nothing routed the message yet: not over (stopping
   // now would drop it, and a report would miss it).
-  EXPECT_EQ((*b)->settle(0.2), open);
-  auto settled = std::async(std::launch::async, [&] { return (*b)->settle(10); });
+  EXPECT_EQ(b->settle(0.2), open);
+  auto settled = std::async(std::launch::async, [&] { return b->settle(10); });
   Collect received;
   bool closed = false;
   for (int i = 0; i < 1000 && !closed; ++i) {
-    (*b)->receive(0, received, closed);
+    b->receive(0, received, closed);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   ASSERT_TRUE(closed);
   EXPECT_TRUE(settled.get().empty());
   EXPECT_EQ(received.messages.size(), 1u);
   received.messages.clear();
-  auto finishA = std::async(std::launch::async, [&] { (*a)->finish(2); });
-  (*b)->finish(2);
+  auto finishA = std::async(std::launch::async, [&] { a->finish(2); });
+  b->finish(2);
   finishA.get();
-  (*a)->stop();
-  (*b)->stop();
+  a->stop();
+  b->stop();
 }
 
 TEST(Transport, LargeMessagesArriveIntactAndInOrderUnderCreditFlowControl) {
-  const Secret secret = newSecret();
-  auto a = Transport::listen(optionsFor(0, secret));
-  auto b = Transport::listen(optionsFor(1, secret));
-  ASSERT_TRUE(a.ok() && b.ok());
-  auto segA = ipc::Segment::create(std::size_t{256} << 20, 0x7f000001);
-  auto segB = ipc::Segment::create(std::size_t{256} << 20, 0x7f000002);
-  ASSERT_TRUE(segA.ok() && segB.ok());
-  (*a)->attachSegment(*segA);
-  (*b)->attachSegment(*segB);
-  (*a)->addConnection(channel0(true));  // capacity 4: the sender must wait for credits
-  (*b)->addConnection(channel0(false));
-  const std::vector<PeerAddress> peers{{0, "127.0.0.1", (*a)->port()}, {1, "127.0.0.2", (*b)->port()}};
-  auto linkB = std::async(std::launch::async, [&] { return (*b)->connectPeers(peers); });
-  ASSERT_TRUE((*a)->connectPeers(peers).ok());
-  ASSERT_TRUE(linkB.get().ok());
+  LinkedPair pair;  // connection 0 holds 4 messages: the sender must wait for credits
+  ASSERT_TRUE(link(pair, std::size_t{256} << 20));
+  auto& a = pair.a;
+  auto& b = pair.b;
+  auto& segA = pair.segA;
 
   // 12 messages of 6 MiB, each with its own fill byte: far more than the socket buffers hold.
   constexpr int kCount = 12;
   constexpr std::size_t kBytes = 6u << 20;
-  auto sink = (*a)->makeSink(0);
+  auto sink = a->makeSink(0);
   Collect received;
   bool closed = false;
   int sent = 0;
@@ -210,7 +212,7 @@ TEST(Transport, LargeMessagesArriveIntactAndInOrderUnderCreditFlowControl) {
       sink->push(daemon::MessageRef(&*segA, handle));
       if (++sent == kCount) sink->close();
     }
-    (*b)->receive(0, received, closed);
+    b->receive(0, received, closed);
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   ASSERT_TRUE(closed);
@@ -224,12 +226,12 @@ TEST(Transport, LargeMessagesArriveIntactAndInOrderUnderCreditFlowControl) {
     EXPECT_EQ(raw[raw.size() - 1], static_cast<std::byte>(i + 1));
   }
   received.messages.clear();
-  EXPECT_EQ((*b)->fatalError(), "");
-  auto stopA = std::async(std::launch::async, [&] { (*a)->finish(2); });
-  (*b)->finish(2);
+  EXPECT_EQ(b->fatalError(), "");
+  auto stopA = std::async(std::launch::async, [&] { a->finish(2); });
+  b->finish(2);
   stopA.get();
-  (*a)->stop();
-  (*b)->stop();
+  a->stop();
+  b->stop();
 }
 
 TEST(Transport, APeerWithoutTheSecretIsRefused) {

@@ -10,6 +10,7 @@
 #include "file_io.hpp"
 #include "text_util.hpp"
 #include "validation.hpp"
+#include "vrflow/base/executable_dir.hpp"
 #include "vrflow/app/validate.hpp"
 
 namespace vrflow::app {
@@ -298,11 +299,8 @@ CompositeSources defaultCompositeSources(const Application& app,
   }
   // Composites that node packages ship (the fluid's fluid_blocks), beside their manifests:
   // <folder of this executable>/../share/vrflow/composites, in the build tree and installs alike.
-  std::error_code error;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
-  if (!error) {
-    sources.searchPath.push_back(
-        (self.parent_path().parent_path() / "share/vrflow/composites").string());
+  if (const auto bin = executableDir(); !bin.empty()) {
+    sources.searchPath.push_back((bin.parent_path() / "share/vrflow/composites").string());
   }
   return sources;
 }

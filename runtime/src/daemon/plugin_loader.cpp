@@ -7,6 +7,7 @@
 #include <mutex>
 #include <set>
 
+#include "vrflow/base/executable_dir.hpp"
 #include "vrflow/daemon/plugin.hpp"
 
 namespace vrflow::daemon {
@@ -185,8 +186,9 @@ std::vector<app::Diagnostic> loadApplicationPlugins(const app::Application& appl
   for (auto& entry : splitPath(std::getenv(kFilterPathVariable))) {
     if (fs::is_directory(entry, error)) dirs.push_back(std::move(entry));
   }
-  const fs::path self = fs::read_symlink("/proc/self/exe", error);
-  if (!error) dirs.push_back((self.parent_path().parent_path() / "lib/vrflow/filters").string());
+  if (const fs::path bin = executableDir(); !bin.empty()) {
+    dirs.push_back((bin.parent_path() / "lib/vrflow/filters").string());
+  }
   const fs::path appDir = fs::path(application.file).parent_path();
 
   std::vector<app::Diagnostic> problems;

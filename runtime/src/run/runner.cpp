@@ -23,6 +23,7 @@
 #include "vrflow/app/graph.hpp"
 #include "vrflow/app/mpi_job.hpp"
 #include "vrflow/base/assert.hpp"
+#include "vrflow/base/executable_dir.hpp"
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/message/ids.hpp"
@@ -541,9 +542,9 @@ RunOutcome Supervisor::run() {
 Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs) {
   std::vector<std::string> dirs = extraDirs;
   for (const auto& d : app::searchPathFromEnvironment()) dirs.push_back(d);
-  std::error_code ec;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) dirs.push_back((self.parent_path().parent_path() / "share/vrflow/packages").string());
+  if (const auto bin = executableDir(); !bin.empty()) {
+    dirs.push_back((bin.parent_path() / "share/vrflow/packages").string());
+  }
   app::Catalog catalog;
   if (auto status = catalog.loadSearchPath(dirs); !status) return status.error();
   const auto plugins = daemon::filterPluginsFromEnvironment();
