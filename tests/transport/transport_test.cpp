@@ -106,6 +106,26 @@ struct LinkedPair {
   return ::testing::AssertionSuccess();
 }
 
+// An empty message with `stamps`, written into `segment`: its block handle.
+uint64_t emptyMessageIn(ipc::Segment& segment, const msg::Stamps& stamps) {
+  const auto bytes = msg::makeEmptyMessage(stamps);
+  const uint64_t handle = segment.allocate(bytes.size());
+  std::memcpy(segment.payload(handle), bytes.data(), bytes.size());
+  segment.block(handle).used = bytes.size();
+  return handle;
+}
+
+// What `transport` receives on connection 0 until the sender closes it (at most 10 s): true when
+// it closed.
+bool receiveUntilClosed(Transport& transport, Collect& received) {
+  bool closed = false;
+  for (int i = 0; i < 1000 && !closed; ++i) {
+    transport.receive(0, received, closed);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return closed;
+}
+
 TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
   LinkedPair pair;
   ASSERT_TRUE(link(pair, 16 << 20));
@@ -115,22 +135,14 @@ TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
 
   msg::Stamps stamps;
   stamps.iteration = 42;
-  const auto bytes = msg::makeEmptyMessage(stamps);
-  const uint64_t handle = segA->allocate(bytes.size());
-  std::memcpy(segA->payload(handle), bytes.data(), bytes.size());
-  segA->block(handle).used = bytes.size();
+  const uint64_t handle = emptyMessageIn(*segA, stamps);
   auto sink = a->makeSink(0);
   ASSERT_TRUE(sink->hasSpace());
   sink->push(daemon::MessageRef(&*segA, handle));
   sink->close();
 
   Collect received;
-  bool closed = false;
-  for (int i = 0; i < 1000 && !closed; ++i) {
-    b->receive(0, received, closed);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ASSERT_TRUE(closed);
+  ASSERT_TRUE(receiveUntilClosed(*b, received));
   ASSERT_EQ(received.messages.size(), 1u);
   auto view = received.messages[0].view();
   ASSERT_TRUE(view.ok());
@@ -153,10 +165,7 @@ TEST(Transport, SettleWaitsUntilWhatCameBeforeThePeersCloseIsRouted) {
   EXPECT_EQ(a->settle(0), open);
   EXPECT_EQ(b->settle(0), open);
 
-  const auto bytes = msg::makeEmptyMessage(msg::Stamps{});
-  const uint64_t handle = segA->allocate(bytes.size());
-  std::memcpy(segA->payload(handle), bytes.data(), bytes.size());
-  segA->block(handle).used = bytes.size();
+  const uint64_t handle = emptyMessageIn(*segA, msg::Stamps{});
   auto sink = a->makeSink(0);
   sink->push(daemon::MessageRef(&*segA, handle));
   sink->close();
@@ -166,12 +175,7 @@ TEST(Transport, SettleWaitsUntilWhatCameBeforeThePeersCloseIsRouted) {
   EXPECT_EQ(b->settle(0.2), open);
   auto settled = std::async(std::launch::async, [&] { return b->settle(10); });
   Collect received;
-  bool closed = false;
-  for (int i = 0; i < 1000 && !closed; ++i) {
-    b->receive(0, received, closed);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ASSERT_TRUE(closed);
+  ASSERT_TRUE(receiveUntilClosed(*b, received));
   EXPECT_TRUE(settled.get().empty());
   EXPECT_EQ(received.messages.size(), 1u);
   received.messages.clear();
