@@ -388,6 +388,23 @@ int runRankWorker(int argc, char** argv) {
   return workerLoop(world);
 }
 
+namespace {
+
+// The blocks of a job that failed together each print their error and exit non-zero; mpirun
+// kills the job's other ranks when the first of them exits, which could be before a slower one
+// printed. So they finalise MPI together at exit, after every one has printed: a barrier first,
+// then MPI_Finalize, from an atexit handler (the module prints on its way out of main).
+void finalizeTogether() {
+  MPI_Barrier(MPI_COMM_WORLD);
+  MPI_Finalize();
+}
+
+void finalizeTogetherAtExit() {
+  std::atexit(finalizeTogether);
+}
+
+}  // namespace
+
 struct JobBlock::Impl {
   std::string job;
   MPI_Comm world = MPI_COMM_NULL;
@@ -438,9 +455,9 @@ Result<std::unique_ptr<JobBlock>> JobBlock::start(const std::string& job,
   MPI_Comm_rank(impl->world, &impl->rank);
   MPI_Comm_size(impl->world, &impl->size);
   // Every block checks the same settings (the job's modules share them through their composite),
-  // so they fail together here; the rest of the job then ends with MPI_Finalize.
+  // so they fail together here and finalise together once each has printed the error.
   auto fail = [&](const std::string& message) -> Result<std::unique_ptr<JobBlock>> {
-    MPI_Finalize();
+    finalizeTogetherAtExit();
     return makeError(message);
   };
   if (impl->size > settings.nz) {
@@ -492,7 +509,7 @@ Result<BlockResult> JobBlock::step(const BlockStep& s) {
   if (result || impl_->stopped) return result;
   impl_->stopped = true;
   if (everyBlockFailed(impl_->failures)) {  // every block reports it and ends cleanly
-    MPI_Finalize();
+    finalizeTogetherAtExit();
     return result;
   }
   std::fprintf(stderr, "vrflow-fluid: MPI block %d of %d (job '%s') failed alone: %s; aborting the job\n",

@@ -94,8 +94,9 @@ class JobBlock {
   bool agree(bool mine);
   /// Block 0's `value`, on every block (collective).
   bool fromFirst(bool value);
-  /// Runs one step on this block. A failure on every block returns the error on each; a block
-  /// that fails alone aborts the job (MPI_Abort) after printing its error.
+  /// Runs one step on this block. A failure on every block returns the error on each (they
+  /// finalise MPI together at exit, once each has printed it); a block that fails alone aborts
+  /// the job (MPI_Abort) after printing its error.
   Result<BlockResult> step(const BlockStep& step);
   /// The rigid bodies and their forces over every block, each body once (from the block that
   /// reports it), in id order on block 0; `bodies` and `forces` are this block's (forces: the
