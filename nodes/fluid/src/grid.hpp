@@ -20,6 +20,18 @@
 
 namespace vrflow::fluid::detail {
 
+/// Four doubles processed together: one AVX register in the x86-64-v3 clones of the hot loops,
+/// two SSE2 registers in the baseline ones (GCC and Clang vector extension). Loaded and stored
+/// with memcpy in place: a function returning a Quad would change the ABI without AVX.
+typedef double Quad __attribute__((vector_size(32)));
+
+[[gnu::always_inline]] inline void load(Quad& v, const double* p) {
+  __builtin_memcpy(&v, p, sizeof v);
+}
+[[gnu::always_inline]] inline void store(double* p, const Quad& v) {
+  __builtin_memcpy(p, &v, sizeof v);
+}
+
 /// What a cell holds this step.
 /// kSolid: inside a kinematic body, a moving wall (no pressure unknown, its faces keep the
 /// body's velocity).

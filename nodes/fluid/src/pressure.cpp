@@ -43,8 +43,16 @@ double sumOver(BlockComm* comm, double local) {
   return comm ? comm->sum(local) : local;
 }
 
+// The sum of a Quad's lanes, in a fixed order.
+double lanes(const Quad& v) {
+  return (v[0] + v[1]) + (v[2] + v[3]);
+}
+
 // q = A s on the unknowns, returning the local part of s.q; s must hold valid halo planes
-// k0 - 1 and k1.
+// k0 - 1 and k1. Rows above the grid's first plane run four cells at a time with no bounds
+// tests: couplings across the walls are zero and their neighbours lie inside the arrays (s has
+// a plane beyond the grid), and cells that are not unknowns get q = 0. Partial sums of s.q are
+// kept per lane, so the sum is not one chain of dependent additions.
 VRFLOW_FLUID_HOT
 double multiply(const Grid& g, const PressureSystem& A, const double* s, double* q,
                 const std::vector<Row>& rows) {
@@ -53,11 +61,43 @@ double multiply(const Grid& g, const PressureSystem& A, const double* s, double*
   const double* ax = A.ax.data();
   const double* ay = A.ay.data();
   const double* az = A.az.data();
+  Quad sq4 = {0, 0, 0, 0};
   double sq = 0.0;
   for (const Row& row : rows) {
-    const bool jLo = row.j > 0, jHi = row.j + 1 < g.ny, kLo = row.k > 0, kHi = row.k + 1 < g.nz;
+    const std::size_t end = row.c + static_cast<std::size_t>(row.i1 - row.i0) + 1;
     std::size_t c = row.c;
-    for (int i = row.i0; i <= row.i1; ++i, ++c) {
+    int i = row.i0;
+    if (row.k > 0) {
+      for (; c + 4 <= end; c += 4, i += 4) {
+        Quad d, sc, a, sn, v;
+        load(d, diag + c);
+        load(sc, s + c);
+        v = d * sc;
+        load(a, ax + c);
+        load(sn, s + c + 1);
+        v += a * sn;
+        load(a, ax + c - 1);
+        load(sn, s + c - 1);
+        v += a * sn;
+        load(a, ay + c);
+        load(sn, s + c + sy);
+        v += a * sn;
+        load(a, ay + c - sy);
+        load(sn, s + c - sy);
+        v += a * sn;
+        load(a, az + c);
+        load(sn, s + c + sz);
+        v += a * sn;
+        load(a, az + c - sz);
+        load(sn, s + c - sz);
+        v += a * sn;
+        v = d == 0.0 ? Quad{0, 0, 0, 0} : v;
+        store(q + c, v);
+        sq4 += sc * v;
+      }
+    }
+    const bool jLo = row.j > 0, jHi = row.j + 1 < g.ny, kLo = row.k > 0, kHi = row.k + 1 < g.nz;
+    for (; c < end; ++i, ++c) {
       if (diag[c] == 0.0) {
         q[c] = 0.0;
         continue;
@@ -73,7 +113,7 @@ double multiply(const Grid& g, const PressureSystem& A, const double* s, double*
       sq += s[c] * v;
     }
   }
-  return sq;
+  return sq + lanes(sq4);
 }
 
 // MIC(0) of the slab's own block of A (couplings that leave the slab are dropped), stored as
@@ -119,69 +159,204 @@ void buildPreconditioner(const Grid& g, const PressureSystem& A, const Slab& sla
   }
 }
 
-// The forward sweep of the preconditioner (L t = r) on one row, after an optional CG update of
-// p and r on the same cells (fused: r is read once); returns the row's part of |r|^2.
-template <bool kUpdate>
-VRFLOW_FLUID_HOT double forwardRow(const Grid& g, const PcgWorkspace& w, const Row& row,
-                                   double alpha, const double* s, const double* q, double* p,
-                                   double* r, double* t) {
+// The sweeps of the preconditioner are recurrences: a cell needs the cells before it along x,
+// y and z. Along x that is one chain of dependent multiply-adds per row, so a row at a time runs
+// at the latency of that chain. Rows (j, k) on one anti-diagonal j + k of the slab do not depend
+// on each other, only on the diagonal before (forward) or after (backward); the sweeps run such
+// rows in groups of up to four, in step along x, so that four chains are in flight. Each cell
+// still sees the same operations in the same order as in a row-by-row sweep.
+void findWaves(const std::vector<Row>& rows, int k0, PcgWorkspace& w) {
+  int diagonals = 0;
+  for (const Row& row : rows) diagonals = std::max(diagonals, row.j + row.k - k0 + 1);
+  auto& start = w.waveStart;
+  start.assign(static_cast<std::size_t>(diagonals) + 1, 0);
+  for (const Row& row : rows) ++start[static_cast<std::size_t>(row.j + row.k - k0) + 1];
+  for (std::size_t d = 1; d < start.size(); ++d) start[d] += start[d - 1];
+  auto& order = w.waveOrder;
+  order.resize(rows.size());
+  std::vector<int>& next = w.waveNext;
+  next.assign(start.begin(), start.end() - 1);
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    order[static_cast<std::size_t>(next[static_cast<std::size_t>(rows[r].j + rows[r].k - k0)]++)] =
+        static_cast<int>(r);
+  }
+  w.waves.clear();
+  for (std::size_t d = 0; d + 1 < start.size(); ++d) {
+    for (int at = start[d]; at < start[d + 1]; at += PcgWorkspace::kWaveRows) {
+      PcgWorkspace::Wave wave;
+      wave.count = std::min(PcgWorkspace::kWaveRows, start[d + 1] - at);
+      for (int l = 0; l < wave.count; ++l) wave.rows[l] = order[static_cast<std::size_t>(at + l)];
+      w.waves.push_back(wave);
+    }
+  }
+}
+
+// p += alpha s and r -= alpha q on one row, four cells at a time; returns the row's |r|^2.
+VRFLOW_FLUID_HOT double updateRow(const Row& row, double alpha, const double* s, const double* q,
+                                  double* p, double* r) {
+  const std::size_t end = row.c + static_cast<std::size_t>(row.i1 - row.i0) + 1;
+  const Quad a = {alpha, alpha, alpha, alpha};
+  Quad rr4 = {0, 0, 0, 0};
+  std::size_t c = row.c;
+  for (; c + 4 <= end; c += 4) {
+    Quad pv, sv, rv, qv;
+    load(pv, p + c);
+    load(sv, s + c);
+    load(rv, r + c);
+    load(qv, q + c);
+    pv += a * sv;
+    rv -= a * qv;
+    store(p + c, pv);
+    store(r + c, rv);
+    rr4 += rv * rv;
+  }
+  double rr = 0.0;
+  for (; c < end; ++c) {
+    p[c] += alpha * s[c];
+    r[c] -= alpha * q[c];
+    rr += r[c] * r[c];
+  }
+  return rr + lanes(rr4);
+}
+
+// r.z on one row, four cells at a time.
+VRFLOW_FLUID_HOT double dotRow(const Row& row, const double* r, const double* z) {
+  const std::size_t end = row.c + static_cast<std::size_t>(row.i1 - row.i0) + 1;
+  Quad rz4 = {0, 0, 0, 0};
+  std::size_t c = row.c;
+  for (; c + 4 <= end; c += 4) {
+    Quad rv, zv;
+    load(rv, r + c);
+    load(zv, z + c);
+    rz4 += rv * zv;
+  }
+  double rz = 0.0;
+  for (; c < end; ++c) rz += r[c] * z[c];
+  return rz + lanes(rz4);
+}
+
+// The lanes of one wave: each row's cell at the wave's first i, and its tests.
+template <int L>
+struct Lanes {
+  std::size_t c[L];
+  bool jLo[L], jHi[L], kLo[L];
+  int lo = 0, hi = 0;
+
+  Lanes(const Grid& g, const std::vector<Row>& rows, const PcgWorkspace::Wave& wave) {
+    const std::size_t sz = static_cast<std::size_t>(g.nx) * static_cast<std::size_t>(g.ny);
+    lo = g.nx;
+    hi = -1;
+    for (int l = 0; l < L; ++l) {
+      const Row& row = rows[static_cast<std::size_t>(wave.rows[l])];
+      lo = std::min(lo, row.i0);
+      hi = std::max(hi, row.i1);
+    }
+    for (int l = 0; l < L; ++l) {
+      const Row& row = rows[static_cast<std::size_t>(wave.rows[l])];
+      c[l] = row.c - static_cast<std::size_t>(row.i0) + static_cast<std::size_t>(lo);
+      jLo[l] = row.j > 0;
+      jHi[l] = row.j + 1 < g.ny;
+      kLo[l] = c[l] >= sz;
+    }
+  }
+};
+
+// The forward sweep (L t = r) over the rows of one wave. Cells of the span that are not unknowns
+// (pivot 0) get t = 0, as they hold; the x neighbour, computed just before, is kept in a
+// register. The recurrence along x is one multiply-add: the pivot is applied to the rest and to
+// the coupling before.
+template <int L>
+VRFLOW_FLUID_HOT void forwardWave(const Grid& g, const PcgWorkspace& w,
+                                  const PcgWorkspace::Wave& wave, const double* r, double* t) {
   const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
   const double* pc = w.pc.data();
   const double* axpc = w.axpc.data();
   const double* aypc = w.aypc.data();
   const double* azpc = w.azpc.data();
+  const Lanes<L> lanes(g, w.rows, wave);
+  double before[L] = {};
+  for (int i = lanes.lo; i <= lanes.hi; ++i) {
+    const std::size_t at = static_cast<std::size_t>(i - lanes.lo);
+    for (int l = 0; l < L; ++l) {
+      const std::size_t c = lanes.c[l] + at;
+      double v = 0.0;
+      if (pc[c] != 0.0) {
+        v = r[c];
+        if (lanes.jLo[l]) v -= aypc[c - sy] * t[c - sy];
+        if (lanes.kLo[l]) v -= azpc[c - sz] * t[c - sz];
+        v *= pc[c];
+        if (i > 0) v -= (pc[c] * axpc[c - 1]) * before[l];
+      }
+      t[c] = v;
+      before[l] = v;
+    }
+  }
+}
+
+// The backward sweep (L^T z = t) over the rows of one wave, from the last cell.
+template <int L>
+VRFLOW_FLUID_HOT void backwardWave(const Grid& g, const PcgWorkspace& w,
+                                   const PcgWorkspace::Wave& wave, const double* t, double* z) {
+  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
+  const double* pc = w.pc.data();
+  const double* axpc = w.axpc.data();
+  const double* aypc = w.aypc.data();
+  const double* azpc = w.azpc.data();
+  const Lanes<L> lanes(g, w.rows, wave);
+  double after[L] = {};
+  for (int i = lanes.hi; i >= lanes.lo; --i) {
+    const std::size_t at = static_cast<std::size_t>(i - lanes.lo);
+    for (int l = 0; l < L; ++l) {
+      const std::size_t c = lanes.c[l] + at;
+      double v = 0.0;
+      if (pc[c] != 0.0) {
+        v = t[c];
+        if (lanes.jHi[l]) v -= aypc[c] * z[c + sy];
+        v -= azpc[c] * z[c + sz];
+        v *= pc[c];
+        if (i + 1 < g.nx) v -= (pc[c] * axpc[c]) * after[l];
+      }
+      z[c] = v;
+      after[l] = v;
+    }
+  }
+}
+
+// The forward sweep over every wave, each row of a wave first updated (p += alpha s,
+// r -= alpha q) when kUpdate (fused: r is fresh in cache for the sweep); returns |r|^2.
+template <bool kUpdate>
+double forward(const Grid& g, const PcgWorkspace& w, double alpha, const double* s,
+               const double* q, double* p, double* r, double* t) {
   double rr = 0.0;
-  std::size_t c = row.c;
-  for (int i = row.i0; i <= row.i1; ++i, ++c) {
+  for (const auto& wave : w.waves) {
     if constexpr (kUpdate) {
-      p[c] += alpha * s[c];
-      r[c] -= alpha * q[c];
-      rr += r[c] * r[c];
+      for (int l = 0; l < wave.count; ++l) {
+        rr += updateRow(w.rows[static_cast<std::size_t>(wave.rows[l])], alpha, s, q, p, r);
+      }
     }
-    if (pc[c] == 0.0) {
-      t[c] = 0.0;
-      continue;
+    switch (wave.count) {
+      case 4: forwardWave<4>(g, w, wave, r, t); break;
+      case 3: forwardWave<3>(g, w, wave, r, t); break;
+      case 2: forwardWave<2>(g, w, wave, r, t); break;
+      default: forwardWave<1>(g, w, wave, r, t); break;
     }
-    // Rows with no row below or behind them read zeros there (t is zero off the unknowns, and
-    // the couplings of cells outside the slab are zero). The x neighbour, computed just before,
-    // comes last, and the recurrence along x is one multiply and one subtraction: the pivot is
-    // applied to the rest and to the coupling before. (Sweeping two rows j, j + 1 together to
-    // keep two recurrences in flight measured no faster.)
-    double v = r[c];
-    if (row.j > 0) v -= aypc[c - sy] * t[c - sy];
-    if (c >= sz) v -= azpc[c - sz] * t[c - sz];
-    v *= pc[c];
-    if (i > 0) v -= (pc[c] * axpc[c - 1]) * t[c - 1];
-    t[c] = v;
   }
   return rr;
 }
 
-// The backward sweep (L^T z = t), completing z = M^-1 r; returns the local part of r.z.
-VRFLOW_FLUID_HOT
+// The backward sweep over every wave, last first, completing z = M^-1 r; returns the local part
+// of r.z.
 double backward(const Grid& g, const PcgWorkspace& w, const double* r, const double* t, double* z) {
-  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
-  const double* pc = w.pc.data();
-  const double* axpc = w.axpc.data();
-  const double* aypc = w.aypc.data();
-  const double* azpc = w.azpc.data();
   double rz = 0.0;
-  for (auto it = w.rows.rbegin(); it != w.rows.rend(); ++it) {
-    const Row& row = *it;
-    const bool jHi = row.j + 1 < g.ny;
-    std::size_t c = row.c + static_cast<std::size_t>(row.i1 - row.i0);
-    for (int i = row.i1; i >= row.i0; --i, --c) {
-      if (pc[c] == 0.0) {
-        z[c] = 0.0;
-        continue;
-      }
-      double v = t[c];
-      if (jHi) v -= aypc[c] * z[c + sy];
-      v -= azpc[c] * z[c + sz];
-      v *= pc[c];
-      if (i + 1 < g.nx) v -= (pc[c] * axpc[c]) * z[c + 1];
-      z[c] = v;
-      rz += r[c] * z[c];
+  for (auto it = w.waves.rbegin(); it != w.waves.rend(); ++it) {
+    switch (it->count) {
+      case 4: backwardWave<4>(g, w, *it, t, z); break;
+      case 3: backwardWave<3>(g, w, *it, t, z); break;
+      case 2: backwardWave<2>(g, w, *it, t, z); break;
+      default: backwardWave<1>(g, w, *it, t, z); break;
+    }
+    for (int l = 0; l < it->count; ++l) {
+      rz += dotRow(w.rows[static_cast<std::size_t>(it->rows[l])], r, z);
     }
   }
   return rz;
@@ -211,7 +386,7 @@ void mergedReductions(const Grid& g, const PressureSystem& A, const Slab& slab, 
   double* as = w.as.data();
   double* t = w.t.data();
   std::vector<double> sums(3);
-  for (const Row& row : w.rows) forwardRow<false>(g, w, row, 0.0, s, q, p, r, t);
+  forward<false>(g, w, 0.0, s, q, p, r, t);
   sums[0] = backward(g, w, r, t, z);
   comm->exchangeHalo(w.z, planeSize, g.nz, slab.k0, slab.k1, 1);
   sums[1] = multiply(g, A, z, q, w.rows);
@@ -226,9 +401,7 @@ void mergedReductions(const Grid& g, const PressureSystem& A, const Slab& slab, 
   });
   double rNorm = bNorm;
   for (int it = 1; it <= maxIterations; ++it) {
-    double rr = 0.0;
-    for (const Row& row : w.rows) rr += forwardRow<true>(g, w, row, alpha, s, as, p, r, t);
-    sums[0] = rr;
+    sums[0] = forward<true>(g, w, alpha, s, as, p, r, t);
     sums[1] = backward(g, w, r, t, z);
     comm->exchangeHalo(w.z, planeSize, g.nz, slab.k0, slab.k1, 1);
     sums[2] = multiply(g, A, z, q, w.rows);
@@ -291,6 +464,7 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
     for (auto* v : vectors) std::fill_n(v->begin() + from, count, 0.0);
   }
   findRows(g, A, slab, w.rows);
+  findWaves(w.rows, slab.k0, w);
   std::uint64_t activeCells = 0;
   for (const Row& row : w.rows) activeCells += static_cast<std::uint64_t>(row.i1 - row.i0 + 1);
   p.assign(n, 0.0);
@@ -314,7 +488,7 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
                      kBytesPerCellIteration + 24, activeCells, out);
     return out;
   }
-  for (const Row& row : w.rows) forwardRow<false>(g, w, row, 0.0, s, q, pp, r, w.t.data());
+  forward<false>(g, w, 0.0, s, q, pp, r, w.t.data());
   double rho = sumOver(comm, backward(g, w, r, w.t.data(), z));
   for (const Row& row : w.rows) {
     for (std::size_t c = row.c; c <= row.c + static_cast<std::size_t>(row.i1 - row.i0); ++c) {
@@ -330,8 +504,7 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
     const double alpha = rho / sq;
     // The preconditioner runs before the convergence test so that |r|^2 and r.z are summed
     // over the blocks together (one reduction instead of two; the last one is wasted).
-    double rr = 0.0;
-    for (const Row& row : w.rows) rr += forwardRow<true>(g, w, row, alpha, s, q, pp, r, w.t.data());
+    double rr = forward<true>(g, w, alpha, s, q, pp, r, w.t.data());
     const double rz = backward(g, w, r, w.t.data(), z);
     double rhoNew = rz;
     if (comm) {

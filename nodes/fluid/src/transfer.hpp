@@ -110,10 +110,6 @@ inline Pair loadPair(const double* p) {
   return v;
 }
 
-/// Four doubles processed together: one AVX register in the x86-64-v3 clones of the particle
-/// loops, two SSE2 registers in the baseline ones.
-typedef double Quad __attribute__((vector_size(32)));
-
 /// gather() of two interleaved fields at once (`pairs` holds two values per face). A face and
 /// its x neighbour are one load of four values, so the eight corners are four loads: z, then y,
 /// then x.
@@ -121,12 +117,11 @@ inline Pair gatherPair(const double* pairs, const Stencil& s) {
   const double* p = pairs + 2 * s.base;
   const std::size_t y = 2 * s.sy, z = 2 * s.sz;
   const Quad fy = {s.fy, s.fy, s.fy, s.fy}, fz = {s.fz, s.fz, s.fz, s.fz};
-  // (Loaded in place: a function returning a Quad would change the ABI without AVX.)
   Quad r00, r10, r01, r11;
-  __builtin_memcpy(&r00, p, sizeof r00);
-  __builtin_memcpy(&r10, p + y, sizeof r10);
-  __builtin_memcpy(&r01, p + z, sizeof r01);
-  __builtin_memcpy(&r11, p + z + y, sizeof r11);
+  load(r00, p);
+  load(r10, p + y);
+  load(r01, p + z);
+  load(r11, p + z + y);
   const Quad c0 = r00 + fz * (r01 - r00);
   const Quad c1 = r10 + fz * (r11 - r10);
   const Quad c = c0 + fy * (c1 - c0);  // the pair at x, then at x + 1
@@ -146,9 +141,9 @@ inline void splat(double* acc, const Stencil& s, double va) {
       double* row = acc + 2 * (s.base + static_cast<std::size_t>(dk) * s.sz +
                                static_cast<std::size_t>(dj) * s.sy);
       Quad sum;
-      __builtin_memcpy(&sum, row, sizeof sum);
+      load(sum, row);
       sum += Quad{wyz, wyz, wyz, wyz} * x;
-      __builtin_memcpy(row, &sum, sizeof sum);
+      store(row, sum);
     }
   }
 }
