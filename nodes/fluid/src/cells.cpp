@@ -248,7 +248,8 @@ void FluidSolver::Impl::extrapolate(std::vector<double>* field, int layers) {
 
 void FluidSolver::Impl::enforceBodies(const std::vector<PreparedBody>& bodies, bool kinematicOnly) {
   const double o[3] = {grid.ox, grid.oy, grid.oz};
-  for (const auto& box : bodies) {
+  for (std::size_t index = 0; index < bodies.size(); ++index) {
+    const auto& box = bodies[index];
     if (kinematicOnly && !box.kinematic) continue;
     for (int a = 0; a < 3; ++a) {
       int lo[3], hi[3];
@@ -278,11 +279,11 @@ void FluidSolver::Impl::enforceBodies(const std::vector<PreparedBody>& bodies, b
                 b = cellBody[loCell];
               }
             }
-            if (b < 0) continue;
-            const auto& body = bodies[static_cast<std::size_t>(b)];
-            if (kinematicOnly && !body.kinematic) continue;
+            // A face of another body lies within that body's own range (its bounds and one
+            // cell): it is set there, once (a net's nodes overlap each other's ranges).
+            if (b != static_cast<int>(index)) continue;
             u[a][f] =
-                detail::rigidVelocity(body, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
+                detail::rigidVelocity(box, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
           }
         }
       }
