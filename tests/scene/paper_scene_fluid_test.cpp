@@ -104,7 +104,8 @@ TEST(PaperSceneFluid, SixtyIterationsKeepBodiesInTheWorldTheLiquidInItsPoolAndDr
 // (composite fluid_blocks: a route filter feeding each block the bodies and the net near its
 // slab, gather filters joining forces and particles). It computes what the fluid's own two
 // blocks compute: after 60 iterations the bodies' and the net's final states are the same
-// bytes, and so are the liquid's particle count, volume, centroid and level.
+// bytes, and so are the liquid's particle count, volume, centroid and level, and the bodies the
+// liquid holds (those that meet its grid, not the crates beside the pool) with their forces.
 TEST(PaperSceneFluid, OneFluidModulePerBlockGivesTheSceneOfTheFluidsOwnTwoBlocks) {
   const char* files[2] = {"paper_scene_fluid.xml", "paper_scene_fluid_blocks.xml"};
   const char* fluidStates[2] = {"fluid-final.json", "fluid-blocks-final.json"};
@@ -123,9 +124,11 @@ TEST(PaperSceneFluid, OneFluidModulePerBlockGivesTheSceneOfTheFluidsOwnTwoBlocks
   EXPECT_FALSE(bodies[0].empty());
   EXPECT_EQ(bodies[1], bodies[0]);
   EXPECT_EQ(net[1], net[0]);
-  for (const char* key : {"particles", "volume", "centroid", "level", "maxSpeed"}) {
+  for (const char* key : {"particles", "volume", "centroid", "level", "maxSpeed", "bodies"}) {
     EXPECT_EQ(fluid[1][key], fluid[0][key]) << key;
   }
+  EXPECT_FALSE(fluid[0]["bodies"].empty());
+  EXPECT_LT(fluid[0]["bodies"].size(), 29u);  // not the 20 crates beside the pool
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 

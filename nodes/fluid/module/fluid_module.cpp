@@ -213,9 +213,21 @@ int main(int argc, char** argv) {
 
   fluid::World world(nodeRadius);
   regions.grid = solver.bounds();
-  // A block of a job couples the objects near its slab only, and says so on `interest` (for a
-  // route filter); its particles are its own, its fluid object's bounds its slab.
-  const msg::Aabb near = jobBlock ? jobBlock->slab(fluid::kLocalBodyMargin) : msg::Aabb{};
+  // The fluid couples the objects whose bounds meet its grid widened by kLocalBodyMargin cells
+  // (what lies beyond touches no cell and no particle); a block of a job, those near its slab
+  // only, and it says so on `interest` (for a route filter). So both forms hold, report and
+  // write to the state file the same bodies. A block's particles are its own, its fluid
+  // object's bounds its slab.
+  const msg::Aabb near = [&] {
+    if (jobBlock) return jobBlock->slab(fluid::kLocalBodyMargin);
+    msg::Aabb box = solver.bounds();
+    const double margin = fluid::kLocalBodyMargin * s.cellSize;
+    for (std::size_t a = 0; a < 3; ++a) {
+      box.min[a] -= margin;
+      box.max[a] += margin;
+    }
+    return box;
+  }();
   const msg::Aabb ownBounds = jobBlock ? jobBlock->slab(0) : solver.bounds();
   std::vector<std::uint64_t> fluidIds, particlesIds;
   for (int r = 0; r < regions.size(); ++r) {
@@ -237,8 +249,8 @@ int main(int argc, char** argv) {
         if (auto status = world.apply(in.view()); !status) return fail(status.error().message);
       }
     }
-    const auto bodies = world.rigidBodies(jobBlock ? &near : nullptr);
-    const auto points = world.pointMasses(jobBlock ? &near : nullptr);
+    const auto bodies = world.rigidBodies(&near);
+    const auto points = world.pointMasses(&near);
     if (!warnedUncoupled && module.iteration() >= 2) {
       for (const auto& line : world.uncoupled()) {
         std::fprintf(stderr, "vrflow-fluid: not coupled: %s\n", line.c_str());
