@@ -15,4 +15,4 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
 cd "$build"
-ctest --output-on-failure -j "$(nproc)" -L 'runtime|message|app|transport'
+ctest --output-on-failure -j "$(nproc)" -L 'runtime|message|app|transport|launcher'

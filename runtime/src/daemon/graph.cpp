@@ -36,6 +36,7 @@ void QueueSink::push(MessageRef message) {
 
 void RingSink::push(MessageRef message) {
   if (ended()) return;  // dropped: nobody will ever read it
+  message.handOver();
   const bool pushed = ring_.push(message.handle());
   if (pushed) {
     message.release();  // the ring holds the reference now

@@ -14,8 +14,27 @@
 #include <string>
 #include <utility>
 
+#if defined(__SANITIZE_THREAD__)
+#include <sanitizer/tsan_interface.h>
+#endif
+
 namespace vrflow::ipc {
 namespace {
+
+// Blocks go from process to process through the rings, and their last reference may be dropped
+// in another process than the one that allocates the block again. The atomics that order this
+// live in the shared mapping, but ThreadSanitizer sees only its own process's, so each hand-over
+// is a release on the block's reference count and each reuse an acquire of it.
+void tsanRelease([[maybe_unused]] void* address) {
+#if defined(__SANITIZE_THREAD__)
+  __tsan_release(address);
+#endif
+}
+void tsanAcquire([[maybe_unused]] void* address) {
+#if defined(__SANITIZE_THREAD__)
+  __tsan_acquire(address);
+#endif
+}
 
 // A free-list head packs a 32-bit tag (bumped on every change, against ABA) with the block
 // offset divided by 64 (blocks are 64-byte aligned), so a segment may be up to 256 GiB.
@@ -128,6 +147,7 @@ uint64_t Segment::allocate(std::size_t payloadBytes) {
   } else {
     // A popper that lost the race may still read `next` of this block: only atomic stores.
     header = &block(handle);
+    tsanAcquire(&header->refs);
     header->next.store(0, std::memory_order_relaxed);
     header->used = 0;
   }
@@ -144,6 +164,10 @@ uint64_t Segment::allocate(std::size_t payloadBytes) {
 
 void Segment::retain(uint64_t handle) const {
   block(handle).refs.fetch_add(1, std::memory_order_relaxed);
+}
+
+void Segment::handOver(uint64_t handle) const {
+  tsanRelease(&block(handle).refs);
 }
 
 void Segment::release(uint64_t handle) {

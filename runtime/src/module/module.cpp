@@ -159,6 +159,9 @@ struct Module::Impl {
       return true;
     }
     ipc::Ring& out = ring(portSlot);
+    // Read before the push: from then on the daemon holds the block and may free it.
+    const uint64_t bytes = segment.block(handle).used;
+    segment.handOver(handle);
     setState(ipc::ModuleState::Putting, portSlot);
     while (!out.push(handle)) {
       const uint32_t seen = slot->bell.prepare();
@@ -167,7 +170,7 @@ struct Module::Impl {
       slot->bell.sleep(seen, kPollNs);
     }
     port.messages.fetch_add(1, std::memory_order_relaxed);
-    port.bytes.fetch_add(segment.block(handle).used, std::memory_order_relaxed);
+    port.bytes.fetch_add(bytes, std::memory_order_relaxed);
     segment.header().daemonBell.ring();
     if (trace != nullptr) {
       const uint64_t now = nowNs();

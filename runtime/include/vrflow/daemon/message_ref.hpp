@@ -41,6 +41,10 @@ class MessageRef {
 
   bool valid() const { return handle_ != 0; }
   uint64_t handle() const { return handle_; }
+  /// Before pushing the handle on a ring to another process: see ipc::Segment::handOver.
+  void handOver() const {
+    if (handle_ != 0) segment_->handOver(handle_);
+  }
   /// Hands the reference over (to a ring): this object no longer holds it.
   uint64_t release() { return std::exchange(handle_, 0); }
   std::span<const std::byte> bytes() const { return segment_->bytes(handle_); }

@@ -85,6 +85,11 @@ class Segment {
   void retain(uint64_t handle) const;
   /// Drops a reference; the last one returns the block to its free list.
   void release(uint64_t handle);
+  /// Says that this thread hands a reference to another process (pushes it on a ring): what
+  /// it did with the block happens before that process drops it. Only ThreadSanitizer needs
+  /// telling (it cannot see another process's atomics, so a block freed there and allocated
+  /// again here would look like a race); otherwise this does nothing.
+  void handOver(uint64_t handle) const;
 
   BlockHeader& block(uint64_t handle) const { return *at<BlockHeader>(handle); }
   std::byte* payload(uint64_t handle) const { return base_ + handle + sizeof(BlockHeader); }
