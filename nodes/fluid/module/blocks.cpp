@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 #include <string>
 
 #include "vrflow/fluid/mpi_block_comm.hpp"
@@ -161,6 +162,23 @@ bool everyBlockFailed(MPI_Comm failures) {
   }
 }
 
+// Frees the communicators that join this block to the others before MPI_Finalize, on every block
+// once none has a message left to send (after the stop, or the agreement that every block
+// failed). Spawned blocks are another MPI job, "connected" to rank 0 through each communicator
+// that spans both jobs, and Open MPI 4.1's MPI_Finalize starts a handshake (synchronous sends)
+// over every such communicator without waiting for it to complete (ompi_dpm_dyn_finalize checks
+// its count against ompi_comm_num_dyncomm + 1 and returns early): the first block to finalise
+// closes its TCP connections while the other still writes its part; that write fails (EPIPE),
+// the TCP BTL starts a reconnection, and the writer's MPI_Finalize then spins forever freeing the
+// event left behind. With those communicators freed there is no handshake: each block finalises
+// on its own. (MPI_Comm_disconnect, meant for this, never returns in Open MPI 4.1 between a
+// spawning and a spawned process.) Under mpirun the blocks are one job: nothing changes.
+void freeComms(std::initializer_list<MPI_Comm*> comms) {
+  for (MPI_Comm* comm : comms) {
+    if (*comm != MPI_COMM_NULL) MPI_Comm_free(comm);
+  }
+}
+
 // Test hook: with VRFLOW_FLUID_TEST_FAIL="BLOCK STEP", step number STEP (from 0, query-only steps
 // not counted) fails on block BLOCK alone, as a bug of one block would (BLOCK -1: on every
 // block). A block cannot fail alone otherwise (the blocks check the same input), so the tests
@@ -201,6 +219,7 @@ Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& s) {
 }
 
 struct BlockGroup::Impl {
+  MPI_Comm spawned = MPI_COMM_NULL;  ///< the intercommunicator to spawned workers
   MPI_Comm world = MPI_COMM_NULL;
   MPI_Comm failures = MPI_COMM_NULL;  ///< only for the agreement after a failed step
   int blocks = 0;
@@ -250,15 +269,14 @@ Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, in
       args.push_back(watchName.data());
     }
     args.push_back(nullptr);
-    MPI_Comm inter;
     std::vector<int> codes(static_cast<std::size_t>(blocks - 1));
     const int rc = MPI_Comm_spawn(executable, args.data(), blocks - 1, MPI_INFO_NULL, 0,
-                                  MPI_COMM_SELF, &inter, codes.data());
+                                  MPI_COMM_SELF, &impl->spawned, codes.data());
     if (rc != MPI_SUCCESS) {
       MPI_Finalize();
       return makeError(std::string("fluid: MPI_Comm_spawn of ") + executable + " failed");
     }
-    MPI_Intercomm_merge(inter, 0, &impl->world);
+    MPI_Intercomm_merge(impl->spawned, 0, &impl->world);
   }
   impl->blocks = blocks;
   Setup setup{settings, fill};
@@ -281,7 +299,7 @@ Result<BlockResult> BlockGroup::step(const BlockStep& s) {
     impl_->stopped = true;
     impl_->watch.reset();  // the workers that failed with this block end on their own
     if (everyBlockFailed(impl_->failures)) {  // they left their loops: a clean end
-      MPI_Finalize();
+      finish();
       return result;
     }
     // The workers are inside the step, waiting for this block: no MPI_Finalize. The module
@@ -301,13 +319,19 @@ void BlockGroup::stop() {
   last.stop = true;
   auto bytes = encodeStep(last);
   broadcast(bytes, impl_->world);
+  finish();
+}
+
+void BlockGroup::finish() {
+  freeComms({&impl_->failures, &impl_->world, &impl_->spawned});  // as the workers do
   MPI_Finalize();
 }
 
 namespace {
 
-// A worker's life on `world` (rank 0 is the module): the setup, then steps until told to stop.
-int workerLoop(MPI_Comm world) {
+// A worker's life on `world` (rank 0 is the module; `parent`: the intercommunicator to it when
+// spawned): the setup, then steps until told to stop.
+int workerLoop(MPI_Comm world, MPI_Comm parent) {
   Setup setup;
   MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, world);
   MPI_Comm failures = MPI_COMM_NULL;
@@ -338,6 +362,7 @@ int workerLoop(MPI_Comm world) {
                  comm.rank(), comm.size(), stepped.error().message.c_str());
     MPI_Abort(world, 1);
   }
+  freeComms({&failures, &world, &parent});  // as rank 0 does (BlockGroup::finish)
   MPI_Finalize();
   return 0;
 }
@@ -367,7 +392,7 @@ int runBlockWorker(int argc, char** argv) {
     MPI_Comm_rank(world, &rank);
     WorkerWatch::tellBlock(watch, rank);
   }
-  return workerLoop(world);
+  return workerLoop(world, parent);
 }
 
 int mpirunRank() {
@@ -385,7 +410,7 @@ int runRankWorker(int argc, char** argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm world;
   MPI_Comm_dup(MPI_COMM_WORLD, &world);
-  return workerLoop(world);
+  return workerLoop(world, MPI_COMM_NULL);
 }
 
 namespace {

@@ -67,6 +67,8 @@ class BlockGroup {
  private:
   struct Impl;
   explicit BlockGroup(std::unique_ptr<Impl> impl);
+  /// Finalises MPI once the workers are leaving their loops (they finalise the same way).
+  void finish();
   std::unique_ptr<Impl> impl_;
 };
 
