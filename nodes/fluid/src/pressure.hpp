@@ -33,15 +33,14 @@ struct PcgWorkspace {
     int j, k, i0, i1;
   };
   std::vector<Row> rows;
-  /// Up to kWaveRows rows of one anti-diagonal j + k, swept together (indices into rows), in
-  /// the order of their diagonals.
-  static constexpr int kWaveRows = 4;
+  /// Up to kWaveRows consecutive rows of one plane, swept together (indices into rows), each
+  /// one cell behind the row before it (see findWaves).
+  static constexpr int kWaveRows = 2;
   struct Wave {
     int count = 0;
     int rows[kWaveRows] = {};
   };
   std::vector<Wave> waves;
-  std::vector<int> waveStart, waveNext, waveOrder;  ///< scratch of findWaves
 };
 
 struct PcgOutcome {
