@@ -167,16 +167,21 @@ void buildPreconditioner(const Grid& g, const PressureSystem& A, const Slab& sla
 // before in its own row, and (i, j - 1), one step before in the row below, so two chains are
 // in flight. The rows of a wave lie next to each other in memory, so the sweep still streams
 // through the vectors in order. Each cell sees the same operations in the same order as in a
-// row-by-row sweep, so the result is the same to the bit. Measured on a 2-core EPYC against a
-// row at a time (CG time per step): two rows 3.9 against 5.4 ms on 32 x 64 x 32 and on par on
-// 64 x 128 x 64; three or four rows gained less on the small grid and lost up to 10 % on the
-// large one (more streams than the loads keep up with); rows of one anti-diagonal j + k across
-// the slab, tried first, scattered a wave over every plane and lost 1.5x on the large grid.
-void findWaves(const std::vector<Row>& rows, PcgWorkspace& w) {
+// row-by-row sweep, so the result is the same to the bit, whichever way a grid is swept.
+// Measured on a 2-core EPYC against a row at a time (CG time per step, alternating runs): on
+// 32 x 64 x 32, two rows 3.9 against 5.4 ms (three or four rows gained less); on 64 x 128 x 64
+// two rows lost 15-30 % (90-120 against 78-93 ms), on one rank as on two, with the vectors (4
+// MiB each) out of the caches, where interleaving two rows seems to cost the prefetchers more
+// than the second chain gains. So grids up to kPairedSweepCells cells (1 MiB per vector) sweep
+// rows in pairs, larger ones a row at a time. (Rows of one anti-diagonal j + k across the slab,
+// tried first, scattered a wave over every plane and lost 1.5x on the large grid.)
+constexpr std::size_t kPairedSweepCells = std::size_t{1} << 17;
+
+void findWaves(const std::vector<Row>& rows, int rowsPerWave, PcgWorkspace& w) {
   w.waves.clear();
   for (std::size_t r = 0; r < rows.size();) {
     PcgWorkspace::Wave wave;
-    while (r < rows.size() && wave.count < PcgWorkspace::kWaveRows &&
+    while (r < rows.size() && wave.count < rowsPerWave &&
            (wave.count == 0 || rows[r].k == rows[static_cast<std::size_t>(wave.rows[0])].k)) {
       wave.rows[wave.count++] = static_cast<int>(r++);
     }
@@ -494,7 +499,10 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
     for (auto* v : vectors) std::fill_n(v->begin() + from, count, 0.0);
   }
   findRows(g, A, slab, w.rows);
-  findWaves(w.rows, w);
+  const int rowsPerWave =
+      w.rowsPerWave > 0 ? std::min(w.rowsPerWave, PcgWorkspace::kWaveRows)
+                        : (g.cells() <= kPairedSweepCells ? PcgWorkspace::kWaveRows : 1);
+  findWaves(w.rows, rowsPerWave, w);
   std::uint64_t activeCells = 0;
   for (const Row& row : w.rows) activeCells += static_cast<std::uint64_t>(row.i1 - row.i0 + 1);
   p.assign(n, 0.0);

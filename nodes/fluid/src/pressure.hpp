@@ -41,6 +41,9 @@ struct PcgWorkspace {
     int rows[kWaveRows] = {};
   };
   std::vector<Wave> waves;
+  /// Rows per wave: 0 chooses by the grid's size (pairs up to 2^17 cells, see pressure.cpp);
+  /// every choice gives the same bits.
+  int rowsPerWave = 0;
 };
 
 struct PcgOutcome {
