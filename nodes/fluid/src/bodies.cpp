@@ -90,11 +90,6 @@ Result<PreparedBody> preparePoint(const PointMass& point) {
   return p;
 }
 
-bool inBounds(const msg::Aabb& box, const double* x) {
-  return x[0] >= box.min[0] && x[0] <= box.max[0] && x[1] >= box.min[1] && x[1] <= box.max[1] &&
-         x[2] >= box.min[2] && x[2] <= box.max[2];
-}
-
 void pushOut(const PreparedBody& body, double* x, double margin) {
   const msg::Vec3 local = msg::rotateInverse(
       body.orientation,

@@ -30,7 +30,11 @@ struct PreparedBody {
 Result<PreparedBody> prepareBody(const RigidBody& body, double liquidDensity);
 Result<PreparedBody> preparePoint(const PointMass& point);
 
-bool inBounds(const msg::Aabb& box, const double* x);
+/// Inline: tested for every particle in a cell some body's bounds reach.
+inline bool inBounds(const msg::Aabb& box, const double* x) {
+  return x[0] >= box.min[0] && x[0] <= box.max[0] && x[1] >= box.min[1] && x[1] <= box.max[1] &&
+         x[2] >= box.min[2] && x[2] <= box.max[2];
+}
 /// Moves a world point inside the body to `margin` outside its surface.
 void pushOut(const PreparedBody& body, double* x, double margin);
 /// Velocity of the body's material at world point x.
