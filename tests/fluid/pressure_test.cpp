@@ -2,9 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
-#include <array>
 #include <random>
 #include <vector>
 
@@ -113,8 +113,8 @@ double relativeResidual(const Problem& pr, const std::vector<double>& p) {
 
 TEST(PressureCg, RowsSweptInPairsGiveTheBitsOfRowsSweptOneAtATime) {
   // Odd and even row lengths and row counts, so pairs end mid-plane and single rows are left.
-  for (const auto& dims : {std::array<int, 3>{13, 10, 7}, std::array<int, 3>{8, 9, 6},
-                           std::array<int, 3>{4, 5, 5}}) {
+  for (const auto& dims :
+       {std::array<int, 3>{13, 10, 7}, std::array<int, 3>{8, 9, 6}, std::array<int, 3>{4, 5, 5}}) {
     const Problem pr = irregularProblem(dims[0], dims[1], dims[2], 7u + dims[0]);
     PcgOutcome single, paired;
     const auto p1 = solve(pr, 1, single);

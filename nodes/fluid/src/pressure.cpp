@@ -70,28 +70,23 @@ double multiply(const Grid& g, const PressureSystem& A, const double* s, double*
     int i = row.i0;
     if (row.k > 0) {
       for (; c + 4 <= end; c += 4, i += 4) {
-        Quad d, sc, a, sn, v;
+        Quad d, sc, v;
         load(d, diag + c);
         load(sc, s + c);
         v = d * sc;
-        load(a, ax + c);
-        load(sn, s + c + 1);
-        v += a * sn;
-        load(a, ax + c - 1);
-        load(sn, s + c - 1);
-        v += a * sn;
-        load(a, ay + c);
-        load(sn, s + c + sy);
-        v += a * sn;
-        load(a, ay + c - sy);
-        load(sn, s + c - sy);
-        v += a * sn;
-        load(a, az + c);
-        load(sn, s + c + sz);
-        v += a * sn;
-        load(a, az + c - sz);
-        load(sn, s + c - sz);
-        v += a * sn;
+        // v += coupling * neighbour, four cells at a time.
+        const auto add = [&v](const double* coupling, const double* neighbour) {
+          Quad a, sn;
+          load(a, coupling);
+          load(sn, neighbour);
+          v += a * sn;
+        };
+        add(ax + c, s + c + 1);
+        add(ax + c - 1, s + c - 1);
+        add(ay + c, s + c + sy);
+        add(ay + c - sy, s + c - sy);
+        add(az + c, s + c + sz);
+        add(az + c - sz, s + c - sz);
         v = d == 0.0 ? Quad{0, 0, 0, 0} : v;
         store(q + c, v);
         sq4 += sc * v;
@@ -264,11 +259,28 @@ struct Lanes {
   }
 };
 
+// The steps of a wave: lane m works on position k = step - m of the span, so each lane is one
+// step behind the lane before it. The lanes run from the last, so that lane m still finds the
+// value lane m - 1 computed in the step before. The first and last L - 1 steps have lanes
+// outside the span; the steps between have none and run without tests.
+template <int L, typename Cell>
+[[gnu::always_inline]] inline void skewedSteps(int span, Cell&& cell) {
+  const auto edge = [&](int step) __attribute__((always_inline)) {
+    for (int m = L - 1; m >= 0; --m) {
+      if (step - m >= 0 && step - m < span) cell(m, step - m);
+    }
+  };
+  for (int step = 0; step < L - 1; ++step) edge(step);
+  for (int step = L - 1; step < span; ++step) {
+#pragma GCC unroll 4
+    for (int m = L - 1; m >= 0; --m) cell(m, step - m);
+  }
+  for (int step = std::max(L - 1, span); step < span + L - 1; ++step) edge(step);
+}
+
 // The forward sweep (L t = r) over the rows of one wave, lane l at cell i = lo + step - l.
-// Cells of the span that are not unknowns (pivot 0) get t = 0, as they hold. The lanes run from
-// the last, so a lane reads its row below's value of the step before before that lane
-// overwrites it. The recurrence along x is one multiply-add: the pivot is applied to the rest
-// and to the coupling before.
+// Cells of the span that are not unknowns (pivot 0) get t = 0, as they hold. The recurrence
+// along x is one multiply-add: the pivot is applied to the rest and to the coupling before.
 template <int L>
 VRFLOW_FLUID_HOT void forwardWave(const Grid& g, const PcgWorkspace& w,
                                   const PcgWorkspace::Wave& wave, const double* r, double* t) {
@@ -284,7 +296,8 @@ VRFLOW_FLUID_HOT void forwardWave(const Grid& g, const PcgWorkspace& w,
     double v = 0.0;
     if (pc[c] != 0.0) {
       v = r[c];
-      if (lanes.jLo[l]) v -= aypc[c - sy] * (lanes.below[l] ? before[l > 0 ? l - 1 : 0] : t[c - sy]);
+      if (lanes.jLo[l])
+        v -= aypc[c - sy] * (lanes.below[l] ? before[l > 0 ? l - 1 : 0] : t[c - sy]);
       if (lanes.kLo[l]) v -= azpc[c - sz] * t[c - sz];
       v *= pc[c];
       if (lanes.lo + at > 0) v -= (pc[c] * axpc[c - 1]) * before[l];
@@ -292,27 +305,12 @@ VRFLOW_FLUID_HOT void forwardWave(const Grid& g, const PcgWorkspace& w,
     t[c] = v;
     before[l] = v;
   };
-  const int span = lanes.hi - lanes.lo + 1;
-  // The first and last L - 1 steps have lanes outside the span; the steps between have none.
-  const int full = std::max(L - 1, span);
-  for (int step = 0; step < L - 1; ++step) {
-    for (int l = L - 1; l >= 0; --l) {
-      if (step - l >= 0 && step - l < span) cell(l, step - l);
-    }
-  }
-  for (int step = L - 1; step < span; ++step) {
-#pragma GCC unroll 4
-    for (int l = L - 1; l >= 0; --l) cell(l, step - l);
-  }
-  for (int step = full; step < span + L - 1; ++step) {
-    for (int l = L - 1; l >= 0; --l) {
-      if (step - l >= 0 && step - l < span) cell(l, step - l);
-    }
-  }
+  skewedSteps<L>(lanes.hi - lanes.lo + 1, cell);
 }
 
 // The backward sweep (L^T z = t) over the rows of one wave, from the last cell; lane l at cell
-// i = hi - step + (L - 1 - l), the lanes from the first.
+// i = hi - step + (L - 1 - l), the lanes from the first (lane l reads lane l + 1's value of the
+// step before).
 template <int L>
 VRFLOW_FLUID_HOT void backwardWave(const Grid& g, const PcgWorkspace& w,
                                    const PcgWorkspace::Wave& wave, const double* t, double* z) {
@@ -336,23 +334,10 @@ VRFLOW_FLUID_HOT void backwardWave(const Grid& g, const PcgWorkspace& w,
     z[c] = v;
     after[l] = v;
   };
+  // Lane l trails lane l + 1 by a step: as lead lane L - 1 - l, from the span's end.
   const int span = lanes.hi - lanes.lo + 1;
-  const int last = span - 1 + L - 1;  // at = last - step - l
-  const int full = std::max(L - 1, span);
-  for (int step = 0; step < L - 1; ++step) {
-    for (int l = 0; l < L; ++l) {
-      if (last - step - l >= 0 && last - step - l < span) cell(l, last - step - l);
-    }
-  }
-  for (int step = L - 1; step < span; ++step) {
-#pragma GCC unroll 4
-    for (int l = 0; l < L; ++l) cell(l, last - step - l);
-  }
-  for (int step = full; step < span + L - 1; ++step) {
-    for (int l = 0; l < L; ++l) {
-      if (last - step - l >= 0 && last - step - l < span) cell(l, last - step - l);
-    }
-  }
+  skewedSteps<L>(
+      span, [&](int m, int k) __attribute__((always_inline)) { cell(L - 1 - m, span - 1 - k); });
 }
 
 // Calls f with the wave's number of lanes as a constant (one instance of a sweep per count).
@@ -370,8 +355,8 @@ void withLanes(int count, F&& f) {
 // The forward sweep over every wave, each row of a wave first updated (p += alpha s,
 // r -= alpha q) when kUpdate (fused: r is fresh in cache for the sweep); returns |r|^2.
 template <bool kUpdate>
-double forward(const Grid& g, const PcgWorkspace& w, double alpha, const double* s,
-               const double* q, double* p, double* r, double* t) {
+double forward(const Grid& g, const PcgWorkspace& w, double alpha, const double* s, const double* q,
+               double* p, double* r, double* t) {
   double rr = 0.0;
   for (const auto& wave : w.waves) {
     if constexpr (kUpdate) {
@@ -499,9 +484,9 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
     for (auto* v : vectors) std::fill_n(v->begin() + from, count, 0.0);
   }
   findRows(g, A, slab, w.rows);
-  const int rowsPerWave =
-      w.rowsPerWave > 0 ? std::min(w.rowsPerWave, PcgWorkspace::kWaveRows)
-                        : (g.cells() <= kPairedSweepCells ? PcgWorkspace::kWaveRows : 1);
+  const int rowsPerWave = w.rowsPerWave > 0
+                              ? std::min(w.rowsPerWave, PcgWorkspace::kWaveRows)
+                              : (g.cells() <= kPairedSweepCells ? PcgWorkspace::kWaveRows : 1);
   findWaves(w.rows, rowsPerWave, w);
   std::uint64_t activeCells = 0;
   for (const Row& row : w.rows) activeCells += static_cast<std::uint64_t>(row.i1 - row.i0 + 1);
