@@ -87,7 +87,9 @@ TEST_F(BuffersTest, BlockingPolicyHoldsTheProducerBackWithFlatMemory) {
   // The queue is full for the whole run (over 3 s): reported once, naming it and its policy.
   EXPECT_EQ(json["connections"][0]["stayed_full"], true);
   ASSERT_EQ(json["warnings"].size(), 1u) << json["warnings"];
-  EXPECT_EQ(json["warnings"][0], "connection fast.out -> slow.in stayed full (8 messages, policy block)");
+  EXPECT_EQ(json["warnings"][0],
+            "connection fast.out -> slow.in stayed full (8 messages, policy block): 'slow' takes "
+            "messages slower than 'fast' sends them, so 'slow' paces 'fast'");
   EXPECT_NE(result.err.find("warning: connection fast.out -> slow.in stayed full"), std::string::npos);
 }
 

@@ -565,9 +565,18 @@ void Daemon::Impl::checkFullQueues(uint64_t now) {
       const char* policy = queue.policy == app::QueuePolicy::Block      ? "block"
                            : queue.policy == app::QueuePolicy::DropOldest ? "drop-oldest"
                                                                             : "drop-newest";
+      // What it means, in the words of the two ends (the ids before the port names).
+      const auto owner = [](const std::string& port) {
+        return "'" + port.substr(0, port.rfind('.')) + "'";
+      };
+      const std::string from = owner(queue.from), to = owner(queue.to);
+      const std::string effect = queue.policy == app::QueuePolicy::Block
+                                     ? ", so " + to + " paces " + from
+                                     : "; what does not fit is dropped";
       graph->warnings.push_back("connection " + queue.from + " -> " + queue.to + " stayed full (" +
                                 std::to_string(queue.capacity) + " messages, policy " + policy +
-                                ")");
+                                "): " + to + " takes messages slower than " + from + " sends them" +
+                                effect);
     }
   }
 }
