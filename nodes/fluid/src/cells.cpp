@@ -248,10 +248,20 @@ void FluidSolver::Impl::extrapolate(std::vector<double>* field, int layers) {
 
 void FluidSolver::Impl::enforceBodies(const std::vector<PreparedBody>& bodies, bool kinematicOnly) {
   const double o[3] = {grid.ox, grid.oy, grid.oz};
-  for (std::size_t index = 0; index < bodies.size(); ++index) {
-    const auto& box = bodies[index];
-    if (kinematicOnly && !box.kinematic) continue;
-    for (int a = 0; a < 3; ++a) {
+  for (int a = 0; a < 3; ++a) {
+    // Each face row (j, k) is visited once, over the union of the bodies' ranges in it (their
+    // bounds and one cell): a net's nodes overlap each other's ranges, and visiting each body's
+    // own range visited most faces several times. A face is set to the velocity of the body it
+    // belongs to, which always lies within that body's range.
+    const int ny = grid.fdim(a, 1);
+    const int planes = kEnd(a) - k0;
+    if (planes <= 0) continue;
+    auto& rowLo = enforceRowLo;
+    auto& rowHi = enforceRowHi;
+    rowLo.assign(static_cast<std::size_t>(planes) * ny, grid.fdim(a, 0));
+    rowHi.assign(static_cast<std::size_t>(planes) * ny, -1);
+    for (const auto& box : bodies) {
+      if (kinematicOnly && !box.kinematic) continue;
       int lo[3], hi[3];
       for (int d = 0; d < 3; ++d) {
         lo[d] = std::max(0, static_cast<int>(std::floor((box.bounds.min[d] - o[d]) * invH)) - 1);
@@ -262,29 +272,38 @@ void FluidSolver::Impl::enforceBodies(const std::vector<PreparedBody>& bodies, b
       hi[2] = std::min(hi[2], kEnd(a) - 1);
       for (int k = lo[2]; k <= hi[2]; ++k) {
         for (int j = lo[1]; j <= hi[1]; ++j) {
-          for (int i = lo[0]; i <= hi[0]; ++i) {
-            const std::size_t f = grid.face(a, i, j, k);
-            int b = faceBody[a][f];
-            if (b < 0 && !onWall(a, i, j, k)) {  // the faces of a kinematic body's cells too
-              const std::size_t hiCell = grid.cell(i, j, k), loCell = hiCell - stride(a);
-              if (kind[hiCell] == detail::kSolid) b = cellBody[hiCell];
-              if (kind[loCell] == detail::kSolid) b = cellBody[loCell];
-              // Between a body's cell and air the body's surface moves with the body: the
-              // liquid's velocity extrapolated there (or zero) would make the body's cells
-              // diverge, and the projection would brake the body as if air were liquid.
-              if (b < 0 && kind[hiCell] == detail::kBody && kind[loCell] == detail::kAir) {
-                b = cellBody[hiCell];
-              }
-              if (b < 0 && kind[loCell] == detail::kBody && kind[hiCell] == detail::kAir) {
-                b = cellBody[loCell];
-              }
+          const std::size_t row = static_cast<std::size_t>(k - k0) * ny + j;
+          rowLo[row] = std::min(rowLo[row], lo[0]);
+          rowHi[row] = std::max(rowHi[row], hi[0]);
+        }
+      }
+    }
+    const std::size_t across = stride(a);
+    for (int k = k0; k < kEnd(a); ++k) {
+      for (int j = 0; j < ny; ++j) {
+        const std::size_t row = static_cast<std::size_t>(k - k0) * ny + j;
+        std::size_t f = grid.face(a, rowLo[row], j, k);
+        for (int i = rowLo[row]; i <= rowHi[row]; ++i, ++f) {
+          int b = faceBody[a][f];
+          if (b < 0 && !onWall(a, i, j, k)) {  // the faces of a kinematic body's cells too
+            const std::size_t hiCell = grid.cell(i, j, k), loCell = hiCell - across;
+            if (kind[hiCell] == detail::kSolid) b = cellBody[hiCell];
+            if (kind[loCell] == detail::kSolid) b = cellBody[loCell];
+            // Between a body's cell and air the body's surface moves with the body: the
+            // liquid's velocity extrapolated there (or zero) would make the body's cells
+            // diverge, and the projection would brake the body as if air were liquid.
+            if (b < 0 && kind[hiCell] == detail::kBody && kind[loCell] == detail::kAir) {
+              b = cellBody[hiCell];
             }
-            // A face of another body lies within that body's own range (its bounds and one
-            // cell): it is set there, once (a net's nodes overlap each other's ranges).
-            if (b != static_cast<int>(index)) continue;
-            u[a][f] =
-                detail::rigidVelocity(box, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
+            if (b < 0 && kind[loCell] == detail::kBody && kind[hiCell] == detail::kAir) {
+              b = cellBody[loCell];
+            }
           }
+          if (b < 0) continue;
+          const auto& box = bodies[static_cast<std::size_t>(b)];
+          if (kinematicOnly && !box.kinematic) continue;
+          u[a][f] =
+              detail::rigidVelocity(box, facePosition(a, i, j, k))[static_cast<std::size_t>(a)];
         }
       }
     }

@@ -190,6 +190,7 @@ struct FluidSolver::Impl {
   // Pushes particles out of the bodies. Per cell (CSR: bodiesAt[c] to bodiesAt[c + 1] in
   // bodyList), the bodies whose bounds reach it; only those are tested.
   std::vector<std::uint32_t> bodiesAt, bodyList, bodyListFill;
+  std::vector<int> enforceRowLo, enforceRowHi;  ///< scratch of enforceBodies: faces per row
   void pushParticlesOut(const std::vector<PreparedBody>& bodies);
 
   void classify(const std::vector<PreparedBody>& bodies);
