@@ -1,4 +1,4 @@
-# vrflow: the four entry points. `make demo` and `make test` are all a new user needs.
+# vrflow: the entry points. `make demo` and `make test` are all a new user needs; `make check` is CI's.
 SHELL := /bin/bash
 BUILD ?= build
 JOBS ?= $(shell nproc)
@@ -9,9 +9,9 @@ PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-r
   libgtest-dev libpugixml-dev libcli11-dev \
   nlohmann-json3-dev libxxhash-dev libzmq3-dev libopenmpi-dev openmpi-bin libxml2-utils procps \
   libbullet-dev libeigen3-dev libosmesa6-dev libpng-dev qt6-base-dev libgraphviz-dev \
-  libsodium-dev openssh-server openssh-client
+  libsodium-dev openssh-server openssh-client clang-format
 
-.PHONY: deps build test demo clean
+.PHONY: deps build test check format demo clean
 
 deps:
 	@missing=$$(for p in $(PACKAGES); do \
@@ -30,8 +30,19 @@ build: deps
 	fi
 	cmake --build $(BUILD) -j $(JOBS)
 
+# The plain suite: unit, end-to-end, physics and editor tests (a few minutes on 2 cores).
 test: build
-	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE 'fuzz|sanitize|format'
+
+# Everything CI runs: the plain suite, then the format check, a short fuzzing campaign and the
+# runtime's tests rebuilt under ASan/UBSan and TSan (each sanitizer in a build tree of its own).
+check: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE 'fuzz|sanitize|format'
+	cd $(BUILD) && ctest --output-on-failure -L 'format|fuzz|sanitize'
+
+# Rewrites every C++ source in place to follow .clang-format.
+format:
+	tests/format/check_format.sh $(CURDIR) --fix
 
 # What `make demo` adds: an encoder for the video (without it the viewer writes PNG frames).
 DEMO_PACKAGES := ffmpeg

@@ -97,3 +97,13 @@ function(vrflow_install_composite file)
   get_filename_component(name ${file} NAME)
   configure_file(${file} ${PROJECT_BINARY_DIR}/share/vrflow/composites/${name} COPYONLY)
 endfunction()
+
+# vrflow_require(FOUND_VAR WHAT PACKAGES OPTION): stops the configuration when a dependency of a
+# part that is switched on was not found, naming the Debian packages and the option that turns
+# the part off (the build never drops a part silently).
+function(vrflow_require found what packages option)
+  if(NOT ${found})
+    message(FATAL_ERROR "${what} was not found (Debian: ${packages}); install it (make deps) "
+                        "or configure with -D${option}=OFF")
+  endif()
+endfunction()
