@@ -76,7 +76,7 @@ TEST_F(TraceTest, EveryArrowEndsAfterItStarts) {
                       connect("r2.out", "r3.in") + connect("r3.out", "rec.in")));
   const auto result = runVrflow({"run", file, "-n", "2000", "--trace", dir.file("t.json")}, 120);
   ASSERT_EQ(result.exitCode, 0) << result.err;
-  const auto arrows = arrowsOf(dir.file("t.json"));
+  auto arrows = arrowsOf(dir.file("t.json"));
   EXPECT_EQ(arrows.total, 4 * 2000);
   EXPECT_EQ(arrows.backwards, 0) << "of " << arrows.total << " arrows";
 }
@@ -91,7 +91,7 @@ TEST_F(TraceTest, AModuleThatForwardsAMessageUnchangedIsAHopOfItsOwn) {
                   connect("src.out", "fwd.in") + connect("fwd.out", "rec.in")));
   const auto result = runVrflow({"run", file, "-n", "30", "--trace", dir.file("t.json")}, 60);
   ASSERT_EQ(result.exitCode, 0) << result.err;
-  const auto arrows = arrowsOf(dir.file("t.json"));
+  auto arrows = arrowsOf(dir.file("t.json"));
   EXPECT_EQ(arrows.byName["src -> fwd"], 30);
   EXPECT_EQ(arrows.byName["fwd -> rec"], 30);
   EXPECT_EQ(arrows.byName.count("src -> rec"), 0u) << "an arrow skips the forwarding module";
@@ -118,7 +118,7 @@ TEST_F(TraceTest, EveryPartOfAMergedInputHasItsArrow) {
           "  </connections>\n</application>\n");
   const auto result = runVrflow({"run", file, "-n", "25", "--trace", dir.file("t.json")}, 60);
   ASSERT_EQ(result.exitCode, 0) << result.err;
-  const auto arrows = arrowsOf(dir.file("t.json"));
+  auto arrows = arrowsOf(dir.file("t.json"));
   EXPECT_EQ(arrows.byName["a -> two"], 25);
   EXPECT_EQ(arrows.byName["b -> two"], 25);
   EXPECT_EQ(arrows.byName["a -> three"], 25);
