@@ -1,5 +1,6 @@
-// A module stopped (SIGSTOP) under `vrflow launch`: the host that runs it names it, its state
-// and its host; the hosts that wait on it do not call the run a deadlock of theirs.
+// Supervision under `vrflow launch`: a module stopped (SIGSTOP) is named by the host that runs
+// it, with its state (the hosts that wait on it do not call the run a deadlock of theirs); a
+// module over --module-memory-limit is named with its host and the limit.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -56,6 +57,32 @@ TEST(LaunchStall, AStoppedModuleIsNamedWithItsHostNotBlamedOnAnotherHost) {
   for (const auto& left : leftoverProcesses()) {
     EXPECT_NE(left.find("(reaped)"), std::string::npos) << "still running: " << left;
   }
+}
+
+TEST(LaunchMemoryLimit, AModuleOverTheLimitIsNamedWithItsHostAndTheLimit) {
+  TempDir dir;
+  const auto file = dir.write(
+      "app.xml",
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"hog\" version=\"1\">\n"
+      "  <hosts>\n    <host id=\"a\" address=\"127.0.0.1\"/>\n"
+      "    <host id=\"b\" address=\"127.0.0.2\"/>\n  </hosts>\n  <modules>\n"
+      "    <module id=\"hog\" package=\"testing\" type=\"hog\" host=\"b\">\n"
+      "      <param name=\"max-mib\" value=\"512\"/>\n    </module>\n"
+      "    <module id=\"rec\" package=\"core\" type=\"recorder\" host=\"a\">\n"
+      "      <param name=\"file\" value=\"" +
+          dir.file("x.csv") +
+          "\"/>\n    </module>\n  </modules>\n  <connections>\n"
+          "    <connection from=\"hog.out\" to=\"rec.in\"/>\n  </connections>\n</application>\n");
+  const auto result = runVrflow(
+      {"launch", file, "--module-memory-limit", "96M", "-n", "200", "--timeout", "60"}, 90);
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("host 'b': module 'hog' (host b, pid "), std::string::npos)
+      << result.err;
+  EXPECT_NE(result.err.find("ran out of memory under the module memory limit of 96 MiB "
+                            "(--module-memory-limit)"),
+            std::string::npos)
+      << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
 }
 
 }  // namespace
