@@ -1,11 +1,13 @@
+#include "vrflow/launcher/launch.hpp"
+
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
-#include <sys/socket.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/signalfd.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,12 +16,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
+#include "monitor_files.hpp"
 #include "vrflow/base/executable_dir.hpp"
-#include "vrflow/launcher/launch.hpp"
 #include "vrflow/net/transport.hpp"
 #include "vrflow/run/trace.hpp"
 
@@ -123,11 +125,6 @@ Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
   return pid;
 }
 
-// Where running launches publish their live state for `vrflow monitor`.
-std::string monitorFile() {
-  return monitorDirectory() + "/monitor-" + std::to_string(getpid()) + ".json";
-}
-
 class Launcher {
  public:
   Launcher(const app::Application& application, const LaunchOptions& options)
@@ -146,6 +143,7 @@ class Launcher {
   void stopAll();
   void publish();
   Clock::time_point lastPublish_{};
+  std::optional<std::string> monitorDir_;  ///< where publish() writes; unset: not yet chosen
   bool allExited() const {
     for (const auto& d : daemons_) {
       if (!d.exited) return false;
@@ -300,6 +298,9 @@ void Launcher::appendDaemonOptions(std::vector<std::string>& argv) const {
   std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
   argv.insert(argv.end(), {"--peer-timeout", timeout});
   if (options_.iterations > 0) argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
+  if (options_.moduleMemoryBytes > 0) {
+    argv.insert(argv.end(), {"--module-memory-limit", std::to_string(options_.moduleMemoryBytes)});
+  }
   for (const auto& p : options_.packageDirs) {
     argv.insert(argv.end(), {"--packages", std::filesystem::absolute(p, ec).string()});
   }
@@ -529,12 +530,18 @@ void Launcher::publish() {
             ",\"before\":" + (d.previousStats.empty() ? "null" : d.previousStats) + "}";
   }
   text += "]}";
-  const std::string path = monitorFile(), temp = path + ".tmp";
-  const int fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-  if (fd < 0) return;
-  const bool ok = write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
-  close(fd);
-  if (ok) rename(temp.c_str(), path.c_str());
+  if (!monitorDir_) {
+    // Chosen once: a folder that may not be trusted is refused (the launch goes on unseen).
+    auto dir = monitorDirectory();
+    if (!dir) {
+      std::fprintf(stderr, "vrflow: warning: `vrflow monitor` will not show this launch: %s\n",
+                   dir.error().message.c_str());
+    } else {
+      removeStaleMonitorFiles(*dir);
+    }
+    monitorDir_ = dir ? *dir : std::string();
+  }
+  if (!monitorDir_->empty()) publishMonitorFile(*monitorDir_, text);
 }
 
 void Launcher::stopAll() {
@@ -596,7 +603,7 @@ run::RunOutcome Launcher::run() {
     }
   }
   stopAll();
-  std::remove(monitorFile().c_str());
+  if (monitorDir_ && !monitorDir_->empty()) removeMonitorFile(*monitorDir_);
   for (auto& d : daemons_) {
     if (d.toDaemon >= 0) close(d.toDaemon);
     if (d.fromDaemon >= 0) close(d.fromDaemon);

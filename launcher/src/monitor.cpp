@@ -1,16 +1,20 @@
 #include <dirent.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
+#include "monitor_files.hpp"
 #include "vrflow/launcher/launch.hpp"
 
 namespace vrflow::launcher {
@@ -106,23 +110,53 @@ std::string render(const json& launch) {
   return out.str();
 }
 
+// A monitor file larger than this is not a launcher's (they hold a few KiB per host).
+constexpr off_t kMaxMonitorFileBytes = off_t{16} << 20;
+
+// The launcher pid in a monitor file's name ("monitor-PID.json", or a temporary
+// "monitor-PID.json.XXXXXX" of publishMonitorFile()), or 0 if the name is not one.
+pid_t launcherOf(const std::string& name, bool& temporary) {
+  if (name.rfind("monitor-", 0) != 0) return 0;
+  char* end = nullptr;
+  const long pid = std::strtol(name.c_str() + 8, &end, 10);
+  if (pid <= 0 || end == name.c_str() + 8 || std::strncmp(end, ".json", 5) != 0) return 0;
+  temporary = end[5] != '\0';
+  if (temporary && end[5] != '.') return 0;
+  return static_cast<pid_t>(pid);
+}
+
+bool processGone(pid_t pid) {
+  return kill(pid, 0) != 0 && errno == ESRCH;
+}
+
+// A regular file of `dir` (never through a symbolic link), at most kMaxMonitorFileBytes.
+std::string readMonitorFile(int dir, const std::string& name) {
+  const int fd = openat(dir, name.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return {};
+  struct stat info {};
+  std::string text;
+  if (fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_size <= kMaxMonitorFileBytes) {
+    text.resize(static_cast<std::size_t>(info.st_size));
+    const ssize_t n = read(fd, text.data(), text.size());
+    text.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
+  }
+  close(fd);
+  return text;
+}
+
 // The live launches: their monitor files whose launcher is still running.
-std::vector<json> liveLaunches() {
+Result<std::vector<json>> liveLaunches() {
+  auto dir = monitorDirectory();
+  if (!dir) return dir.error();
+  removeStaleMonitorFiles(*dir);
   std::vector<json> launches;
-  const std::string dir = monitorDirectory();
-  DIR* d = opendir(dir.c_str());
+  DIR* d = opendir(dir->c_str());
   if (d == nullptr) return launches;
   while (dirent* e = readdir(d)) {
-    const std::string name = e->d_name;
-    if (name.rfind("monitor-", 0) != 0 || name.size() < 14 ||
-        name.compare(name.size() - 5, 5, ".json") != 0) {
-      continue;
-    }
-    const pid_t pid = std::atoi(name.c_str() + 8);
-    if (pid <= 0 || kill(pid, 0) != 0) continue;
-    std::ifstream in(dir + "/" + name);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    auto j = json::parse(text, nullptr, false);
+    bool temporary = false;
+    const pid_t pid = launcherOf(e->d_name, temporary);
+    if (pid <= 0 || temporary || kill(pid, 0) != 0) continue;
+    auto j = json::parse(readMonitorFile(dirfd(d), e->d_name), nullptr, false);
     if (!j.is_discarded() && j.is_object() && j.contains("hosts")) launches.push_back(std::move(j));
   }
   closedir(d);
@@ -131,29 +165,93 @@ std::vector<json> liveLaunches() {
 
 }  // namespace
 
-std::string monitorDirectory() {
+Result<std::string> monitorDirectory() {
   std::string dir;
   if (const char* runtime = std::getenv("XDG_RUNTIME_DIR"); runtime != nullptr && *runtime != '\0') {
     dir = std::string(runtime) + "/vrflow";
   } else {
     dir = "/tmp/vrflow-" + std::to_string(getuid());
   }
-  mkdir(dir.c_str(), 0700);
+  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
+    return makeError("cannot create the monitor folder '" + dir + "': " + std::strerror(errno));
+  }
+  // As ssh and tmux do: a folder that someone else owns or may write to could hand our files
+  // (or links in their place) to another user.
+  struct stat info {};
+  if (lstat(dir.c_str(), &info) != 0) {
+    return makeError("cannot use the monitor folder '" + dir + "': " + std::strerror(errno));
+  }
+  if (!S_ISDIR(info.st_mode)) {
+    return makeError("the monitor folder '" + dir + "' is not a folder (a link or a file): " +
+                     "remove it, or set XDG_RUNTIME_DIR");
+  }
+  if (info.st_uid != getuid()) {
+    return makeError("the monitor folder '" + dir + "' belongs to uid " +
+                     std::to_string(info.st_uid) + ", not to you (uid " + std::to_string(getuid()) +
+                     "): remove it, or set XDG_RUNTIME_DIR");
+  }
+  if ((info.st_mode & (S_IWGRP | S_IWOTH)) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(info.st_mode & 07777));
+    return makeError("the monitor folder '" + dir + "' may be written by others (mode " + mode +
+                     "): make it private with `chmod 700 " + dir + "`");
+  }
   return dir;
+}
+
+void removeStaleMonitorFiles(const std::string& dir) {
+  DIR* d = opendir(dir.c_str());
+  if (d == nullptr) return;
+  while (dirent* e = readdir(d)) {
+    bool temporary = false;
+    const pid_t pid = launcherOf(e->d_name, temporary);
+    if (pid > 0 && processGone(pid)) {
+      unlinkat(dirfd(d), e->d_name, 0);
+    }
+  }
+  closedir(d);
+}
+
+bool publishMonitorFile(const std::string& dir, const std::string& text) {
+  const std::string path = dir + "/monitor-" + std::to_string(getpid()) + ".json";
+  // mkostemp opens with O_CREAT | O_EXCL: a name that exists (a link planted there included)
+  // is never opened, and rename() replaces a link at `path` instead of following it.
+  std::string temp = path + ".XXXXXX";
+  const int fd = mkostemp(temp.data(), O_CLOEXEC);
+  if (fd < 0) return false;
+  bool ok = fchmod(fd, 0600) == 0;
+  for (std::size_t done = 0; ok && done < text.size();) {
+    const ssize_t n = write(fd, text.data() + done, text.size() - done);
+    ok = n > 0;
+    if (ok) done += static_cast<std::size_t>(n);
+  }
+  ok = close(fd) == 0 && ok;
+  if (ok && rename(temp.c_str(), path.c_str()) == 0) return true;
+  unlink(temp.c_str());
+  return false;
+}
+
+void removeMonitorFile(const std::string& dir) {
+  unlink((dir + "/monitor-" + std::to_string(getpid()) + ".json").c_str());
 }
 
 int monitor(bool once, bool asJson) {
   bool seen = false;
   while (true) {
     const auto launches = liveLaunches();
-    if (launches.empty()) {
-      if (!seen) std::fprintf(stderr, "vrflow monitor: no launch is running (looked in %s)\n",
-                              monitorDirectory().c_str());
+    if (!launches) {
+      std::fprintf(stderr, "vrflow monitor: %s\n", launches.error().message.c_str());
+      return 1;
+    }
+    if (launches->empty()) {
+      if (!seen)
+        std::fprintf(stderr, "vrflow monitor: no launch is running (looked in %s)\n",
+                     monitorDirectory()->c_str());
       return seen ? 0 : 1;
     }
     seen = true;
     std::string text;
-    for (const auto& l : launches) text += asJson ? l.dump() + "\n" : render(l) + "\n";
+    for (const auto& l : *launches) text += asJson ? l.dump() + "\n" : render(l) + "\n";
     if (!once && !asJson && isatty(STDOUT_FILENO)) std::fputs("\033[H\033[2J", stdout);
     std::fputs(text.c_str(), stdout);
     std::fflush(stdout);

@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
                  "Run under `vrflow launch --backend mpirun`: reach the launcher at ADDRESS:PORT; "
                  "the run secret is read from $VRFLOW_RUN_SECRET, which is cleared at once");
   cli.add_flag("--trace", options.trace, "Record modules' spans and send them to the launcher");
+  cli.add_option("--module-memory-limit", options.moduleMemoryBytes,
+                 "Cap each module's data memory (e.g. 2G, 512M)")
+      ->transform(CLI::AsSizeValue(false));
   cli.add_option("--bind", bindAddress, "Address to listen on (default: the host's address)");
   cli.add_option("--peer-timeout", peerTimeout,
                  "A link to another host silent this long is declared lost (seconds)")
@@ -207,6 +210,7 @@ int main(int argc, char** argv) {
     }
     if (from) local.connections.push_back(c);
   }
+  options.wholeApplication = &*application;
   const auto outcome = vrflow::run::runApplication(local, *catalog, options);
   if (link) return outcome.exitCode;  // the launcher reports
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow-daemon: %s\n", outcome.error.c_str());

@@ -106,6 +106,9 @@ int main(int argc, char** argv) {
   run->add_option("--shm-size", shmMiB, "Shared-memory segment size in MiB (sparse)")
       ->check(CLI::Range(1.0, 262144.0));
   run->add_flag("--no-progress", noProgress, "Do not show live progress on a terminal");
+  run->add_option("--module-memory-limit", options.moduleMemoryBytes,
+                  "Cap each module's data memory (e.g. 2G, 512M); hitting it is named as the cause")
+      ->transform(CLI::AsSizeValue(false));
   run->add_option("--trace", options.tracePath,
                   "Write a Chrome/Perfetto trace (modules' wait/compute spans, messages as flows)");
 
@@ -132,6 +135,11 @@ int main(int argc, char** argv) {
                      "mpirun: this machine's address as the daemons reach it (default 127.0.0.1)");
   launch->add_option("--trace", launchOptions.tracePath,
                      "Write a Chrome/Perfetto trace of every host, clocks aligned");
+  launch
+      ->add_option(
+          "--module-memory-limit", launchOptions.moduleMemoryBytes,
+          "Cap each module's data memory (e.g. 2G, 512M); hitting it is named as the cause")
+      ->transform(CLI::AsSizeValue(false));
   launch
       ->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,
                    "A host silent this long (no heartbeat) is declared lost (seconds)")

@@ -68,6 +68,7 @@ struct Daemon::Impl {
   std::mutex warningsMutex;
   std::vector<std::string> warnings;
   std::string fatal;  ///< first protocol violation by a module (guarded by warningsMutex)
+  std::vector<ipc::TraceMerge> traceMerges;  ///< guarded by warningsMutex
   std::vector<QueueSnapshot> snapshot;  ///< guarded by warningsMutex
   void publishSnapshot();
 
@@ -95,6 +96,7 @@ Result<std::unique_ptr<Daemon>> Daemon::create(const app::Application& applicati
   if (!segment) return segment.error();
   d.segment = std::move(*segment);
   d.graph = std::make_unique<Graph>(d.segment);
+  d.graph->traceMerges = options.trace;
   if (options.transport != nullptr) {
     options.transport->attachSegment(d.segment);
     auto* bell = &d.segment.header().daemonBell;
@@ -420,6 +422,7 @@ void Daemon::shutdown() {
   // sees every message that was put.
   while (d.pass()) {
   }
+  d.publishWarnings();
   // Drop every message still buffered: in queues, and in the rings of every module.
   for (auto& queue : d.graph->queues) queue.items.clear();
   for (const auto& moduleRings : d.rings) {
@@ -598,10 +601,12 @@ std::vector<QueueSnapshot> Daemon::queueSnapshot() {
 }
 
 void Daemon::Impl::publishWarnings() {
-  if (graph->warnings.empty()) return;
+  if (graph->warnings.empty() && graph->merges.empty()) return;
   std::lock_guard lock(warningsMutex);
   for (auto& w : graph->warnings) warnings.push_back(std::move(w));
   graph->warnings.clear();
+  traceMerges.insert(traceMerges.end(), graph->merges.begin(), graph->merges.end());
+  graph->merges.clear();
 }
 
 std::string Daemon::fatalError() {
@@ -612,6 +617,11 @@ std::string Daemon::fatalError() {
 std::vector<std::string> Daemon::takeWarnings() {
   std::lock_guard lock(impl_->warningsMutex);
   return std::exchange(impl_->warnings, {});
+}
+
+std::vector<ipc::TraceMerge> Daemon::takeTraceMerges() {
+  std::lock_guard lock(impl_->warningsMutex);
+  return std::exchange(impl_->traceMerges, {});
 }
 
 std::vector<ConnectionStats> Daemon::connectionStats() const {

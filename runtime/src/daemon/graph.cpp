@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "../module/shm_sink.hpp"
+#include "vrflow/message/ids.hpp"
 
 namespace vrflow::daemon {
 namespace {
@@ -84,6 +85,18 @@ Result<MessageRef> Node::concatenate(std::span<const MessageRef> parts) {
     if (!view) return makeError("filter '" + id_ + "': malformed message: " + view.error().message);
     views.push_back(*view);
     total += part.size();
+  }
+  if (graph_->traceMerges && views.size() > 1) {
+    // The merged message is stamped with the first part's source and the largest iteration.
+    uint64_t mergedIteration = 0;
+    for (const auto& view : views)
+      mergedIteration = std::max(mergedIteration, view.stamps().iteration);
+    const uint32_t mergedHash = msg::fnv1a32(views.front().stamps().source);
+    for (const auto& view : views) {
+      const auto stamps = view.stamps();
+      graph_->merges.push_back(
+          {mergedHash, msg::fnv1a32(stamps.source), mergedIteration, stamps.iteration});
+    }
   }
   return compose(total, [&](msg::MessageBuilder& builder) {
     uint64_t iteration = 0;

@@ -149,6 +149,8 @@ class Graph {
   std::vector<std::unique_ptr<Node>> nodes;
   std::vector<ModuleSource> sources;
   std::vector<std::string> warnings;
+  bool traceMerges = false;             ///< the run is traced: concatenate() records `merges`
+  std::vector<ipc::TraceMerge> merges;  ///< taken with the warnings (Daemon::takeTraceMerges)
   uint64_t operations = 0;  ///< bumped on every move, to detect progress
   uint64_t wakeAtNs = 0;    ///< earliest time a filter asked to be run again; 0 = none
 };

@@ -142,7 +142,10 @@ uint64_t Segment::allocate(std::size_t payloadBytes) {
   BlockHeader* header = nullptr;
   if (handle == 0) {
     handle = reserve(std::size_t{1} << k, 64);
-    if (handle == 0) return 0;
+    if (handle == 0) {
+      header_->failedAllocations.fetch_add(1, std::memory_order_relaxed);
+      return 0;
+    }
     header = new (base_ + handle) BlockHeader();  // never seen by anyone before
   } else {
     // A popper that lost the race may still read `next` of this block: only atomic stores.

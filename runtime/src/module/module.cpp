@@ -4,16 +4,16 @@
 #include <sys/prctl.h>
 #include <unistd.h>
 
-#include <csignal>
-
 #include <atomic>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <map>
+#include <new>
 #include <vector>
 
 #include "shm_sink.hpp"
@@ -94,6 +94,15 @@ Result<long> moduleIndexFromEnvironment() {
   return list[static_cast<std::size_t>(rank)];
 }
 
+// The slot of this process's module, marked when operator new finds no memory (the runtime
+// then names its memory limit as the cause of the module's end).
+std::atomic<ipc::ModuleSlot*> slotToMarkOutOfMemory{nullptr};
+
+void markOutOfMemory() {
+  if (auto* slot = slotToMarkOutOfMemory.load()) slot->outOfMemory.store(1);
+  std::set_new_handler(nullptr);  // operator new now throws std::bad_alloc
+}
+
 }  // namespace
 
 struct OutgoingMessage::Impl {
@@ -132,6 +141,21 @@ struct Module::Impl {
     trace->record({begin, end, iteration, sourceIteration, static_cast<uint32_t>(kind),
                    static_cast<uint32_t>(sourceHash)});
   }
+  using TraceEvent = ipc::TraceEvent;
+  TraceEvent sentEvent(uint64_t handle) const {
+    const uint64_t now = nowNs();
+    TraceEvent event{now,
+                     now,
+                     iteration,
+                     iteration,
+                     static_cast<uint32_t>(ipc::TraceKind::Sent),
+                     msg::fnv1a32(id)};
+    if (auto view = msg::MessageView::parse(segment.bytes(handle))) {
+      event.sourceHash = msg::fnv1a32(view->stamps().source);
+      event.sourceIteration = view->stamps().iteration;
+    }
+    return event;
+  }
   double simTime = 0.0;
   double timeStep = 0.0;
   std::map<std::string, std::string, std::less<>> params;
@@ -161,6 +185,10 @@ struct Module::Impl {
     ipc::Ring& out = ring(portSlot);
     // Read before the push: from then on the daemon holds the block and may free it.
     const uint64_t bytes = segment.block(handle).used;
+    // Traced: the send time is taken before the push (a receiver may wake at once), with the
+    // stamps that name the message, which differ from this module's when it forwards one.
+    TraceEvent sent{};
+    if (trace != nullptr) sent = sentEvent(handle);
     segment.handOver(handle);
     setState(ipc::ModuleState::Putting, portSlot);
     while (!out.push(handle)) {
@@ -172,10 +200,7 @@ struct Module::Impl {
     port.messages.fetch_add(1, std::memory_order_relaxed);
     port.bytes.fetch_add(bytes, std::memory_order_relaxed);
     segment.header().daemonBell.ring();
-    if (trace != nullptr) {
-      const uint64_t now = nowNs();
-      traceEvent(ipc::TraceKind::Sent, now, now);
-    }
+    if (trace != nullptr) trace->record(sent);
     setState(ipc::ModuleState::Computing);
     return true;
   }
@@ -294,6 +319,8 @@ Status Module::init() {
   }
   m.id = m.slot->id;
   m.slot->pid.store(static_cast<int32_t>(getpid()));
+  slotToMarkOutOfMemory.store(m.slot);
+  if (std::get_new_handler() == nullptr) std::set_new_handler(&markOutOfMemory);
   m.current.resize(m.slot->portCount);
   if (m.slot->traceOffset != 0 && m.segment.contains(m.slot->traceOffset, sizeof(ipc::TraceRing))) {
     m.trace = m.segment.at<ipc::TraceRing>(m.slot->traceOffset);

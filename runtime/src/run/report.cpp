@@ -51,6 +51,7 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
     m["host"] = module.host;
     m["iterations"] = iterations;
     m["exit"] = ends[i].exit;
+    if (!ends[i].cause.empty()) m["cause"] = ends[i].cause;
     ordered_json timing;
     const double computeS = static_cast<double>(slot.computeNs.load()) / 1e9;
     timing["iteration_ms_mean"] = iterations ? computeS * 1e3 / static_cast<double>(iterations) : 0.0;

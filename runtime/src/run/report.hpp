@@ -10,7 +10,8 @@ namespace vrflow::run {
 
 /// What the supervisor knows of one module at the end.
 struct ModuleEnd {
-  std::string exit;  ///< "status 0", "signal 9", "running" (killed at stop)
+  std::string exit;   ///< "status 0", "signal 9", "running" (killed at stop)
+  std::string cause;  ///< why it ended, when the runtime knows more than `exit` (empty if not)
 };
 
 /// The run report as JSON text (what writeReport() writes).

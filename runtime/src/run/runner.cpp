@@ -54,16 +54,71 @@ std::string portName(const ipc::PortSlot& port) {
   return std::string(port.name, strnlen(port.name, sizeof port.name));
 }
 
-// Who feeds an input port, for deadlock reports.
-std::string sourcesOf(const app::Application& application, const std::string& module,
-                      const std::string& port) {
+// Who feeds an input port, for deadlock reports: `whole` is the whole application, `local`
+// this host's share of it (the same under `vrflow run`). Sets `remote` if a feeder is elsewhere.
+std::string sourcesOf(const app::Application& whole, const app::Application& local,
+                      const std::string& module, const std::string& port, bool& remote) {
   std::string text;
-  for (const auto& c : application.connections) {
-    if (c.to.node == module && c.to.port == port) {
-      text += (text.empty() ? "" : ", ") + app::toString(c.from);
+  for (const auto& c : whole.connections) {
+    if (c.to.node != module || c.to.port != port) continue;
+    text += (text.empty() ? "" : ", ") + app::toString(c.from);
+    const bool here = std::any_of(local.modules.begin(), local.modules.end(),
+                                  [&](const app::Module& m) { return m.id == c.from.node; }) ||
+                      std::any_of(local.filters.begin(), local.filters.end(),
+                                  [&](const app::Filter& f) { return f.id == c.from.node; });
+    if (!here) {
+      remote = true;
+      std::string host = "?";
+      for (const auto& m : whole.modules) {
+        if (m.id == c.from.node) host = app::effectiveHost(whole, m.host);
+      }
+      for (const auto& f : whole.filters) {
+        if (f.id == c.from.node) host = app::effectiveHost(whole, f.host);
+      }
+      text += " on host " + host;
     }
   }
   return text.empty() ? "initial messages only" : "from " + text;
+}
+
+// What /proc/PID/stat says of a process: its state letter (R, S, D, T, t, Z...) and CPU time.
+struct ProcessSample {
+  char state = '?';
+  uint64_t cpuNs = 0;
+  bool known = false;
+};
+
+ProcessSample sampleProcess(pid_t pid) {
+  ProcessSample sample;
+  std::FILE* stat = std::fopen(("/proc/" + std::to_string(pid) + "/stat").c_str(), "r");
+  if (stat == nullptr) return sample;
+  char text[1024] = {};
+  const std::size_t n = std::fread(text, 1, sizeof text - 1, stat);
+  std::fclose(stat);
+  const char* close = std::strrchr(text, ')');
+  const long ticks = sysconf(_SC_CLK_TCK);
+  unsigned long utime = 0, stime = 0;
+  char state = '?';
+  if (n > 0 && close != nullptr && ticks > 0 &&
+      std::sscanf(close + 2, "%c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &state, &utime,
+                  &stime) == 3) {
+    sample.state = state;
+    sample.cpuNs = (utime + stime) * (1'000'000'000ull / static_cast<unsigned long>(ticks));
+    sample.known = true;
+  }
+  return sample;
+}
+
+// Why a process that should answer does not, from its state letter; empty if it may run.
+std::string notRunningReason(char state) {
+  switch (state) {
+    case 'T':
+      return "stopped (process state T: SIGSTOP or SIGTSTP; SIGCONT resumes it)";
+    case 't':
+      return "stopped by a debugger or tracer (process state t)";
+    default:
+      return {};
+  }
 }
 
 class Supervisor {
@@ -81,7 +136,7 @@ class Supervisor {
     int mpiRanks = 0;  ///< above 1: `pid` is the mpirun that runs this many ranks
     int job = -1;      ///< index in jobs_: `pid` is the mpirun of that job, shared by its modules
     bool alive = false;
-    ModuleEnd end{"not started"};
+    ModuleEnd end{"not started", ""};
   };
   std::string jobLabel(const app::MpiJob& job, pid_t mpirun) const;
   std::optional<std::string> jobsWithoutMpirun() const;
@@ -90,7 +145,12 @@ class Supervisor {
   void reap(RunOutcome& outcome, bool stopping);
   void stopAll();
   std::size_t liveCount() const;
-  bool deadlocked(std::string& detail);
+  pid_t processOf(std::size_t module) const;
+  std::string memoryCause() const;
+  std::string waitDetail(std::size_t module, bool& remote) const;
+  std::optional<RunOutcome> noProgress();
+  std::vector<uint64_t> stallCpuNs_;    ///< per module: CPU time when the stall check sampled
+  Clock::time_point stallSampledAt_{};  ///< when; unset while modules progress
   bool notJoined(std::string& detail);
   bool lingering(std::string& detail);
   Clock::time_point finishedSince_{};
@@ -109,6 +169,10 @@ class Supervisor {
       auto& ring = *daemon_.segment().at<ipc::TraceRing>(slot.traceOffset);
       drainTraceRing(ring, static_cast<uint32_t>(i), trace_);
     }
+    for (const auto& merge : daemon_.takeTraceMerges()) {
+      if (trace_.merges.size() >= kMaxTraceEventsPerHost) break;
+      trace_.merges.push_back(merge);
+    }
   }
   HostTrace trace_;
 
@@ -118,7 +182,6 @@ class Supervisor {
     j["t_ns"] = std::chrono::duration_cast<std::chrono::nanoseconds>(
                     Clock::now().time_since_epoch()).count();
     auto modules = nlohmann::json::array();
-    const long ticks = sysconf(_SC_CLK_TCK);
     const long page = sysconf(_SC_PAGESIZE);
     for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
       const auto& module = daemon_.modules()[i];
@@ -132,22 +195,9 @@ class Supervisor {
       uint64_t cpuNs = 0, rss = 0;
       // A module of an MPI job is its rank's process (it wrote its pid when it joined), not
       // the mpirun it shares with the job's other modules.
-      const int32_t own = slot.pid.load();
-      const pid_t pid = children_[i].job >= 0 && own > 0 ? own : children_[i].pid;
+      const pid_t pid = processOf(i);
       if (children_[i].alive) {
-        std::FILE* stat = std::fopen(("/proc/" + std::to_string(pid) + "/stat").c_str(), "r");
-        if (stat != nullptr) {
-          char text[1024] = {};
-          const std::size_t n = std::fread(text, 1, sizeof text - 1, stat);
-          std::fclose(stat);
-          const char* close = std::strrchr(text, ')');
-          unsigned long utime = 0, stime = 0;
-          if (n > 0 && close != nullptr &&
-              std::sscanf(close + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &utime,
-                          &stime) == 2 && ticks > 0) {
-            cpuNs = (utime + stime) * (1'000'000'000ull / static_cast<unsigned long>(ticks));
-          }
-        }
+        cpuNs = sampleProcess(pid).cpuNs;
         std::FILE* statm = std::fopen(("/proc/" + std::to_string(pid) + "/statm").c_str(), "r");
         if (statm != nullptr) {
           unsigned long size = 0, resident = 0;
@@ -179,6 +229,7 @@ class Supervisor {
   std::vector<app::MpiJob> jobs_;  ///< only those of several modules
   std::vector<int> jobOf_;         ///< per module: its index in jobs_, or -1
   std::vector<Child> children_;
+  MpiBackingFolder mpiFolder_;  ///< removed after every process of the run ended (~Supervisor)
   Clock::time_point start_ = Clock::now();
   uint64_t lastIterationSum_ = 0;
   Clock::time_point lastProgress_ = Clock::now();
@@ -236,7 +287,13 @@ bool Supervisor::startJob(std::size_t jobIndex, int segmentFd,
   for (const std::size_t m : job.modules) slots.push_back(daemon_.modules()[m].slotIndex);
   environment.push_back("VRFLOW_MPI_JOB=" + job.name);
   const auto& first = daemon_.modules()[job.modules.front()];
-  auto pid = spawnMpiJob(first.executable, slots, segmentFd, environment);
+  auto backing = mpiFolder_.path();
+  if (!backing) {
+    outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + backing.error().message};
+    return false;
+  }
+  auto pid = spawnMpiJob(first.executable, slots, segmentFd, environment, *backing,
+                         options_.moduleMemoryBytes);
   if (!pid) {
     outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + pid.error().message};
     return false;
@@ -262,6 +319,7 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
   while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
     // One process: a module, or the mpirun of an MPI job that all its modules share.
     std::string notJoined;  // the first module that never joined, if any
+    std::string outOfMemory;  // the first module that ran out of memory, if any
     int job = -1;
     std::size_t first = children_.size();
     for (std::size_t i = 0; i < children_.size(); ++i) {
@@ -276,6 +334,10 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
                                    static_cast<uint32_t>(ipc::ModuleState::Starting)) {
         notJoined = module.id;
       }
+      if (daemon_.slot(module.slotIndex).outOfMemory.load() != 0) {
+        child.end.cause = memoryCause();
+        if (outOfMemory.empty()) outOfMemory = module.id;
+      }
       if (first == children_.size()) first = i;
       job = child.job;
     }
@@ -284,26 +346,42 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
     if ((clean && notJoined.empty()) || stopping || outcome.exitCode != kExitOk) continue;
     outcome.exitCode = kExitRunFailed;
     outcome.status = "failed";
+    const std::string memory =
+        outOfMemory.empty() ? "" : ": module '" + outOfMemory + "' " + memoryCause();
     if (job >= 0) {
       outcome.error = jobLabel(jobs_[static_cast<std::size_t>(job)], pid) + " " +
                       describeMpirunWaitStatus(status) +
                       (notJoined.empty() ? ""
                                          : " before module '" + notJoined +
                                                "' joined the run (it never called "
-                                               "Module::init())");
+                                               "Module::init())") +
+                      memory;
       continue;
     }
     const Child& child = children_[first];
     const auto& module = daemon_.modules()[first];
     const bool mpirun = child.mpiRanks > 1;
-    outcome.error = "module '" + module.id + "' (host " + module.host + ", " +
-                    (mpirun ? std::to_string(child.mpiRanks) + " MPI ranks, mpirun pid "
-                            : std::string("pid ")) +
-                    std::to_string(pid) + ") " +
-                    (mpirun ? describeMpirunWaitStatus(status) : describeWaitStatus(status)) +
-                    (notJoined.empty() ? ""
-                                       : " before joining the run (it never called Module::init())");
+    outcome.error =
+        "module '" + module.id + "' (host " + module.host + ", " +
+        (mpirun ? std::to_string(child.mpiRanks) + " MPI ranks, mpirun pid "
+                : std::string("pid ")) +
+        std::to_string(pid) + ") " +
+        (mpirun ? describeMpirunWaitStatus(status) : describeWaitStatus(status)) +
+        (notJoined.empty() ? "" : " before joining the run (it never called Module::init())") +
+        (outOfMemory.empty() ? "" : ": it " + memoryCause());
   }
+}
+
+// Why a module that marked itself out of memory failed: "ran out of memory under the module
+// memory limit of 64 MiB (--module-memory-limit)", or without a limit, just that.
+std::string Supervisor::memoryCause() const {
+  if (options_.moduleMemoryBytes == 0) return "ran out of memory (an allocation failed)";
+  char text[128];
+  std::snprintf(text, sizeof text,
+                "ran out of memory under the module memory limit of %.4g MiB "
+                "(--module-memory-limit)",
+                static_cast<double>(options_.moduleMemoryBytes) / 1048576.0);
+  return text;
 }
 
 // Every live module finished its iterations long ago but has not exited.
@@ -349,45 +427,125 @@ bool Supervisor::notJoined(std::string& detail) {
   return false;
 }
 
-bool Supervisor::deadlocked(std::string& detail) {
+// The process of module `module`: its own (it wrote its pid when it joined) when it is a rank
+// of an MPI job or of an mpirun of its own, else the one started for it.
+pid_t Supervisor::processOf(std::size_t module) const {
+  const int32_t own = daemon_.slot(daemon_.modules()[module].slotIndex).pid.load();
+  const Child& child = children_[module];
+  return (child.job >= 0 || child.mpiRanks > 1) && own > 0 ? own : child.pid;
+}
+
+// "waits on input 'in' (from src.out) at iteration 3", as the module's slot tells.
+std::string Supervisor::waitDetail(std::size_t module, bool& remote) const {
+  const auto& slot = daemon_.slot(daemon_.modules()[module].slotIndex);
+  int port = slot.waitingPort.load();
+  if (port >= static_cast<int>(std::min<uint32_t>(slot.portCount, ipc::kMaxPortsPerModule)))
+    port = -1;
+  const auto state = static_cast<ipc::ModuleState>(slot.state.load());
+  std::string detail;
+  if (port >= 0 && state == ipc::ModuleState::Waiting) {
+    const std::string name = portName(slot.ports[port]);
+    const app::Application& whole =
+        options_.wholeApplication != nullptr ? *options_.wholeApplication : application_;
+    detail = "waits on input '" + name + "' (" +
+             sourcesOf(whole, application_, daemon_.modules()[module].id, name, remote) + ")";
+  } else if (port >= 0) {
+    detail = "is blocked sending on '" + portName(slot.ports[port]) + "'";
+  } else {
+    detail = stateName(slot.state.load());
+  }
+  return detail + " at iteration " + std::to_string(slot.iterations.load());
+}
+
+// No module has finished an iteration for options_.deadlockSeconds: a deadlock (every live
+// module blocked in wait() or put(), each process able to run), a stall (a module that does not
+// respond: stopped, or spinning while its slot says it waits), or nothing to report yet (a
+// module still computing). The processes are sampled twice, a second apart, to tell spinning.
+std::optional<RunOutcome> Supervisor::noProgress() {
   uint64_t sum = 0;
-  bool allWaiting = true;
   for (std::size_t i = 0; i < children_.size(); ++i) {
-    const auto& slot = daemon_.slot(daemon_.modules()[i].slotIndex);
-    sum += slot.iterations.load();
-    if (!children_[i].alive) continue;
-    const auto state = static_cast<ipc::ModuleState>(slot.state.load());
-    if (state != ipc::ModuleState::Waiting && state != ipc::ModuleState::Putting) allWaiting = false;
+    sum += daemon_.slot(daemon_.modules()[i].slotIndex).iterations.load();
   }
   const auto now = Clock::now();
-  if (sum != lastIterationSum_ || !allWaiting || liveCount() == 0) {
+  if (sum != lastIterationSum_ || liveCount() == 0) {
     lastIterationSum_ = sum;
     lastProgress_ = now;
-    return false;
+    stallSampledAt_ = Clock::time_point{};
+    return std::nullopt;
   }
-  if (std::chrono::duration<double>(now - lastProgress_).count() < options_.deadlockSeconds) {
-    return false;
+  const double quiet = std::chrono::duration<double>(now - lastProgress_).count();
+  if (quiet < options_.deadlockSeconds) return std::nullopt;
+  if (stallSampledAt_ == Clock::time_point{} || secondsSince(stallSampledAt_) < 1.0) {
+    if (stallSampledAt_ == Clock::time_point{}) {
+      stallCpuNs_.assign(children_.size(), 0);
+      for (std::size_t i = 0; i < children_.size(); ++i) {
+        if (children_[i].alive) stallCpuNs_[i] = sampleProcess(processOf(i)).cpuNs;
+      }
+      stallSampledAt_ = now;
+    }
+    return std::nullopt;
   }
-  detail.clear();
+  const double sampled = secondsSince(stallSampledAt_);
+  std::string stuck, others;
+  bool busy = false, remote = false;
   for (std::size_t i = 0; i < children_.size(); ++i) {
     if (!children_[i].alive) continue;
     const auto& module = daemon_.modules()[i];
-    const auto& slot = daemon_.slot(module.slotIndex);
-    int port = slot.waitingPort.load();
-    if (port >= static_cast<int>(std::min<uint32_t>(slot.portCount, ipc::kMaxPortsPerModule))) port = -1;
-    const auto state = static_cast<ipc::ModuleState>(slot.state.load());
-    detail += (detail.empty() ? "" : "; ") + std::string("module '") + module.id + "' ";
-    if (port >= 0 && state == ipc::ModuleState::Waiting) {
-      const std::string name = portName(slot.ports[port]);
-      detail += "waits on input '" + name + "' (" + sourcesOf(application_, module.id, name) + ")";
-    } else if (port >= 0) {
-      detail += "is blocked sending on '" + portName(slot.ports[port]) + "'";
-    } else {
-      detail += stateName(slot.state.load());
+    const auto state = static_cast<ipc::ModuleState>(daemon_.slot(module.slotIndex).state.load());
+    const bool inWait = state == ipc::ModuleState::Waiting || state == ipc::ModuleState::Putting;
+    const pid_t pid = processOf(i);
+    const ProcessSample process = sampleProcess(pid);
+    const double cpu = process.known && process.cpuNs >= stallCpuNs_[i]
+                           ? static_cast<double>(process.cpuNs - stallCpuNs_[i]) / 1e9 / sampled
+                           : 0.0;
+    std::string why = notRunningReason(process.state);
+    if (why.empty() && inWait && cpu > 0.5) {
+      char text[96];
+      std::snprintf(text, sizeof text, "spinning (%.0f%% CPU, process state %c) instead of waiting",
+                    100.0 * cpu, process.state);
+      why = text;
     }
-    detail += " at iteration " + std::to_string(slot.iterations.load());
+    bool ignored = false;
+    if (!why.empty()) {
+      stuck += (stuck.empty() ? "" : "; ") + std::string("module '") + module.id + "' (host " +
+               module.host + ", pid " + std::to_string(pid) + ") is not responding: it is " + why +
+               " (its slot says: " + waitDetail(i, ignored) + ")";
+    } else if (!inWait) {
+      busy = true;  // computing (or starting, finishing): it may yet progress
+    } else {
+      others += (others.empty() ? "" : "; ") + std::string("module '") + module.id + "' " +
+                waitDetail(i, remote);
+    }
   }
-  return true;
+  char quietText[64];
+  std::snprintf(quietText, sizeof quietText, "%g s", options_.deadlockSeconds);
+  const auto& header = daemon_.segment().header();
+  const uint64_t failed = header.failedAllocations.load();
+  if (failed > 0 && stuck.empty() && !busy) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "shared memory exhausted: %llu allocation(s) failed in the %.3g MiB segment; "
+                  "no module progressed for %s since (raise --shm-size): ",
+                  static_cast<unsigned long long>(failed),
+                  static_cast<double>(header.size) / 1048576.0, quietText);
+    return RunOutcome{kExitRunFailed, "failed", text + others};
+  }
+  if (!stuck.empty()) {
+    return RunOutcome{kExitRunFailed, "stalled",
+                      std::string("stalled: no module progressed for ") + quietText + ": " + stuck +
+                          (others.empty() ? "" : "; waiting on it: " + others)};
+  }
+  // Still computing: look again in a second.
+  // Waiting on another host: its daemon judges its own modules first (a stopped module there
+  // is named by it), so this host gives it time before it calls the run a deadlock.
+  const double remoteGrace = std::max(2.0, options_.deadlockSeconds / 2);
+  if (busy || (remote && quiet < options_.deadlockSeconds + remoteGrace)) {
+    stallSampledAt_ = Clock::time_point{};
+    return std::nullopt;
+  }
+  return RunOutcome{kExitRunFailed, "deadlock",
+                    std::string("deadlock: no module progressed for ") + quietText +
+                        " and every module is blocked in wait() or put(): " + others};
 }
 
 void Supervisor::showProgress(bool final) {
@@ -434,6 +592,7 @@ void Supervisor::stopAll() {
         continue;
       }
       kill(-child.pid, sig);  // its whole process group: wrappers too
+      if (sig == SIGTERM) kill(-child.pid, SIGCONT);  // a stopped module takes it too
       signalled.push_back(child.pid);
     }
     const auto end = Clock::now() + std::chrono::seconds(1);
@@ -454,6 +613,7 @@ RunOutcome Supervisor::run() {
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGCHLD);
   if (auto refused = jobsWithoutMpirun()) return {kExitRunFailed, "failed", *refused};
+  removeStaleMpiBackingFolders();  // of runtimes killed with SIGKILL
   if (auto status = daemon_.start(); !status) {
     return {kExitRunFailed, "failed", status.error().message};
   }
@@ -472,8 +632,16 @@ RunOutcome Supervisor::run() {
     }
     const char* mpirun = std::getenv("VRFLOW_MPIRUN");
     const bool viaMpirun = module.mpiRanks > 1 && !(mpirun != nullptr && std::string(mpirun) == "none");
-    auto pid = viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, fd, environment)
-                         : spawnModule(module.executable, {}, fd, environment);
+    auto backing = viaMpirun ? mpiFolder_.path() : Result<std::string>(std::string());
+    if (!backing) {
+      outcome = {kExitRunFailed, "failed",
+                 "module '" + module.id + "': " + backing.error().message};
+      break;
+    }
+    auto pid =
+        viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, fd, environment, *backing,
+                                   options_.moduleMemoryBytes)
+                  : spawnModule(module.executable, {}, fd, environment, options_.moduleMemoryBytes);
     if (!pid) {
       outcome = {kExitRunFailed, "failed", "module '" + module.id + "': " + pid.error().message};
       break;
@@ -525,11 +693,8 @@ RunOutcome Supervisor::run() {
       outcome = {kExitRunFailed, "failed", detail};
       break;
     }
-    if (outcome.exitCode == kExitOk && deadlocked(detail)) {
-      char text[64];
-      std::snprintf(text, sizeof text, "deadlock: no module progressed for %g s: ",
-                    options_.deadlockSeconds);
-      outcome = {kExitRunFailed, "deadlock", text + detail};
+    if (outcome.exitCode == kExitOk) {
+      if (auto stalled = noProgress()) outcome = *stalled;
     }
   }
   if (displayed_) showProgress(true);

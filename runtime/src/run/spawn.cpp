@@ -1,8 +1,11 @@
 #include "spawn.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,13 +13,15 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 
 extern char** environ;
 
 namespace vrflow::run {
 
 Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::string>& args,
-                          int inheritFd, const std::vector<std::string>& extraEnvironment) {
+                          int inheritFd, const std::vector<std::string>& extraEnvironment,
+                          uint64_t memoryLimitBytes) {
   std::string path = executable;
   if (path.find('/') == std::string::npos) {  // a bare name: looked up on PATH
     const char* searchPath = std::getenv("PATH");
@@ -65,6 +70,14 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
     sigprocmask(SIG_SETMASK, &none, nullptr);
     signal(SIGPIPE, SIG_DFL);
     if (inheritFd >= 0) fcntl(inheritFd, F_SETFD, 0);
+    if (memoryLimitBytes > 0) {
+      const rlimit limit{memoryLimitBytes, memoryLimitBytes};
+      if (setrlimit(RLIMIT_DATA, &limit) != 0) {
+        const char* text = "vrflow: cannot set the module memory limit (RLIMIT_DATA)\n";
+        (void)!write(2, text, std::strlen(text));
+        _exit(127);
+      }
+    }
     execve(argv[0], argv.data(), envp.data());
     const char* text = "vrflow: exec of a module failed\n";
     (void)!write(2, text, std::strlen(text));
@@ -80,7 +93,8 @@ namespace {
 // launcher), with `extraEnvironment` exported to every rank (VRFLOW_SEGMENT_FD replaced by
 // VRFLOW_SEGMENT_PATH: mpirun closes inherited descriptors).
 Result<pid_t> spawnMpirun(const std::string& executable, int ranks, int segmentFd,
-                          const std::vector<std::string>& extraEnvironment) {
+                          const std::vector<std::string>& extraEnvironment,
+                          const std::string& backingDir, uint64_t memoryLimitBytes) {
   const char* launcher = std::getenv("VRFLOW_MPIRUN");
   const std::string mpirun = launcher != nullptr && *launcher != '\0' ? launcher : "mpirun";
   std::vector<std::string> environment;
@@ -96,6 +110,10 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, int segmentF
   std::vector<std::string> args{"-np", std::to_string(ranks), "--oversubscribe",
                                 "--mca", "mpi_yield_when_idle", "1",
                                 "--mca", "btl_vader_single_copy_mechanism", "none"};
+  if (!backingDir.empty()) {
+    // The ranks' shared-memory files go to a folder the runtime removes, even after kill -9.
+    args.insert(args.end(), {"--mca", "btl_vader_backing_directory", backingDir});
+  }
   if (geteuid() == 0) {
     environment.push_back("OMPI_ALLOW_RUN_AS_ROOT=1");
     environment.push_back("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1");
@@ -107,16 +125,18 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, int segmentF
     }
   }
   args.push_back(executable);
-  return spawnModule(mpirun, args, -1, environment);
+  // The limit is inherited by the ranks, which mpirun forks.
+  return spawnModule(mpirun, args, -1, environment, memoryLimitBytes);
 }
 
 }  // namespace
 
 Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segmentFd,
-                             const std::vector<std::string>& extraEnvironment) {
+                             const std::vector<std::string>& extraEnvironment,
+                             const std::string& backingDir, uint64_t memoryLimitBytes) {
   std::vector<std::string> environment = extraEnvironment;
   environment.push_back("VRFLOW_MPI_RANKS=" + std::to_string(ranks));
-  auto pid = spawnMpirun(executable, ranks, segmentFd, environment);
+  auto pid = spawnMpirun(executable, ranks, segmentFd, environment, backingDir, memoryLimitBytes);
   if (!pid) {
     return makeError(pid.error().message + " (a module of " + std::to_string(ranks) +
                      " MPI ranks is started through mpirun: install Open MPI, or set "
@@ -126,7 +146,8 @@ Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segme
 }
 
 Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>& slotIndices,
-                          int segmentFd, const std::vector<std::string>& extraEnvironment) {
+                          int segmentFd, const std::vector<std::string>& extraEnvironment,
+                          const std::string& backingDir, uint64_t memoryLimitBytes) {
   std::string indices;
   for (const int index : slotIndices) {
     indices += (indices.empty() ? "" : ",") + std::to_string(index);
@@ -140,13 +161,60 @@ Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>&
   }
   environment.push_back("VRFLOW_MODULE_INDICES=" + indices);
   const int ranks = static_cast<int>(slotIndices.size());
-  auto pid = spawnMpirun(executable, ranks, segmentFd, environment);
+  auto pid = spawnMpirun(executable, ranks, segmentFd, environment, backingDir, memoryLimitBytes);
   if (!pid) {
     return makeError(pid.error().message + " (an MPI job of " + std::to_string(ranks) +
                      " modules is started through mpirun: install Open MPI, or set "
                      "VRFLOW_MPIRUN)");
   }
   return pid;
+}
+
+namespace {
+
+constexpr const char* kBackingParent = "/dev/shm";
+constexpr const char* kBackingPrefix = "ompi-job.";
+
+}  // namespace
+
+MpiBackingFolder::~MpiBackingFolder() {
+  if (path_.empty()) return;
+  std::error_code ignored;
+  std::filesystem::remove_all(path_, ignored);
+}
+
+Result<std::string> MpiBackingFolder::path() {
+  if (!path_.empty()) return path_;
+  std::string pattern =
+      std::string(kBackingParent) + "/" + kBackingPrefix + std::to_string(getpid()) + ".XXXXXX";
+  if (mkdtemp(pattern.data()) == nullptr) {  // mode 0700
+    return makeError("cannot make a folder for the MPI jobs' shared memory in " +
+                     std::string(kBackingParent) + ": " + std::strerror(errno));
+  }
+  path_ = pattern;
+  return path_;
+}
+
+void removeStaleMpiBackingFolders() {
+  DIR* dir = opendir(kBackingParent);
+  if (dir == nullptr) return;
+  const std::size_t prefix = std::strlen(kBackingPrefix);
+  while (dirent* entry = readdir(dir)) {
+    const std::string name = entry->d_name;
+    if (name.compare(0, prefix, kBackingPrefix) != 0) continue;
+    char* end = nullptr;
+    const long pid = std::strtol(name.c_str() + prefix, &end, 10);
+    if (pid <= 0 || *end != '.') continue;
+    struct stat info {};
+    if (fstatat(dirfd(dir), entry->d_name, &info, AT_SYMLINK_NOFOLLOW) != 0 ||
+        !S_ISDIR(info.st_mode) || info.st_uid != getuid()) {
+      continue;
+    }
+    if (kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // its runtime lives
+    std::error_code ignored;
+    std::filesystem::remove_all(std::string(kBackingParent) + "/" + name, ignored);
+  }
+  closedir(dir);
 }
 
 namespace {

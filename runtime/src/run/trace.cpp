@@ -4,6 +4,7 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "vrflow/message/ids.hpp"
 
@@ -34,6 +35,11 @@ std::string hostTraceToJson(const HostTrace& trace) {
                       e.event.sourceHash, e.event.sourceIteration});
   }
   j["events"] = std::move(events);
+  auto merges = nlohmann::json::array();
+  for (const auto& m : trace.merges) {
+    merges.push_back({m.mergedSourceHash, m.mergedIteration, m.partSourceHash, m.partIteration});
+  }
+  j["merges"] = std::move(merges);
   return j.dump();
 }
 
@@ -58,11 +64,47 @@ Result<HostTrace> hostTraceFromJson(const std::string& text) {
       event.event.sourceIteration = e.at(6).get<uint64_t>();
       trace.events.push_back(event);
     }
+    if (j.contains("merges")) {
+      for (const auto& m : j.at("merges")) {
+        trace.merges.push_back({m.at(0).get<uint32_t>(), m.at(2).get<uint32_t>(),
+                                m.at(1).get<uint64_t>(), m.at(3).get<uint64_t>()});
+      }
+    }
     return trace;
   } catch (const nlohmann::json::exception& e) {
     return makeError(std::string("malformed host trace: ") + e.what());
   }
 }
+
+namespace {
+
+// Per module: the modules whose outputs reach it through filters only.
+std::map<std::string, std::set<std::string>> modulesFeeding(const app::Application& application) {
+  std::set<std::string> modules;
+  for (const auto& m : application.modules) modules.insert(m.id);
+  std::map<std::string, std::vector<std::string>> into;  // node -> nodes connected to its inputs
+  for (const auto& c : application.connections) into[c.to.node].push_back(c.from.node);
+  std::map<std::string, std::set<std::string>> feeding;
+  for (const auto& m : application.modules) {
+    auto& found = feeding[m.id];
+    std::set<std::string> seen;
+    std::vector<std::string> pending{m.id};
+    while (!pending.empty()) {
+      const std::string node = std::move(pending.back());
+      pending.pop_back();
+      for (const auto& from : into[node]) {
+        if (modules.count(from) != 0) {
+          found.insert(from);
+        } else if (seen.insert(from).second) {
+          pending.push_back(from);  // a filter: look further up
+        }
+      }
+    }
+  }
+  return feeding;
+}
+
+}  // namespace
 
 std::string chromeTrace(const app::Application& application, const std::vector<HostTrace>& hosts) {
   using nlohmann::json;
@@ -85,8 +127,6 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
     }
     return static_cast<int>(application.modules.size());
   };
-  std::map<uint32_t, std::string> byHash;
-  for (const auto& m : application.modules) byHash[msg::fnv1a32(m.id)] = m.id;
 
   // The earliest aligned time is 0.
   int64_t base = std::numeric_limits<int64_t>::max();
@@ -100,17 +140,21 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
   };
   json events = json::array();
   uint64_t dropped = 0;
-  // Where each module put each iteration's first message: flows start there.
-  struct Put {
-    int pid, tid;
-    double ts;
-  };
-  std::map<std::pair<std::string, uint64_t>, Put> puts;
   for (std::size_t i = 0; i < application.hosts.size(); ++i) {
     const app::Host& host = application.hosts[i];
     events.push_back({{"ph", "M"}, {"name", "process_name"}, {"pid", static_cast<int>(i) + 1},
                       {"args", {{"name", "host " + host.id + " (" + host.address + ")"}}}});
   }
+  // Every put of a message, by the message's stamps (source, iteration): its sender's own put,
+  // then each module that forwarded it unchanged.
+  struct Put {
+    std::string module;
+    int pid, tid;
+    double ts;
+  };
+  std::map<std::pair<uint32_t, uint64_t>, std::vector<Put>> puts;
+  // The parts of each merged message, by the merged message's stamps.
+  std::map<std::pair<uint32_t, uint64_t>, std::vector<std::pair<uint32_t, uint64_t>>> parts;
   for (const auto& h : hosts) {
     dropped += h.dropped;
     for (const auto& m : h.modules) {
@@ -120,15 +164,44 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
     for (const auto& e : h.events) {
       if (e.event.kind != static_cast<uint32_t>(ipc::TraceKind::Sent)) continue;
       const std::string& m = h.modules[e.module];
-      puts.emplace(std::make_pair(m, e.event.iteration),
-                   Put{pidOf(m), moduleIndex(m) + 1, us(h, e.event.beginNs)});
+      puts[{e.event.sourceHash, e.event.sourceIteration}].push_back(
+          Put{m, pidOf(m), moduleIndex(m) + 1, us(h, e.event.beginNs)});
+    }
+    for (const auto& m : h.merges) {
+      auto& list = parts[{m.mergedSourceHash, m.mergedIteration}];
+      const std::pair<uint32_t, uint64_t> part{m.partSourceHash, m.partIteration};
+      if (std::find(list.begin(), list.end(), part) == list.end()) list.push_back(part);
     }
   }
+  const auto feeders = modulesFeeding(application);
+  // The put that delivered a message to `receiver` at `ts`: among the modules that put it and
+  // feed the receiver (through filters only), the last hop; its first put not after `ts`.
+  auto deliveringPut = [&](const std::vector<Put>& candidates, const std::string& receiver,
+                           double ts) -> const Put* {
+    // A module the application does not connect (none known) takes any sender.
+    const auto fed = feeders.find(receiver);
+    const bool known = fed != feeders.end() && !fed->second.empty();
+    std::map<std::string, const Put*> firstOfModule;
+    const Put* earliest = nullptr;  // across hosts, clocks are aligned only so well
+    for (const auto& p : candidates) {
+      if (known && fed->second.count(p.module) == 0) continue;
+      if (earliest == nullptr || p.ts < earliest->ts) earliest = &p;
+      if (p.ts > ts) continue;
+      auto& first = firstOfModule[p.module];
+      if (first == nullptr || p.ts < first->ts) first = &p;
+    }
+    const Put* best = nullptr;
+    for (const auto& [module, p] : firstOfModule) {
+      if (best == nullptr || p->ts > best->ts) best = p;
+    }
+    return best != nullptr ? best : earliest;
+  };
   uint64_t flowId = 0;
   for (const auto& h : hosts) {
     for (const auto& e : h.events) {
-      const int pid = pidOf(h.modules[e.module]);
-      const int tid = moduleIndex(h.modules[e.module]) + 1;
+      const std::string& receiver = h.modules[e.module];
+      const int pid = pidOf(receiver);
+      const int tid = moduleIndex(receiver) + 1;
       const auto kind = static_cast<ipc::TraceKind>(e.event.kind);
       if (kind == ipc::TraceKind::Wait || kind == ipc::TraceKind::Compute) {
         events.push_back({{"ph", "X"},
@@ -140,16 +213,34 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
                           {"dur", static_cast<double>(e.event.endNs - e.event.beginNs) / 1000.0},
                           {"args", {{"iteration", e.event.iteration}}}});
       } else if (kind == ipc::TraceKind::Received) {
-        const auto source = byHash.find(e.event.sourceHash);
-        if (source == byHash.end()) continue;  // an initial message: no sender
-        const auto put = puts.find({source->second, e.event.sourceIteration});
-        if (put == puts.end()) continue;
-        ++flowId;
-        const std::string name = source->second + " -> " + h.modules[e.module];
-        events.push_back({{"ph", "s"}, {"name", name}, {"cat", "message"}, {"id", flowId},
-                          {"pid", put->second.pid}, {"tid", put->second.tid}, {"ts", put->second.ts}});
-        events.push_back({{"ph", "f"}, {"bp", "e"}, {"name", name}, {"cat", "message"},
-                          {"id", flowId}, {"pid", pid}, {"tid", tid}, {"ts", us(h, e.event.endNs)}});
+        const std::pair<uint32_t, uint64_t> received{e.event.sourceHash, e.event.sourceIteration};
+        const auto merged = parts.find(received);
+        const std::vector<std::pair<uint32_t, uint64_t>> messages =
+            merged != parts.end() ? merged->second : std::vector{received};
+        const double ts = us(h, e.event.endNs);
+        for (const auto& message : messages) {
+          const auto put = puts.find(message);
+          if (put == puts.end()) continue;  // an initial message, or one a filter made
+          const Put* from = deliveringPut(put->second, receiver, ts);
+          if (from == nullptr) continue;
+          ++flowId;
+          const std::string name = from->module + " -> " + receiver;
+          events.push_back({{"ph", "s"},
+                            {"name", name},
+                            {"cat", "message"},
+                            {"id", flowId},
+                            {"pid", from->pid},
+                            {"tid", from->tid},
+                            {"ts", from->ts}});
+          events.push_back({{"ph", "f"},
+                            {"bp", "e"},
+                            {"name", name},
+                            {"cat", "message"},
+                            {"id", flowId},
+                            {"pid", pid},
+                            {"tid", tid},
+                            {"ts", ts}});
+        }
       }
     }
   }

@@ -41,6 +41,7 @@ struct LaunchOptions {
   double timeoutSeconds = 0;
   double peerTimeoutSeconds = 3;  ///< heartbeat timeout between daemons
   double startSeconds = 30;       ///< every daemon must be linked within this
+  uint64_t moduleMemoryBytes = 0;  ///< run::RunOptions::moduleMemoryBytes of every host
   std::vector<std::string> packageDirs, compositeDirs;
   std::vector<std::string> overrides;  ///< `--set ID.PARAM=VALUE`, applied by every daemon
   bool progress = false;
@@ -52,8 +53,9 @@ std::string mergeReports(const app::Application& application, const std::vector<
                          const run::RunOutcome& outcome, uint64_t iterations, double wallSeconds);
 
 /// Folder (mode 0700) where running launches publish their live state:
-/// $XDG_RUNTIME_DIR/vrflow, or /tmp/vrflow-<uid>.
-std::string monitorDirectory();
+/// $XDG_RUNTIME_DIR/vrflow, or /tmp/vrflow-<uid>; created if missing. An error if it is not a
+/// folder of this user that only they may write (as ssh and tmux refuse theirs).
+Result<std::string> monitorDirectory();
 
 /// `vrflow monitor`: shows the live state of the launches running for this user, per host and
 /// module (iterations/s, wait vs compute, state, CPU, memory), per connection (queue, messages/s,

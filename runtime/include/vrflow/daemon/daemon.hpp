@@ -102,6 +102,8 @@ class Daemon {
   std::string fatalError();
   /// Warnings raised while running (full queues, filter problems); thread-safe snapshot.
   std::vector<std::string> takeWarnings();
+  /// When the run is traced: the parts of the messages concatenated since the last call.
+  std::vector<ipc::TraceMerge> takeTraceMerges();
   /// Live queue lengths and counters (thread-safe; at most about 0.5 s old).
   std::vector<QueueSnapshot> queueSnapshot();
   /// Statistics; call after shutdown().

@@ -47,6 +47,7 @@ struct ModuleSlot {
   std::atomic<uint64_t> waitNs{0};            ///< total time spent in wait()
   std::atomic<uint64_t> histogram[kHistogramBuckets];  ///< iteration durations, log-linear buckets
   uint64_t traceOffset = 0;                   ///< a TraceRing when the run is traced; 0: not traced
+  std::atomic<uint32_t> outOfMemory{0};       ///< set by the module when an allocation failed
 };
 
 /// What a module records when the run is traced (`--trace`), in steady-clock ns.
@@ -56,12 +57,22 @@ enum class TraceKind : uint32_t { Wait = 0, Compute = 1, Received = 2, Sent = 3 
 struct TraceEvent {
   uint64_t beginNs = 0, endNs = 0;
   uint64_t iteration = 0;        ///< the module's iteration
-  uint64_t sourceIteration = 0;  ///< Received: the message's iteration stamp
+  uint64_t sourceIteration = 0;  ///< Received, Sent: the message's iteration stamp
   uint32_t kind = 0;             ///< a TraceKind
-  uint32_t sourceHash = 0;       ///< Received: FNV-1a 32 of the message's source module id
+  uint32_t sourceHash = 0;       ///< Received, Sent: FNV-1a 32 of the message's source module id
 };
 
 inline constexpr uint64_t kTraceCapacity = 8192;
+
+/// When the run is traced: one part of a message that a daemon's filter concatenated (merge,
+/// gather, an input fed by several connections), so that the trace draws an arrow per part.
+/// The merged message carries the stamps (source, iteration) `merged*`; a part those `part*`.
+struct TraceMerge {
+  uint32_t mergedSourceHash = 0;  ///< FNV-1a 32 of the merged message's source module id
+  uint32_t partSourceHash = 0;    ///< FNV-1a 32 of the part's source module id
+  uint64_t mergedIteration = 0;
+  uint64_t partIteration = 0;
+};
 
 /// Object ids (host id << 32 | counter): module slot i draws its first 2^kIdBlockBits ids from
 /// its own block of counter values, [(i + 1) << kIdBlockBits, (i + 2) << kIdBlockBits), so the

@@ -15,7 +15,7 @@ inline constexpr int kMinBlockClass = 7;   // 128 B
 inline constexpr int kMaxBlockClass = 30;  // 1 GiB
 inline constexpr int kBlockClasses = kMaxBlockClass - kMinBlockClass + 1;
 inline constexpr uint32_t kSegmentMagic = 0x53465256;  // "VRFS"
-inline constexpr uint32_t kSegmentVersion = 1;
+inline constexpr uint32_t kSegmentVersion = 2;
 
 /// The header in front of every message block (one cache line).
 struct alignas(64) BlockHeader {
@@ -38,6 +38,7 @@ struct alignas(64) SegmentHeader {
   std::atomic<uint64_t> bump{0};        ///< first never-used byte
   std::atomic<uint64_t> inUseBytes{0};  ///< bytes of blocks currently held
   std::atomic<uint64_t> peakInUseBytes{0};
+  std::atomic<uint64_t> failedAllocations{0};  ///< allocate() calls that found no room
   uint64_t controlOffset = 0;           ///< where the run's control table starts (0: none)
   std::atomic<uint64_t> freeHeads[kBlockClasses];  ///< Treiber stacks, tagged against ABA
 };

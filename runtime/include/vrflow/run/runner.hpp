@@ -36,12 +36,18 @@ struct RunOptions {
   double timeoutSeconds = 0;          ///< 0 = no limit
   double deadlockSeconds = 10;        ///< no progress this long with every module waiting
   std::size_t segmentBytes = std::size_t{1} << 30;
+  /// Caps each module process's data memory (RLIMIT_DATA); 0 = no cap. A module that runs out
+  /// under it is reported with the cap as the cause.
+  uint64_t moduleMemoryBytes = 0;
   std::string reportPath;             ///< JSON report; empty = none
   bool progress = false;              ///< live iterations/s on stderr
   double stopGraceSeconds = 2;        ///< after a stop request, before SIGTERM then SIGKILL
   double joinSeconds = 20;            ///< a module must call Module::init() within this
   double lingerSeconds = 5;           ///< a module that finished must exit within this
   HostLink* hostLink = nullptr;       ///< set by vrflow-daemon under the launcher
+  /// The whole application when runApplication() gets one host's share (vrflow-daemon), to
+  /// name the feeders on other hosts in deadlock reports; null: the application given.
+  const app::Application* wholeApplication = nullptr;
   bool trace = false;                 ///< record modules' spans (also implied by tracePath)
   std::string tracePath;              ///< Chrome trace-event JSON; empty = none
 };
@@ -49,7 +55,7 @@ struct RunOptions {
 /// What happened, for the report and the exit code.
 struct RunOutcome {
   int exitCode = kExitOk;
-  std::string status = "ok";  ///< ok, failed, deadlock, timeout, interrupted
+  std::string status = "ok";  ///< ok, failed, deadlock, stalled, timeout, interrupted
   std::string error;          ///< one line a person can act on; empty on success
 };
 

@@ -22,6 +22,7 @@ struct HostTrace {
     ipc::TraceEvent event;
   };
   std::vector<Event> events;
+  std::vector<ipc::TraceMerge> merges;  ///< the parts of the messages this host's filters merged
   uint64_t dropped = 0;  ///< events lost to full rings or to the per-host cap
 };
 
@@ -37,7 +38,9 @@ Result<HostTrace> hostTraceFromJson(const std::string& text);
 
 /// The Chrome trace-event JSON of every host: one process per host, one thread per module,
 /// "wait" and "compute" spans, each message a flow from its sender's put to its receiver's
-/// wait; clocks aligned by each host's clockOffsetNs.
+/// wait; clocks aligned by each host's clockOffsetNs. A flow starts when the put starts, so it
+/// never ends before it starts on one host; a merged message has a flow per part; a message a
+/// module forwards unchanged is a hop of its own (from the forwarding module).
 std::string chromeTrace(const app::Application& application, const std::vector<HostTrace>& hosts);
 
 }  // namespace vrflow::run
