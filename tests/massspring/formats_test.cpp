@@ -1,7 +1,6 @@
 // Net files, the spring records, the node-force events, object chunks, and bad input.
-#include <gtest/gtest.h>
-
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
 

@@ -1,6 +1,5 @@
 // The modules end to end through the real `vrflow run`.
 #include <gtest/gtest.h>
-
 #include <sys/stat.h>
 
 #include <cmath>
@@ -230,8 +229,9 @@ TEST(MassSpringNetwork, NetFileThatIsNotARegularFileIsRefusedBeforeTheRun) {
   const auto ran = run(dir, appWith(fifo), 10);
   EXPECT_NE(ran.exitCode, 0);
   EXPECT_LT(ran.exitCode, 128) << "killed at the timeout: it waited on the FIFO";
-  EXPECT_NE(ran.err.find("names '" + fifo + "', an input that must be a regular file (it is a "
-                                            "FIFO, not a regular file)"),
+  EXPECT_NE(ran.err.find("names '" + fifo +
+                         "', an input that must be a regular file (it is a "
+                         "FIFO, not a regular file)"),
             std::string::npos)
       << ran.err;
 }
