@@ -24,6 +24,7 @@ vrflow_add_library(app
     src/app/mpi_job.cpp
     src/app/overrides.cpp
     src/app/package.cpp
+    src/app/package_files.cpp
     src/app/source_location.cpp
     src/app/source_text.cpp
     src/app/template_text.cpp

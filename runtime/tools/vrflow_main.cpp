@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "vrflow/app/expand.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/overrides.hpp"
+#include "vrflow/app/package_files.hpp"
 #include "vrflow/app/validate.hpp"
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/plugin.hpp"
@@ -24,12 +26,12 @@ namespace {
 
 // Loads the file and expands its composites (search path: the file's folder, --composites,
 // $VRFLOW_COMPOSITE_PATH), applies the --set parameters, and validates the flat application when
-// a catalog is given. Prints every diagnostic; returns the flat application when there is no
-// error.
-std::optional<vrflow::app::Application> loadFlat(const std::string& file,
-                                                 const std::vector<std::string>& compositeDirs,
-                                                 const std::vector<std::string>& overrides,
-                                                 vrflow::app::Catalog* catalog) {
+// a catalog is given; with `files`, also checks the files its modules name on this machine.
+// Prints every diagnostic; returns the flat application when there is no error.
+std::optional<vrflow::app::Application> loadFlat(
+    const std::string& file, const std::vector<std::string>& compositeDirs,
+    const std::vector<std::string>& overrides, vrflow::app::Catalog* catalog,
+    std::optional<vrflow::app::ModuleFileChecks> files = std::nullopt) {
   std::vector<vrflow::app::Diagnostic> problems;
   auto application = vrflow::app::loadApplicationFile(file, &problems);
   if (!application) {
@@ -54,6 +56,10 @@ std::optional<vrflow::app::Application> loadFlat(const std::string& file,
     problems.insert(problems.end(), plugins.begin(), plugins.end());
     auto more = vrflow::app::validate(*flat, *catalog);
     problems.insert(problems.end(), more.begin(), more.end());
+    if (files) {
+      auto named = vrflow::app::checkModuleFiles(*flat, *catalog, *files);
+      problems.insert(problems.end(), named.begin(), named.end());
+    }
   }
   vrflow::app::sortAndDeduplicate(problems);
   for (const auto& d : problems)
@@ -172,7 +178,10 @@ int main(int argc, char** argv) {
     return vrflow::run::kExitInvalid;
   }
   if (validate->parsed()) {
-    return loadFlat(validateFile, compositeDirs, overrides, &*catalog) ? 0 : 1;
+    return loadFlat(validateFile, compositeDirs, overrides, &*catalog,
+                    vrflow::app::ModuleFileChecks{})
+               ? 0
+               : 1;
   }
 #ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
@@ -186,7 +195,8 @@ int main(int argc, char** argv) {
     return outcome.exitCode;
   }
 #endif
-  auto application = loadFlat(runFile, compositeDirs, overrides, &*catalog);
+  auto application = loadFlat(runFile, compositeDirs, overrides, &*catalog,
+                              vrflow::app::ModuleFileChecks{.executables = true});
   if (!application) return vrflow::run::kExitInvalid;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
   options.progress = !noProgress && isatty(STDERR_FILENO) != 0;

@@ -50,5 +50,16 @@ TEST(Schema, EveryTestManifestMatchesThePackageSchema) {
   }
 }
 
+// The manifests that ship with vrflow, with their file parameters' `access`, match the schema.
+TEST(Schema, EveryShippedManifestMatchesThePackageSchema) {
+  if (!haveXmllint()) GTEST_SKIP() << "xmllint is not installed";
+  for (const char* folder :
+       {"runtime/modules/core", "nodes/fluid", "nodes/massspring", "nodes/rigid", "nodes/viewer"}) {
+    EXPECT_TRUE(validAgainst(schemaPath("vrflow-package.xsd"),
+                             testing::sourceDir() + "/" + folder + "/vrflow-package.xml"))
+        << folder;
+  }
+}
+
 }  // namespace
 }  // namespace vrflow::app

@@ -1,8 +1,15 @@
 // Net files, the spring records, the node-force events, object chunks, and bad input.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <future>
 #include <limits>
 
 #include "process_helpers.hpp"
@@ -92,7 +99,8 @@ TEST(MassSpringFormats, HandWrittenFileWithDefaultRestLengths) {
 }
 
 TEST(MassSpringFormats, BadFilesGiveClearErrors) {
-  expectError(loadNet("/nonexistent/net.txt"), "cannot open net file '/nonexistent/net.txt'");
+  expectError(loadNet("/nonexistent/net.txt"),
+              "/nonexistent/net.txt: net file: cannot read file (No such file or directory)");
   expectError(parseNet("springy 1\n"), "<text>:1: expected the header 'massspring 1'");
   expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n"), "<text>:3: the file ends after 1 of 2 nodes");
   expectError(parseNet("massspring 1\nnodes 1\n0 0 zero 1 0\nsprings 0\n"), "<text>:3: 'zero' is not a number");
@@ -105,6 +113,33 @@ TEST(MassSpringFormats, BadFilesGiveClearErrors) {
   expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n1 0 0 1 0\nsprings 1\n0 1 1 -5 0 0\n"), "stiffness must be");
   expectError(parseNet("massspring 1\nnodes 1\nnan 0 0 1 0\nsprings 0\n"), "non-finite");
   expectError(parseNet("massspring 1\nnodes 1\n0 0 0 1 0\nsprings 0\nextra 3\n"), "<text>:5: expected 'triangles T'");
+}
+
+// A net is read only from a regular file of at most 256 MiB: a device, a FIFO (without
+// blocking) or a folder is refused with one error naming the file and what it is.
+TEST(MassSpringFormats, NetFromADeviceFifoFolderOrHugeFileIsRefusedWithoutReadingIt) {
+  expectError(loadNet("/dev/zero"),
+              "/dev/zero: net file: cannot read file (it is a character device, not a regular "
+              "file)");
+  testing::TempDir dir;
+  const std::string fifo = dir.file("net.txt");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  // Hang guard: a reader that blocks in open() is released by a writer after 20 s.
+  auto fromFifo = std::async(std::launch::async, [&] { return loadNet(fifo); });
+  if (fromFifo.wait_for(std::chrono::seconds(20)) != std::future_status::ready) {
+    const int writer = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (writer >= 0) close(writer);
+    ADD_FAILURE() << "loadNet blocked on a FIFO for 20 s";
+  }
+  expectError(fromFifo.get(),
+              fifo + ": net file: cannot read file (it is a FIFO, not a regular file)");
+  expectError(loadNet(dir.path()), "it is a directory, not a regular file");
+  const std::string huge = dir.file("huge.txt");
+  std::ofstream(huge) << "massspring 1\n";
+  std::filesystem::resize_file(huge, std::uintmax_t{1} << 30);  // 1 GiB, sparse
+  expectError(loadNet(huge), huge +
+                                 ": net file: cannot read file (it is 1073741824 bytes, above the "
+                                 "limit of 268435456 bytes (256 MiB))");
 }
 
 TEST(MassSpringFormats, BadGeneratorParametersGiveClearErrors) {

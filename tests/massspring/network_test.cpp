@@ -1,5 +1,6 @@
 // The modules end to end through the real `vrflow run`.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 
@@ -174,7 +175,10 @@ TEST(MassSpringNetwork, MissingNetFileFailsTheRunWithAClearMessage) {
 )";
   const auto result = run(dir, app, 10);
   EXPECT_NE(result.exitCode, 0);
-  EXPECT_NE((result.out + result.err).find("cannot open net file 'no-such.net'"), std::string::npos)
+  EXPECT_NE((result.out + result.err)
+                .find("names 'no-such.net', an input that must be a regular file (No such file or "
+                      "directory)"),
+            std::string::npos)
       << result.out << result.err;
 }
 
@@ -193,6 +197,43 @@ TEST(MassSpringNetwork, BadParameterFailsTheRunWithAClearMessage) {
   EXPECT_NE((result.out + result.err).find("parameter 'orientation' = '0 0 1' must be 4 finite numbers"),
             std::string::npos)
       << result.out << result.err;
+}
+
+// A net file that is not a regular file is refused before anything starts, naming it: `validate`
+// says so for /dev/zero, and `run` does not wait on a FIFO.
+TEST(MassSpringNetwork, NetFileThatIsNotARegularFileIsRefusedBeforeTheRun) {
+  TempDir dir;
+  const auto appWith = [](const std::string& file) {
+    return std::string(kHeader) + R"(  <modules>
+    <module id="net" package="massspring" type="animator" host="local">
+      <param name="file" value=")" +
+           file + R"("/>
+    </module>
+  </modules>
+  <connections/>
+</application>
+)";
+  };
+  const auto zeroApp = dir.write("zero.xml", appWith("/dev/zero"));
+  const auto validated =
+      testing::runCommand({testing::binDir() + "/vrflow", "validate", zeroApp}, 30);
+  EXPECT_EQ(validated.exitCode, 1) << validated.err;
+  EXPECT_NE(validated.err.find("parameter 'file' of module 'net' (massspring/animator) names "
+                               "'/dev/zero', an input that must be a regular file (it is a "
+                               "character device, not a regular file)"),
+            std::string::npos)
+      << validated.err;
+
+  const std::string fifo = dir.file("net.txt");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const auto ran = run(dir, appWith(fifo), 10);
+  EXPECT_NE(ran.exitCode, 0);
+  EXPECT_LT(ran.exitCode, 128) << "killed at the timeout: it waited on the FIFO";
+  EXPECT_NE(ran.err.find("names '" + fifo +
+                         "', an input that must be a regular file (it is a "
+                         "FIFO, not a regular file)"),
+            std::string::npos)
+      << ran.err;
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The rigid package's modules through the real `vrflow run`: animator, rigid interactor and force
 // field in a cycle (figure 4 of the paper), checked against the same solvers in one process.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <fstream>
@@ -154,6 +155,36 @@ TEST(RigidNetwork, ForceFieldMovesPointMassesByType) {
   EXPECT_NEAR(std::stod(f[7]), y, 1e-4);
   EXPECT_GT(std::stod(f[7]), -10 * 0.5);  // slower than free fall
   EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+// A scene that is not a regular file is refused before anything starts, with one error naming
+// it: `validate` says so, and `run` neither reads /dev/zero without end nor waits on a FIFO.
+TEST(RigidNetwork, SceneThatIsNotARegularFileIsRefusedBeforeTheRun) {
+  TempDir dir;
+  const auto zeroApp = dir.file("zero.xml");
+  std::ofstream(zeroApp) << app("/dev/zero", dir.file("state.json"));
+  const auto validated = runCommand({binDir() + "/vrflow", "validate", zeroApp}, 30);
+  EXPECT_EQ(validated.exitCode, 1) << validated.err;
+  EXPECT_NE(validated.err.find("parameter 'scene' of module 'bodies' (rigid/animator) names "
+                               "'/dev/zero', an input that must be a regular file (it is a "
+                               "character device, not a regular file)"),
+            std::string::npos)
+      << validated.err;
+
+  const std::string fifo = dir.file("scene.json");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const auto fifoApp = dir.file("fifo.xml");
+  std::ofstream(fifoApp) << app(fifo, dir.file("state.json"));
+  const auto ran = runCommand({binDir() + "/vrflow", "run", fifoApp, "-n", "10"}, 30);
+  EXPECT_NE(ran.exitCode, 0);
+  EXPECT_LT(ran.exitCode, 128) << "killed after 30 s: it waited on the FIFO";
+  EXPECT_NE(ran.err.find("names '" + fifo +
+                         "', an input that must be a regular file (it is a "
+                         "FIFO, not a regular file)"),
+            std::string::npos)
+      << ran.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
+  EXPECT_TRUE(vrflowShmEntries().empty());
 }
 
 }  // namespace

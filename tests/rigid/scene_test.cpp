@@ -1,10 +1,16 @@
 // Scene files and generators.
 #include "vrflow/rigid/scene.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <future>
 
 #include "process_helpers.hpp"
 
@@ -80,6 +86,43 @@ TEST(RigidScene, BadFilesGiveErrorsNamingFileAndLine) {
   auto missing = loadScene("/nonexistent/scene.json");
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("/nonexistent/scene.json"), std::string::npos);
+}
+
+// A scene is read only from a regular file of at most 256 MiB: a device, a FIFO (without
+// blocking) or a folder is refused with one error naming the file and what it is.
+TEST(RigidScene, SceneFromADeviceFifoFolderOrHugeFileIsRefusedWithoutReadingIt) {
+  auto zero = loadScene("/dev/zero");
+  ASSERT_FALSE(zero);
+  EXPECT_EQ(zero.error().message,
+            "/dev/zero: scene file: cannot read file (it is a character device, not a regular "
+            "file)");
+  testing::TempDir dir;
+  const std::string fifo = dir.file("scene.json");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  // Hang guard: a reader that blocks in open() is released by a writer after 20 s.
+  auto fromFifo = std::async(std::launch::async, [&] { return loadScene(fifo); });
+  if (fromFifo.wait_for(std::chrono::seconds(20)) != std::future_status::ready) {
+    const int writer = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (writer >= 0) close(writer);
+    ADD_FAILURE() << "loadScene blocked on a FIFO for 20 s";
+  }
+  const auto fifoResult = fromFifo.get();
+  ASSERT_FALSE(fifoResult);
+  EXPECT_EQ(fifoResult.error().message,
+            fifo + ": scene file: cannot read file (it is a FIFO, not a regular file)");
+  auto folder = loadScene(dir.path());
+  ASSERT_FALSE(folder);
+  EXPECT_NE(folder.error().message.find("it is a directory, not a regular file"), std::string::npos)
+      << folder.error().message;
+  const std::string huge = dir.file("huge.json");
+  std::ofstream(huge) << "{\"bodies\": [";
+  std::filesystem::resize_file(huge, std::uintmax_t{1} << 30);  // 1 GiB, sparse
+  auto tooLarge = loadScene(huge);
+  ASSERT_FALSE(tooLarge);
+  EXPECT_EQ(tooLarge.error().message,
+            huge +
+                ": scene file: cannot read file (it is 1073741824 bytes, above the limit of "
+                "268435456 bytes (256 MiB))");
 }
 
 TEST(RigidScene, GeneratorsAndTheirErrors) {

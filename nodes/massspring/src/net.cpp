@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "vrflow/base/file_access.hpp"
 #include "vrflow/message/shape.hpp"
 
 namespace vrflow::massspring {
@@ -260,11 +261,9 @@ Result<Net> parseNet(const std::string& text, const std::string& origin) {
 }
 
 Result<Net> loadNet(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return makeError("cannot open net file '" + path + "'");
-  std::ostringstream text;
-  text << file.rdbuf();
-  return parseNet(text.str(), path);
+  Result<std::string> text = readRegularFile(path, kMaxDataFileBytes);
+  if (!text) return makeError(path + ": net file: " + text.error().message);
+  return parseNet(*text, path);
 }
 
 std::string formatNet(const Net& net) {

@@ -5,10 +5,11 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+
+#include "vrflow/base/file_access.hpp"
 
 namespace vrflow::rigid {
 namespace {
@@ -281,11 +282,9 @@ Result<std::vector<Body>> parseScene(std::string_view text, const std::string& o
 }
 
 Result<std::vector<Body>> loadScene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(path + ": cannot open the scene file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parseScene(buffer.str(), path);
+  Result<std::string> text = readRegularFile(path, kMaxDataFileBytes);
+  if (!text) return makeError(path + ": scene file: " + text.error().message);
+  return parseScene(*text, path);
 }
 
 namespace {

@@ -1,8 +1,9 @@
 #include "vrflow/viewer/camera.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
+
+#include "vrflow/base/file_access.hpp"
 
 namespace vrflow::viewer {
 namespace {
@@ -78,11 +79,9 @@ Result<CameraPath> CameraPath::parse(const std::string& text, const Camera& base
 }
 
 Result<CameraPath> CameraPath::load(const std::string& path, const Camera& base) {
-  std::ifstream in(path);
-  if (!in) return makeError("cannot read camera path '" + path + "'");
-  std::stringstream text;
-  text << in.rdbuf();
-  auto parsed = parse(text.str(), base);
+  Result<std::string> text = readRegularFile(path, kMaxDataFileBytes);
+  if (!text) return makeError(path + ": camera path: " + text.error().message);
+  auto parsed = parse(*text, base);
   if (!parsed) return makeError(path + ": " + parsed.error().message);
   return parsed;
 }

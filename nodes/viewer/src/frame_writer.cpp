@@ -8,6 +8,9 @@
 #include <filesystem>
 #include <utility>
 
+#include "vrflow/base/echo.hpp"
+#include "vrflow/base/file_access.hpp"
+
 namespace vrflow::viewer {
 namespace {
 
@@ -72,10 +75,15 @@ Result<FrameWriter> FrameWriter::open(const FrameWriterSettings& settings) {
     return makeError("frame size must be positive, got " + std::to_string(settings.width) + "x" +
                      std::to_string(settings.height));
   }
+  // The folder is created, but its own missing parents only inside the working folder.
+  if (auto parent = prepareOutputPath(settings.directory); !parent) {
+    return makeError("cannot create output directory " + quotedValue(settings.directory) + ": " +
+                     parent.error().message);
+  }
   std::error_code ec;
-  std::filesystem::create_directories(settings.directory, ec);
+  std::filesystem::create_directory(settings.directory, ec);
   if (!std::filesystem::is_directory(settings.directory, ec)) {
-    return makeError("cannot create output directory '" + settings.directory + "'");
+    return makeError("cannot create output directory " + quotedValue(settings.directory));
   }
   FrameWriter writer;
   writer.settings_ = settings;

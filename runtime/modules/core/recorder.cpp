@@ -2,9 +2,10 @@
 // iteration,source,source_iteration,sim_time,kind,id,values...
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 
+#include "vrflow/base/echo.hpp"
+#include "vrflow/base/file_access.hpp"
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/module/module.hpp"
 
@@ -17,14 +18,17 @@ int main() {
     return 2;
   }
   const std::string path = module.param("file", "recording.csv");
-  std::error_code ignored;  // a missing folder is created; a failure shows when opening
-  if (const auto parent = std::filesystem::path(path).parent_path(); !parent.empty()) {
-    std::filesystem::create_directories(parent, ignored);
+  // A missing folder is created only inside the run's working folder.
+  if (auto folder = prepareOutputPath(path); !folder) {
+    std::fprintf(stderr, "vrflow-core-recorder: module %s: cannot write %s: %s\n",
+                 quotedValue(module.id()).c_str(), quotedValue(path).c_str(),
+                 folder.error().message.c_str());
+    return 2;
   }
   std::ofstream csv(path);
   if (!csv) {
-    std::fprintf(stderr, "vrflow-core-recorder: module '%s': cannot write '%s'\n",
-                 module.id().c_str(), path.c_str());
+    std::fprintf(stderr, "vrflow-core-recorder: module %s: cannot write %s\n",
+                 quotedValue(module.id()).c_str(), quotedValue(path).c_str());
     return 2;
   }
   csv << "iteration,source,source_iteration,sim_time,kind,id,x,y,z\n";

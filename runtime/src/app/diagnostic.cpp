@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <tuple>
 
+#include "vrflow/base/echo.hpp"
+
 namespace vrflow::app {
 
 namespace {
@@ -25,7 +27,7 @@ std::string formatDiagnostic(const Diagnostic& diagnostic) {
   const SourceLocation& loc = diagnostic.loc;
   std::string text = placeText(loc.file, loc.line, loc.column);
   text += diagnostic.severity == Diagnostic::Error ? "error: " : "warning: ";
-  text += diagnostic.message;
+  text += boundMessage(diagnostic.message);
   for (const InstanceSite& site : loc.expandedFrom) {
     text += "\n" + placeText(site.file, site.line, site.column) + "note: in instance '" +
             site.instance + "' of composite '" + site.composite + "'";

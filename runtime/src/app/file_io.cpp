@@ -4,26 +4,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <system_error>
+
+#include "vrflow/base/file_access.hpp"
 
 namespace vrflow::app::detail {
 
-Result<std::string> readWholeFile(const std::string& path) try {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    return makeError("cannot read file (it is a directory)");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    return makeError(std::string("cannot read file (") + std::strerror(errno) + ")");
-  }
-  std::ostringstream content;
-  content << in.rdbuf();
-  if (in.bad()) return makeError("cannot read file (read failed)");
-  return content.str();
-} catch (const std::exception& e) {
-  return makeError(std::string("cannot read file (") + e.what() + ")");
+Result<std::string> readWholeFile(const std::string& path) {
+  return readRegularFile(path, kMaxDescriptionFileBytes);
 }
 
 Status writeWholeFile(const std::string& path, const std::string& content) try {

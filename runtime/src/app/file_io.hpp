@@ -10,7 +10,8 @@
 
 namespace vrflow::app::detail {
 
-/// The whole content of a file, or an error "cannot read file (REASON)" without the path.
+/// The whole content of a description file (application, manifest, composite): a regular file of
+/// at most kMaxDescriptionFileBytes, or an error "cannot read file (REASON)" without the path.
 Result<std::string> readWholeFile(const std::string& path);
 
 /// Writes `content` to `path` through a temporary file in the same folder renamed into place,

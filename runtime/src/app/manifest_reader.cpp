@@ -32,7 +32,7 @@ PortSpec readPort(const ReadContext& context, const pugi::xml_node& node, bool i
 
 ParamSpec readParamSpec(const ReadContext& context, const pugi::xml_node& node) {
   const ElementReader reader(context, node,
-                             {"name", "type", "default", "min", "max", "choices", "doc"});
+                             {"name", "type", "default", "min", "max", "choices", "access", "doc"});
   ParamSpec param;
   param.name = reader.required("name");
   const std::string typeText = reader.required("type");
@@ -80,6 +80,12 @@ ParamSpec readParamSpec(const ReadContext& context, const pugi::xml_node& node) 
   } else if (param.type == ParamType::Enum && !typeText.empty()) {
     context.error(reader.loc(), missingAttributeMessage("param", "choices") + " (enum)");
   }
+  if (reader.has("access")) {
+    if (param.type != ParamType::File) {
+      reader.errorAt("access", "attribute 'access' applies only to file parameters");
+    }
+    param.access = reader.keyword("access", FileAccess::Unstated, parseFileAccess, "input, output");
+  }
   if (reader.has("default") && !param.name.empty()) {
     if (const auto problem = checkParamValue(param, param.defaultValue)) {
       reader.errorAt("default", "default of parameter '" + param.name + "' " + *problem);
@@ -89,8 +95,10 @@ ParamSpec readParamSpec(const ReadContext& context, const pugi::xml_node& node) 
   return param;
 }
 
-// Relative to the manifest's folder when that file exists there, else as written (looked up
-// on PATH when the module starts).
+// A relative path (one with a '/') is always taken from the manifest's folder, whether the file
+// is there yet or not (a module not built yet must fail naming that path, not the text written).
+// A bare name is the file beside the manifest when there is one, else a program looked up on
+// PATH when the module starts.
 std::string resolveExecutable(const std::string& executable, const std::string& manifestFile) {
   namespace fs = std::filesystem;
   if (executable.empty() || fs::path(executable).is_absolute()) return executable;
@@ -98,6 +106,7 @@ std::string resolveExecutable(const std::string& executable, const std::string& 
   const fs::path folder = fs::absolute(fs::path(manifestFile), ec).parent_path();
   if (ec) return executable;
   const fs::path candidate = (folder / executable).lexically_normal();
+  if (executable.find('/') != std::string::npos) return candidate.string();
   if (fs::is_regular_file(candidate, ec)) return candidate.string();
   return executable;
 }

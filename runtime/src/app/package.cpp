@@ -96,6 +96,25 @@ std::optional<ParamType> parseParamType(std::string_view text) {
   return std::nullopt;
 }
 
+std::string toString(FileAccess access) {
+  switch (access) {
+    case FileAccess::Input:
+      return "input";
+    case FileAccess::Output:
+      return "output";
+    case FileAccess::Unstated:
+      return "";
+  }
+  return "";
+}
+
+std::optional<FileAccess> parseFileAccess(std::string_view text) {
+  for (const FileAccess access : {FileAccess::Input, FileAccess::Output}) {
+    if (toString(access) == text) return access;
+  }
+  return std::nullopt;
+}
+
 std::string toString(ModuleKind kind) {
   switch (kind) {
     case ModuleKind::Animator:

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "text_util.hpp"
+#include "vrflow/base/echo.hpp"
 
 namespace vrflow::app::detail {
 namespace {
@@ -171,13 +172,6 @@ std::string_view trimmed(std::string_view text) {
   return text;
 }
 
-// Quotes template text in a message, shortened so that a huge value cannot make huge messages.
-std::string quoted(std::string_view text) {
-  constexpr std::size_t kLongest = 60;
-  if (text.size() <= kLongest) return "'" + std::string(text) + "'";
-  return "'" + std::string(text.substr(0, kLongest - 3)) + "...'";
-}
-
 }  // namespace
 
 bool isTemplateName(std::string_view text) {
@@ -215,10 +209,10 @@ Result<std::string> substituteTemplate(std::string_view text, const TemplateScop
     }
     const std::size_t close = text.find('}', dollar + 2);
     if (close == std::string_view::npos) {
-      return makeError("'${' without a closing '}' in " + quoted(text));
+      return makeError("'${' without a closing '}' in " + quotedValue(text));
     }
     const std::string_view inner = trimmed(text.substr(dollar + 2, close - dollar - 2));
-    const std::string written = quoted(text.substr(dollar, close + 1 - dollar));
+    const std::string written = quotedValue(text.substr(dollar, close + 1 - dollar));
     if (isTemplateName(inner)) {
       const auto it = scope.find(inner);
       if (it == scope.end()) {

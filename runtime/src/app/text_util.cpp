@@ -5,6 +5,8 @@
 #include <cmath>
 #include <system_error>
 
+#include "vrflow/base/echo.hpp"
+
 namespace vrflow::app::detail {
 namespace {
 
@@ -35,7 +37,7 @@ std::string joinNames(const std::vector<std::string>& names, std::size_t limit) 
   std::string joined;
   for (std::size_t i = 0; i < names.size() && i < limit; ++i) {
     if (i > 0) joined += ", ";
-    joined += names[i];
+    joined += shortenedValue(names[i]);  // ids a user wrote: a list of them stays bounded
   }
   if (names.size() > limit) {
     joined += " and " + std::to_string(names.size() - limit) + " more";
@@ -62,7 +64,7 @@ std::optional<std::string> closestName(std::string_view word,
 
 std::string didYouMean(std::string_view word, const std::vector<std::string>& candidates) {
   const auto closest = closestName(word, candidates);
-  return closest ? "; did you mean '" + *closest + "'?" : std::string();
+  return closest ? "; did you mean " + quotedValue(*closest) + "?" : std::string();
 }
 
 std::string formatNumber(double value) {

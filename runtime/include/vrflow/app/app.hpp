@@ -11,5 +11,6 @@
 #include "vrflow/app/model.hpp"           // IWYU pragma: export
 #include "vrflow/app/mpi_job.hpp"         // IWYU pragma: export
 #include "vrflow/app/package.hpp"         // IWYU pragma: export
+#include "vrflow/app/package_files.hpp"   // IWYU pragma: export
 #include "vrflow/app/validate.hpp"        // IWYU pragma: export
 #include "vrflow/app/writer.hpp"          // IWYU pragma: export

@@ -19,6 +19,7 @@ struct Diagnostic {
 /// (empty file, line 0, column 0) are left out. A problem inside a composite is followed by one
 /// line per instance it came through, innermost first:
 /// "APP.xml:12:5: note: in instance 'w' of composite 'workers'".
+/// Values quoted in MESSAGE are cut to a bounded length with their length noted (boundMessage()).
 std::string formatDiagnostic(const Diagnostic& diagnostic);
 
 /// All diagnostics, formatted, one per line (each line ends with '\n').

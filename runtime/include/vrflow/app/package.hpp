@@ -34,14 +34,23 @@ struct PortSpec {
 /// The value types of parameters.
 enum class ParamType { Int, Float, Bool, String, Enum, Vec3, File };
 
+/// What a module does with the path a file parameter names (manifest attribute `access`).
+enum class FileAccess {
+  Unstated,  ///< not declared: no check of the path
+  Input,     ///< read: must be a regular file
+  Output,    ///< written (a file, or a folder for a folder-valued parameter): its parent folder
+             ///< must exist unless it lies inside the run's working folder
+};
+
 /// A parameter declared by a module or filter type.
 struct ParamSpec {
   std::string name;
   ParamType type = ParamType::String;
   std::string defaultValue;
-  std::optional<double> min;         ///< int, float, vec3 (each component)
-  std::optional<double> max;         ///< int, float, vec3 (each component)
-  std::vector<std::string> choices;  ///< enum only
+  std::optional<double> min;                 ///< int, float, vec3 (each component)
+  std::optional<double> max;                 ///< int, float, vec3 (each component)
+  std::vector<std::string> choices;          ///< enum only
+  FileAccess access = FileAccess::Unstated;  ///< file only
   std::string doc;
 };
 
@@ -52,7 +61,9 @@ enum class ModuleKind { Animator, Interactor, Viewer, Input, Other };
 struct ModuleType {
   std::string package;
   std::string type;
-  std::string executable;  ///< absolute when found next to the manifest, else as written
+  /// Absolute for a path written with a '/' (resolved against the manifest's folder) or a bare
+  /// name found beside the manifest; otherwise the bare name, looked up on PATH at start.
+  std::string executable;
   ModuleKind kind = ModuleKind::Other;
   /// Empty, or the name of an int parameter: when a module's value of it is N > 1, the runtime
   /// starts the module as N MPI ranks through `mpirun` (rank 0 is the module vrflow talks to;
@@ -101,6 +112,10 @@ struct FilterType {
 std::string toString(ParamType type);
 /// The type written `text`, or nullopt.
 std::optional<ParamType> parseParamType(std::string_view text);
+/// "input", "output" or "" (unstated).
+std::string toString(FileAccess access);
+/// The access written `text` ("input" or "output"), or nullopt.
+std::optional<FileAccess> parseFileAccess(std::string_view text);
 /// "animator", "interactor", "viewer", "input" or "other".
 std::string toString(ModuleKind kind);
 /// The kind written `text`, or nullopt.
