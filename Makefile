@@ -3,6 +3,10 @@ SHELL := /bin/bash
 BUILD ?= build
 JOBS ?= $(shell nproc)
 BUILD_TYPE ?= Release
+# ccache keys on paths relative to the checkout, so every clone (CI's included) shares one cache;
+# the sanitizer builds (-g) too, whose debug information then names relative paths.
+export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_NOHASHDIR := 1
 
 # Every Debian package the project needs to build, test and benchmark.
 PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-rt-14-dev \
