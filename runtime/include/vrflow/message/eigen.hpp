@@ -12,6 +12,8 @@
 // (coeffs() is x, y, z, w), so asEigen(q) maps the wire's four doubles as they are. Eigen's
 // constructor takes w first: Eigen::Quaterniond(w, x, y, z). Write a wire quaternion with toQuat().
 // Matrices: the wire's Mat3 is row-major, asEigen maps it as a RowMatrix3d.
+// Header-only; include it only from targets that link Eigen3::Eigen (the node packages do);
+// vrflow::message itself uses Eigen privately, so its users do not see Eigen.
 
 namespace vrflow::msg {
 
