@@ -1,5 +1,8 @@
 # vrflow::message: the binary message layout (docs/message-layout.md): builder, checked
-# zero-copy reader, object types, ids and digests.
+# zero-copy reader, object types, ids and digests. Eigen (header-only) does the shape geometry;
+# it stays private: the node packages that include vrflow/message/eigen.hpp (Eigen views of the
+# wire's arrays) link Eigen3::Eigen themselves, and nothing else sees it.
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 vrflow_add_library(message
   SOURCES
     src/message/builder.cpp
@@ -16,4 +19,4 @@ vrflow_add_library(message
     src/message/stamps.cpp
     src/message/view.cpp
   PUBLIC_DEPS vrflow::base
-  PRIVATE_DEPS PkgConfig::XXHASH)
+  PRIVATE_DEPS PkgConfig::XXHASH Eigen3::Eigen)

@@ -23,7 +23,7 @@ Body ground(std::uint64_t id = 1) {
 }
 
 double norm(const Vec3& v) {
-  return std::sqrt(dot(v, v));
+  return asEigen(v).norm();
 }
 
 TEST(RigidPhysics, FreeFallMatchesSemiImplicitEulerAndTheAnalyticCurve) {
@@ -101,24 +101,24 @@ TEST(RigidPhysics, TwoBodyCollisionConservesMomentum) {
   b.angularVelocity = {0, 0, 0.3};
   ASSERT_TRUE(world.add({a, b}));
   auto momentum = [&] {
-    Vec3 p{};
-    for (const Body& x : world.state().bodies()) p = add(p, scale(x.linearVelocity, x.mass));
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (const Body& x : world.state().bodies()) p += asEigen(x.linearVelocity) * x.mass;
     return p;
   };
   auto angular = [&] {  // about the origin: r x m v + I_w w
-    Vec3 l{};
+    Eigen::Vector3d l = Eigen::Vector3d::Zero();
     for (const Body& x : world.state().bodies())
-      l = add(l, add(cross(x.position, scale(x.linearVelocity, x.mass)), angularMomentum(x)));
+      l += asEigen(x.position).cross(asEigen(x.linearVelocity) * x.mass) + angularMomentum(x);
     return l;
   };
-  const Vec3 p0 = momentum(), l0 = angular();
+  const Eigen::Vector3d p0 = momentum(), l0 = angular();
   const double va0 = world.state().find(1)->linearVelocity[0];
   for (int i = 0; i < 150; ++i) world.step(kDt);
-  const Vec3 p1 = momentum(), l1 = angular();
+  const Eigen::Vector3d p1 = momentum(), l1 = angular();
   EXPECT_LT(world.state().find(1)->linearVelocity[0], va0 - 1.0) << "no collision happened";
   for (int k = 0; k < 3; ++k) {
-    EXPECT_NEAR(p1[k], p0[k], 1e-9 * (1 + norm(p0)));
-    EXPECT_NEAR(l1[k], l0[k], 1e-6 * (1 + norm(l0)));
+    EXPECT_NEAR(p1[k], p0[k], 1e-9 * (1 + p0.norm()));
+    EXPECT_NEAR(l1[k], l0[k], 1e-6 * (1 + l0.norm()));
   }
   // Separating after the impact.
   EXPECT_GT(world.state().find(2)->linearVelocity[0], world.state().find(1)->linearVelocity[0]);
@@ -135,7 +135,7 @@ TEST(RigidPhysics, StackOfFiveBoxesStandsForTenSeconds) {
   double drift = 0, speed = 0, tilt = 0;
   for (std::size_t i = 1; i < start.size(); ++i) {
     const Body& b = world.state().bodies()[i];
-    drift = std::max(drift, norm(sub(b.position, start[i].position)));
+    drift = std::max(drift, (asEigen(b.position) - asEigen(start[i].position)).norm());
     speed = std::max(speed, norm(b.linearVelocity));
     tilt = std::max(tilt, std::abs(1 - std::abs(b.orientation[3])));
   }
@@ -319,18 +319,17 @@ TEST(RigidPhysics, FreeAsymmetricBodyConservesAngularMomentum) {
       makeBody(1, msg::Shape::box({0.5, 0.2, 0.1}), 3.0, {0, 0, 0}, {0.1, 0.3, -0.2, 0.927});
   body.angularVelocity = {0.4, 2.0, 0.3};  // near the unstable middle axis: tumbles
   ASSERT_TRUE(state.addBody(body));
-  const Vec3 l0 = angularMomentum(*state.find(1));
+  const Eigen::Vector3d l0 = angularMomentum(*state.find(1));
   const double e0 = kineticEnergy(*state.find(1));
   const Vec3 w0 = state.find(1)->angularVelocity;
   for (int i = 0; i < 2000; ++i) state.step(0.001);
   const Body& b = *state.find(1);
-  const Vec3 l1 = angularMomentum(b);
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(l1[k], l0[k], 1e-9 * norm(l0));
-  EXPECT_GT(norm(sub(b.angularVelocity, w0)), 0.1) << "w should precess for an asymmetric body";
+  const Eigen::Vector3d l1 = angularMomentum(b);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(l1[k], l0[k], 1e-9 * l0.norm());
+  EXPECT_GT((asEigen(b.angularVelocity) - asEigen(w0)).norm(), 0.1)
+      << "w should precess for an asymmetric body";
   EXPECT_NEAR(kineticEnergy(b), e0, 0.02 * e0);
-  const double qn = std::sqrt(dot({b.orientation[0], b.orientation[1], b.orientation[2]},
-                                  {b.orientation[0], b.orientation[1], b.orientation[2]}) +
-                              b.orientation[3] * b.orientation[3]);
+  const double qn = asEigen(b.orientation).norm();
   EXPECT_NEAR(qn, 1.0, 1e-12);
 }
 

@@ -39,8 +39,7 @@ TEST(RigidScene, LoadsEveryShapeKindWithMassOrDensity) {
   EXPECT_GT(props.volume, 0);
   bool found = false;
   for (std::size_t i = 0; i < rock.shape.vertices.size(); i += 3) {
-    const Vec3 world = add(rock.position, {rock.shape.vertices[i], rock.shape.vertices[i + 1],
-                                           rock.shape.vertices[i + 2]});
+    const Eigen::Vector3d world = asEigen(rock.position) + msg::asVector3(&rock.shape.vertices[i]);
     if (std::abs(world[0] - (-1.0 + 0.2)) < 1e-9 && std::abs(world[1] - 0.6) < 1e-9 &&
         std::abs(world[2] + 0.5) < 1e-9)
       found = true;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "vrflow/message/eigen.hpp"
+
 namespace vrflow::fluid::detail {
 namespace {
 
@@ -14,8 +16,12 @@ bool finite(const double* v, int n) {
   return true;
 }
 
-msg::Vec3 cross(const msg::Vec3& a, const msg::Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+using Eigen::Vector3d;
+using msg::asEigen;
+
+/// x relative to the body's centre, in the body's frame.
+msg::Vec3 toLocal(const PreparedBody& body, const Vector3d& x) {
+  return msg::toVec3(asEigen(body.orientation).conjugate() * (x - asEigen(body.position)));
 }
 
 std::string name(std::uint64_t id) {
@@ -91,21 +97,16 @@ Result<PreparedBody> preparePoint(const PointMass& point) {
 }
 
 void pushOut(const PreparedBody& body, double* x, double margin) {
-  const msg::Vec3 local = msg::rotateInverse(
-      body.orientation,
-      {x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]});
-  const auto sd = msg::signedDistance(body.shape, local);
+  const auto sd = msg::signedDistance(body.shape, toLocal(body, msg::asVector3(x)));
   if (sd.distance >= 0.0) return;
-  const msg::Vec3 n = msg::rotate(body.orientation, sd.normal);
+  const Vector3d n = asEigen(body.orientation) * asEigen(sd.normal);
   const double move = -sd.distance + margin;
-  for (int d = 0; d < 3; ++d) x[d] += move * n[d];
+  msg::asVector3(x) += move * n;
 }
 
 msg::Vec3 rigidVelocity(const PreparedBody& body, const msg::Vec3& x) {
-  const msg::Vec3 r{x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]};
-  const msg::Vec3 w = cross(body.angularVelocity, r);
-  return {body.linearVelocity[0] + w[0], body.linearVelocity[1] + w[1],
-          body.linearVelocity[2] + w[2]};
+  const Vector3d r = asEigen(x) - asEigen(body.position);
+  return msg::toVec3(asEigen(body.linearVelocity) + asEigen(body.angularVelocity).cross(r));
 }
 
 void rasterise(const Grid& g, const std::vector<PreparedBody>& bodies, std::vector<int>& cellBody,
@@ -132,14 +133,12 @@ void rasterise(const Grid& g, const std::vector<PreparedBody>& bodies, std::vect
       for (int k = lo[2]; k <= hi[2]; ++k) {
         for (int j = lo[1]; j <= hi[1]; ++j) {
           for (int i = lo[0]; i <= hi[0]; ++i) {
-            msg::Vec3 x{o[0] + (i + 0.5) * g.h, o[1] + (j + 0.5) * g.h, o[2] + (k + 0.5) * g.h};
-            if (a >= 0) x[static_cast<std::size_t>(a)] -= 0.5 * g.h;
+            Vector3d x{o[0] + (i + 0.5) * g.h, o[1] + (j + 0.5) * g.h, o[2] + (k + 0.5) * g.h};
+            if (a >= 0) x[a] -= 0.5 * g.h;
             auto& slot = a < 0 ? cellBody[g.cell(i, j, k)] : faceBody[a][g.face(a, i, j, k)];
             if (slot >= 0) continue;
-            const msg::Vec3 local = msg::rotateInverse(
-                body.orientation,
-                {x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]});
-            if (msg::signedDistance(body.shape, local).distance < 0.0) slot = static_cast<int>(b);
+            if (msg::signedDistance(body.shape, toLocal(body, x)).distance < 0.0)
+              slot = static_cast<int>(b);
           }
         }
       }
@@ -171,13 +170,12 @@ void bodyForceSums(const Grid& g, const PreparedBody& body, int bodyIndex,
           const double d = uNew[a][f] - uOld[a][f] - gravity[a] * dt;
           out[0] += d;
           out[1] += 1.0;
-          msg::Vec3 x{g.ox + (i + 0.5) * g.h, g.oy + (j + 0.5) * g.h, g.oz + (k + 0.5) * g.h};
-          x[static_cast<std::size_t>(a)] -= 0.5 * g.h;
-          msg::Vec3 e{};
-          e[static_cast<std::size_t>(a)] = d;
-          const auto t =
-              cross({x[0] - body.position[0], x[1] - body.position[1], x[2] - body.position[2]}, e);
-          for (int c = 0; c < 3; ++c) out[2 + c] += t[c];
+          Vector3d x{g.ox + (i + 0.5) * g.h, g.oy + (j + 0.5) * g.h, g.oz + (k + 0.5) * g.h};
+          x[a] -= 0.5 * g.h;
+          Vector3d e = Vector3d::Zero();
+          e[a] = d;
+          const Vector3d t = (x - asEigen(body.position)).cross(e);
+          msg::asVector3(out + 2) += t;
         }
       }
     }

@@ -4,21 +4,28 @@
 #include <cmath>
 #include <limits>
 
+#include "vrflow/message/eigen.hpp"
+
 namespace vrflow::massspring {
 namespace {
 
-msg::Vec3 sub(const msg::Vec3& a, const msg::Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-msg::Vec3 add(const msg::Vec3& a, const msg::Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-msg::Vec3 scale(const msg::Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-double dot(const msg::Vec3& a, const msg::Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-msg::Vec3 cross(const msg::Vec3& a, const msg::Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+using Eigen::Vector3d;
+using msg::asEigen;
+
+/// Node i's position and velocity as Eigen vectors (copies of the net's flat arrays).
+Vector3d positionOf(const Net& net, std::size_t i) {
+  return msg::asVector3(&net.positions[3 * i]);
+}
+Vector3d velocityOf(const Net& net, std::size_t i) {
+  return msg::asVector3(&net.velocities[3 * i]);
 }
 
-double invMass(const Net& net, std::size_t i) { return net.pinned[i] ? 0.0 : 1.0 / net.masses[i]; }
+double invMass(const Net& net, std::size_t i) {
+  return net.pinned[i] ? 0.0 : 1.0 / net.masses[i];
+}
 
-void addTo(std::vector<double>& forces, std::size_t node, const msg::Vec3& f) {
-  for (int k = 0; k < 3; ++k) forces[3 * node + k] += f[k];
+void addTo(std::vector<double>& forces, std::size_t node, const Vector3d& f) {
+  msg::asVector3(&forces[3 * node]) += f;
 }
 
 /// The contact force magnitude of the header's formula (0 when not approaching enough).
@@ -34,46 +41,47 @@ std::vector<double>& forcesOf(ContactForces& out, std::uint64_t id, const Net& n
   return f;
 }
 
-bool inBox(const msg::Vec3& p, const msg::Aabb& box, double margin) {
-  for (int k = 0; k < 3; ++k) {
-    if (p[k] < box.min[k] - margin || p[k] > box.max[k] + margin) return false;
-  }
-  return true;
+bool inBox(const Vector3d& p, const msg::Aabb& box, double margin) {
+  const Vector3d grow = Vector3d::Constant(margin);
+  return Eigen::AlignedBox3d(asEigen(box.min) - grow, asEigen(box.max) + grow).contains(p);
 }
 
 struct PlaneHit {
   bool hit = false;
-  double distance = 0;   ///< along normal, negative once crossed
-  double gap = 0;        ///< 3-D distance to the closest point (to choose among triangles)
-  msg::Vec3 normal{};    ///< unit, pointing to the side the point came from
+  double distance = 0;  ///< along normal, negative once crossed
+  double gap = 0;       ///< 3-D distance to the closest point (to choose among triangles)
+  Vector3d normal = Vector3d::Zero();  ///< unit, pointing to the side the point came from
   TrianglePoint closest;
-  int side = 0;          ///< that side along the triangle's own normal (+1 / -1)
+  int side = 0;  ///< that side along the triangle's own normal (+1 / -1)
 };
 
 /// A point x moving at `relative` (point minus surface) against triangle abc.
-PlaneHit pointTriangle(const msg::Vec3& x, const msg::Vec3& relative, const msg::Vec3& a, const msg::Vec3& b,
-                       const msg::Vec3& c, const ContactParams& p, int knownSide = 0) {
+PlaneHit pointTriangle(const Vector3d& x, const Vector3d& relative, const Vector3d& a,
+                       const Vector3d& b, const Vector3d& c, const ContactParams& p,
+                       int knownSide = 0) {
   PlaneHit out;
-  msg::Vec3 n = cross(sub(b, a), sub(c, a));
-  const double length = std::sqrt(dot(n, n));
+  Vector3d n = (b - a).cross(c - a);
+  const double length = n.norm();
   if (length < 1e-300) return out;
-  n = scale(n, 1.0 / length);
-  const double s = dot(sub(x, a), n);
-  const double along = dot(relative, n);
+  n *= 1.0 / length;
+  const double s = (x - a).dot(n);
+  const double along = relative.dot(n);
   const double before = s - along * p.dt;
-  const double side = knownSide != 0 ? knownSide : before > 0 ? 1.0 : before < 0 ? -1.0 : (s >= 0 ? 1.0 : -1.0);
+  const double side = knownSide != 0 ? knownSide
+                      : before > 0   ? 1.0
+                      : before < 0   ? -1.0
+                                     : (s >= 0 ? 1.0 : -1.0);
   const double distance = s * side;
   const double deepest = std::abs(along) * p.dt + (knownSide != 0 ? 5.0 : 1.0) * p.thickness;
   if (distance >= p.thickness || distance < -deepest) return out;
-  const msg::Vec3 onPlane = sub(x, scale(n, s));
-  const auto closest = closestPointOnTriangle(onPlane, a, b, c);
-  const msg::Vec3 off = sub(onPlane, closest.point);
-  if (dot(off, off) > p.thickness * p.thickness) return out;
-  const msg::Vec3 gap = sub(x, closest.point);
+  const Vector3d onPlane = x - n * s;
+  const auto closest =
+      closestPointOnTriangle(msg::toVec3(onPlane), msg::toVec3(a), msg::toVec3(b), msg::toVec3(c));
+  if ((onPlane - asEigen(closest.point)).squaredNorm() > p.thickness * p.thickness) return out;
   out.hit = true;
   out.distance = distance;
-  out.gap = std::sqrt(dot(gap, gap));
-  out.normal = scale(n, side);
+  out.gap = (x - asEigen(closest.point)).norm();
+  out.normal = n * side;
   out.closest = closest;
   out.side = side > 0 ? 1 : -1;
   return out;
@@ -105,18 +113,17 @@ Adjacency adjacency(const Net& net) {
 /// springMassWeight * dt^2 times the stiffness of its springs along n (axial k (u.n)^2 plus the
 /// tension's transverse stiffness T/L (1 - (u.n)^2)): a node held by its springs does not give
 /// way like a free particle within one outer step.
-double effectiveInvMass(const Net& net, const Adjacency& adj, std::size_t i,
-                        const msg::Vec3& n, const ContactParams& p) {
+double effectiveInvMass(const Net& net, const Adjacency& adj, std::size_t i, const Vector3d& n,
+                        const ContactParams& p) {
   if (net.pinned[i]) return 0.0;
   double stiffness = 0;
-  const auto x = net.position(i);
+  const Vector3d x = positionOf(net, i);
   for (std::size_t k = adj.start[i]; k < adj.start[i + 1]; ++k) {
     const auto& s = net.springs[adj.springs[k]];
-    const auto other = net.position(s.a == i ? s.b : s.a);
-    const msg::Vec3 d = sub(other, x);
-    const double length = std::sqrt(dot(d, d));
+    const Vector3d d = positionOf(net, s.a == i ? s.b : s.a) - x;
+    const double length = d.norm();
     if (length < 1e-12) continue;
-    const double c = dot(d, n) / length;
+    const double c = d.dot(n) / length;
     const double tension = std::max(0.0, s.stiffness * (length - s.restLength));
     stiffness += s.stiffness * c * c + tension / length * (1 - c * c);
   }
@@ -127,44 +134,49 @@ double effectiveInvMass(const Net& net, const Adjacency& adj, std::size_t i,
 }  // namespace
 
 Status validateContactParams(const ContactParams& p) {
-  if (!(p.thickness > 0) || !std::isfinite(p.thickness)) return makeError("contact: thickness must be finite and > 0");
+  if (!(p.thickness > 0) || !std::isfinite(p.thickness))
+    return makeError("contact: thickness must be finite and > 0");
   if (!(p.beta >= 0 && p.beta <= 1)) return makeError("contact: beta must be in [0, 1]");
   if (!(p.dt > 0) || !std::isfinite(p.dt)) return makeError("contact: dt must be finite and > 0");
-  if (!(p.springMassWeight >= 0) || !std::isfinite(p.springMassWeight)) return makeError("contact: spring mass weight must be >= 0");
+  if (!(p.springMassWeight >= 0) || !std::isfinite(p.springMassWeight))
+    return makeError("contact: spring mass weight must be >= 0");
   return {};
 }
 
-TrianglePoint closestPointOnTriangle(const msg::Vec3& p, const msg::Vec3& a, const msg::Vec3& b, const msg::Vec3& c) {
-  const msg::Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return {a, 1, 0, 0};
-  const msg::Vec3 bp = sub(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return {b, 0, 1, 0};
+TrianglePoint closestPointOnTriangle(const msg::Vec3& point, const msg::Vec3& vertexA,
+                                     const msg::Vec3& vertexB, const msg::Vec3& vertexC) {
+  const auto p = asEigen(point), a = asEigen(vertexA), b = asEigen(vertexB), c = asEigen(vertexC);
+  const Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {vertexA, 1, 0, 0};
+  const Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {vertexB, 0, 1, 0};
   const double vc = d1 * d4 - d3 * d2;
   if (vc <= 0 && d1 >= 0 && d3 <= 0) {
     const double v = d1 / (d1 - d3);
-    return {add(a, scale(ab, v)), 1 - v, v, 0};
+    return {msg::toVec3(a + ab * v), 1 - v, v, 0};
   }
-  const msg::Vec3 cp = sub(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return {c, 0, 0, 1};
+  const Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {vertexC, 0, 0, 1};
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0 && d2 >= 0 && d6 <= 0) {
     const double w = d2 / (d2 - d6);
-    return {add(a, scale(ac, w)), 1 - w, 0, w};
+    return {msg::toVec3(a + ac * w), 1 - w, 0, w};
   }
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
     const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {add(b, scale(sub(c, b), w)), 0, 1 - w, w};
+    return {msg::toVec3(b + (c - b) * w), 0, 1 - w, w};
   }
   const double denom = 1.0 / (va + vb + vc);
   const double v = vb * denom, w = vc * denom;
-  return {add(a, add(scale(ab, v), scale(ac, w))), 1 - v - w, v, w};
+  return {msg::toVec3(a + (ab * v + ac * w)), 1 - v - w, v, w};
 }
 
-ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& p, ContactMemory* memory) {
+ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& p,
+                            ContactMemory* memory) {
   ContactForces out;
   std::map<std::tuple<std::uint64_t, std::uint32_t, std::uint64_t>, int> sides;
   std::map<std::uint64_t, msg::Aabb> boxes;
@@ -181,18 +193,19 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
       bool overlap = true;
       const double margin = p.thickness + 1.0;  // nodes up to 1 m/step fast still seen
       for (int k = 0; k < 3; ++k) {
-        overlap = overlap && boxA.min[k] <= boxB.max[k] + margin && boxB.min[k] <= boxA.max[k] + margin;
+        overlap =
+            overlap && boxA.min[k] <= boxB.max[k] + margin && boxB.min[k] <= boxA.max[k] + margin;
       }
       if (!overlap) continue;
       for (std::size_t i = 0; i < a.nodeCount(); ++i) {
-        const msg::Vec3 x = a.position(i);
-        const auto& vi = a.velocity(i);
-        if (!inBox(x, boxB, p.thickness + (std::abs(vi[0]) + std::abs(vi[1]) + std::abs(vi[2])) * p.dt)) continue;
+        const Vector3d x = positionOf(a, i);
+        const Vector3d vi = velocityOf(a, i);
+        if (!inBox(x, boxB, p.thickness + vi.lpNorm<1>() * p.dt)) continue;
         const double invA = invMass(a, i);
         if (invA == 0) continue;
         // The nearest feature of net b within the thickness: a triangle, or a node.
         double best = p.thickness;
-        msg::Vec3 normal{}, surfaceVelocity{};
+        Vector3d normal = Vector3d::Zero(), surfaceVelocity = Vector3d::Zero();
         double invB = 0;
         std::size_t tri[3] = {0, 0, 0};
         double weights[3] = {0, 0, 0};
@@ -208,19 +221,18 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
           double bestGap = 1e300;
           for (std::size_t t = 0; t + 2 < b.surface.size(); t += 3) {
             const std::size_t ia = b.surface[t], ib = b.surface[t + 1], ic = b.surface[t + 2];
-            const auto pa = b.position(ia), pb = b.position(ib), pc = b.position(ic);
-            const double reach = p.thickness + std::abs(a.velocity(i)[0]) * p.dt + std::abs(a.velocity(i)[1]) * p.dt +
-                                 std::abs(a.velocity(i)[2]) * p.dt;
+            const Vector3d pa = positionOf(b, ia), pb = positionOf(b, ib), pc = positionOf(b, ic);
+            const double reach = p.thickness + std::abs(vi[0]) * p.dt + std::abs(vi[1]) * p.dt +
+                                 std::abs(vi[2]) * p.dt;
             bool near = true;
             for (int k = 0; k < 3 && near; ++k) {
-              near = x[k] >= std::min({pa[k], pb[k], pc[k]}) - reach && x[k] <= std::max({pa[k], pb[k], pc[k]}) + reach;
+              near = x[k] >= std::min({pa[k], pb[k], pc[k]}) - reach &&
+                     x[k] <= std::max({pa[k], pb[k], pc[k]}) + reach;
             }
             if (!near) continue;
-            const auto& w0 = b.velocity(ia);
-            const auto& w1 = b.velocity(ib);
-            const auto& w2 = b.velocity(ic);
-            const msg::Vec3 centre = scale(add(add(w0, w1), w2), 1.0 / 3.0);
-            const auto hit = pointTriangle(x, sub(a.velocity(i), centre), pa, pb, pc, p, knownSide);
+            const Vector3d centre =
+                (velocityOf(b, ia) + velocityOf(b, ib) + velocityOf(b, ic)) * (1.0 / 3.0);
+            const auto hit = pointTriangle(x, vi - centre, pa, pb, pc, p, knownSide);
             if (!hit.hit || hit.gap >= bestGap) continue;
             bestGap = hit.gap;
             side = hit.side;
@@ -232,11 +244,11 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
           }
         } else {
           for (std::size_t j = 0; j < b.nodeCount(); ++j) {
-            const msg::Vec3 d = sub(x, b.position(j));
-            const double dist = std::sqrt(dot(d, d));
+            const Vector3d d = x - positionOf(b, j);
+            const double dist = d.norm();
             if (dist >= best || dist < 1e-12) continue;
             best = dist;
-            normal = scale(d, 1.0 / dist);
+            normal = d * (1.0 / dist);
             tri[0] = j;
             weights[0] = 1;
             featureNodes = 1;
@@ -244,21 +256,21 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
         }
         if (featureNodes == 0) continue;
         if (side != 0) sides[key] = knownSide != 0 ? knownSide : side;
-        surfaceVelocity = {0, 0, 0};
+        surfaceVelocity.setZero();
         for (int f = 0; f < featureNodes; ++f) {
-          surfaceVelocity = add(surfaceVelocity, scale(b.velocity(tri[f]), weights[f]));
+          surfaceVelocity += velocityOf(b, tri[f]) * weights[f];
           invB += weights[f] * weights[f] * effectiveInvMass(b, adjacent[idB], tri[f], normal, p);
         }
         const double invNode = effectiveInvMass(a, adjacent[idA], i, normal, p);
-        const double vn = dot(sub(a.velocity(i), surfaceVelocity), normal);
+        const double vn = (vi - surfaceVelocity).dot(normal);
         const double magnitude = contactMagnitude(best, vn, invNode + invB, p);
         if (magnitude <= 0) continue;
         ++out.contacts;
-        const msg::Vec3 f = scale(normal, magnitude);
+        const Vector3d f = normal * magnitude;
         addTo(forcesOf(out, idA, a), i, f);
         auto& fb = forcesOf(out, idB, b);
         for (int k = 0; k < featureNodes; ++k) {
-          if (!b.pinned[tri[k]]) addTo(fb, tri[k], scale(f, -weights[k]));
+          if (!b.pinned[tri[k]]) addTo(fb, tri[k], f * -weights[k]);
         }
       }
     }
@@ -267,7 +279,8 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
   return out;
 }
 
-ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std::map<std::uint64_t, RigidBody>& rigids,
+ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
+                            const std::map<std::uint64_t, RigidBody>& rigids,
                             const ContactParams& p, ContactMemory* memory) {
   ContactForces out;
   ContactMemory next;
@@ -279,8 +292,10 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
     auto box = msg::worldBounds(body.shape, body.position, body.orientation);
     // Nets whose box (grown by the thickness and one step of the rigid's motion) misses the
     // rigid's box are skipped.
-    const double speed = std::abs(body.linearVelocity[0]) + std::abs(body.linearVelocity[1]) + std::abs(body.linearVelocity[2]);
-    const double spin = std::abs(body.angularVelocity[0]) + std::abs(body.angularVelocity[1]) + std::abs(body.angularVelocity[2]);
+    const double speed = std::abs(body.linearVelocity[0]) + std::abs(body.linearVelocity[1]) +
+                         std::abs(body.linearVelocity[2]);
+    const double spin = std::abs(body.angularVelocity[0]) + std::abs(body.angularVelocity[1]) +
+                        std::abs(body.angularVelocity[2]);
     double radius = 0;
     for (int k = 0; k < 3; ++k) radius = std::max(radius, 0.5 * (box.max[k] - box.min[k]));
     const double margin = p.thickness + (speed + spin * radius) * p.dt;
@@ -293,7 +308,7 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
     };
     const bool kinematic = !(body.mass > 0) || !std::isfinite(body.mass);
     const double invRigid = kinematic ? 0.0 : 1.0 / body.mass;
-    msg::Vec3 totalForce{}, totalTorque{};
+    Vector3d totalForce = Vector3d::Zero(), totalTorque = Vector3d::Zero();
     bool touched = false;
     // Contacts are gathered first, then answered with the rigid's mass shared among them (each
     // contact sees 1/count of it), so that many simultaneous contacts do not each push the
@@ -304,22 +319,25 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
       std::size_t nodes[3];
       double w[3];
       int count;
-      msg::Vec3 normal;  // pushes the nodes along it (the rigid the other way)
+      Vector3d normal;  // pushes the nodes along it (the rigid the other way)
       double distance, vn, invNet;
-      msg::Vec3 r;
+      Vector3d r;
     };
     std::vector<Candidate> candidates;
-    auto pointVelocity = [&](const msg::Vec3& r) { return add(body.linearVelocity, cross(body.angularVelocity, r)); };
+    auto pointVelocity = [&](const Vector3d& r) -> Vector3d {
+      return asEigen(body.linearVelocity) + asEigen(body.angularVelocity).cross(r);
+    };
+    const auto orientation = asEigen(body.orientation);
     // Nodes against the shape.
     for (const auto& [netId, net] : nets) {
       if (!netNear(netId)) continue;
       for (std::size_t i = 0; i < net.nodeCount(); ++i) {
-        const msg::Vec3 x = net.position(i);
+        const Vector3d x = positionOf(net, i);
         if (!inBox(x, box, p.thickness)) continue;
         if (invMass(net, i) + invRigid == 0) continue;
-        const msg::Vec3 r = sub(x, body.position);
-        const msg::Vec3 local = msg::rotateInverse(body.orientation, r);
-        auto sd = msg::signedDistance(body.shape, local);
+        const Vector3d r = x - asEigen(body.position);
+        const Vector3d local = orientation.conjugate() * r;
+        auto sd = msg::signedDistance(body.shape, msg::toVec3(local));
         const auto key = std::tuple{rigidId, netId, static_cast<std::uint32_t>(i)};
         const ContactMemory::Plane* plane = nullptr;
         if (memory) {
@@ -329,52 +347,69 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
         if (plane && sd.distance < p.thickness) {
           // A lasting contact: distance to the plane where it began.
           sd.normal = plane->normal;
-          sd.distance = dot(local, plane->normal) - plane->offset;
+          sd.distance = local.dot(asEigen(plane->normal)) - plane->offset;
         }
         if (sd.distance >= p.thickness) continue;
-        const msg::Vec3 relative = sub(net.velocity(i), pointVelocity(r));
+        const Vector3d relative = velocityOf(net, i) - pointVelocity(r);
         if (!plane && sd.distance < 0) {
           // Inside: take the normal of where the node was one step before, if it was outside then.
-          const msg::Vec3 before = sub(r, scale(relative, p.dt));
-          const auto sdBefore = msg::signedDistance(body.shape, msg::rotateInverse(body.orientation, before));
+          const Vector3d before = r - relative * p.dt;
+          const auto sdBefore =
+              msg::signedDistance(body.shape, msg::toVec3(orientation.conjugate() * before));
           if (sdBefore.distance > 0) sd.normal = sdBefore.normal;
         }
-        next.planes[key] = plane ? *plane : ContactMemory::Plane{sd.normal, dot(local, sd.normal) - sd.distance};
-        const msg::Vec3 normal = msg::rotate(body.orientation, sd.normal);
+        next.planes[key] =
+            plane ? *plane
+                  : ContactMemory::Plane{sd.normal, local.dot(asEigen(sd.normal)) - sd.distance};
+        const Vector3d normal = orientation * asEigen(sd.normal);
         const double invNode = effectiveInvMass(net, adjacent[netId], i, normal, p);
-        candidates.push_back({netId, &net, {i, 0, 0}, {1, 0, 0}, 1, normal, sd.distance, dot(relative, normal), invNode, r});
+        candidates.push_back({netId,
+                              &net,
+                              {i, 0, 0},
+                              {1, 0, 0},
+                              1,
+                              normal,
+                              sd.distance,
+                              relative.dot(normal),
+                              invNode,
+                              r});
       }
     }
     // Corners of boxes, vertices of hulls and meshes against the nets' triangles.
-    std::vector<msg::Vec3> corners;
+    std::vector<Vector3d> corners;
     if (body.shape.kind == msg::ShapeKind::Box) {
       const auto& h = body.shape.halfExtents;
-      for (int c = 0; c < 8; ++c) corners.push_back({c & 1 ? h[0] : -h[0], c & 2 ? h[1] : -h[1], c & 4 ? h[2] : -h[2]});
-    } else if (body.shape.kind == msg::ShapeKind::ConvexHull || body.shape.kind == msg::ShapeKind::TriangleMesh) {
+      for (int c = 0; c < 8; ++c)
+        corners.emplace_back(c & 1 ? h[0] : -h[0], c & 2 ? h[1] : -h[1], c & 4 ? h[2] : -h[2]);
+    } else if (body.shape.kind == msg::ShapeKind::ConvexHull ||
+               body.shape.kind == msg::ShapeKind::TriangleMesh) {
       for (std::size_t v = 0; v + 2 < body.shape.vertices.size(); v += 3) {
-        corners.push_back({body.shape.vertices[v], body.shape.vertices[v + 1], body.shape.vertices[v + 2]});
+        corners.emplace_back(msg::asVector3(&body.shape.vertices[v]));
       }
     }
     for (const auto& [netId, net] : nets) {
       if (corners.empty() || net.surface.empty() || !netNear(netId)) continue;
       for (const auto& corner : corners) {
-        const msg::Vec3 r = msg::rotate(body.orientation, corner);
-        const msg::Vec3 x = add(body.position, r);
-        const msg::Vec3 vx = pointVelocity(r);
-        const double reach = p.thickness + (std::abs(vx[0]) + std::abs(vx[1]) + std::abs(vx[2])) * p.dt;
+        const Vector3d r = orientation * corner;
+        const Vector3d x = asEigen(body.position) + r;
+        const Vector3d vx = pointVelocity(r);
+        const double reach = p.thickness + vx.lpNorm<1>() * p.dt;
         PlaneHit best;
         best.gap = 1e300;
         std::size_t tri[3] = {0, 0, 0};
         for (std::size_t t = 0; t + 2 < net.surface.size(); t += 3) {
           const std::size_t ia = net.surface[t], ib = net.surface[t + 1], ic = net.surface[t + 2];
-          const auto pa = net.position(ia), pb = net.position(ib), pc = net.position(ic);
+          const Vector3d pa = positionOf(net, ia), pb = positionOf(net, ib),
+                         pc = positionOf(net, ic);
           bool near = true;
           for (int k = 0; k < 3 && near; ++k) {
-            near = x[k] >= std::min({pa[k], pb[k], pc[k]}) - reach && x[k] <= std::max({pa[k], pb[k], pc[k]}) + reach;
+            near = x[k] >= std::min({pa[k], pb[k], pc[k]}) - reach &&
+                   x[k] <= std::max({pa[k], pb[k], pc[k]}) + reach;
           }
           if (!near) continue;
-          const msg::Vec3 surface = scale(add(add(net.velocity(ia), net.velocity(ib)), net.velocity(ic)), 1.0 / 3.0);
-          const auto hit = pointTriangle(x, sub(vx, surface), pa, pb, pc, p);
+          const Vector3d surface =
+              (velocityOf(net, ia) + velocityOf(net, ib) + velocityOf(net, ic)) * (1.0 / 3.0);
+          const auto hit = pointTriangle(x, vx - surface, pa, pb, pc, p);
           if (!hit.hit || hit.gap >= best.gap) continue;
           best = hit;
           tri[0] = ia, tri[1] = ib, tri[2] = ic;
@@ -382,34 +417,47 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets, const std:
         if (!best.hit) continue;
         const double w[3] = {best.closest.wa, best.closest.wb, best.closest.wc};
         double invSurface = 0;
-        msg::Vec3 surfaceVelocity{};
+        Vector3d surfaceVelocity = Vector3d::Zero();
         for (int k = 0; k < 3; ++k) {
           // The triangle point's inverse mass: sum of w^2 / m over its nodes (pinned: 0).
-          invSurface += w[k] * w[k] * effectiveInvMass(net, adjacent[netId], tri[k], best.normal, p);
-          surfaceVelocity = add(surfaceVelocity, scale(net.velocity(tri[k]), w[k]));
+          invSurface +=
+              w[k] * w[k] * effectiveInvMass(net, adjacent[netId], tri[k], best.normal, p);
+          surfaceVelocity += velocityOf(net, tri[k]) * w[k];
         }
         if (invSurface + invRigid == 0) continue;
         // best.normal points to the rigid's side: the triangle is pushed against it.
-        const msg::Vec3 n = scale(best.normal, -1.0);
-        candidates.push_back({netId, &net, {tri[0], tri[1], tri[2]}, {w[0], w[1], w[2]}, 3, n, best.distance,
-                              dot(sub(surfaceVelocity, vx), n), invSurface, r});
+        const Vector3d n = best.normal * -1.0;
+        candidates.push_back({netId,
+                              &net,
+                              {tri[0], tri[1], tri[2]},
+                              {w[0], w[1], w[2]},
+                              3,
+                              n,
+                              best.distance,
+                              (surfaceVelocity - vx).dot(n),
+                              invSurface,
+                              r});
       }
     }
-    const double share = invRigid * static_cast<double>(std::max<std::size_t>(1, candidates.size()));
+    const double share =
+        invRigid * static_cast<double>(std::max<std::size_t>(1, candidates.size()));
     for (const auto& c : candidates) {
       const double magnitude = contactMagnitude(c.distance, c.vn, c.invNet + share, p);
       if (magnitude <= 0) continue;
       ++out.contacts;
-      const msg::Vec3 f = scale(c.normal, magnitude);  // on the net
+      const Vector3d f = c.normal * magnitude;  // on the net
       auto& forces = forcesOf(out, c.netId, *c.net);
       for (int k = 0; k < c.count; ++k) {
-        if (invMass(*c.net, c.nodes[k]) > 0) addTo(forces, c.nodes[k], scale(f, c.w[k]));
+        if (invMass(*c.net, c.nodes[k]) > 0) addTo(forces, c.nodes[k], f * c.w[k]);
       }
-      totalForce = sub(totalForce, f);
-      totalTorque = sub(totalTorque, cross(c.r, f));
+      totalForce -= f;
+      totalTorque -= c.r.cross(f);
       touched = true;
     }
-    if (touched && !kinematic) out.rigidForces[rigidId] = msg::ForceEvent{totalForce, totalTorque, body.position, p.dt};
+    if (touched && !kinematic) {
+      out.rigidForces[rigidId] =
+          msg::ForceEvent{msg::toVec3(totalForce), msg::toVec3(totalTorque), body.position, p.dt};
+    }
   }
   if (memory) *memory = std::move(next);
   return out;

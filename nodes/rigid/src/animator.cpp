@@ -13,16 +13,18 @@ Quat normalized(const Quat& q) {
   return {q[0] / n, q[1] / n, q[2] / n, q[3] / n};
 }
 
-// q' = q + dt/2 [w, 0] q, renormalised.
-Quat integrate(const Quat& q, const Vec3& w, double dt) {
+// q' = q + dt/2 [w, 0] q, renormalised. The product and the norm are written out in the order
+// the examples' digests were recorded with (Eigen's 4-wide products and norms sum differently).
+Quat integrate(const Quat& q, const Eigen::Vector3d& w, double dt) {
   const double h = 0.5 * dt;
   const Quat dq{w[0] * q[3] + w[1] * q[2] - w[2] * q[1], w[1] * q[3] + w[2] * q[0] - w[0] * q[2],
                 w[2] * q[3] + w[0] * q[1] - w[1] * q[0], -w[0] * q[0] - w[1] * q[1] - w[2] * q[2]};
   return normalized({q[0] + h * dq[0], q[1] + h * dq[1], q[2] + h * dq[2], q[3] + h * dq[3]});
 }
 
-bool isZero(const Vec3& v) {
-  return v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0;
+/// The body's rotation as a row-major matrix.
+RowMatrix3d rotationOf(const Body& body) {
+  return asEigen(body.orientation).toRotationMatrix();
 }
 
 }  // namespace
@@ -92,14 +94,14 @@ bool RigidAnimatorState::applyForce(std::uint64_t id, const msg::ForceEvent& eve
   // duration <= 0 means "over the step": kept as a force and scaled by dt in step().
   Accumulator& acc = impulses_[it->second];
   const double duration = event.duration > 0 ? event.duration : -1.0;
-  const Vec3 arm = sub(event.point, body.position);
-  const Vec3 torque = add(event.torque, cross(arm, event.force));
+  const Eigen::Vector3d arm = asEigen(event.point) - asEigen(body.position);
+  const Eigen::Vector3d torque = asEigen(event.torque) + arm.cross(asEigen(event.force));
   if (duration > 0) {
-    acc.linear = add(acc.linear, scale(event.force, duration));
-    acc.angular = add(acc.angular, scale(torque, duration));
+    asEigen(acc.linear) += asEigen(event.force) * duration;
+    asEigen(acc.angular) += torque * duration;
   } else {
-    stepForces_[it->second].linear = add(stepForces_[it->second].linear, event.force);
-    stepForces_[it->second].angular = add(stepForces_[it->second].angular, torque);
+    asEigen(stepForces_[it->second].linear) += asEigen(event.force);
+    asEigen(stepForces_[it->second].angular) += torque;
   }
   return true;
 }
@@ -110,26 +112,27 @@ std::vector<Change> RigidAnimatorState::step(double dt) {
     Body& b = bodies_[i];
     Change change{b.id, false, false};
     if (b.kinematic) {
-      if (!isZero(b.linearVelocity)) {
-        b.position = add(b.position, scale(b.linearVelocity, dt));
+      if (!asEigen(b.linearVelocity).isZero(0.0)) {
+        asEigen(b.position) += asEigen(b.linearVelocity) * dt;
         change.pose = true;
       }
-      if (!isZero(b.angularVelocity)) {
-        b.orientation = integrate(b.orientation, b.angularVelocity, dt);
+      if (!asEigen(b.angularVelocity).isZero(0.0)) {
+        b.orientation = integrate(b.orientation, asEigen(b.angularVelocity), dt);
         change.pose = true;
       }
     } else {
-      const Vec3 linear = add(impulses_[i].linear, scale(stepForces_[i].linear, dt));
-      const Vec3 angular = add(impulses_[i].angular, scale(stepForces_[i].angular, dt));
+      const Eigen::Vector3d linear =
+          asEigen(impulses_[i].linear) + asEigen(stepForces_[i].linear) * dt;
+      const Eigen::Vector3d angular =
+          asEigen(impulses_[i].angular) + asEigen(stepForces_[i].angular) * dt;
       Rest& rest = rest_[i];
       if (rest.asleep) {
         // A sleeping body stays put while the impulses it receives nearly cancel (its weight
         // and its support); a blow or a lost support wakes it.
-        const Vec3 dv = scale(linear, 1.0 / b.mass);
-        const Vec3 dw =
-            mul(rotateTensor(rotationMatrix(b.orientation), inverse(b.inertia)), angular);
-        if (std::sqrt(dot(dv, dv)) < sleep_.wakeLinear &&
-            std::sqrt(dot(dw, dw)) < sleep_.wakeAngular) {
+        const Eigen::Vector3d dv = linear * (1.0 / b.mass);
+        const Eigen::Vector3d dw =
+            rotateTensor(rotationOf(b), inverse(asEigen(b.inertia))) * angular;
+        if (dv.norm() < sleep_.wakeLinear && dw.norm() < sleep_.wakeAngular) {
           impulses_[i] = Accumulator{};
           stepForces_[i] = Accumulator{};
           continue;
@@ -139,22 +142,20 @@ std::vector<Change> RigidAnimatorState::step(double dt) {
       const Vec3 v0 = b.linearVelocity, w0 = b.angularVelocity;
       const Quat q0 = b.orientation;
       const Vec3 p0 = b.position;
-      b.linearVelocity = add(b.linearVelocity, scale(linear, 1.0 / b.mass));
-      b.position = add(b.position, scale(b.linearVelocity, dt));
-      if (!isZero(b.angularVelocity) || !isZero(angular)) {
-        const Mat3 inertiaInverse = inverse(b.inertia);
+      asEigen(b.linearVelocity) += linear * (1.0 / b.mass);
+      asEigen(b.position) += asEigen(b.linearVelocity) * dt;
+      if (!asEigen(b.angularVelocity).isZero(0.0) || !angular.isZero(0.0)) {
+        const RowMatrix3d inertiaInverse = inverse(asEigen(b.inertia));
         // Angular momentum in the world frame with the current orientation, plus the impulse.
-        const Vec3 momentum =
-            add(mul(rotateTensor(rotationMatrix(b.orientation), b.inertia), b.angularVelocity),
-                angular);
-        const Vec3 w = mul(rotateTensor(rotationMatrix(b.orientation), inertiaInverse), momentum);
+        const Eigen::Vector3d momentum =
+            rotateTensor(rotationOf(b), asEigen(b.inertia)) * asEigen(b.angularVelocity) + angular;
+        const Eigen::Vector3d w = rotateTensor(rotationOf(b), inertiaInverse) * momentum;
         b.orientation = integrate(b.orientation, w, dt);
-        b.angularVelocity =
-            mul(rotateTensor(rotationMatrix(b.orientation), inertiaInverse), momentum);
+        asEigen(b.angularVelocity) = rotateTensor(rotationOf(b), inertiaInverse) * momentum;
       }
       if (sleep_.enabled) {
-        const bool slow = std::sqrt(dot(b.linearVelocity, b.linearVelocity)) < sleep_.linear &&
-                          std::sqrt(dot(b.angularVelocity, b.angularVelocity)) < sleep_.angular;
+        const bool slow = asEigen(b.linearVelocity).norm() < sleep_.linear &&
+                          asEigen(b.angularVelocity).norm() < sleep_.angular;
         rest.still = slow ? rest.still + dt : 0.0;
         if (slow && rest.still >= sleep_.time) {
           rest.asleep = true;

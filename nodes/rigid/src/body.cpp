@@ -29,52 +29,47 @@ Body makeKinematic(std::uint64_t id, const msg::Shape& shape, const Vec3& positi
   return body;
 }
 
-Mat3 rotationMatrix(const Quat& q) {
-  const double x = q[0], y = q[1], z = q[2], w = q[3];
-  return {1 - 2 * (y * y + z * z), 2 * (x * y - z * w),     2 * (x * z + y * w),
-          2 * (x * y + z * w),     1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
-          2 * (x * z - y * w),     2 * (y * z + x * w),     1 - 2 * (x * x + y * y)};
+RowMatrix3d rotateTensor(const RowMatrix3d& r, const RowMatrix3d& m) {
+  // A column-major right factor makes Eigen's lazy product sum each entry over k = 0, 1, 2 in
+  // order, as the plain triple loop did (the bits of the examples' digests depend on it).
+  const RowMatrix3d rm = r * Eigen::Matrix3d(m);
+  return rm * r.transpose();
 }
 
-Mat3 rotateTensor(const Mat3& r, const Mat3& m) {
-  Mat3 rm{};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 3; ++k) rm[i * 3 + j] += r[i * 3 + k] * m[k * 3 + j];
-  Mat3 out{};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 3; ++k) out[i * 3 + j] += rm[i * 3 + k] * r[j * 3 + k];
+RowMatrix3d inverse(const RowMatrix3d& m) {
+  // The adjugate's columns are cross products of the rows; det by the first row.
+  const Eigen::Vector3d c0 = m.row(1).cross(m.row(2));
+  const double det = m.row(0).dot(c0);
+  if (!(std::abs(det) > 0) || !std::isfinite(det)) return RowMatrix3d::Zero();
+  const double s = 1.0 / det;
+  RowMatrix3d out;
+  out.col(0) = c0 * s;
+  out.col(1) = m.row(2).cross(m.row(0)).transpose() * s;
+  out.col(2) = m.row(0).cross(m.row(1)).transpose() * s;
   return out;
 }
 
-Mat3 inverse(const Mat3& m) {
-  const double c00 = m[4] * m[8] - m[5] * m[7];
-  const double c01 = m[5] * m[6] - m[3] * m[8];
-  const double c02 = m[3] * m[7] - m[4] * m[6];
-  const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
-  if (!(std::abs(det) > 0) || !std::isfinite(det)) return Mat3{};
-  const double s = 1.0 / det;
-  return {c00 * s, (m[2] * m[7] - m[1] * m[8]) * s, (m[1] * m[5] - m[2] * m[4]) * s,
-          c01 * s, (m[0] * m[8] - m[2] * m[6]) * s, (m[2] * m[3] - m[0] * m[5]) * s,
-          c02 * s, (m[1] * m[6] - m[0] * m[7]) * s, (m[0] * m[4] - m[1] * m[3]) * s};
+namespace {
+/// The body's rotation as a row-major matrix (Eigen's toRotationMatrix of the wire quaternion).
+RowMatrix3d rotationOf(const Body& body) {
+  return asEigen(body.orientation).toRotationMatrix();
+}
+}  // namespace
+
+RowMatrix3d worldInverseInertia(const Body& body) {
+  if (body.kinematic) return RowMatrix3d::Zero();
+  return rotateTensor(rotationOf(body), inverse(asEigen(body.inertia)));
 }
 
-Mat3 worldInverseInertia(const Body& body) {
-  if (body.kinematic) return Mat3{};
-  return rotateTensor(rotationMatrix(body.orientation), inverse(body.inertia));
-}
-
-Vec3 angularMomentum(const Body& body) {
-  const Mat3 iw = rotateTensor(rotationMatrix(body.orientation), body.inertia);
-  return mul(iw, body.angularVelocity);
+Eigen::Vector3d angularMomentum(const Body& body) {
+  return rotateTensor(rotationOf(body), asEigen(body.inertia)) * asEigen(body.angularVelocity);
 }
 
 double kineticEnergy(const Body& body) {
   if (body.kinematic) return 0.0;
-  const Mat3 iw = rotateTensor(rotationMatrix(body.orientation), body.inertia);
-  return 0.5 * body.mass * dot(body.linearVelocity, body.linearVelocity) +
-         0.5 * dot(body.angularVelocity, mul(iw, body.angularVelocity));
+  const RowMatrix3d iw = rotateTensor(rotationOf(body), asEigen(body.inertia));
+  const Eigen::Vector3d v = asEigen(body.linearVelocity), w = asEigen(body.angularVelocity);
+  return 0.5 * body.mass * v.dot(v) + 0.5 * w.dot(iw * w);
 }
 
 }  // namespace vrflow::rigid

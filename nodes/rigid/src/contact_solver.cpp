@@ -14,7 +14,7 @@ namespace {
 btVector3 toBt(const Vec3& v) {
   return {static_cast<btScalar>(v[0]), static_cast<btScalar>(v[1]), static_cast<btScalar>(v[2])};
 }
-Vec3 fromBt(const btVector3& v) {
+Eigen::Vector3d fromBt(const btVector3& v) {
   return {v.x(), v.y(), v.z()};
 }
 btTransform transformOf(const Vec3& position, const Quat& q) {
@@ -24,7 +24,7 @@ btTransform transformOf(const Vec3& position, const Quat& q) {
 }
 
 // A deterministic tangent basis of a unit normal (as btPlaneSpace1).
-void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+void tangents(const Eigen::Vector3d& n, Eigen::Vector3d& t1, Eigen::Vector3d& t2) {
   if (std::abs(n[2]) > 0.7071067811865476) {
     const double a = n[1] * n[1] + n[2] * n[2];
     const double k = 1.0 / std::sqrt(a);
@@ -190,8 +190,9 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   std::vector<Impl::Entry*> bodies;
   bodies.reserve(n);
   std::vector<double> invMass(n);
-  std::vector<Mat3> invInertia(n);
-  std::vector<Vec3> v(n), w(n), linear(n), angular(n);
+  std::vector<RowMatrix3d> invInertia(n);
+  std::vector<Eigen::Vector3d> v(n), w(n), linear(n, Eigen::Vector3d::Zero()),
+      angular(n, Eigen::Vector3d::Zero());
   for (auto& [id, entry] : impl_->entries) {
     const std::size_t k = bodies.size();
     entry->dense = k;
@@ -199,8 +200,9 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     const Body& b = entry->body;
     invMass[k] = b.inverseMass();
     invInertia[k] = worldInverseInertia(b);
-    v[k] = b.kinematic ? b.linearVelocity : add(b.linearVelocity, scale(p.gravity, dt));
-    w[k] = b.angularVelocity;
+    v[k] = asEigen(b.linearVelocity);
+    if (!b.kinematic) v[k] += asEigen(p.gravity) * dt;
+    w[k] = asEigen(b.angularVelocity);
   }
 
   {
@@ -215,25 +217,25 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   // Jacobian's angular parts r x d and their images through the inverse inertia are precomputed.
   struct Constraint {
     std::size_t a, b;
-    Vec3 ra, rb;
-    std::array<Vec3, 3> dir, raxd, rbxd, ia, ib;
+    Eigen::Vector3d ra, rb;
+    std::array<Eigen::Vector3d, 3> dir, raxd, rbxd, ia, ib;
     std::array<double, 3> mass, acc;
     double target;
-    Vec3 accRoll;
-    Mat3 rollMass;  // inverse of (Ia^-1 + Ib^-1)
-    bool rolls;     // a sphere or capsule is involved
+    Eigen::Vector3d accRoll;
+    RowMatrix3d rollMass;  // inverse of (Ia^-1 + Ib^-1)
+    bool rolls;            // a sphere or capsule is involved
     btManifoldPoint* point;
   };
   std::vector<Constraint> constraints;
   auto velocityAlong = [&](const Constraint& c, int axis) {
-    return dot(v[c.a], c.dir[axis]) + dot(w[c.a], c.raxd[axis]) - dot(v[c.b], c.dir[axis]) -
-           dot(w[c.b], c.rbxd[axis]);
+    return v[c.a].dot(c.dir[axis]) + w[c.a].dot(c.raxd[axis]) - v[c.b].dot(c.dir[axis]) -
+           w[c.b].dot(c.rbxd[axis]);
   };
   auto push = [&](const Constraint& c, int axis, double impulse) {
-    v[c.a] = add(v[c.a], scale(c.dir[axis], impulse * invMass[c.a]));
-    w[c.a] = add(w[c.a], scale(c.ia[axis], impulse));
-    v[c.b] = sub(v[c.b], scale(c.dir[axis], impulse * invMass[c.b]));
-    w[c.b] = sub(w[c.b], scale(c.ib[axis], impulse));
+    v[c.a] += c.dir[axis] * (impulse * invMass[c.a]);
+    w[c.a] += c.ia[axis] * impulse;
+    v[c.b] -= c.dir[axis] * (impulse * invMass[c.b]);
+    w[c.b] -= c.ib[axis] * impulse;
   };
 
   // Manifolds in the order of their pair of ids (then Bullet's order, deterministic too).
@@ -264,26 +266,27 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       c.a = ea->dense;
       c.b = eb->dense;
       c.point = &pt;
-      Vec3 normal = fromBt(pt.m_normalWorldOnB);
-      const double len = std::sqrt(dot(normal, normal));
+      c.accRoll.setZero();
+      Eigen::Vector3d normal = fromBt(pt.m_normalWorldOnB);
+      const double len = normal.norm();
       if (!(len > 0)) continue;
-      normal = scale(normal, 1.0 / len);
+      normal *= 1.0 / len;
       // One point for both bodies (the middle of the pair of closest points), so that the
       // contact's impulses are equal, opposite and collinear: momenta are conserved.
-      const Vec3 pa = fromBt(pt.getPositionWorldOnA());
-      const Vec3 pb = fromBt(pt.getPositionWorldOnB());
-      const Vec3 middle = scale(add(pa, pb), 0.5);
-      c.ra = sub(middle, ea->body.position);
-      c.rb = sub(middle, eb->body.position);
+      const Eigen::Vector3d pa = fromBt(pt.getPositionWorldOnA());
+      const Eigen::Vector3d pb = fromBt(pt.getPositionWorldOnB());
+      const Eigen::Vector3d middle = (pa + pb) * 0.5;
+      c.ra = middle - asEigen(ea->body.position);
+      c.rb = middle - asEigen(eb->body.position);
       c.dir[0] = normal;
       tangents(normal, c.dir[1], c.dir[2]);
       for (int axis = 0; axis < 3; ++axis) {
-        c.raxd[axis] = cross(c.ra, c.dir[axis]);
-        c.rbxd[axis] = cross(c.rb, c.dir[axis]);
-        c.ia[axis] = mul(invInertia[c.a], c.raxd[axis]);
-        c.ib[axis] = mul(invInertia[c.b], c.rbxd[axis]);
-        const double k = invMass[c.a] + invMass[c.b] + dot(c.ia[axis], c.raxd[axis]) +
-                         dot(c.ib[axis], c.rbxd[axis]);
+        c.raxd[axis] = c.ra.cross(c.dir[axis]);
+        c.rbxd[axis] = c.rb.cross(c.dir[axis]);
+        c.ia[axis] = invInertia[c.a] * c.raxd[axis];
+        c.ib[axis] = invInertia[c.b] * c.rbxd[axis];
+        const double k = invMass[c.a] + invMass[c.b] + c.ia[axis].dot(c.raxd[axis]) +
+                         c.ib[axis].dot(c.rbxd[axis]);
         c.mass[axis] = k > 0 ? 1.0 / k : 0.0;
       }
       auto round = [](const Impl::Entry* e) {
@@ -292,9 +295,7 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       };
       c.rolls = p.rollingFriction > 0 && (round(ea) || round(eb));
       if (c.rolls) {
-        Mat3 sum{};
-        for (int k = 0; k < 9; ++k) sum[k] = invInertia[c.a][k] + invInertia[c.b][k];
-        c.rollMass = inverse(sum);
+        c.rollMass = inverse(invInertia[c.a] + invInertia[c.b]);
       }
       const double distance = pt.getDistance();
       const double vn = velocityAlong(c, 0);
@@ -311,7 +312,8 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
         c.acc = {pt.m_appliedImpulse, pt.m_appliedImpulseLateral1, pt.m_appliedImpulseLateral2};
       }
       constraints.push_back(c);
-      contacts_.push_back({ea->body.id, eb->body.id, pb, normal, distance});
+      contacts_.push_back(
+          {ea->body.id, eb->body.id, msg::toVec3(pb), msg::toVec3(normal), distance});
     }
   }
 
@@ -333,17 +335,15 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       if (c.rolls && c.acc[0] > 0) {
         // Rolling and spinning resistance: an angular impulse against the relative rotation,
         // each component within rollingFriction * the normal impulse.
-        const Vec3 wrel = sub(w[c.a], w[c.b]);
+        const Eigen::Vector3d wrel = w[c.a] - w[c.b];
         const double rollLimit = p.rollingFriction * c.acc[0];
-        const Vec3 wanted = sub(c.accRoll, mul(c.rollMass, wrel));
-        const Vec3 next{std::clamp(wanted[0], -rollLimit, rollLimit),
-                        std::clamp(wanted[1], -rollLimit, rollLimit),
-                        std::clamp(wanted[2], -rollLimit, rollLimit)};
-        const Vec3 delta = sub(next, c.accRoll);
+        const Eigen::Vector3d wanted = c.accRoll - c.rollMass * wrel;
+        const Eigen::Vector3d next = wanted.cwiseMax(-rollLimit).cwiseMin(rollLimit);
+        const Eigen::Vector3d delta = next - c.accRoll;
         c.accRoll = next;
-        if (delta != Vec3{}) {
-          w[c.a] = add(w[c.a], mul(invInertia[c.a], delta));
-          w[c.b] = sub(w[c.b], mul(invInertia[c.b], delta));
+        if (!delta.isZero(0.0)) {
+          w[c.a] += invInertia[c.a] * delta;
+          w[c.b] -= invInertia[c.b] * delta;
         }
       }
       const double next = std::max(c.acc[0] + c.mass[0] * (c.target - velocityAlong(c, 0)), 0.0);
@@ -358,20 +358,21 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     c.point->m_appliedImpulse = static_cast<btScalar>(c.acc[0]);
     c.point->m_appliedImpulseLateral1 = static_cast<btScalar>(c.acc[1]);
     c.point->m_appliedImpulseLateral2 = static_cast<btScalar>(c.acc[2]);
-    const Vec3 impulse =
-        add(scale(c.dir[0], c.acc[0]), add(scale(c.dir[1], c.acc[1]), scale(c.dir[2], c.acc[2])));
-    linear[c.a] = add(linear[c.a], impulse);
-    linear[c.b] = sub(linear[c.b], impulse);
-    angular[c.a] = add(angular[c.a], add(cross(c.ra, impulse), c.accRoll));
-    angular[c.b] = sub(angular[c.b], add(cross(c.rb, impulse), c.accRoll));
+    const Eigen::Vector3d impulse =
+        c.dir[0] * c.acc[0] + (c.dir[1] * c.acc[1] + c.dir[2] * c.acc[2]);
+    linear[c.a] += impulse;
+    linear[c.b] -= impulse;
+    angular[c.a] += c.ra.cross(impulse) + c.accRoll;
+    angular[c.b] -= c.rb.cross(impulse) + c.accRoll;
   }
 
   for (std::size_t k = 0; k < n; ++k) {
     const Body& b = bodies[k]->body;
     if (b.kinematic) continue;
-    if (linear[k] == Vec3{} && angular[k] == Vec3{}) continue;
-    result.emplace_back(b.id, msg::ForceEvent{scale(linear[k], 1.0 / dt),
-                                              scale(angular[k], 1.0 / dt), b.position, dt});
+    if (linear[k].isZero(0.0) && angular[k].isZero(0.0)) continue;
+    result.emplace_back(b.id,
+                        msg::ForceEvent{msg::toVec3(linear[k] * (1.0 / dt)),
+                                        msg::toVec3(angular[k] * (1.0 / dt)), b.position, dt});
   }
   return result;
 }

@@ -66,20 +66,20 @@ msg::ForceEvent ForceField::forceOn(const FieldTarget& target, double dt) const 
   for (const FieldTerm& term : terms_) {
     switch (term.kind) {
       case FieldTerm::Kind::Gravity:
-        event.force = rigid::add(event.force, scale(term.vector, target.mass));
+        asEigen(event.force) += asEigen(term.vector) * target.mass;
         break;
       case FieldTerm::Kind::Uniform:
-        event.force = rigid::add(event.force, term.vector);
+        asEigen(event.force) += asEigen(term.vector);
         break;
       case FieldTerm::Kind::Attractor: {
-        const Vec3 d = sub(term.vector, target.position);
-        const double r = std::max(std::sqrt(dot(d, d)), term.minRadius);
-        event.force = rigid::add(event.force, scale(d, target.mass * term.strength / (r * r * r)));
+        const Eigen::Vector3d d = asEigen(term.vector) - asEigen(target.position);
+        const double r = std::max(d.norm(), term.minRadius);
+        asEigen(event.force) += d * (target.mass * term.strength / (r * r * r));
         break;
       }
       case FieldTerm::Kind::Drag:
-        event.force = sub(event.force, scale(target.linearVelocity, term.strength));
-        event.torque = sub(event.torque, scale(target.angularVelocity, term.angular));
+        asEigen(event.force) -= asEigen(target.linearVelocity) * term.strength;
+        asEigen(event.torque) -= asEigen(target.angularVelocity) * term.angular;
         break;
     }
   }
@@ -89,7 +89,7 @@ msg::ForceEvent ForceField::forceOn(const FieldTarget& target, double dt) const 
 Vec3 ForceField::gravity() const {
   Vec3 g{};
   for (const FieldTerm& term : terms_)
-    if (term.kind == FieldTerm::Kind::Gravity) g = rigid::add(g, term.vector);
+    if (term.kind == FieldTerm::Kind::Gravity) asEigen(g) += asEigen(term.vector);
   return g;
 }
 

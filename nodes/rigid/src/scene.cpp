@@ -128,7 +128,7 @@ Body parseBody(const json& j, std::uint64_t id) {
   if (!(norm > 1e-9)) throw BodyError{"'orientation' must be a non-zero quaternion [x, y, z, w]"};
   for (auto& c : orientation) c /= norm;
   // A recentred hull keeps its points where the file put them.
-  position = add(position, msg::rotate(orientation, offset));
+  asEigen(position) += asEigen(orientation) * asEigen(offset);
   Body body;
   if (kinematic) {
     if (j.contains("mass") || j.contains("density"))
@@ -194,22 +194,22 @@ Result<msg::Shape> convexHullFromPoints(const std::vector<Vec3>& input, Vec3* ce
                    static_cast<int>(input.size()), 0, 0);
   if (computer.vertices.size() < 4 || computer.faces.size() < 4)
     return makeError("the convex hull's points are flat (coplanar or collinear)");
-  std::vector<Vec3> vertices;
-  Vec3 mean{};
+  std::vector<Eigen::Vector3d> vertices;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (int i = 0; i < computer.vertices.size(); ++i) {
     // The hull computer works in btScalar (float): take the exact input point it came from.
     const auto& v = computer.vertices[i];
-    const Vec3 approx{v.x(), v.y(), v.z()};
+    const Eigen::Vector3d approx{v.x(), v.y(), v.z()};
     std::size_t best = 0;
     double bestDistance = 1e300;
     for (std::size_t k = 0; k < input.size(); ++k) {
-      const Vec3 d = sub(input[k], approx);
-      if (dot(d, d) < bestDistance) bestDistance = dot(d, d), best = k;
+      const double squared = (asEigen(input[k]) - approx).squaredNorm();
+      if (squared < bestDistance) bestDistance = squared, best = k;
     }
-    vertices.push_back(input[best]);
-    mean = add(mean, vertices.back());
+    vertices.push_back(asEigen(input[best]));
+    mean += vertices.back();
   }
-  mean = scale(mean, 1.0 / static_cast<double>(vertices.size()));
+  mean *= 1.0 / static_cast<double>(vertices.size());
   std::vector<std::uint32_t> triangles;
   for (int f = 0; f < computer.faces.size(); ++f) {
     const btConvexHullComputer::Edge* first = &computer.edges[computer.faces[f]];
@@ -221,31 +221,31 @@ Result<msg::Shape> convexHullFromPoints(const std::vector<Vec3>& input, Vec3* ce
     } while (e != first);
     for (std::size_t k = 1; k + 1 < loop.size(); ++k) {
       std::array<int, 3> t{loop[0], loop[k], loop[k + 1]};
-      const Vec3& a = vertices[static_cast<std::size_t>(t[0])];
-      const Vec3 normal = cross(sub(vertices[static_cast<std::size_t>(t[1])], a),
-                                sub(vertices[static_cast<std::size_t>(t[2])], a));
-      if (dot(normal, sub(a, mean)) < 0) std::swap(t[1], t[2]);
+      const Eigen::Vector3d& a = vertices[static_cast<std::size_t>(t[0])];
+      const Eigen::Vector3d normal = (vertices[static_cast<std::size_t>(t[1])] - a)
+                                         .cross(vertices[static_cast<std::size_t>(t[2])] - a);
+      if (normal.dot(a - mean) < 0) std::swap(t[1], t[2]);
       for (int i : t) triangles.push_back(static_cast<std::uint32_t>(i));
     }
   }
   // Volume centroid from the signed tetrahedra with `mean`.
-  Vec3 c{};
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
   double volume = 0;
   for (std::size_t t = 0; t < triangles.size(); t += 3) {
-    const Vec3 a = sub(vertices[triangles[t]], mean), b = sub(vertices[triangles[t + 1]], mean),
-               d = sub(vertices[triangles[t + 2]], mean);
-    const double v6 = dot(a, cross(b, d));
+    const Eigen::Vector3d a = vertices[triangles[t]] - mean, b = vertices[triangles[t + 1]] - mean,
+                          d = vertices[triangles[t + 2]] - mean;
+    const double v6 = a.dot(b.cross(d));
     volume += v6;
-    c = add(c, scale(add(add(a, b), d), v6 / 4.0));
+    c += (a + b + d) * (v6 / 4.0);
   }
   if (!(volume > 0)) return makeError("the convex hull has no volume");
-  const Vec3 shift = add(mean, scale(c, 1.0 / volume));
+  const Eigen::Vector3d shift = mean + c * (1.0 / volume);
   std::vector<double> xyz;
   for (const auto& v : vertices) {
-    const Vec3 r = sub(v, shift);
-    xyz.insert(xyz.end(), r.begin(), r.end());
+    const Eigen::Vector3d r = v - shift;
+    xyz.insert(xyz.end(), r.data(), r.data() + 3);
   }
-  if (centroid) *centroid = shift;
+  if (centroid) *centroid = msg::toVec3(shift);
   return msg::Shape::convexHull(std::move(xyz), std::move(triangles));
 }
 
@@ -298,11 +298,9 @@ struct Lcg {
   }
 };
 
-Quat axisAngle(Vec3 axis, double angle) {
-  const double n = std::sqrt(dot(axis, axis));
-  axis = scale(axis, 1.0 / n);
-  const double s = std::sin(angle / 2);
-  return {axis[0] * s, axis[1] * s, axis[2] * s, std::cos(angle / 2)};
+Quat axisAngle(const Vec3& axis, double angle) {
+  const Eigen::Vector3d unit = asEigen(axis) * (1.0 / asEigen(axis).norm());
+  return msg::toQuat(Eigen::Quaterniond(Eigen::AngleAxisd(angle, unit)));
 }
 
 }  // namespace

@@ -6,83 +6,45 @@
 #include <cmath>
 #include <vector>
 
+#include "vrflow/message/eigen.hpp"
 #include "vrflow/message/shape.hpp"
 
 namespace vrflow::viewer {
 namespace {
 
-// Column-major 4x4 for glMultMatrixd.
-using Matrix = std::array<double, 16>;
+using msg::asEigen;
 
-msg::Vec3 sub(const msg::Vec3& a, const msg::Vec3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-msg::Vec3 cross(const msg::Vec3& a, const msg::Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const msg::Vec3& a, const msg::Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+// Column-major 4x4 for glMultMatrixd: Eigen's default storage order.
+using Matrix = Eigen::Matrix4d;
 
 Matrix lookAt(const Camera& camera) {
   const ViewBasis b = viewBasis(camera);
-  const msg::Vec3& f = b.forward;
-  const msg::Vec3& s = b.side;
-  const msg::Vec3& u = b.up;
-  return {s[0],
-          u[0],
-          -f[0],
-          0.0,
-          s[1],
-          u[1],
-          -f[1],
-          0.0,
-          s[2],
-          u[2],
-          -f[2],
-          0.0,
-          -dot(s, camera.eye),
-          -dot(u, camera.eye),
-          dot(f, camera.eye),
-          1.0};
+  const auto f = asEigen(b.forward), s = asEigen(b.side), u = asEigen(b.up);
+  const auto eye = asEigen(camera.eye);
+  Matrix m = Matrix::Identity();
+  m.block<1, 3>(0, 0) = s.transpose();
+  m.block<1, 3>(1, 0) = u.transpose();
+  m.block<1, 3>(2, 0) = -f.transpose();
+  m.block<3, 1>(0, 3) = Eigen::Vector3d(-s.dot(eye), -u.dot(eye), f.dot(eye));
+  return m;
 }
 
 Matrix rotation(const msg::Quat& q) {
-  double x = q[0], y = q[1], z = q[2], w = q[3];
+  // The norm summed in x, y, z, w order (Eigen's 4-wide norm sums in pairs: other last bits).
+  const double x = q[0], y = q[1], z = q[2], w = q[3];
   const double n = std::sqrt(x * x + y * y + z * z + w * w);
-  if (!(n > 0.0) || !std::isfinite(n)) return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  x /= n, y /= n, z /= n, w /= n;
-  return {1 - 2 * (y * y + z * z),
-          2 * (x * y + z * w),
-          2 * (x * z - y * w),
-          0,
-          2 * (x * y - z * w),
-          1 - 2 * (x * x + z * z),
-          2 * (y * z + x * w),
-          0,
-          2 * (x * z + y * w),
-          2 * (y * z - x * w),
-          1 - 2 * (x * x + y * y),
-          0,
-          0,
-          0,
-          0,
-          1};
+  Matrix m = Matrix::Identity();
+  if (!(n > 0.0) || !std::isfinite(n)) return m;
+  m.topLeftCorner<3, 3>() = Eigen::Quaterniond(w / n, x / n, y / n, z / n).toRotationMatrix();
+  return m;
 }
 
-// Projects onto the plane y = h along the direction towards a directional light.
+// Projects onto the plane y = h along the direction towards a directional light: d I - l p^T.
 Matrix shadowMatrix(double h) {
   const auto& kKeyLight = kLighting.keyDirection;
-  const double l[4] = {kKeyLight[0], kKeyLight[1], kKeyLight[2], 0.0};
-  const double p[4] = {0.0, 1.0, 0.0, -h};
-  const double d = p[0] * l[0] + p[1] * l[1] + p[2] * l[2] + p[3] * l[3];
-  Matrix m{};
-  for (std::size_t col = 0; col < 4; ++col) {
-    for (std::size_t row = 0; row < 4; ++row) {
-      m[col * 4 + row] = (row == col ? d : 0.0) - l[row] * p[col];
-    }
-  }
-  return m;
+  const Eigen::Vector4d l(kKeyLight[0], kKeyLight[1], kKeyLight[2], 0.0);
+  const Eigen::Vector4d p(0.0, 1.0, 0.0, -h);
+  return p.dot(l) * Matrix::Identity() - l * p.transpose();
 }
 
 bool meets(const msg::Aabb& a, const msg::Aabb& b) {
@@ -122,13 +84,13 @@ DrawMesh netMesh(const CachedObject& net) {
   for (std::size_t t = 0; t + 2 < net.surface.size(); t += 3) {
     const std::uint32_t a = net.surface[t], b = net.surface[t + 1], c = net.surface[t + 2];
     if (a >= masses || b >= masses || c >= masses) continue;
-    const auto p = [&](std::uint32_t i) {
-      const std::size_t at = std::size_t{3} * i;
-      return msg::Vec3{mesh.xyz[at], mesh.xyz[at + 1], mesh.xyz[at + 2]};
+    // Doubles of the float positions, as the normals were always computed.
+    const auto p = [&](std::uint32_t i) -> Eigen::Vector3d {
+      return Eigen::Map<const Eigen::Vector3f>(&mesh.xyz[std::size_t{3} * i]).cast<double>();
     };
-    const msg::Vec3 n = cross(sub(p(b), p(a)), sub(p(c), p(a)));
+    const Eigen::Vector3f n = (p(b) - p(a)).cross(p(c) - p(a)).cast<float>();
     for (const std::uint32_t i : {a, b, c}) {
-      for (int k = 0; k < 3; ++k) mesh.normals[std::size_t{3} * i + k] += static_cast<float>(n[k]);
+      Eigen::Map<Eigen::Vector3f>(&mesh.normals[std::size_t{3} * i]) += n;
     }
     mesh.indices.insert(mesh.indices.end(), {a, b, c});
   }

@@ -8,24 +8,14 @@
 #include <sstream>
 #include <vector>
 
+#include "vrflow/message/eigen.hpp"
+
 namespace vrflow::viewer {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-msg::Vec3 sub(const msg::Vec3& a, const msg::Vec3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-msg::Vec3 cross(const msg::Vec3& a, const msg::Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const msg::Vec3& a, const msg::Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-msg::Vec3 unit(const msg::Vec3& v) {
-  const double length = std::sqrt(dot(v, v));
-  return length > 0.0 ? msg::Vec3{v[0] / length, v[1] / length, v[2] / length} : msg::Vec3{0, 0, 0};
-}
+using msg::asEigen;
 
 using Polygon = std::vector<msg::Vec3>;
 
@@ -69,10 +59,13 @@ Result<Tile> parseTile(std::string_view text) {
 
 ViewBasis viewBasis(const Camera& camera) {
   ViewBasis basis;
-  basis.forward = unit(sub(camera.target, camera.eye));
-  basis.side = unit(cross(basis.forward, camera.up));
-  if (dot(basis.side, basis.side) == 0.0) basis.side = unit(cross(basis.forward, {0.0, 0.0, 1.0}));
-  basis.up = cross(basis.side, basis.forward);
+  // normalized() leaves a zero vector as it is.
+  const Eigen::Vector3d forward = (asEigen(camera.target) - asEigen(camera.eye)).normalized();
+  Eigen::Vector3d side = forward.cross(asEigen(camera.up)).normalized();
+  if (side.squaredNorm() == 0.0) side = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  basis.forward = msg::toVec3(forward);
+  basis.side = msg::toVec3(side);
+  basis.up = msg::toVec3(side.cross(forward));
   return basis;
 }
 
@@ -158,11 +151,11 @@ std::optional<msg::Aabb> viewVolume(const Camera& camera, const Frustum& frustum
       const msg::Vec3 p{(corner & 1) ? clipBox->max[0] : clipBox->min[0],
                         (corner & 2) ? clipBox->max[1] : clipBox->min[1],
                         (corner & 4) ? clipBox->max[2] : clipBox->min[2]};
-      const msg::Vec3 v = sub(p, camera.eye);
-      const double d = dot(v, b.forward);
+      const Eigen::Vector3d v = asEigen(p) - asEigen(camera.eye);
+      const double d = v.dot(asEigen(b.forward));
       if (d < n || d > far) continue;
-      const double x = dot(v, b.side) * n / d;
-      const double y = dot(v, b.up) * n / d;
+      const double x = v.dot(asEigen(b.side)) * n / d;
+      const double y = v.dot(asEigen(b.up)) * n / d;
       if (x >= l && x <= r && y >= lo && y <= hi) points.push_back(p);
     }
   }

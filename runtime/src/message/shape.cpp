@@ -8,6 +8,8 @@
 #include <string>
 #include <utility>
 
+#include "vrflow/message/eigen.hpp"
+
 namespace vrflow::msg {
 namespace {
 
@@ -15,24 +17,21 @@ namespace {
 constexpr std::uint32_t kShapeMagic = 0x31504853u;
 constexpr std::size_t kShapeHeaderSize = 56;
 
-Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3 add(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-Vec3 scale(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double length(const Vec3& a) { return std::sqrt(dot(a, a)); }
-Vec3 normalized(const Vec3& a, const Vec3& fallback) {
-  const double len = length(a);
-  return len > 1e-300 ? scale(a, 1.0 / len) : fallback;
+using Eigen::Vector3d;
+
+/// The unit vector along a, or the fallback for a (near) zero vector.
+Vector3d normalized(const Vector3d& a, const Vector3d& fallback) {
+  const double len = a.norm();
+  return len > 1e-300 ? Vector3d(a * (1.0 / len)) : fallback;
 }
 
-Vec3 vertex(const Shape& shape, std::uint32_t i) {
-  return {shape.vertices[3 * i], shape.vertices[3 * i + 1], shape.vertices[3 * i + 2]};
+Vector3d vertex(const Shape& shape, std::uint32_t i) {
+  return asVector3(&shape.vertices[3 * i]);
 }
 
-bool finitePositive(double v) { return std::isfinite(v) && v > 0.0; }
+bool finitePositive(double v) {
+  return std::isfinite(v) && v > 0.0;
+}
 
 template <typename T>
 void put(std::vector<std::byte>& out, std::size_t offset, const T& value) {
@@ -46,26 +45,27 @@ T get(std::span<const std::byte> in, std::size_t offset) {
 }
 
 // Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
-Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+Vector3d closestOnTriangle(const Vector3d& p, const Vector3d& a, const Vector3d& b,
+                           const Vector3d& c) {
+  const Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = sub(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  const Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
   if (d3 >= 0 && d4 <= d3) return b;
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return add(a, scale(ab, d1 / (d1 - d3)));
-  const Vec3 cp = sub(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
   if (d6 >= 0 && d5 <= d6) return c;
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return add(a, scale(ac, d2 / (d2 - d6)));
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    return add(b, scale(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
   }
   const double denom = 1.0 / (va + vb + vc);
-  return add(a, add(scale(ab, vb * denom), scale(ac, vc * denom)));
+  return a + (ab * (vb * denom) + ac * (vc * denom));
 }
 
 // A UV sphere of radius r; with lift > 0 its upper half moves up and its lower half down by
@@ -93,7 +93,8 @@ RenderMesh roundMesh(double r, double lift, int segments) {
     }
   }
   const auto at = [slices](std::size_t i, int j) {
-    return static_cast<std::uint32_t>(i * static_cast<std::size_t>(slices + 1) + static_cast<std::size_t>(j));
+    return static_cast<std::uint32_t>(i * static_cast<std::size_t>(slices + 1) +
+                                      static_cast<std::size_t>(j));
   };
   for (std::size_t i = 0; i + 1 < rings.size(); ++i) {
     for (int j = 0; j < slices; ++j) {
@@ -120,9 +121,11 @@ RenderMesh boxMesh(const Vec3& h) {
         for (double c : p) mesh.xyz.push_back(static_cast<float>(c));
       }
       if (sign > 0) {
-        mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+        mesh.indices.insert(mesh.indices.end(),
+                            {base, base + 1, base + 2, base, base + 2, base + 3});
       } else {
-        mesh.indices.insert(mesh.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+        mesh.indices.insert(mesh.indices.end(),
+                            {base, base + 2, base + 1, base, base + 3, base + 2});
       }
     }
   }
@@ -207,8 +210,8 @@ Status validateShape(const Shape& shape) {
       }
       for (std::uint32_t i : shape.indices) {
         if (i >= vertexCount) {
-          return makeError(std::string(what) + ": index " + std::to_string(i) +
-                           " out of range (" + std::to_string(vertexCount) + " vertices)");
+          return makeError(std::string(what) + ": index " + std::to_string(i) + " out of range (" +
+                           std::to_string(vertexCount) + " vertices)");
         }
       }
       return {};
@@ -257,7 +260,8 @@ Result<Shape> decodeShape(std::span<const std::byte> bytes) {
     return makeError("shape resource too large: " + std::to_string(vertexCount) + " vertices, " +
                      std::to_string(indexCount) + " indices");
   }
-  const std::size_t need = kShapeHeaderSize + 24u * std::size_t{vertexCount} + 4u * std::size_t{indexCount};
+  const std::size_t need =
+      kShapeHeaderSize + 24u * std::size_t{vertexCount} + 4u * std::size_t{indexCount};
   if (bytes.size() < need) {
     return makeError("shape resource truncated: " + std::to_string(bytes.size()) + " bytes, " +
                      std::to_string(need) + " needed");
@@ -265,10 +269,12 @@ Result<Shape> decodeShape(std::span<const std::byte> bytes) {
   shape.vertices.resize(3u * vertexCount);
   shape.indices.resize(indexCount);
   if (vertexCount > 0) {
-    std::memcpy(shape.vertices.data(), bytes.data() + kShapeHeaderSize, 24u * std::size_t{vertexCount});
+    std::memcpy(shape.vertices.data(), bytes.data() + kShapeHeaderSize,
+                24u * std::size_t{vertexCount});
   }
   if (indexCount > 0) {
-    std::memcpy(shape.indices.data(), bytes.data() + kShapeHeaderSize + 24u * std::size_t{vertexCount},
+    std::memcpy(shape.indices.data(),
+                bytes.data() + kShapeHeaderSize + 24u * std::size_t{vertexCount},
                 4u * std::size_t{indexCount});
   }
   if (auto valid = validateShape(shape); !valid.ok()) return valid.error();
@@ -278,9 +284,10 @@ Result<Shape> decodeShape(std::span<const std::byte> bytes) {
 Aabb localBounds(const Shape& shape) {
   switch (shape.kind) {
     case ShapeKind::Sphere:
-      return {{-shape.radius, -shape.radius, -shape.radius}, {shape.radius, shape.radius, shape.radius}};
+      return {{-shape.radius, -shape.radius, -shape.radius},
+              {shape.radius, shape.radius, shape.radius}};
     case ShapeKind::Box:
-      return {scale(shape.halfExtents, -1.0), shape.halfExtents};
+      return {toVec3(asEigen(shape.halfExtents) * -1.0), shape.halfExtents};
     case ShapeKind::Capsule: {
       const double r = shape.radius, h = shape.halfHeight + shape.radius;
       return {{-r, -h, -r}, {r, h, r}};
@@ -304,18 +311,19 @@ Aabb localBounds(const Shape& shape) {
 }
 
 Vec3 rotate(const Quat& q, const Vec3& v) {
-  // v' = v + 2w (u x v) + 2 u x (u x v), u = (x, y, z).
-  const Vec3 u{q[0], q[1], q[2]};
-  const Vec3 t = scale(cross(u, v), 2.0);
-  return add(add(v, scale(t, q[3])), cross(u, t));
+  // Eigen's q * v: v + 2w (u x v) + 2 u x (u x v), u = (x, y, z).
+  return toVec3(asEigen(q) * asEigen(v));
 }
 
-Vec3 rotateInverse(const Quat& q, const Vec3& v) { return rotate({-q[0], -q[1], -q[2], q[3]}, v); }
+Vec3 rotateInverse(const Quat& q, const Vec3& v) {
+  return toVec3(asEigen(q).conjugate() * asEigen(v));
+}
 
 Aabb worldBounds(const Shape& shape, const Vec3& position, const Quat& orientation) {
   if (shape.kind == ShapeKind::Sphere) {
     const double r = shape.radius;
-    return {sub(position, {r, r, r}), add(position, {r, r, r})};
+    const Vector3d extent = Vector3d::Constant(r);
+    return {toVec3(asEigen(position) - extent), toVec3(asEigen(position) + extent)};
   }
   if (shape.kind == ShapeKind::Capsule) {
     const Vec3 axis = rotate(orientation, {0.0, shape.halfHeight, 0.0});
@@ -330,8 +338,8 @@ Aabb worldBounds(const Shape& shape, const Vec3& position, const Quat& orientati
   if (shape.kind == ShapeKind::ConvexHull || shape.kind == ShapeKind::TriangleMesh) {
     Aabb box{position, position};
     for (std::size_t i = 0; i + 2 < shape.vertices.size(); i += 3) {
-      const Vec3 p = add(position, rotate(orientation, {shape.vertices[i], shape.vertices[i + 1],
-                                                        shape.vertices[i + 2]}));
+      const Vec3 p =
+          toVec3(asEigen(position) + asEigen(orientation) * asVector3(&shape.vertices[i]));
       for (std::size_t k = 0; k < 3; ++k) {
         box.min[k] = std::min(box.min[k], p[k]);
         box.max[k] = std::max(box.max[k], p[k]);
@@ -354,7 +362,9 @@ Aabb worldBounds(const Shape& shape, const Vec3& position, const Quat& orientati
 
 MassProperties massProperties(const Shape& shape, double mass) {
   MassProperties out;
-  const auto diagonal = [&out](double x, double y, double z) { out.inertia = {x, 0, 0, 0, y, 0, 0, 0, z}; };
+  const auto diagonal = [&out](double x, double y, double z) {
+    out.inertia = {x, 0, 0, 0, y, 0, 0, 0, z};
+  };
   switch (shape.kind) {
     case ShapeKind::Sphere: {
       const double r = shape.radius;
@@ -389,12 +399,12 @@ MassProperties massProperties(const Shape& shape, double mass) {
       double volume = 0.0;
       std::array<double, 9> cov{};
       for (std::size_t t = 0; t + 2 < shape.indices.size(); t += 3) {
-        const Vec3 a = vertex(shape, shape.indices[t]);
-        const Vec3 b = vertex(shape, shape.indices[t + 1]);
-        const Vec3 c = vertex(shape, shape.indices[t + 2]);
-        const double det = dot(a, cross(b, c));
+        const Vector3d a = vertex(shape, shape.indices[t]);
+        const Vector3d b = vertex(shape, shape.indices[t + 1]);
+        const Vector3d c = vertex(shape, shape.indices[t + 2]);
+        const double det = a.dot(b.cross(c));
         volume += det / 6.0;
-        const Vec3 s = add(add(a, b), c);
+        const Vector3d s = a + b + c;
         for (std::size_t i = 0; i < 3; ++i) {
           for (std::size_t j = 0; j < 3; ++j) {
             cov[3 * i + j] += det / 120.0 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j]);
@@ -419,7 +429,7 @@ MassProperties massProperties(const Shape& shape, double mass) {
 SurfaceDistance signedDistance(const Shape& shape, const Vec3& p) {
   switch (shape.kind) {
     case ShapeKind::Sphere:
-      return {length(p) - shape.radius, normalized(p, {0.0, 1.0, 0.0})};
+      return {asEigen(p).norm() - shape.radius, toVec3(normalized(asEigen(p), Vector3d::UnitY()))};
     case ShapeKind::Box: {
       const Vec3& h = shape.halfExtents;
       const Vec3 q{std::abs(p[0]) - h[0], std::abs(p[1]) - h[1], std::abs(p[2]) - h[2]};
@@ -427,7 +437,7 @@ SurfaceDistance signedDistance(const Shape& shape, const Vec3& p) {
       if (q[0] > 0.0 || q[1] > 0.0 || q[2] > 0.0) {
         const Vec3 outside{std::max(q[0], 0.0) * sign(p[0]), std::max(q[1], 0.0) * sign(p[1]),
                            std::max(q[2], 0.0) * sign(p[2])};
-        return {length(outside), normalized(outside, {0.0, 1.0, 0.0})};
+        return {asEigen(outside).norm(), toVec3(normalized(asEigen(outside), Vector3d::UnitY()))};
       }
       std::size_t axis = 0;
       if (q[1] > q[axis]) axis = 1;
@@ -437,20 +447,20 @@ SurfaceDistance signedDistance(const Shape& shape, const Vec3& p) {
       return {q[axis], normal};
     }
     case ShapeKind::Capsule: {
-      const Vec3 onAxis{0.0, std::clamp(p[1], -shape.halfHeight, shape.halfHeight), 0.0};
-      const Vec3 d = sub(p, onAxis);
-      return {length(d) - shape.radius, normalized(d, {1.0, 0.0, 0.0})};
+      const Vector3d onAxis{0.0, std::clamp(p[1], -shape.halfHeight, shape.halfHeight), 0.0};
+      const Vector3d d = asEigen(p) - onAxis;
+      return {d.norm() - shape.radius, toVec3(normalized(d, Vector3d::UnitX()))};
     }
     case ShapeKind::ConvexHull: {
       SurfaceDistance best{-std::numeric_limits<double>::infinity(), {0.0, 1.0, 0.0}};
       for (std::size_t t = 0; t + 2 < shape.indices.size(); t += 3) {
-        const Vec3 a = vertex(shape, shape.indices[t]);
-        const Vec3 n = normalized(cross(sub(vertex(shape, shape.indices[t + 1]), a),
-                                        sub(vertex(shape, shape.indices[t + 2]), a)),
-                                  {0.0, 0.0, 0.0});
-        if (n == Vec3{0.0, 0.0, 0.0}) continue;  // degenerate triangle
-        const double d = dot(sub(p, a), n);
-        if (d > best.distance) best = {d, n};
+        const Vector3d a = vertex(shape, shape.indices[t]);
+        const Vector3d n = normalized((vertex(shape, shape.indices[t + 1]) - a)
+                                          .cross(vertex(shape, shape.indices[t + 2]) - a),
+                                      Vector3d::Zero());
+        if (n == Vector3d::Zero()) continue;  // degenerate triangle
+        const double d = (asEigen(p) - a).dot(n);
+        if (d > best.distance) best = {d, toVec3(n)};
       }
       return best;
     }
@@ -458,18 +468,17 @@ SurfaceDistance signedDistance(const Shape& shape, const Vec3& p) {
       double bestSquared = std::numeric_limits<double>::infinity();
       SurfaceDistance best{std::numeric_limits<double>::infinity(), {0.0, 1.0, 0.0}};
       for (std::size_t t = 0; t + 2 < shape.indices.size(); t += 3) {
-        const Vec3 a = vertex(shape, shape.indices[t]);
-        const Vec3 b = vertex(shape, shape.indices[t + 1]);
-        const Vec3 c = vertex(shape, shape.indices[t + 2]);
-        const Vec3 closest = closestOnTriangle(p, a, b, c);
-        const Vec3 d = sub(p, closest);
-        const double squared = dot(d, d);
+        const Vector3d a = vertex(shape, shape.indices[t]);
+        const Vector3d b = vertex(shape, shape.indices[t + 1]);
+        const Vector3d c = vertex(shape, shape.indices[t + 2]);
+        const Vector3d d = asEigen(p) - closestOnTriangle(asEigen(p), a, b, c);
+        const double squared = d.squaredNorm();
         if (squared >= bestSquared) continue;
         bestSquared = squared;
-        const Vec3 faceNormal = normalized(cross(sub(b, a), sub(c, a)), {0.0, 1.0, 0.0});
-        const double side = dot(d, faceNormal) < 0.0 ? -1.0 : 1.0;
+        const Vector3d faceNormal = normalized((b - a).cross(c - a), Vector3d::UnitY());
+        const double side = d.dot(faceNormal) < 0.0 ? -1.0 : 1.0;
         const double dist = std::sqrt(squared);
-        best = {side * dist, dist > 1e-12 ? scale(d, side / dist) : faceNormal};
+        best = {side * dist, toVec3(dist > 1e-12 ? Vector3d(d * (side / dist)) : faceNormal)};
       }
       return best;
     }

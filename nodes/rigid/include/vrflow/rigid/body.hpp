@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "vrflow/message/eigen.hpp"
 #include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/message/shape.hpp"
 #include "vrflow/message/values.hpp"
@@ -42,36 +43,20 @@ Body makeKinematic(std::uint64_t id, const msg::Shape& shape, const Vec3& positi
 
 inline constexpr double kInfiniteMass = std::numeric_limits<double>::infinity();
 
-// Small vector helpers shared by the solvers.
-inline Vec3 add(const Vec3& a, const Vec3& b) {
-  return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-}
-inline Vec3 sub(const Vec3& a, const Vec3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-inline Vec3 scale(const Vec3& a, double s) {
-  return {a[0] * s, a[1] * s, a[2] * s};
-}
-inline double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-inline Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-inline Vec3 mul(const Mat3& m, const Vec3& v) {
-  return {m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
-          m[6] * v[0] + m[7] * v[1] + m[8] * v[2]};
-}
-/// Rotation matrix (row-major) of a unit quaternion (x, y, z, w).
-Mat3 rotationMatrix(const Quat& q);
-/// R M R^T.
-Mat3 rotateTensor(const Mat3& r, const Mat3& m);
+// Geometry is Eigen's over the Body's wire arrays (vrflow/message/eigen.hpp): asEigen(position)
+// is an Eigen::Vector3d, asEigen(orientation) an Eigen::Quaterniond (the wire's x, y, z, w is
+// Eigen's storage order), asEigen(inertia) a row-major Eigen 3x3 matrix.
+using msg::asEigen;
+using msg::RowMatrix3d;
+
+/// R M R^T (the products are written so that they round as the plain loops over k = 0, 1, 2).
+RowMatrix3d rotateTensor(const RowMatrix3d& r, const RowMatrix3d& m);
 /// Inverse of a symmetric positive definite 3x3 matrix (zero matrix if singular).
-Mat3 inverse(const Mat3& m);
+RowMatrix3d inverse(const RowMatrix3d& m);
 /// The inverse inertia in the world frame, R I_b^-1 R^T (zero for a kinematic body).
-Mat3 worldInverseInertia(const Body& body);
+RowMatrix3d worldInverseInertia(const Body& body);
 /// Kinetic energy and momenta (for tests and diagnostics).
-Vec3 angularMomentum(const Body& body);
+Eigen::Vector3d angularMomentum(const Body& body);
 double kineticEnergy(const Body& body);
 
 }  // namespace vrflow::rigid
