@@ -60,10 +60,10 @@ void addSharedOptions(CLI::App& command, SharedOptions& into) {
       ->allow_extra_args(false);
 }
 
-// Seconds, a finite number > 0 ("0" is refused: leaving the option out means no limit).
-CLI::Validator positiveSeconds() {
+// Seconds, a finite number > 0; `hint` follows the message for 0 or less.
+CLI::Validator positiveSeconds(std::string hint = {}) {
   return CLI::Validator(
-      [](std::string& text) -> std::string {
+      [hint](std::string& text) -> std::string {
         char* end = nullptr;
         errno = 0;
         const double value = std::strtod(text.c_str(), &end);
@@ -71,7 +71,7 @@ CLI::Validator positiveSeconds() {
             !std::isfinite(value)) {
           return "'" + text + "' is not a number of seconds";
         }
-        if (value <= 0) return "must be more than 0 seconds, got '" + text + "'";
+        if (value <= 0) return "must be more than 0 seconds, got '" + text + "'" + hint;
         return {};
       },
       "SECONDS>0");
@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
   run->add_option("--report", options.reportPath, "Write a JSON run report to FILE");
   run->add_option("--timeout", options.timeoutSeconds,
                   "Fail if the run lasts longer (seconds, > 0; without it, no limit)")
-      ->check(positiveSeconds());
+      ->check(positiveSeconds(" (leave --timeout out to run without a time limit)"));
   run->add_option("--deadlock-timeout", options.deadlockSeconds,
                   "Report a deadlock after this long without progress (seconds, > 0)")
       ->check(positiveSeconds());
@@ -227,7 +227,7 @@ int main(int argc, char** argv) {
   launch
       ->add_option("--timeout", launchOptions.timeoutSeconds,
                    "Fail if the run lasts longer (seconds, > 0; without it, no limit)")
-      ->check(positiveSeconds());
+      ->check(positiveSeconds(" (leave --timeout out to run without a time limit)"));
   launch->add_option("--control-address", launchOptions.controlAddress,
                      "mpirun: this machine's address as the daemons reach it (default 127.0.0.1)");
   launch->add_option("--trace", launchOptions.tracePath,
