@@ -324,17 +324,15 @@ TEST(CompositeErrors, NestedRepeatsAreBoundedByTheProductOfTheirCountsBeforeExpa
                        "before expanding");
 }
 
-TEST(CompositeErrors, ManyDistinctProblemsAtOnePlaceAreKeptEachOnceInLinearTime) {
-  // 400 merges of 256 unconnected inputs: 102,400 problems at one source location, which
-  // sorting and deduplicating compared pairwise (quadratic).
-  const auto begin = std::chrono::steady_clock::now();
+TEST(CompositeErrors, AFilterWithManyUnconnectedInputsIsOneProblemNotOnePerInput) {
+  // 400 merges of 256 unconnected inputs made 102,400 problems at one source location, which
+  // took minutes to sort and deduplicate (pairwise) and as many lines to print.
   const std::vector<Diagnostic> found = checkComposed(oneInstance(R"(
       <filters><repeat var="i" count="400"><filter id="m${i}" type="merge"><param name="inputs" value="256"/></filter></repeat></filters>)"));
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-  ASSERT_EQ(found.size(), 400u * 256u);
-  EXPECT_NE(found.back().message.find("is not connected"), std::string::npos);
-  EXPECT_LT(seconds, 20.0) << "a hang guard, not a timing";
+  ASSERT_EQ(found.size(), 400u);
+  EXPECT_EQ(found[0].message,
+            "required inputs 'in0', 'in1', 'in2', 'in3' and 252 more of filter 'w:m0' (merge) are "
+            "not connected");
 }
 
 }  // namespace

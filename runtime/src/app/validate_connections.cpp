@@ -182,11 +182,20 @@ void checkRequiredInputs(Validation& v) {
   }
   for (const NodeInfo& node : v.nodes) {
     if (v.misnamedTargets.count(node.id()) != 0) continue;
+    std::vector<std::string> unconnected;
     for (const PortSpec& port : node.ports) {
       if (!port.isInput || !port.required) continue;
       if (connected.count({node.id(), port.name}) != 0) continue;
+      unconnected.push_back("'" + port.name + "'");
+    }
+    // One problem per node, however many inputs it has (a merge has up to 256): the number of
+    // diagnostics stays bounded by the number of nodes.
+    if (unconnected.size() == 1) {
       v.error(node.loc(),
-              "required input '" + port.name + "' of " + node.label + " is not connected");
+              "required input " + unconnected[0] + " of " + node.label + " is not connected");
+    } else if (!unconnected.empty()) {
+      v.error(node.loc(), "required inputs " + joinNames(unconnected, 4) + " of " + node.label +
+                              " are not connected");
     }
   }
 }
