@@ -274,5 +274,42 @@ TEST(LoadApplication, MissingFileFailsWithItsPath) {
             "/nonexistent/app.xml: error: cannot read file (No such file or directory)");
 }
 
+TEST(LoadApplication, InvalidUtf8IsRefusedAtItsLineAndColumn) {
+  // Latin-1 "é" (0xE9) in an attribute: accepted and echoed raw before.
+  const std::vector<Diagnostic> found = check(
+      "<application>\n  <modules>\n    <module id=\"caf\xE9\" package=\"core\" "
+      "type=\"source\"/>\n  </modules>\n</application>\n");
+  EXPECT_ONLY_ERROR_AT(found, 3, 20, "invalid UTF-8 (byte 0xE9)");
+  EXPECT_EQ(found[0].message.find('\xE9'), std::string::npos) << "the byte is not echoed";
+}
+
+TEST(LoadApplication, Utf16FileIsNamedAsUtf16WithHowToConvertIt) {
+  const std::string utf8 = "<application>\n</application>\n";
+  std::string utf16 = "\xFF\xFE";
+  for (const char c : utf8) utf16 += std::string{c, '\0'};
+  const std::vector<Diagnostic> found = check(utf16);
+  ASSERT_EQ(found.size(), 1u) << formatDiagnostics(found);
+  EXPECT_EQ(found[0].loc.file, "app.xml");
+  EXPECT_NE(found[0].message.find("encoded in UTF-16LE"), std::string::npos) << found[0].message;
+  EXPECT_NE(found[0].message.find("iconv -f UTF-16LE -t UTF-8"), std::string::npos);
+  // Without a byte order mark too.
+  const std::vector<Diagnostic> bare = check(utf16.substr(2));
+  ASSERT_EQ(bare.size(), 1u) << formatDiagnostics(bare);
+  EXPECT_NE(bare[0].message.find("UTF-16LE"), std::string::npos) << bare[0].message;
+}
+
+TEST(LoadApplication, RepeatedAttributeOfAMisplacedElementIsReportedToo) {
+  // A <module> written outside <modules>: its repeated attribute was never mentioned.
+  const std::vector<Diagnostic> found = loadProblems(
+      "<application>\n  <module id=\"a\" id=\"b\" package=\"core\" type=\"relay\"/>\n"
+      "</application>\n");
+  ASSERT_EQ(found.size(), 2u) << formatDiagnostics(found);
+  EXPECT_EQ(found[0].loc.column, 3);
+  EXPECT_NE(found[0].message.find("unknown element <module> in <application>"), std::string::npos);
+  EXPECT_EQ(found[1].loc.line, 2);
+  EXPECT_EQ(found[1].loc.column, 18);
+  EXPECT_NE(found[1].message.find("attribute 'id' is repeated on <module>"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace vrflow::app

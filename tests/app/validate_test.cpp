@@ -661,5 +661,90 @@ TEST(FormatDiagnostic, WritesFileLineColumnSeverityAndMessage) {
   EXPECT_EQ(formatDiagnostic(diagnostic), "a.xml: warning: bad");
 }
 
+TEST(Validate, HostAddressMustBeAnIpv4AddressOrAHostName) {
+  EXPECT_ONLY_ERROR_AT(check(R"(<application>
+  <hosts>
+    <host id="a" address="999.1.1.1"/>
+  </hosts>
+</application>
+)"),
+                       3, 18,
+                       "address '999.1.1.1' of host 'a' is not a valid IPv4 address (four numbers "
+                       "0-255 separated by dots)");
+  const std::vector<Diagnostic> bad = check(R"(<application>
+  <hosts>
+    <host id="a" address="1.2.3"/>
+    <host id="b" address="node_1"/>
+    <host id="c" address="-node"/>
+  </hosts>
+</application>
+)");
+  EXPECT_EQ(bad.size(), 3u) << formatDiagnostics(bad);
+  const std::vector<Diagnostic> good = check(R"(<application>
+  <hosts>
+    <host id="a" address="10.0.0.255"/>
+    <host id="b" address="node-1.cluster.example"/>
+    <host id="c" address="localhost"/>
+  </hosts>
+</application>
+)");
+  EXPECT_TRUE(good.empty()) << formatDiagnostics(good);
+}
+
+TEST(Validate, IdWithANewlineOrAControlCharacterIsRefused) {
+  EXPECT_ONLY_ERROR_AT(check(R"(<application>
+  <modules>
+    <module id="a&#10;b" package="core" type="source"/>
+  </modules>
+</application>
+)"),
+                       3, 13, "id 'a\\nb' contains a control character (U+000A)");
+  EXPECT_ONLY_ERROR_AT(check(R"(<application>
+  <hosts>
+    <host id="h&#9;1"/>
+  </hosts>
+</application>
+)"),
+                       3, 11, "id 'h\\t1' contains a control character (U+0009)");
+}
+
+TEST(Validate, OutOfRangePortCountIsTheOnlyErrorNotHundredsOfUnconnectedInputs) {
+  EXPECT_ONLY_ERROR_AT(check(R"(<application>
+  <filters>
+    <filter id="m" type="merge">
+      <param name="inputs" value="1000000"/>
+    </filter>
+  </filters>
+</application>
+)"),
+                       4, 28, "parameter 'inputs' of filter 'm' (merge)");
+}
+
+TEST(Validate, BadEndpointIsReportedNotTheInputItMeantToFeed) {
+  // Before: "required input 'in' of module 'b' is not connected" came first (line 4).
+  const std::vector<Diagnostic> wrongPort = check(R"(<application>
+  <modules>
+    <module id="a" package="core" type="source"/>
+    <module id="b" package="core" type="sink"/>
+  </modules>
+  <connections>
+    <connection from="a.out" to="b.inn"/>
+  </connections>
+</application>
+)");
+  EXPECT_ONLY_ERROR_AT(wrongPort, 7, 30, "has no input 'inn' (inputs: in, beginIt); did you mean 'in'?");
+  const std::vector<Diagnostic> wrongNode = check(R"(<application>
+  <modules>
+    <module id="a" package="core" type="source"/>
+    <module id="sink" package="core" type="sink"/>
+  </modules>
+  <connections>
+    <connection from="a.out" to="snik.in"/>
+  </connections>
+</application>
+)");
+  EXPECT_ONLY_ERROR_AT(wrongNode, 7, 30, "no module or filter 'snik'");
+}
+
 }  // namespace
 }  // namespace vrflow::app

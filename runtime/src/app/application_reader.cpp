@@ -214,6 +214,10 @@ namespace detail {
 std::optional<Application> readApplication(std::string_view xml, const std::string& fileName,
                                            std::vector<Diagnostic>& found) {
   const SourceText source(xml, fileName);
+  if (std::optional<Diagnostic> problem = encodingProblem(source)) {
+    found.push_back(std::move(*problem));
+    return std::nullopt;
+  }
   pugi::xml_document document;
   const pugi::xml_parse_result parsed =
       document.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);

@@ -290,6 +290,10 @@ void readInstances(const ReadContext& context, const pugi::xml_node& section, Ap
 std::optional<Composite> readCompositeFile(std::string_view xml, const std::string& fileName,
                                            std::vector<Diagnostic>& problems) {
   const SourceText source(xml, fileName);
+  if (std::optional<Diagnostic> problem = encodingProblem(source)) {
+    problems.push_back(std::move(*problem));
+    return std::nullopt;
+  }
   pugi::xml_document document;
   const pugi::xml_parse_result parsed =
       document.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);

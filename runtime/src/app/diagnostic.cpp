@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <tuple>
+#include <unordered_set>
 
 #include "vrflow/base/echo.hpp"
 
@@ -52,17 +53,20 @@ void sortAndDeduplicate(std::vector<Diagnostic>& diagnostics) {
   };
   std::stable_sort(diagnostics.begin(), diagnostics.end(),
                    [&](const Diagnostic& a, const Diagnostic& b) { return place(a) < place(b); });
+  // Sorted by place: only diagnostics at the same place can repeat one another. A hash set of
+  // the kept ones at the current place keeps this linear, however many share one place (a
+  // <repeat> makes thousands).
   std::vector<Diagnostic> unique;
   unique.reserve(diagnostics.size());
+  std::unordered_set<std::string> kept;  // severity and message of the kept ones at this place
+  std::tuple<std::string, int, int> current{"", -1, -1};
   for (Diagnostic& diagnostic : diagnostics) {
-    // Sorted by place: only the kept diagnostics at the same place can repeat this one.
-    bool repeated = false;
-    for (auto kept = unique.rbegin(); kept != unique.rend() && place(*kept) == place(diagnostic);
-         ++kept) {
-      repeated = repeated ||
-                 (kept->severity == diagnostic.severity && kept->message == diagnostic.message);
+    if (place(diagnostic) != current) {
+      current = {diagnostic.loc.file, diagnostic.loc.line, diagnostic.loc.column};
+      kept.clear();
     }
-    if (!repeated) unique.push_back(std::move(diagnostic));
+    std::string key = (diagnostic.severity == Diagnostic::Error ? "E" : "W") + diagnostic.message;
+    if (kept.insert(std::move(key)).second) unique.push_back(std::move(diagnostic));
   }
   diagnostics = std::move(unique);
 }

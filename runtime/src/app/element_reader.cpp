@@ -1,5 +1,7 @@
 #include "element_reader.hpp"
 
+#include <algorithm>
+
 #include "text_util.hpp"
 
 namespace vrflow::app::detail {
@@ -40,10 +42,9 @@ ElementReader::ElementReader(const ReadContext& context, const pugi::xml_node& n
                              didYouMean(name, allowedNames));
       continue;
     }
-    bool repeated = false;
-    for (const std::string_view previous : seen) repeated = repeated || previous == name;
-    if (repeated) {
-      context_.error(at, "attribute '" + std::string(name) + "' is repeated on " + tag());
+    if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+      context_.error(at, "attribute '" + std::string(name) + "' is repeated on " + tag() +
+                             " (an attribute is written once)");
     }
     seen.push_back(name);
   }
@@ -113,6 +114,27 @@ bool ElementReader::boolean(const char* name, bool fallback) const {
   return *parsed;
 }
 
+void reportRepeatedAttributes(const ReadContext& context, const pugi::xml_node& node,
+                              const SourceLocation& loc) {
+  std::vector<std::string_view> seen;
+  std::size_t index = 0;
+  for (const pugi::xml_attribute& attribute : node.attributes()) {
+    const std::string_view name = attribute.name();
+    // The n-th attribute of the element is the n-th one scanned in the tag text.
+    SourceLocation at = loc;
+    if (index < loc.attributes.size()) {
+      at.line = loc.attributes[index].line;
+      at.column = loc.attributes[index].column;
+    }
+    ++index;
+    if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+      context.error(at, "attribute '" + std::string(name) + "' is repeated on <" +
+                            std::string(node.name()) + "> (an attribute is written once)");
+    }
+    seen.push_back(name);
+  }
+}
+
 void forEachChild(const ReadContext& context, const pugi::xml_node& parent,
                   const std::vector<std::string_view>& allowed,
                   const std::function<void(const pugi::xml_node&)>& read) {
@@ -137,9 +159,11 @@ void forEachChild(const ReadContext& context, const pugi::xml_node& parent,
     }
     const std::string expected =
         allowedNames.empty() ? "it holds no elements" : "allowed: " + joinNames(allowedNames);
-    context.error(context.source.element(child), "unknown element <" + std::string(name) +
-                                                     "> in <" + parent.name() + "> (" + expected +
-                                                     ")" + didYouMean(name, allowedNames));
+    const SourceLocation loc = context.source.element(child);
+    context.error(loc, "unknown element <" + std::string(name) + "> in <" + parent.name() + "> (" +
+                           expected + ")" + didYouMean(name, allowedNames));
+    // Its attributes are not read, but one written twice is a mistake of its own.
+    reportRepeatedAttributes(context, child, loc);
   }
 }
 

@@ -74,6 +74,11 @@ class ElementReader {
 /// that a problem found by both is reported once.
 std::string missingAttributeMessage(std::string_view element, std::string_view attribute);
 
+/// Reports each attribute of `node` written a second time, at that attribute (`loc`: the
+/// element's location from SourceText::element()).
+void reportRepeatedAttributes(const ReadContext& context, const pugi::xml_node& node,
+                              const SourceLocation& loc);
+
 /// Calls `read` for each child element of `parent` named in `allowed`, in order; reports text
 /// and other elements as unexpected.
 void forEachChild(const ReadContext& context, const pugi::xml_node& parent,

@@ -1,5 +1,7 @@
 // Expansion of one instance's body: <repeat>, `${...}` substitution, and the modules, filters,
 // instances and connections it makes, with their ids prefixed and endpoints resolved.
+#include <algorithm>
+
 #include "expansion.hpp"
 #include "text_util.hpp"
 
@@ -136,6 +138,23 @@ void Expander::walkRepeat(const TemplateElement& repeat, Frame& frame,
                                     "same name; rename it");
     return;
   }
+  // The work is bounded before it is done: this count times those of the repeats around it (in
+  // this body and the instances it is in) is how many times the body is expanded.
+  unsigned long long iterations = 0;
+  if (__builtin_mul_overflow(repeatProduct_, static_cast<unsigned long long>(*count),
+                             &iterations) ||
+      iterations > kMaxExpandedElements) {
+    tooLarge_ = true;
+    const bool nested = repeatProduct_ > 1;
+    error(loc, "the expansion makes more than " + std::to_string(kMaxExpandedElements) +
+                   " modules, filters, connections and repeat iterations: repeat count " +
+                   std::to_string(*count) +
+                   (nested ? " times the counts of the repeats around it" : std::string()) +
+                   " is refused before expanding; check the repeat counts");
+    return;
+  }
+  const unsigned long long enclosing = repeatProduct_;
+  repeatProduct_ = std::max(iterations, 1ULL);
   for (long long k = 0; k < *count; ++k) {
     long long value = 0;
     if (__builtin_add_overflow(*start, k, &value)) {
@@ -147,6 +166,7 @@ void Expander::walkRepeat(const TemplateElement& repeat, Frame& frame,
     walk(repeat.children, frame, visit);
     if (tooLarge_) break;
   }
+  repeatProduct_ = enclosing;
   frame.scope.erase(*var);
 }
 

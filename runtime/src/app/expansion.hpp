@@ -105,6 +105,8 @@ class Expander {
   std::optional<std::vector<std::string>> known_;  ///< names for "unknown composite" messages
   std::set<std::string, std::less<>> reported_;    ///< "file:line:column:message" of each error
   std::size_t spent_ = 0;
+  /// The product of the counts of the repeats being expanded (across nested instances).
+  unsigned long long repeatProduct_ = 1;
   std::size_t bytes_ = 0;  ///< attribute text made by substitution
   bool tooLarge_ = false;
 };

@@ -1,11 +1,13 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <pugixml.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/source_location.hpp"
 
 namespace vrflow::app::detail {
@@ -31,5 +33,10 @@ class SourceText {
   std::string file_;
   std::vector<std::size_t> lineStarts_;
 };
+
+/// Files are read as UTF-8: a UTF-16 or UTF-32 file (byte order mark, or NUL bytes around the
+/// first '<') is named as such with how to convert it, and the first byte that is not valid
+/// UTF-8 is reported at its line and column; nullopt when the text is valid UTF-8.
+std::optional<Diagnostic> encodingProblem(const SourceText& source);
 
 }  // namespace vrflow::app::detail

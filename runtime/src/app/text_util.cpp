@@ -97,4 +97,70 @@ std::optional<bool> parseBool(std::string_view text) {
   return std::nullopt;
 }
 
+std::optional<char> firstControlCharacter(std::string_view text) {
+  for (const char c : text) {
+    if (static_cast<unsigned char>(c) < 0x20U || c == '\x7F') return c;
+  }
+  return std::nullopt;
+}
+
+std::string escapeControlCharacters(std::string_view text) {
+  std::string escaped;
+  escaped.reserve(text.size());
+  for (const char c : text) {
+    if (c == '\n') {
+      escaped += "\\n";
+    } else if (c == '\r') {
+      escaped += "\\r";
+    } else if (c == '\t') {
+      escaped += "\\t";
+    } else if (static_cast<unsigned char>(c) < 0x20U || c == '\x7F') {
+      static constexpr char kHex[] = "0123456789ABCDEF";
+      const auto byte = static_cast<unsigned char>(c);
+      escaped += "\\x";
+      escaped += kHex[byte >> 4U];
+      escaped += kHex[byte & 0xFU];
+    } else {
+      escaped += c;
+    }
+  }
+  return escaped;
+}
+
+std::optional<std::string> hostAddressProblem(std::string_view address) {
+  if (address.empty()) return "is empty";
+  std::vector<std::string_view> labels;
+  for (std::size_t start = 0;;) {
+    const std::size_t dot = address.find('.', start);
+    labels.push_back(address.substr(start, dot == std::string_view::npos ? dot : dot - start));
+    if (dot == std::string_view::npos) break;
+    start = dot + 1;
+  }
+  const auto allDigits = [](std::string_view label) {
+    return !label.empty() &&
+           std::all_of(label.begin(), label.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (allDigits(labels.back())) {
+    // Written as an IPv4 address: it must be one.
+    const bool valid = labels.size() == 4 && std::all_of(labels.begin(), labels.end(), [&](auto l) {
+                         return allDigits(l) && l.size() <= 3 && std::stoi(std::string(l)) <= 255;
+                       });
+    if (valid) return std::nullopt;
+    return "is not a valid IPv4 address (four numbers 0-255 separated by dots)";
+  }
+  if (address.size() > 253) return "is not a valid host name (more than 253 characters)";
+  for (const std::string_view label : labels) {
+    const bool valid = !label.empty() && label.size() <= 63 && label.front() != '-' &&
+                       label.back() != '-' && std::all_of(label.begin(), label.end(), [](char c) {
+                         return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+                                (c >= '0' && c <= '9') || c == '-';
+                       });
+    if (!valid) {
+      return "is neither an IPv4 address nor a valid host name (letters, digits and '-' in "
+             "dot-separated labels)";
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace vrflow::app::detail

@@ -28,4 +28,13 @@ std::optional<double> parseFloat(std::string_view text);
 /// Parses "true"/"false"/"1"/"0" (xs:boolean), or nullopt.
 std::optional<bool> parseBool(std::string_view text);
 
+/// The first control character (below U+0020, or U+007F) in `text`, or nullopt.
+std::optional<char> firstControlCharacter(std::string_view text);
+/// `text` with its control characters written as C escapes ("\n", "\x01"), for messages.
+std::string escapeControlCharacters(std::string_view text);
+/// Why `address` is neither an IPv4 address (a.b.c.d, each 0-255) nor a host name (RFC 1123:
+/// dot-separated labels of letters, digits and '-', 1-63 characters, not starting or ending
+/// with '-', 253 characters at most, the last label not all digits), or nullopt.
+std::optional<std::string> hostAddressProblem(std::string_view address);
+
 }  // namespace vrflow::app::detail

@@ -1,5 +1,7 @@
 #include "vrflow/app/validate.hpp"
 
+#include <cstdio>
+
 #include "application_reader.hpp"
 #include "element_reader.hpp"
 #include "file_io.hpp"
@@ -24,12 +26,30 @@ void requireNonEmpty(Validation& v, const std::string& value, const SourceLocati
   if (value.empty()) v.error(loc, missingAttributeMessage(element, attribute));
 }
 
+// Ids are printed in reports, logs and messages, one per line: no control characters.
+void checkPrintableId(Validation& v, const std::string& id, const SourceLocation& loc) {
+  if (const std::optional<char> c = firstControlCharacter(id)) {
+    char code[8];
+    std::snprintf(code, sizeof code, "U+%04X",
+                  static_cast<unsigned>(static_cast<unsigned char>(*c)));
+    v.error(loc.attribute("id"), "id '" + escapeControlCharacters(id) +
+                                     "' contains a control character (" + code +
+                                     "); ids are printed one per line in reports and logs");
+  }
+}
+
 // Ids of modules and filters share one namespace (connections name them); hosts have theirs.
 void checkIds(Validation& v) {
   std::map<std::string, const SourceLocation*, std::less<>> hosts;
   for (const Host& host : v.app.hosts) {
+    if (const auto problem = hostAddressProblem(host.address)) {
+      v.error(host.loc.attribute("address"), "address '" + escapeControlCharacters(host.address) +
+                                                 "' of host '" + escapeControlCharacters(host.id) +
+                                                 "' " + *problem);
+    }
     requireNonEmpty(v, host.id, host.loc, "host", "id");
     if (host.id.empty()) continue;
+    checkPrintableId(v, host.id, host.loc);
     const auto [it, added] = hosts.emplace(host.id, &host.loc);
     if (!added) {
       v.error(host.loc.attribute("id"),
@@ -41,6 +61,7 @@ void checkIds(Validation& v) {
                                const char* element) {
     requireNonEmpty(v, id, loc, element, "id");
     if (id.empty()) return;
+    checkPrintableId(v, id, loc);
     if (id.find('.') != std::string::npos) {
       v.error(loc.attribute("id"),
               "id '" + id + "' must not contain '.' (connections write node.port)");
@@ -142,6 +163,15 @@ void checkEditor(Validation& v) {
   }
 }
 
+// True when every parameter is declared by the type and its value is valid.
+bool paramsValid(const std::vector<Param>& params, const FilterType& type) {
+  return std::all_of(params.begin(), params.end(), [&](const Param& param) {
+    const auto spec = std::find_if(type.params.begin(), type.params.end(),
+                                   [&](const ParamSpec& s) { return s.name == param.name; });
+    return spec != type.params.end() && !checkParamValue(*spec, param.value);
+  });
+}
+
 }  // namespace
 
 Validation::Validation(const Application& application, const Catalog& types)
@@ -152,6 +182,7 @@ Validation::Validation(const Application& application, const Catalog& types)
     node.module = &module;
     node.moduleType = catalog.findModule(module.package, module.type);
     if (node.moduleType != nullptr) node.ports = node.moduleType->ports;
+    node.portsKnown = node.moduleType != nullptr;
     node.label = moduleLabel(module);
     byId_.emplace(module.id, nodes.size());
     nodes.push_back(std::move(node));
@@ -161,11 +192,15 @@ Validation::Validation(const Application& application, const Catalog& types)
     NodeInfo node;
     node.filter = &filter;
     node.filterType = catalog.findFilter(filter.type);
-    if (node.filterType != nullptr) node.ports = node.filterType->portsFor(filter.params);
+    // Ports are made from the parameters only when they are valid: an out-of-range `inputs`
+    // is reported as such, not as hundreds of unconnected inputs.
+    node.portsKnown = node.filterType != nullptr && paramsValid(filter.params, *node.filterType);
+    if (node.portsKnown) node.ports = node.filterType->portsFor(filter.params);
     node.label = filterLabel(filter);
     byId_.emplace(filter.id, nodes.size());
     nodes.push_back(std::move(node));
   }
+  for (const NodeInfo& node : nodes) ids_.push_back(node.id());
 }
 
 const NodeInfo* Validation::find(std::string_view id) const {
@@ -176,12 +211,6 @@ const NodeInfo* Validation::find(std::string_view id) const {
 std::size_t Validation::indexOf(std::string_view id) const {
   const auto it = byId_.find(id);
   return it == byId_.end() ? nodes.size() : it->second;
-}
-
-std::vector<std::string> Validation::nodeIds() const {
-  std::vector<std::string> ids;
-  for (const NodeInfo& node : nodes) ids.push_back(node.id());
-  return ids;
 }
 
 void Validation::error(const SourceLocation& loc, std::string message) {

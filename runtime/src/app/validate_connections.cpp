@@ -18,7 +18,7 @@ std::vector<std::string> portNames(const NodeInfo& node, bool inputs) {
 }
 
 // The port at one end of a connection, or nullptr after reporting why there is none (or
-// silently when the node's type is unknown: that is reported once, on the node).
+// silently when the node's ports are unknown: that is reported once, on the node).
 const PortSpec* resolveEnd(Validation& v, const Connection& connection, bool source,
                            const NodeInfo** nodeOut) {
   const Endpoint& end = source ? connection.from : connection.to;
@@ -35,15 +35,18 @@ const PortSpec* resolveEnd(Validation& v, const Connection& connection, bool sou
   }
   const NodeInfo* node = v.find(end.node);
   if (node == nullptr) {
-    const std::vector<std::string> ids = v.nodeIds();
+    const std::vector<std::string>& ids = v.nodeIds();
+    const std::optional<std::string> close = closestName(end.node, ids);
+    if (!source && close) v.misnamedTargets.insert(*close);
     v.error(at, "no module or filter '" + end.node + "' (known: " + joinNames(ids) + ")" +
-                    didYouMean(end.node, ids));
+                    (close ? "; did you mean '" + *close + "'?" : ""));
     return nullptr;
   }
   *nodeOut = node;
-  if (!node->typeKnown()) return nullptr;
+  if (!node->portsKnown) return nullptr;
   const PortSpec* port = findPort(node->ports, end.port);
   const std::string direction = source ? "output" : "input";
+  if (!source && (port == nullptr || !port->isInput)) v.misnamedTargets.insert(node->id());
   if (port == nullptr) {
     const std::vector<std::string> names = portNames(*node, source ? false : true);
     v.error(at, node->label + " has no " + direction + " '" + end.port + "' (" + direction +
@@ -140,7 +143,7 @@ void checkEachConnection(Validation& v) {
 void checkInputConfigs(Validation& v) {
   for (const Module& module : v.app.modules) {
     const NodeInfo* node = v.find(module.id);
-    const bool known = node != nullptr && node->module == &module && node->typeKnown();
+    const bool known = node != nullptr && node->module == &module && node->portsKnown;
     for (const InputConfig& input : module.inputs) {
       if (input.initialMessages < 0) {
         v.error(
@@ -178,11 +181,21 @@ void checkRequiredInputs(Validation& v) {
     connected.emplace(connection.to.node, connection.to.port);
   }
   for (const NodeInfo& node : v.nodes) {
+    if (v.misnamedTargets.count(node.id()) != 0) continue;
+    std::vector<std::string> unconnected;
     for (const PortSpec& port : node.ports) {
       if (!port.isInput || !port.required) continue;
       if (connected.count({node.id(), port.name}) != 0) continue;
+      unconnected.push_back("'" + port.name + "'");
+    }
+    // One problem per node, however many inputs it has (a merge has up to 256): the number of
+    // diagnostics stays bounded by the number of nodes.
+    if (unconnected.size() == 1) {
       v.error(node.loc(),
-              "required input '" + port.name + "' of " + node.label + " is not connected");
+              "required input " + unconnected[0] + " of " + node.label + " is not connected");
+    } else if (!unconnected.empty()) {
+      v.error(node.loc(), "required inputs " + joinNames(unconnected, 4) + " of " + node.label +
+                              " are not connected");
     }
   }
 }

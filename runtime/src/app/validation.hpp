@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <map>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,10 +19,14 @@ struct NodeInfo {
   const Filter* filter = nullptr;  ///< set for filters
   const ModuleType* moduleType = nullptr;
   const FilterType* filterType = nullptr;
-  std::vector<PortSpec> ports;  ///< empty when the type is unknown
-  std::string label;            ///< "module 'a' (core/source)", for messages
+  /// Empty when the type is unknown, or when a parameter the ports depend on is invalid.
+  std::vector<PortSpec> ports;
+  /// The ports are known: the type is, and its parameters are valid (a filter's ports may
+  /// depend on them, as merge's `inputs`). Connections to a node without known ports are not
+  /// checked: the problem is reported once, on the node or its parameter.
+  bool portsKnown = false;
+  std::string label;  ///< "module 'a' (core/source)", for messages
 
-  bool typeKnown() const { return moduleType != nullptr || filterType != nullptr; }
   const std::string& id() const { return module ? module->id : filter->id; }
   const SourceLocation& loc() const { return module ? module->loc : filter->loc; }
   const std::vector<Param>& params() const { return module ? module->params : filter->params; }
@@ -37,19 +42,23 @@ class Validation {
   std::vector<Diagnostic> diagnostics;
   /// Modules then filters, in file order, each id once (its first definition).
   std::vector<NodeInfo> nodes;
+  /// Nodes that a connection meant to feed but named wrongly (a bad port, or a node id close to
+  /// theirs): their unconnected inputs are not reported, the bad endpoint is.
+  std::set<std::string, std::less<>> misnamedTargets;
 
   /// The node with this id, or nullptr.
   const NodeInfo* find(std::string_view id) const;
   /// Its index in `nodes`, or nodes.size().
   std::size_t indexOf(std::string_view id) const;
   /// The ids of all nodes, in file order (for "known: ..." lists).
-  std::vector<std::string> nodeIds() const;
+  const std::vector<std::string>& nodeIds() const { return ids_; }
 
   void error(const SourceLocation& loc, std::string message);
   void warning(const SourceLocation& loc, std::string message);
 
  private:
   std::map<std::string, std::size_t, std::less<>> byId_;
+  std::vector<std::string> ids_;
 };
 
 /// " at line N" for a location read from a file, "" for one built in code.
