@@ -50,7 +50,7 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
     m["id"] = module.id;
     m["host"] = module.host;
     m["iterations"] = iterations;
-    m["exit"] = ends[i].exit;
+    m["exit"] = i < ends.size() ? ends[i].exit : "not started";  // stopped before "go"
     ordered_json timing;
     const double computeS = static_cast<double>(slot.computeNs.load()) / 1e9;
     timing["iteration_ms_mean"] = iterations ? computeS * 1e3 / static_cast<double>(iterations) : 0.0;
