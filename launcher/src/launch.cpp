@@ -22,6 +22,7 @@
 
 #include "monitor_files.hpp"
 #include "vrflow/base/executable_dir.hpp"
+#include "vrflow/net/control.hpp"
 #include "vrflow/net/transport.hpp"
 #include "vrflow/run/trace.hpp"
 
@@ -29,6 +30,12 @@ namespace vrflow::launcher {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// A daemon answers "stop" with "stopping" from its control reader at once; one that has not
+// within this time (frozen, stopped by a signal, swapping) is killed.
+constexpr double kStopAnswerSeconds = 0.5;
+// A daemon that answered must then exit within this time, or it is killed too.
+constexpr double kStopExitSeconds = 8;
 
 int64_t steadyNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
@@ -58,6 +65,7 @@ struct HostDaemon {
   bool viaSsh = false;
   bool viaMpirun = false;
   bool connected = false, finished = false, exited = false;
+  bool stopAnswered = false;  ///< it answered "stop"
   int finishedCode = 0;
   std::string finishedStatus, finishedError, report, exitText, trace;
   std::string stats, previousStats;  ///< the last two "stats" lines (vrflow monitor)
@@ -168,45 +176,57 @@ void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
   // "lost the link": keep the first root cause.
   if (failure_ && (failureIsRoot_ || !rootCause)) return;
   if (!failure_) failureAt_ = Clock::now();
+  // Said when seen: stopping the other hosts takes a moment, and the cause must not wait for it.
+  std::fprintf(stderr, "vrflow: %s; stopping every host\n", outcome.error.c_str());
   failure_ = std::move(outcome);
   failureIsRoot_ = rootCause;
 }
 
 void Launcher::onLine(HostDaemon& d, const std::string& line) {
-  std::istringstream words(line);
-  std::string word;
-  words >> word;
-  if (word == "listening") {
-    words >> d.port;
-  } else if (word == "connected") {
-    d.connected = true;
-  } else if (word == "error") {
-    failWith({run::kExitRunFailed, "failed", "host '" + d.host + "': " + line.substr(6)}, true);
-  } else if (word == "finished") {
-    d.finished = true;
-    words >> d.finishedCode >> d.finishedStatus;
-    std::getline(words, d.finishedError);
-    if (!d.finishedError.empty() && d.finishedError[0] == ' ') d.finishedError.erase(0, 1);
-    if (d.finishedCode != 0 && d.finishedStatus != "stopped") {
-      const bool lostLink = d.finishedError.rfind("lost the link", 0) == 0;
-      failWith({d.finishedCode, d.finishedStatus, "host '" + d.host + "': " + d.finishedError},
-               !lostLink);
-    }
-  } else if (word == "report") {
-    d.report = line.substr(7);
-  } else if (word == "stats") {
-    d.previousStats = std::move(d.stats);
-    d.stats = line.substr(6);
-  } else if (word == "trace") {
-    d.trace = line.substr(6);
-  } else if (word == "clock") {
-    // "clock T0 Td": our send time echoed with the daemon's clock; the daemon read its clock
-    // about half-way through the round trip.
-    int64_t sent = 0, theirs = 0;
-    if (words >> sent >> theirs) {
-      d.clockOffsetNs = theirs - (sent + steadyNs()) / 2;
+  auto parsed = net::parseControlEvent(line);
+  if (!parsed) return;  // not a line of the protocol: nothing to act on
+  net::ControlEvent& event = *parsed;
+  using Kind = net::ControlEvent::Kind;
+  switch (event.kind) {
+    case Kind::Listening:
+      d.port = event.port;
+      break;
+    case Kind::Connected:
+      d.connected = true;
+      break;
+    case Kind::Stopping:
+      d.stopAnswered = true;
+      break;
+    case Kind::Error:
+      failWith({run::kExitRunFailed, "failed", "host '" + d.host + "': " + event.text}, true);
+      break;
+    case Kind::Finished:
+      d.finished = true;
+      d.finishedCode = event.exitCode;
+      d.finishedStatus = event.status;
+      d.finishedError = event.text;
+      if (d.finishedCode != 0 && d.finishedStatus != "stopped") {
+        const bool lostLink = d.finishedError.rfind("lost the link", 0) == 0;
+        failWith({d.finishedCode, d.finishedStatus, "host '" + d.host + "': " + d.finishedError},
+                 !lostLink);
+      }
+      break;
+    case Kind::Report:
+      d.report = std::move(event.text);
+      break;
+    case Kind::Stats:
+      d.previousStats = std::move(d.stats);
+      d.stats = std::move(event.text);
+      break;
+    case Kind::Trace:
+      d.trace = std::move(event.text);
+      break;
+    case Kind::Clock:
+      // "clock T0 Td": our send time echoed with the daemon's clock; the daemon read its clock
+      // about half-way through the round trip.
+      d.clockOffsetNs = event.clockDaemonNs - (event.clockSentNs + steadyNs()) / 2;
       d.clockKnown = true;
-    }
+      break;
   }
 }
 
@@ -550,7 +570,20 @@ void Launcher::stopAll() {
     if (!d.exited) d.send("stop");
   }
   const auto begin = Clock::now();
-  while (!allExited() && secondsSince(begin) < 8) pump(20);
+  auto allAnswered = [&] {
+    for (const auto& d : daemons_) {
+      if (!d.exited && !d.stopAnswered) return false;
+    }
+    return true;
+  };
+  while (!allAnswered() && secondsSince(begin) < kStopAnswerSeconds) pump(20);
+  for (const auto& d : daemons_) {
+    if (d.exited || d.stopAnswered) continue;
+    std::fprintf(stderr, "vrflow: the %s did not answer \"stop\" within %g s: killed\n",
+                 d.name().c_str(), kStopAnswerSeconds);
+    kill(-d.pid, SIGKILL);
+  }
+  while (!allExited() && secondsSince(begin) < kStopExitSeconds) pump(20);
   for (int round = 0; round < 2 && !allExited(); ++round) {
     for (const auto& d : daemons_) {
       if (!d.exited) kill(-d.pid, round == 0 ? SIGTERM : SIGKILL);

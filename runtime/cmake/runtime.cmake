@@ -23,6 +23,7 @@ vrflow_add_library(runtime
     src/daemon/plugin_loader.cpp
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
+    src/net/control.cpp
     src/net/frame.cpp
     src/net/secret.cpp
     src/net/transport.cpp

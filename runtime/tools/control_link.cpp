@@ -5,14 +5,13 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <cstring>
-
 #include <chrono>
 #include <cstdio>
-#include <sstream>
+#include <cstring>
 
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/message/ids.hpp"
+#include "vrflow/net/control.hpp"
 
 namespace vrflow::tools {
 namespace {
@@ -59,6 +58,7 @@ Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application&
     std::fill(line.begin(), line.end(), '\0');
     if (!secret) return secret.error();
   }
+  link->host_ = host;
   link->selfIndex_ = hostIndex(application, host);
   if (link->selfIndex_ < 0) return makeError("no host '" + host + "' in the application");
   const app::Host& self = application.hosts[static_cast<std::size_t>(link->selfIndex_)];
@@ -145,6 +145,9 @@ ControlLink::~ControlLink() {
 void ControlLink::readLoop(int fd, const std::shared_ptr<Inbox>& inbox) {
   std::string line;
   while (readLine(fd, line)) {
+    // Answered here, at once, whatever the main thread is doing: the launcher kills a daemon
+    // that does not (a frozen one) instead of waiting for it.
+    if (line == "stop") sendOn(*inbox, "stopping");
     std::lock_guard lock(inbox->mutex);
     inbox->lines.push_back(line);
     inbox->changed.notify_all();
@@ -169,11 +172,17 @@ std::string ControlLink::next(double seconds) {
 }
 
 void ControlLink::send(const std::string& line) {
+  sendOn(*inbox_, line);
+}
+
+void ControlLink::sendOn(Inbox& inbox, const std::string& line) {
+  std::lock_guard lock(inbox.writeMutex);
+  const int fd = inbox.out;
   std::string text = line + "\n";
   const char* p = text.data();
   std::size_t left = text.size();
   while (left > 0) {
-    const ssize_t n = write(out_, p, left);
+    const ssize_t n = write(fd, p, left);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return;  // the launcher is gone; poll() sees the end of input
     p += n;
@@ -191,38 +200,61 @@ void ControlLink::configure(daemon::DaemonOptions& options) {
 Status ControlLink::ready() {
   std::vector<net::PeerAddress> peers;
   while (true) {
-    const std::string line = next(-1);
-    if (line == "connect") break;
-    if (line == "eof" || line == "stop") {
-      stopped_ = true;
-      return makeError("stopped by the launcher before the start");
+    const auto command = nextCommand();
+    if (!command) continue;
+    if (command->kind == net::ControlCommand::Kind::Connect) break;
+    if (command->kind == net::ControlCommand::Kind::End ||
+        command->kind == net::ControlCommand::Kind::Stop) {
+      return stoppedBeforeStart(*command);
     }
-    std::istringstream words(line);
-    std::string word;
-    net::PeerAddress peer;
-    if (words >> word && word == "peer" && words >> peer.index >> peer.address >> peer.port) {
-      peers.push_back(peer);
+    if (command->kind == net::ControlCommand::Kind::Peer) {
+      peers.push_back({command->peerIndex, command->peerAddress, command->peerPort});
     }
   }
   if (auto status = transport_->connectPeers(peers); !status) {
+    std::fprintf(stderr, "vrflow-daemon (host %s): cannot link to the other hosts: %s\n",
+                 host_.c_str(), status.error().message.c_str());
     send("error " + status.error().message);
     return status;
   }
   send("connected");
   while (true) {
-    const std::string line = next(-1);
-    if (line == "go") return {};
+    const auto command = nextCommand();
+    if (!command) continue;
+    if (command->kind == net::ControlCommand::Kind::Go) return {};
     // "clock T": the launcher aligns this host's clock with its own (--trace).
-    if (line.rfind("clock ", 0) == 0) {
+    if (command->kind == net::ControlCommand::Kind::Clock) {
       const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
                            std::chrono::steady_clock::now().time_since_epoch())
                            .count();
-      send(line + " " + std::to_string(now));
+      send("clock " + std::to_string(command->clockNs) + " " + std::to_string(now));
       continue;
     }
-    stopped_ = true;  // "stop" or the end of input
-    return makeError("stopped by the launcher before the start");
+    if (command->kind == net::ControlCommand::Kind::End ||
+        command->kind == net::ControlCommand::Kind::Stop) {
+      return stoppedBeforeStart(*command);
+    }
   }
+}
+
+std::optional<net::ControlCommand> ControlLink::nextCommand() {
+  const std::string line = next(-1);
+  auto command = net::parseControlCommand(line);
+  if (!command) {
+    std::fprintf(stderr, "vrflow-daemon (host %s): ignored a line of the launcher: %s\n",
+                 host_.c_str(), command.error().message.c_str());
+    return std::nullopt;
+  }
+  return *command;
+}
+
+Status ControlLink::stoppedBeforeStart(const net::ControlCommand& command) {
+  stopped_ = true;
+  const std::string why = command.kind == net::ControlCommand::Kind::Stop
+                              ? "stopped by the launcher before the start"
+                              : "the launcher closed the control channel before the start";
+  std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", host_.c_str(), why.c_str());
+  return makeError(why);
 }
 
 std::optional<run::RunOutcome> ControlLink::poll() {
@@ -237,7 +269,7 @@ std::optional<run::RunOutcome> ControlLink::poll() {
 }
 
 std::vector<std::string> ControlLink::drain(const run::RunOutcome& outcome) {
-  send("finished " + std::to_string(outcome.exitCode) + " " + outcome.status + " " + outcome.error);
+  send(net::finishedLine(outcome.exitCode, outcome.status, outcome.error));
   std::vector<std::string> warnings;
   // Keep routing (messages for the other hosts) until the launcher says every host is done.
   while (!stopped_) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "vrflow/app/model.hpp"
+#include "vrflow/net/control.hpp"
 #include "vrflow/net/transport.hpp"
 #include "vrflow/run/runner.hpp"
 
@@ -41,7 +42,7 @@ class ControlLink final : public run::HostLink {
   void stats(const std::string& json) override;
 
  private:
-  ControlLink(int in, int out) : in_(in), out_(out) {}
+  ControlLink(int in, int out) : in_(in), out_(out) { inbox_->out = out; }
   void send(const std::string& line);
   /// The next command from the launcher ("eof" when it went away); waits up to `seconds`
   /// (negative: forever); empty on timeout.
@@ -50,7 +51,14 @@ class ControlLink final : public run::HostLink {
   /// returns a warning for those still open.
   std::vector<std::string> settle();
 
+  /// The next command from the launcher, waiting for it; none (and a line on stderr) for a
+  /// malformed one.
+  std::optional<net::ControlCommand> nextCommand();
+  /// Stops before "go" ("stop" or the end of input): says so on stderr; the error.
+  Status stoppedBeforeStart(const net::ControlCommand& command);
+
   int in_, out_;
+  std::string host_;
   int selfIndex_ = 0;
   bool stopped_ = false;  ///< the launcher said stop (or went away)
   uint32_t hostId_ = 0;
@@ -63,7 +71,11 @@ class ControlLink final : public run::HostLink {
     std::mutex mutex;
     std::condition_variable changed;
     std::deque<std::string> lines;
+    int out = -1;           ///< the channel to the launcher
+    std::mutex writeMutex;  ///< one line at a time on `out`, from either thread
   };
+  /// Writes `line` and a newline on the channel to the launcher (any thread).
+  static void sendOn(Inbox& inbox, const std::string& line);
   std::shared_ptr<Inbox> inbox_ = std::make_shared<Inbox>();
   static void readLoop(int fd, const std::shared_ptr<Inbox>& inbox);
 };

@@ -11,6 +11,7 @@
 #include <sys/uio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -24,9 +25,9 @@
 #include <thread>
 
 #include "daemon/graph.hpp"
+#include "handshake.hpp"
 #include "vrflow/ipc/segment.hpp"
 #include "vrflow/message/reader.hpp"
-#include "handshake.hpp"
 
 namespace vrflow::net {
 namespace {
@@ -35,6 +36,13 @@ constexpr std::size_t kReadBufferBytes = 256 * 1024;
 constexpr std::size_t kDirectReadMin = 16 * 1024;
 constexpr int kMaxIov = 64;
 constexpr uint64_t kImmediateAfterIdleNs = 20'000;
+// accept() out of descriptors (EMFILE/ENFILE): the listening socket is left alone this long,
+// doubling up to the maximum, instead of being polled (and failing) in a loop.
+constexpr uint64_t kAcceptBackoffMinNs = 50'000'000;
+constexpr uint64_t kAcceptBackoffMaxNs = 1'000'000'000;
+// Connections refused before authentication: the first few are logged, then one line says
+// that the rest are not (a hostile peer must not fill the log).
+constexpr int kLoggedRefusals = 5;
 
 uint64_t nowNs() {
   return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -149,6 +157,10 @@ struct Transport::Impl {
   std::atomic<bool> wakePending{false};
   std::function<void()> onArrival;
   std::vector<std::byte> readBuffer = std::vector<std::byte>(kReadBufferBytes);
+  uint64_t listenPausedUntilNs = 0;  ///< accept() back-off (I/O thread)
+  uint64_t acceptBackoffNs = 0;
+  bool loggedAcceptFailure = false;
+  int loggedRefusals = 0;
 
   void wake() {
     if (!wakePending.exchange(true)) {
@@ -174,6 +186,8 @@ struct Transport::Impl {
     if (wakeFd >= 0) close(wakeFd);
   }
   void newLink(int fd, bool connector, int peer);
+  void acceptPeers();
+  void releaseRefusedLinks();
   void loop();
   void readFrom(Link& link);
   void writeTo(Link& link);
@@ -370,13 +384,18 @@ void Transport::Impl::fail(Link& link, const std::string& why) {
   } else if (link.connector && setupFailure.empty()) {
     setupFailure = "host '" + hostName(link.peer) + "' (" + link.address + "): " + why;
   }
-  if (!link.byeReceived) {
-    std::fprintf(stderr, "vrflow-daemon (host %s): closed the connection %s %s: %s\n",
-                 hostName(options.selfIndex).c_str(),
-                 link.authenticated ? "to host" : "from",
-                 link.authenticated ? ("'" + hostName(link.peer) + "' (" + link.address + ")").c_str()
-                                    : link.address.c_str(),
-                 why.c_str());
+  if (link.authenticated || link.connector) {
+    if (!link.byeReceived) {
+      std::fprintf(stderr, "vrflow-daemon (host %s): closed the connection to host '%s' (%s): %s\n",
+                   hostName(options.selfIndex).c_str(), hostName(link.peer).c_str(),
+                   link.address.c_str(), why.c_str());
+    }
+  } else if (loggedRefusals < kLoggedRefusals) {
+    ++loggedRefusals;
+    std::fprintf(
+        stderr, "vrflow-daemon (host %s): closed the connection from %s: %s%s\n",
+        hostName(options.selfIndex).c_str(), link.address.c_str(), why.c_str(),
+        loggedRefusals == kLoggedRefusals ? " (further refused connections are not logged)" : "");
   }
   link.out.clear();
   if (link.fd >= 0) close(link.fd);
@@ -515,7 +534,8 @@ void Transport::Impl::loop() {
     }
     fds.clear();
     fds.push_back({wakeFd, POLLIN, 0});
-    fds.push_back({listenFd, POLLIN, 0});
+    // The listening socket rests while accept() is backing off.
+    fds.push_back({nowNs() >= listenPausedUntilNs ? listenFd : -1, POLLIN, 0});
     for (auto& link : links) {
       short events = 0;
       if (!link->failed) {
@@ -527,19 +547,22 @@ void Transport::Impl::loop() {
     }
     const int timeoutMs = std::max(1, static_cast<int>(options.heartbeatSeconds * 1000 / 2));
     const int ready = poll(fds.data(), fds.size(), timeoutMs);
-    if (ready < 0 && errno != EINTR) break;
+    if (ready < 0 && errno != EINTR) {
+      // Never a silent end: the run learns why its links went quiet.
+      const std::string why = "the transport's I/O thread stopped: poll: " + errnoText(errno);
+      std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", hostName(options.selfIndex).c_str(),
+                   why.c_str());
+      std::lock_guard lock(mutex);
+      if (fatal.empty()) fatal = why;
+      changed.notify_all();
+      break;
+    }
     if (fds[0].revents & POLLIN) {
       uint64_t value = 0;
       [[maybe_unused]] auto n = read(wakeFd, &value, sizeof value);
       wakePending.store(false);
     }
-    if (fds[1].revents & POLLIN) {
-      const int fd = accept4(listenFd, nullptr, nullptr, SOCK_CLOEXEC);
-      if (fd >= 0) {
-        tuneSocket(fd);
-        newLink(fd, false, -1);
-      }
-    }
+    if (fds[1].revents & POLLIN) acceptPeers();
     const std::size_t existing = std::min(links.size(), fds.size() - 2);
     for (std::size_t i = 0; i < existing; ++i) {
       Link& link = *links[i];
@@ -552,7 +575,57 @@ void Transport::Impl::loop() {
     for (auto& link : links) {
       if (!link->failed) writeTo(*link);
     }
+    releaseRefusedLinks();
   }
+}
+
+// Takes what waits on the listening socket. Each accepted connection must authenticate within
+// the handshake time; past options.maxUnauthenticatedLinks waiting at once, the oldest waiting
+// one is dropped. Out of descriptors, the listening socket rests (back-off) and one line says so.
+void Transport::Impl::acceptPeers() {
+  for (int round = 0; round < 64; ++round) {
+    const int fd = accept4(listenFd, nullptr, nullptr, SOCK_CLOEXEC);
+    if (fd < 0) {
+      const int err = errno;
+      if (err == EMFILE || err == ENFILE || err == ENOBUFS || err == ENOMEM) {
+        acceptBackoffNs = acceptBackoffNs == 0 ? kAcceptBackoffMinNs
+                                               : std::min(2 * acceptBackoffNs, kAcceptBackoffMaxNs);
+        listenPausedUntilNs = nowNs() + acceptBackoffNs;
+        if (!loggedAcceptFailure) {
+          loggedAcceptFailure = true;
+          std::fprintf(stderr,
+                       "vrflow-daemon (host %s): cannot accept connections: %s; retrying with "
+                       "back-off (raise the open-file limit, `ulimit -n`, if this lasts)\n",
+                       hostName(options.selfIndex).c_str(), errnoText(err).c_str());
+        }
+      }
+      return;  // EAGAIN: nothing more waits; others (ECONNABORTED...): the next poll retries
+    }
+    acceptBackoffNs = 0;
+    Link* oldest = nullptr;
+    int waiting = 0;
+    for (auto& link : links) {
+      if (link->failed || link->authenticated || link->connector) continue;
+      ++waiting;
+      if (oldest == nullptr) oldest = link.get();
+    }
+    if (waiting >= options.maxUnauthenticatedLinks && oldest != nullptr) {
+      fail(*oldest, "dropped: more than " + std::to_string(options.maxUnauthenticatedLinks) +
+                        " connections awaiting authentication");
+    }
+    tuneSocket(fd);
+    newLink(fd, false, -1);
+  }
+}
+
+// A link closed before authentication is released at once (its socket is already closed):
+// nothing of it stays in the poll set. Authenticated links stay, failed or not: their counters
+// go into the report, and there is at most one per peer.
+void Transport::Impl::releaseRefusedLinks() {
+  std::lock_guard lock(mutex);  // linkStats() walks the list
+  std::erase_if(links, [](const std::unique_ptr<Link>& link) {
+    return link->failed && !link->authenticated;
+  });
 }
 
 Transport::Transport() : impl_(std::make_unique<Impl>()) {}

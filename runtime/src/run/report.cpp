@@ -50,8 +50,12 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
     m["id"] = module.id;
     m["host"] = module.host;
     m["iterations"] = iterations;
-    m["exit"] = ends[i].exit;
-    if (!ends[i].cause.empty()) m["cause"] = ends[i].cause;
+    if (i >= ends.size()) {
+      m["exit"] = "not started";  // stopped before "go"
+    } else {
+      m["exit"] = ends[i].exit;
+      if (!ends[i].cause.empty()) m["cause"] = ends[i].cause;
+    }
     ordered_json timing;
     const double computeS = static_cast<double>(slot.computeNs.load()) / 1e9;
     timing["iteration_ms_mean"] = iterations ? computeS * 1e3 / static_cast<double>(iterations) : 0.0;

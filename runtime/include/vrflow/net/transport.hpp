@@ -63,6 +63,9 @@ struct TransportOptions {
   double heartbeatSeconds = 0.2;        ///< a link silent this long gets a heartbeat
   double peerTimeoutSeconds = 3.0;      ///< a link silent this long is declared lost
   double handshakeSeconds = 5.0;        ///< an unauthenticated link is dropped after this
+  /// At most this many accepted connections wait for authentication at once; one more drops
+  /// the oldest of them (docs/transport.md, "Unauthenticated connections").
+  int maxUnauthenticatedLinks = 16;
   double connectSeconds = 10.0;         ///< connectPeers() gives up after this
 };
 
