@@ -1,6 +1,10 @@
 // fluidtest/box: a tiny rigid animator for the fluid's end-to-end tests: one cubic box,
 // translation only (semi-implicit Euler from the force events it receives plus its own gravity),
-// the plane y = 0 as a floor. Writes `iteration,y,vy` per iteration to `trajectory`.
+// the plane y = 0 as a floor. Writes `iteration,y,vy` per iteration to `trajectory`. With
+// `broken-at` = k > 0 it sends, from iteration k on, an orientation quaternion of zero, as a
+// broken animator would: a well-formed message (finite numbers) with a body that the fluid's
+// solver must refuse, for the fluid's failure tests.
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -22,6 +26,7 @@ int main() {
   const double half = module.paramDouble("half", 0.15);
   const double density = module.paramDouble("density", 500);
   const double dt = module.paramDouble("dt", 0.01);
+  const auto brokenAt = static_cast<std::uint64_t>(module.paramInt("broken-at", 0));
   msg::Vec3 position{};
   std::istringstream(module.param("start", "0.4 0.5 0.4")) >> position[0] >> position[1] >>
       position[2];
@@ -74,10 +79,13 @@ int main() {
           .set(msg::RigidParam::kBounds, bounds)
           .set(msg::RigidParam::kShape, shapeId);
     } else {
-      b.addObject(id, msg::rigidType(), msg::ObjectOp::Update)
-          .set(msg::RigidParam::kPosition, position)
+      auto object = b.addObject(id, msg::rigidType(), msg::ObjectOp::Update);
+      object.set(msg::RigidParam::kPosition, position)
           .set(msg::RigidParam::kLinearVelocity, velocity)
           .set(msg::RigidParam::kBounds, bounds);
+      if (brokenAt > 0 && module.iteration() >= brokenAt) {
+        object.set(msg::RigidParam::kOrientation, msg::Quat{0.0, 0.0, 0.0, 0.0});
+      }
     }
     if (!module.put(objects, std::move(out))) break;
   }

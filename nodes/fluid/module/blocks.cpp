@@ -11,11 +11,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <initializer_list>
 #include <string>
 
 #include "vrflow/fluid/mpi_block_comm.hpp"
-#include "worker_watch.hpp"
 
 namespace vrflow::fluid {
 namespace {
@@ -128,13 +126,11 @@ void prepareMpi() {
   // Open MPI's I/O forwarding may write to the module's output pipes after vrflow stopped
   // reading them at the end of a run; a write error must not kill the process with SIGPIPE.
   std::signal(SIGPIPE, SIG_IGN);
-  // Open MPI refuses root unless told; oversubscription: more blocks than cores is allowed.
+  // Open MPI refuses root unless told (an MPI singleton: no mpirun told it).
   if (geteuid() == 0) {
     setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
     setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
   }
-  setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
-  setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
 }
 
 struct Setup {
@@ -162,45 +158,6 @@ bool everyBlockFailed(MPI_Comm failures) {
   }
 }
 
-// Frees the communicators that join this block to the others before MPI_Finalize, on every block
-// once none has a message left to send (after the stop, or the agreement that every block
-// failed). Spawned blocks are another MPI job, "connected" to rank 0 through each communicator
-// that spans both jobs, and Open MPI 4.1's MPI_Finalize starts a handshake (synchronous sends)
-// over every such communicator without waiting for it to complete (ompi_dpm_dyn_finalize checks
-// its count against ompi_comm_num_dyncomm + 1 and returns early): the first block to finalise
-// closes its TCP connections while the other still writes its part; that write fails (EPIPE),
-// the TCP BTL starts a reconnection, and the writer's MPI_Finalize then spins forever freeing the
-// event left behind. With those communicators freed there is no handshake: each block finalises
-// on its own. (MPI_Comm_disconnect, meant for this, never returns in Open MPI 4.1 between a
-// spawning and a spawned process.) Under mpirun the blocks are one job: nothing changes.
-void freeComms(std::initializer_list<MPI_Comm*> comms) {
-  for (MPI_Comm* comm : comms) {
-    if (*comm != MPI_COMM_NULL) MPI_Comm_free(comm);
-  }
-}
-
-// Test hook: with VRFLOW_FLUID_TEST_FAIL="BLOCK STEP", step number STEP (from 0, query-only steps
-// not counted) fails on block BLOCK alone, as a bug of one block would (BLOCK -1: on every
-// block). A block cannot fail alone otherwise (the blocks check the same input), so the tests
-// need it to reach that path.
-bool injectedFailure(int block, std::uint64_t step) {
-  const char* text = std::getenv("VRFLOW_FLUID_TEST_FAIL");
-  int failBlock = -2;
-  unsigned long long failStep = 0;
-  return text != nullptr && std::sscanf(text, "%d %llu", &failBlock, &failStep) == 2 &&
-         (failBlock == block || failBlock == -1) && failStep == step;
-}
-
-// One step on this block, or the injected failure.
-Result<BlockResult> runStep(FluidSolver& solver, const BlockStep& s, int block,
-                            std::uint64_t& steps) {
-  if (!s.queryOnly && injectedFailure(block, steps++)) {
-    return makeError("fluid: block " + std::to_string(block) +
-                     ": failure injected by VRFLOW_FLUID_TEST_FAIL");
-  }
-  return stepBlock(solver, s);
-}
-
 }  // namespace
 
 Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& s) {
@@ -219,14 +176,11 @@ Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& s) {
 }
 
 struct BlockGroup::Impl {
-  MPI_Comm spawned = MPI_COMM_NULL;  ///< the intercommunicator to spawned workers
   MPI_Comm world = MPI_COMM_NULL;
   MPI_Comm failures = MPI_COMM_NULL;  ///< only for the agreement after a failed step
   int blocks = 0;
-  std::uint64_t steps = 0;
   std::unique_ptr<MpiBlockComm> comm;
   std::unique_ptr<FluidSolver> solver;
-  std::unique_ptr<WorkerWatch> watch;  ///< spawned workers only (mpirun watches its own ranks)
   bool stopped = false;
 };
 
@@ -238,12 +192,17 @@ FluidSolver& BlockGroup::solver() {
   return *impl_->solver;
 }
 
-Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, int blocks,
-                                                      const FluidSettings& settings,
+Result<std::unique_ptr<BlockGroup>> BlockGroup::start(int blocks, const FluidSettings& settings,
                                                       const msg::Aabb& fill) {
   if (blocks < 2 || blocks > settings.nz) {
     return makeError("fluid: " + std::to_string(blocks) + " blocks for " +
                      std::to_string(settings.nz) + " z-planes: use 2 to nz blocks (1 = serial)");
+  }
+  if (mpirunRank() != 0) {
+    return makeError("fluid: blocks = " + std::to_string(blocks) +
+                     ", but this process is not rank 0 of the module's MPI ranks: vrflow starts "
+                     "a module with blocks above 1 as that many ranks through mpirun (the "
+                     "manifest's mpi-ranks); started another way, set blocks to 1");
   }
   prepareMpi();
   int argc = 0;
@@ -251,33 +210,12 @@ Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, in
   MPI_Init(&argc, &argv);
   MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   auto impl = std::make_unique<Impl>();
-  if (mpirunRank() >= 0) {  // started by vrflow through mpirun: the workers are already there
-    int size = 0;
-    MPI_Comm_size(MPI_COMM_WORLD, &size);
-    if (size != blocks) {
-      MPI_Abort(MPI_COMM_WORLD, 2);  // the runtime starts exactly `blocks` ranks
-    }
-    MPI_Comm_dup(MPI_COMM_WORLD, &impl->world);
-  } else {
-    // Open MPI does not tell rank 0 when a spawned worker dies: rank 0 watches them itself.
-    impl->watch = WorkerWatch::start(blocks - 1);
-    std::string workerFlag = "--block-worker", watchFlag = "--watch";
-    std::string watchName = impl->watch ? impl->watch->name() : "";
-    std::vector<char*> args{workerFlag.data()};
-    if (impl->watch) {
-      args.push_back(watchFlag.data());
-      args.push_back(watchName.data());
-    }
-    args.push_back(nullptr);
-    std::vector<int> codes(static_cast<std::size_t>(blocks - 1));
-    const int rc = MPI_Comm_spawn(executable, args.data(), blocks - 1, MPI_INFO_NULL, 0,
-                                  MPI_COMM_SELF, &impl->spawned, codes.data());
-    if (rc != MPI_SUCCESS) {
-      MPI_Finalize();
-      return makeError(std::string("fluid: MPI_Comm_spawn of ") + executable + " failed");
-    }
-    MPI_Intercomm_merge(impl->spawned, 0, &impl->world);
+  int size = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (size != blocks) {
+    MPI_Abort(MPI_COMM_WORLD, 2);  // the runtime starts exactly `blocks` ranks
   }
+  MPI_Comm_dup(MPI_COMM_WORLD, &impl->world);
   impl->blocks = blocks;
   Setup setup{settings, fill};
   MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, impl->world);
@@ -294,17 +232,16 @@ Result<std::unique_ptr<BlockGroup>> BlockGroup::start(const char* executable, in
 Result<BlockResult> BlockGroup::step(const BlockStep& s) {
   auto bytes = encodeStep(s);
   broadcast(bytes, impl_->world);
-  auto result = runStep(*impl_->solver, s, 0, impl_->steps);
+  auto result = stepBlock(*impl_->solver, s);
   if (!result && !impl_->stopped) {
     impl_->stopped = true;
-    impl_->watch.reset();  // the workers that failed with this block end on their own
     if (everyBlockFailed(impl_->failures)) {  // they left their loops: a clean end
-      finish();
+      MPI_Finalize();
       return result;
     }
     // The workers are inside the step, waiting for this block: no MPI_Finalize. The module
-    // reports the error and exits non-zero, and Open MPI (mpirun, or the singleton's orted)
-    // ends the workers when it sees rank 0 gone.
+    // reports the error and exits non-zero, and mpirun ends the workers when it sees rank 0
+    // gone.
     return makeError(result.error().message + " (MPI block 0 of " + std::to_string(impl_->blocks) +
                      " alone: the other blocks did not fail with it; stopping them)");
   }
@@ -314,24 +251,17 @@ Result<BlockResult> BlockGroup::step(const BlockStep& s) {
 void BlockGroup::stop() {
   if (impl_->stopped) return;
   impl_->stopped = true;
-  impl_->watch.reset();  // the workers end after the stop below
   BlockStep last;
   last.stop = true;
   auto bytes = encodeStep(last);
   broadcast(bytes, impl_->world);
-  finish();
-}
-
-void BlockGroup::finish() {
-  freeComms({&impl_->failures, &impl_->world, &impl_->spawned});  // as the workers do
-  MPI_Finalize();
+  MPI_Finalize();  // as the workers do when told to stop
 }
 
 namespace {
 
-// A worker's life on `world` (rank 0 is the module; `parent`: the intercommunicator to it when
-// spawned): the setup, then steps until told to stop.
-int workerLoop(MPI_Comm world, MPI_Comm parent) {
+// A worker's life on `world` (rank 0 is the module): the setup, then steps until told to stop.
+int workerLoop(MPI_Comm world) {
   Setup setup;
   MPI_Bcast(&setup, sizeof setup, MPI_BYTE, 0, world);
   MPI_Comm failures = MPI_COMM_NULL;
@@ -341,7 +271,6 @@ int workerLoop(MPI_Comm world, MPI_Comm parent) {
   if (!created) return 1;  // rank 0 made the same check and reports it
   auto solver = std::move(created.value());
   if (!solver->setBlockComm(&comm) || !solver->addLiquidBox(setup.fill)) return 1;
-  std::uint64_t steps = 0;
   for (;;) {
     std::vector<char> bytes;
     broadcast(bytes, world);
@@ -352,7 +281,7 @@ int workerLoop(MPI_Comm world, MPI_Comm parent) {
       MPI_Abort(world, 3);
     }
     if (s.stop) break;
-    auto stepped = runStep(*solver, s, comm.rank(), steps);
+    auto stepped = stepBlock(*solver, s);
     if (stepped) continue;
     // Failed with every block: rank 0 reports it. Failed alone: the other blocks wait for this
     // one inside the step; end the whole job, rank 0 with it, so that vrflow reports the module.
@@ -362,38 +291,11 @@ int workerLoop(MPI_Comm world, MPI_Comm parent) {
                  comm.rank(), comm.size(), stepped.error().message.c_str());
     MPI_Abort(world, 1);
   }
-  freeComms({&failures, &world, &parent});  // as rank 0 does (BlockGroup::finish)
   MPI_Finalize();
   return 0;
 }
 
 }  // namespace
-
-int runBlockWorker(int argc, char** argv) {
-  prepareMpi();
-  // Rank 0's watch (worker_watch.hpp) sees this process end by its connection closing.
-  int watch = -1;
-  if (argc >= 4 && std::strcmp(argv[2], "--watch") == 0) {
-    watch = WorkerWatch::join(argv[3]);
-    if (watch < 0) return 2;
-  }
-  MPI_Init(&argc, &argv);
-  MPI_Comm parent = MPI_COMM_NULL;
-  MPI_Comm_get_parent(&parent);
-  if (parent == MPI_COMM_NULL) {
-    std::fprintf(stderr, "vrflow-fluid --block-worker: not started by a fluid module\n");
-    MPI_Finalize();
-    return 2;
-  }
-  MPI_Comm world;
-  MPI_Intercomm_merge(parent, 1, &world);
-  if (watch >= 0) {
-    int rank = 0;
-    MPI_Comm_rank(world, &rank);
-    WorkerWatch::tellBlock(watch, rank);
-  }
-  return workerLoop(world, parent);
-}
 
 int mpirunRank() {
   if (std::getenv("VRFLOW_MPI_RANKS") == nullptr) return -1;
@@ -410,7 +312,7 @@ int runRankWorker(int argc, char** argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm world;
   MPI_Comm_dup(MPI_COMM_WORLD, &world);
-  return workerLoop(world, MPI_COMM_NULL);
+  return workerLoop(world);
 }
 
 namespace {
@@ -436,7 +338,6 @@ struct JobBlock::Impl {
   MPI_Comm failures = MPI_COMM_NULL;  ///< only for the agreement after a failed step
   int rank = 0;
   int size = 1;
-  std::uint64_t steps = 0;
   std::unique_ptr<MpiBlockComm> comm;
   std::unique_ptr<FluidSolver> solver;
   bool stopped = false;
@@ -530,7 +431,7 @@ bool JobBlock::fromFirst(bool value) {
 }
 
 Result<BlockResult> JobBlock::step(const BlockStep& s) {
-  auto result = runStep(*impl_->solver, s, impl_->rank, impl_->steps);
+  auto result = stepBlock(*impl_->solver, s);
   if (result || impl_->stopped) return result;
   impl_->stopped = true;
   if (everyBlockFailed(impl_->failures)) {  // every block reports it and ends cleanly

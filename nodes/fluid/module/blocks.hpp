@@ -6,23 +6,20 @@
 
 #include "vrflow/fluid/solver.hpp"
 
-// The fluid module as several MPI blocks, rank 0 being the module vrflow talks to. Two ways to
-// start them:
-// - through mpirun (the usual one): the manifest's `mpi-ranks="blocks"` makes vrflow start the
-//   module as `mpirun -np blocks vrflow-fluid`; rank 0 joins the run (it opens the run's shared
-//   memory by VRFLOW_SEGMENT_PATH, since mpirun closes inherited descriptors), the other ranks
-//   run as workers on MPI_COMM_WORLD;
-// - without mpirun (VRFLOW_MPIRUN=none, or no Open MPI launcher): the module, started by vrflow
-//   like any other, initialises MPI as a singleton and spawns `blocks - 1` copies of its own
-//   executable with `--block-worker --watch NAME` (MPI_Comm_spawn; NAME: rank 0's WorkerWatch);
-//   together they form one communicator.
-// Each iteration rank 0 broadcasts the step (dt, bodies, what to report) and every rank steps its
-// slab; forces and particles come back to rank 0 through the solver's collective calls.
-// A failure ends the whole group, never leaves rank 0 waiting: blocks whose step failed agree
-// (a barrier bounded to 5 s) that they all failed it, and stop cleanly with rank 0 reporting it;
-// a block that failed alone aborts the MPI job (MPI_Abort; rank 0 returns the error and exits
-// without MPI_Finalize). A dead rank ends an mpirun job; spawned workers are watched by rank 0
-// (worker_watch.hpp), which Open MPI does not tell when one dies.
+// The fluid module as several MPI blocks, two ways, both started by vrflow (only the runtime
+// starts processes):
+// - BlockGroup, one module of `blocks` ranks: the manifest's `mpi-ranks="blocks"` makes vrflow
+//   start the module as `mpirun -np blocks vrflow-fluid`; rank 0 joins the run as the module (it
+//   opens the run's shared memory by VRFLOW_SEGMENT_PATH, since mpirun closes inherited
+//   descriptors), the other ranks run as its workers on MPI_COMM_WORLD. Each iteration rank 0
+//   broadcasts the step (dt, bodies, what to report) and every rank steps its slab; forces and
+//   particles come back to rank 0 through the solver's collective calls.
+// - JobBlock, one module per block: the modules of one MPI job (the manifest's `mpi-job="job"`,
+//   the composite fluid_blocks), which vrflow starts as one mpirun, one rank each.
+// A failure ends the whole group, never leaves a block waiting: blocks whose step failed agree
+// (a barrier bounded to 5 s) that they all failed it, and stop cleanly with the error reported;
+// a block that failed alone aborts the MPI job (MPI_Abort; BlockGroup's rank 0 returns the error
+// and exits without MPI_Finalize). A dead rank ends its mpirun, and so the job.
 
 namespace vrflow::fluid {
 
@@ -48,13 +45,13 @@ struct BlockResult {
 /// Runs one step on this block, with the collective queries the step asks for.
 Result<BlockResult> stepBlock(FluidSolver& solver, const BlockStep& step);
 
-/// Rank 0's side: spawns the workers and drives them.
+/// Rank 0's side of a module started as `blocks` ranks through mpirun: drives the workers.
 class BlockGroup {
  public:
-  /// Starts MPI and `blocks - 1` workers running `executable --block-worker`; sends them the
-  /// settings and the liquid box. The solver returned is rank 0's block.
-  static Result<std::unique_ptr<BlockGroup>> start(const char* executable, int blocks,
-                                                   const FluidSettings& settings,
+  /// Starts MPI on rank 0 of the module's mpirun job and sends the workers (runRankWorker) the
+  /// settings and the liquid box. The solver returned is rank 0's block. An error when this
+  /// process is not rank 0 of such a job (VRFLOW_MPI_RANKS unset: not started by vrflow so).
+  static Result<std::unique_ptr<BlockGroup>> start(int blocks, const FluidSettings& settings,
                                                    const msg::Aabb& fill);
   ~BlockGroup();
   /// Runs one step on every block (collective). After an error the workers are gone or going:
@@ -67,8 +64,6 @@ class BlockGroup {
  private:
   struct Impl;
   explicit BlockGroup(std::unique_ptr<Impl> impl);
-  /// Finalises MPI once the workers are leaving their loops (they finalise the same way).
-  void finish();
   std::unique_ptr<Impl> impl_;
 };
 
@@ -113,14 +108,11 @@ class JobBlock {
   std::unique_ptr<Impl> impl_;
 };
 
-/// A worker's main (the executable run with --block-worker).
-int runBlockWorker(int argc, char** argv);
-
 /// This process's rank when vrflow started the module through mpirun (VRFLOW_MPI_RANKS set),
 /// else -1.
 int mpirunRank();
 
-/// The main of ranks 1 ... N-1 of a module started through mpirun.
+/// The main of ranks 1 ... N-1 of a module started through mpirun (BlockGroup's workers).
 int runRankWorker(int argc, char** argv);
 
 }  // namespace vrflow::fluid

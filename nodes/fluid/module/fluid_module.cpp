@@ -104,9 +104,6 @@ int fail(const std::string& message) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1 && std::string(argv[1]) == "--block-worker") {
-    return fluid::runBlockWorker(argc, argv);
-  }
   if (fluid::mpirunRank() > 0) return fluid::runRankWorker(argc, argv);  // blocks via mpirun
   Module module;
   auto& objectsIn = module.addInput("objects");
@@ -174,7 +171,7 @@ int main(int argc, char** argv) {
     serial = std::move(created.value());
     if (auto status = serial->addLiquidBox(fill); !status) return fail(status.error().message);
   } else {
-    auto started = fluid::BlockGroup::start(argv[0], static_cast<int>(blocks), s, fill);
+    auto started = fluid::BlockGroup::start(static_cast<int>(blocks), s, fill);
     if (!started) return fail(started.error().message);
     group = std::move(started.value());
   }

@@ -124,9 +124,9 @@ std::string notRunningReason(char state) {
 class Supervisor {
  public:
   /// `jobs`: the MPI jobs of `application` (app::mpiJobs); those of several modules start as
-  /// one mpirun each.
-  Supervisor(const app::Application& application, const RunOptions& options,
-             daemon::Daemon& daemon, std::vector<app::MpiJob> jobs);
+  /// one mpirun each. `catalog`: the module types of `application`.
+  Supervisor(const app::Application& application, const app::Catalog& catalog,
+             const RunOptions& options, daemon::Daemon& daemon, std::vector<app::MpiJob> jobs);
 
   RunOutcome run();
 
@@ -139,7 +139,7 @@ class Supervisor {
     ModuleEnd end{"not started", ""};
   };
   std::string jobLabel(const app::MpiJob& job, pid_t mpirun) const;
-  std::optional<std::string> jobsWithoutMpirun() const;
+  std::optional<std::string> refusedWithoutMpirun() const;
   bool startJob(std::size_t jobIndex, int segmentFd, std::vector<std::string> environment,
                 RunOutcome& outcome);
   void reap(RunOutcome& outcome, bool stopping);
@@ -224,6 +224,7 @@ class Supervisor {
  private:
 
   const app::Application& application_;
+  const app::Catalog& catalog_;
   const RunOptions& options_;
   daemon::Daemon& daemon_;
   std::vector<app::MpiJob> jobs_;  ///< only those of several modules
@@ -245,9 +246,10 @@ class Supervisor {
   }
 };
 
-Supervisor::Supervisor(const app::Application& application, const RunOptions& options,
-                       daemon::Daemon& daemon, std::vector<app::MpiJob> jobs)
-    : application_(application), options_(options), daemon_(daemon) {
+Supervisor::Supervisor(const app::Application& application, const app::Catalog& catalog,
+                       const RunOptions& options, daemon::Daemon& daemon,
+                       std::vector<app::MpiJob> jobs)
+    : application_(application), catalog_(catalog), options_(options), daemon_(daemon) {
   // Modules and slots follow the application's module order (Daemon::create).
   VRFLOW_ASSERT(daemon_.modules().size() == application_.modules.size(),
                 "one daemon module per application module");
@@ -266,16 +268,31 @@ std::string Supervisor::jobLabel(const app::MpiJob& job, pid_t mpirun) const {
          first.host + (mpirun > 0 ? "; mpirun pid " + std::to_string(mpirun) : "") + ")";
 }
 
-// With VRFLOW_MPIRUN=none no job of several modules can start (its modules are the ranks of
-// one mpirun): the reason, before anything starts.
-std::optional<std::string> Supervisor::jobsWithoutMpirun() const {
+// With VRFLOW_MPIRUN=none nothing that runs as several MPI ranks can start, since only mpirun
+// starts them: neither a job of several modules (its modules are the ranks of one mpirun) nor a
+// module whose type's mpi-ranks parameter is above 1. The reason, before anything starts.
+std::optional<std::string> Supervisor::refusedWithoutMpirun() const {
   const char* mpirun = std::getenv("VRFLOW_MPIRUN");
-  if (jobs_.empty() || mpirun == nullptr || std::string(mpirun) != "none") return std::nullopt;
-  const app::MpiJob& job = jobs_.front();
-  return jobLabel(job, 0) + " cannot start: VRFLOW_MPIRUN=none, but its " +
-         std::to_string(job.modules.size()) +
-         " modules run as the ranks of one mpirun (unset VRFLOW_MPIRUN, or give each module a "
-         "job of its own)";
+  if (mpirun == nullptr || std::string(mpirun) != "none") return std::nullopt;
+  if (!jobs_.empty()) {
+    const app::MpiJob& job = jobs_.front();
+    return jobLabel(job, 0) + " cannot start: VRFLOW_MPIRUN=none, but its " +
+           std::to_string(job.modules.size()) +
+           " modules run as the ranks of one mpirun (unset VRFLOW_MPIRUN, or give each module a "
+           "job of its own)";
+  }
+  for (std::size_t m = 0; m < daemon_.modules().size(); ++m) {
+    const auto& module = daemon_.modules()[m];
+    if (module.mpiRanks <= 1) continue;
+    const app::Module& declared = application_.modules[m];
+    const app::ModuleType* type = catalog_.findModule(declared.package, declared.type);
+    const std::string param = type != nullptr ? "'" + type->mpiRanksParam + "'" : "mpi-ranks";
+    const std::string ranks = std::to_string(module.mpiRanks);
+    return "module '" + module.id + "' (host " + module.host +
+           ") cannot start: VRFLOW_MPIRUN=none, but its " + param + " = " + ranks + " makes it " +
+           ranks + " MPI ranks of one mpirun (unset VRFLOW_MPIRUN, or set " + param + " to 1)";
+  }
+  return std::nullopt;
 }
 
 // Starts every module of jobs_[jobIndex] as one mpirun; false (and `outcome` says why) when it
@@ -612,7 +629,7 @@ RunOutcome Supervisor::run() {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGCHLD);
-  if (auto refused = jobsWithoutMpirun()) return {kExitRunFailed, "failed", *refused};
+  if (auto refused = refusedWithoutMpirun()) return {kExitRunFailed, "failed", *refused};
   removeStaleMpiBackingFolders();  // of runtimes killed with SIGKILL
   if (auto status = daemon_.start(); !status) {
     return {kExitRunFailed, "failed", status.error().message};
@@ -630,8 +647,7 @@ RunOutcome Supervisor::run() {
       if (!startJob(static_cast<std::size_t>(jobOf_[i]), fd, environment, outcome)) break;
       continue;
     }
-    const char* mpirun = std::getenv("VRFLOW_MPIRUN");
-    const bool viaMpirun = module.mpiRanks > 1 && !(mpirun != nullptr && std::string(mpirun) == "none");
+    const bool viaMpirun = module.mpiRanks > 1;  // VRFLOW_MPIRUN=none: refused above
     auto backing = viaMpirun ? mpiFolder_.path() : Result<std::string>(std::string());
     if (!backing) {
       outcome = {kExitRunFailed, "failed",
@@ -757,7 +773,8 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
     return {kExitRunFailed, "failed", daemon.error().message};
   }
   const auto start = Clock::now();
-  Supervisor supervisor(application, options, **daemon, app::mpiJobs(application, catalog));
+  Supervisor supervisor(application, catalog, options, **daemon,
+                        app::mpiJobs(application, catalog));
   RunOutcome outcome;
   if (options.hostLink != nullptr) {
     if (auto status = options.hostLink->ready(); !status) {
