@@ -48,6 +48,8 @@ std::string mergeReports(const app::Application& application, const std::vector<
   std::stable_sort(outputs.begin(), outputs.end(), [&](const auto& a, const auto& b) {
     return moduleRank(a.value("module", "")) < moduleRank(b.value("module", ""));
   });
+  // Filters in the order of the hosts' shares (each host reports the filters it runs).
+  auto filters = collect("filters");
   ordered_json report;
   report["format"] = "vrflow-run-report/1";
   report["application"] = application.name;
@@ -57,6 +59,7 @@ std::string mergeReports(const app::Application& application, const std::vector<
   report["iterations_requested"] = iterations;
   report["modules"] = modules;
   report["connections"] = connections;
+  report["filters"] = filters;
   report["outputs"] = outputs;
   ordered_json warnings = ordered_json::array();
   ordered_json hosts = ordered_json::array();

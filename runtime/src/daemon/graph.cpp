@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "../module/shm_sink.hpp"
+#include "filters/filters.hpp"
 
 namespace vrflow::daemon {
 namespace {
@@ -54,6 +55,28 @@ std::string Node::param(const std::string& key, const std::string& fallback) con
   return it == params_.end() ? fallback : it->second;
 }
 
+void Node::countDropped(std::size_t i, uint64_t count, std::string_view reason) {
+  if (count == 0) return;
+  if (dropped.size() < inputs.size()) dropped.resize(inputs.size());
+  auto& byReason = dropped[i];
+  const auto found = byReason.find(reason);
+  if (found != byReason.end()) {
+    found->second += count;
+  } else {
+    byReason.emplace(std::string(reason), count);
+  }
+}
+
+bool Node::outputEnded(std::size_t o) const {
+  const auto& sinks = outputs[o];
+  return !sinks.empty() &&
+         std::all_of(sinks.begin(), sinks.end(), [](const auto& sink) { return sink->ended(); });
+}
+
+bool Node::runCountsIterations() const {
+  return graph_->countsIterations;
+}
+
 bool Node::canEmit(std::size_t o) const {
   return std::all_of(outputs[o].begin(), outputs[o].end(),
                      [](const auto& sink) { return sink->hasSpace(); });
@@ -62,8 +85,16 @@ bool Node::canEmit(std::size_t o) const {
 void Node::emit(std::size_t o, MessageRef message) {
   ++emitted;
   ++graph_->operations;
+  if (sent.size() < outputs.size()) {
+    sent.resize(outputs.size());
+    sentNowhere.resize(outputs.size());
+  }
+  ++sent[o];
   auto& sinks = outputs[o];
-  if (sinks.empty()) return;  // nothing connected: dropped here, as in FlowVR
+  if (sinks.empty()) {  // nothing connected: dropped here, as in FlowVR
+    ++sentNowhere[o];
+    return;
+  }
   for (std::size_t i = 0; i + 1 < sinks.size(); ++i) sinks[i]->push(message);
   sinks.back()->push(std::move(message));
 }
@@ -76,32 +107,7 @@ Result<MessageRef> Node::makeEmpty(uint64_t iteration, bool stampsOnly) {
 }
 
 Result<MessageRef> Node::concatenate(std::span<const MessageRef> parts) {
-  std::size_t total = 128;
-  std::vector<msg::MessageView> views;
-  views.reserve(parts.size());
-  for (const auto& part : parts) {
-    auto view = part.view();
-    if (!view) return makeError("filter '" + id_ + "': malformed message: " + view.error().message);
-    views.push_back(*view);
-    total += part.size();
-  }
-  return compose(total, [&](msg::MessageBuilder& builder) {
-    uint64_t iteration = 0;
-    double simTime = 0.0;
-    for (std::size_t i = 0; i < views.size(); ++i) {
-      const auto stamps = views[i].stamps();
-      if (i == 0) {
-        builder.setSource(stamps.source);
-        builder.setTimeStep(stamps.timeStep);
-        builder.setSendTimeNs(stamps.sendTimeNs);
-      }
-      iteration = std::max(iteration, stamps.iteration);
-      simTime = std::max(simTime, stamps.simTime);
-      builder.appendChunks(views[i]);
-    }
-    builder.setIteration(iteration);
-    builder.setSimTime(simTime);
-  });
+  return filters::join(*this, parts, {});
 }
 
 Result<MessageRef> Node::compose(std::size_t sizeHint,
