@@ -181,14 +181,14 @@ struct Module::Impl {
     setState(ipc::ModuleState::Computing);
     return true;
   }
-  // Closes the iteration in progress; `leaving`: the module left its loop (no endIt then).
-  void endIteration(bool leaving) {
+  // Closes the iteration in progress (at the next wait(), or as the module leaves its loop).
+  void endIteration() {
     const uint64_t now = nowNs();
     const uint64_t took = now - iterationStartNs;
     slot->computeNs.fetch_add(took, std::memory_order_relaxed);
     slot->histogram[ipc::histogramBucket(took)].fetch_add(1, std::memory_order_relaxed);
     traceEvent(ipc::TraceKind::Compute, iterationStartNs, now);
-    if (!leaving && slot->endItAfterWait == 0) sendEndIt();
+    if (slot->endItAfterWait == 0) sendEndIt();
     inIteration = false;
     ++iteration;
     slot->iterations.store(iteration, std::memory_order_release);
@@ -240,7 +240,7 @@ Module::Module() : impl_(std::make_unique<Impl>()) {}
 Module::~Module() {
   if (impl_->slot == nullptr) return;
   // Leaving the loop ends the iteration in progress: it counts (docs/module-api.md).
-  if (impl_->inIteration) impl_->endIteration(true);
+  if (impl_->inIteration) impl_->endIteration();
   impl_->finish(ipc::EndCause::LeftLoop);
 }
 
@@ -360,7 +360,7 @@ bool Module::wait() {
   Impl& m = *impl_;
   VRFLOW_ASSERT(m.initialized, "call init() before wait()");
   if (m.finished) return false;
-  if (m.inIteration) m.endIteration(false);
+  if (m.inIteration) m.endIteration();
   if (m.slot->iterationLimit != 0 && m.iteration >= m.slot->iterationLimit) {
     m.finish(ipc::EndCause::IterationLimit);
     return false;
