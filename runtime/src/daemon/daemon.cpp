@@ -690,8 +690,8 @@ void Daemon::Impl::markUnneededModules() {
   for (std::size_t m = 0; m < moduleOutputs.size(); ++m) {
     ipc::ModuleSlot& slot = slots[m];
     if (moduleOutputs[m].empty() || hasDataInputs[m] ||
-        slot.unneeded.load(std::memory_order_relaxed) != 0 ||
-        reachOfModule(m) != OnlyEnded || ended[m].load(std::memory_order_acquire) ||
+        slot.unneeded.load(std::memory_order_relaxed) != 0 || reachOfModule(m) != OnlyEnded ||
+        ended[m].load(std::memory_order_acquire) ||
         slot.state.load(std::memory_order_acquire) ==
             static_cast<uint32_t>(ipc::ModuleState::Finished)) {
       continue;
