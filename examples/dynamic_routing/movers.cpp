@@ -37,9 +37,9 @@ int main() {
   for (std::size_t m = 0; m < meshCount; ++m) meshIds.push_back(module.newId());
   for (std::size_t i = 0; i < count; ++i) bodyIds.push_back(module.newId());
   const auto& rigid = msg::rigidType();
-  while (module.wait()) {
+  // wait() only for an iteration it will do: leaving the loop counts the one in progress.
+  for (uint64_t done = 0; (iterations == 0 || done < iterations) && module.wait(); ++done) {
     const uint64_t it = module.iteration();
-    if (iterations != 0 && it >= iterations) break;
     const double t = static_cast<double>(it) * dt;
     auto out = module.newMessage(count * 256 + meshCount * triangles * 48 + 256);
     auto& builder = out.builder();

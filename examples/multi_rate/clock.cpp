@@ -16,9 +16,9 @@ int main() {
   }
   const double dt = module.paramDouble("dt", 0.2);
   const auto count = static_cast<uint64_t>(module.paramInt("count", 10));
-  while (module.wait()) {
+  // wait() only for an iteration it will do: leaving the loop counts the one in progress.
+  for (uint64_t done = 0; (count == 0 || done < count) && module.wait(); ++done) {
     const uint64_t i = module.iteration();
-    if (count != 0 && i >= count) break;
     auto message = module.newMessage();
     message.builder().setSimTime(static_cast<double>(i) * dt);
     message.builder().setTimeStep(dt);

@@ -48,6 +48,20 @@ std::string mergeReports(const app::Application& application, const std::vector<
   std::stable_sort(outputs.begin(), outputs.end(), [&](const auto& a, const auto& b) {
     return moduleRank(a.value("module", "")) < moduleRank(b.value("module", ""));
   });
+  // As `vrflow run` orders them: the modules' input filters ("module.port") in module order,
+  // then the application's filters in file order.
+  auto filterRank = [&](const ordered_json& f) -> std::size_t {
+    const std::string id = f.value("id", "");
+    if (const auto dot = id.find('.'); dot != std::string::npos)
+      return moduleRank(id.substr(0, dot));
+    for (std::size_t i = 0; i < application.filters.size(); ++i) {
+      if (application.filters[i].id == id) return application.modules.size() + 1 + i;
+    }
+    return application.modules.size() + 1 + application.filters.size();
+  };
+  auto filters = collect("filters");
+  std::stable_sort(filters.begin(), filters.end(),
+                   [&](const auto& a, const auto& b) { return filterRank(a) < filterRank(b); });
   ordered_json report;
   report["format"] = "vrflow-run-report/1";
   report["application"] = application.name;
@@ -57,6 +71,7 @@ std::string mergeReports(const app::Application& application, const std::vector<
   report["iterations_requested"] = iterations;
   report["modules"] = modules;
   report["connections"] = connections;
+  report["filters"] = filters;
   report["outputs"] = outputs;
   ordered_json warnings = ordered_json::array();
   ordered_json hosts = ordered_json::array();

@@ -309,8 +309,8 @@ TEST(CompositeErrors, StructuralProblemsOfACompositeAreFoundWhenLoading) {
           "9:9 required attribute 'count' of <repeat> is missing or empty",
           "9:25 unknown attribute 'cont' on <repeat> (allowed: var, count, start); did you "
           "mean 'count'?",
-          "9:77 unknown attribute 'hots' on <module> (allowed: id, package, type, host); did "
-          "you mean 'host'?"}));
+          "9:77 unknown attribute 'hots' on <module> (allowed: id, package, type, host, endit); "
+          "did you mean 'host'?"}));
 }
 
 TEST(CompositeErrors, NestedRepeatsAreBoundedByTheProductOfTheirCountsBeforeExpanding) {

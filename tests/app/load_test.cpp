@@ -61,6 +61,13 @@ TEST(LoadApplication, ModulesAndFiltersWithoutHostRunOnTheFirstHost) {
   EXPECT_EQ(findHost(*app, "node2")->address, "127.0.0.1");
 }
 
+TEST(LoadApplication, ReadsTheEndItTimingOfAModule) {
+  const Result<Application> app = loadApplicationFile(testing::dataDir() + "/valid_physics.xml");
+  ASSERT_TRUE(app.ok()) << app.error().message;
+  EXPECT_EQ(findModule(*app, "inter")->endIt, EndItTiming::AfterWait);
+  EXPECT_EQ(findModule(*app, "anim")->endIt, EndItTiming::AfterIteration);
+}
+
 TEST(LoadApplication, ReadsEveryElementInFileOrder) {
   const Result<Application> app = loadApplicationFile(testing::dataDir() + "/valid_cluster.xml");
   ASSERT_TRUE(app.ok()) << app.error().message;

@@ -32,9 +32,9 @@ int main() {
   const auto payload =
       static_cast<std::size_t>(std::max<int64_t>(8, module.paramInt("payload", 8)));
   const uint64_t resource = module.newId();
-  while (module.wait()) {
+  // wait() only for an iteration it will do: leaving the loop counts the one in progress.
+  for (uint64_t done = 0; (count == 0 || done < count) && module.wait(); ++done) {
     const uint64_t it = module.iteration();
-    if (count != 0 && it >= count) break;
     auto message = module.newMessage(1024 + payload);
     auto& builder = message.builder();
     for (std::size_t k = 0; k < points.size(); ++k) {

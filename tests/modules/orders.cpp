@@ -15,9 +15,9 @@ int main() {
   const int64_t step = module.paramInt("step", 1);
   const int64_t offset = module.paramInt("offset", 0);
   const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
-  while (module.wait()) {
+  // wait() only for an iteration it will do: leaving the loop counts the one in progress.
+  for (uint64_t done = 0; (count == 0 || done < count) && module.wait(); ++done) {
     const uint64_t it = module.iteration();
-    if (count != 0 && it >= count) break;
     auto message = module.newMessage();
     message.builder().addInt64Stamp("iteration", offset + static_cast<int64_t>(it) * step);
     if (!module.put(out, std::move(message))) break;

@@ -18,9 +18,10 @@ int main() {
   const std::string pattern = module.param("pattern", "10");
   const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
   const uint64_t resource = module.newId();
-  while (module.wait()) {
+  // wait() only for an iteration it will do: leaving the loop counts the one in progress.
+  for (uint64_t done = 0; ((count == 0 || done < count) && !pattern.empty()) && module.wait();
+       ++done) {
     const uint64_t it = module.iteration();
-    if ((count != 0 && it >= count) || pattern.empty()) break;
     const char token = pattern[it % pattern.size()];
     auto message = module.newMessage();
     if (token == '1' || token == 'c') message.builder().addRawResource(resource, true, {});

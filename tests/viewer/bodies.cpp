@@ -36,9 +36,9 @@ int main() {
     }
   }
   std::vector<double> masses(kSide * kSide * 3);
-  while (module.wait()) {
+  // wait() only for an iteration it will do: leaving the loop counts the one in progress.
+  for (std::uint64_t done = 0; (done < count) && module.wait(); ++done) {
     const std::uint64_t it = module.iteration();
-    if (it >= count) break;
     const double t = static_cast<double>(it);
     for (int j = 0; j < kSide; ++j) {
       for (int i = 0; i < kSide; ++i) {

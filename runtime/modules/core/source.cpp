@@ -19,9 +19,9 @@ int main() {
   const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
   std::vector<std::byte> payload(size < 8 ? 8 : size);
   const uint64_t resource = module.newId();
-  while (module.wait()) {
+  // wait() only for an iteration it will do: leaving the loop counts the one in progress.
+  for (uint64_t done = 0; (count == 0 || done < count) && module.wait(); ++done) {
     const uint64_t counter = module.iteration();
-    if (count != 0 && counter >= count) break;
     std::memcpy(payload.data(), &counter, sizeof counter);
     auto message = module.newMessage(payload.size() + 256);
     message.builder().addRawResource(resource, true, payload);

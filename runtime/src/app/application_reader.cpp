@@ -63,12 +63,14 @@ InputConfig readInput(const ReadContext& context, const pugi::xml_node& node) {
 }
 
 Module readModule(const ReadContext& context, const pugi::xml_node& node) {
-  const ElementReader reader(context, node, {"id", "package", "type", "host"});
+  const ElementReader reader(context, node, {"id", "package", "type", "host", "endit"});
   Module module;
   module.id = reader.required("id");
   module.package = reader.required("package");
   module.type = reader.required("type");
   module.host = reader.text("host");
+  module.endIt = reader.keyword("endit", EndItTiming::AfterIteration, parseEndItTiming,
+                                "after-iteration, after-wait");
   module.loc = reader.loc();
   detail::forEachChild(context, node, {"param", "input"}, [&](const pugi::xml_node& child) {
     if (std::string_view(child.name()) == "param") {

@@ -50,6 +50,7 @@ void writeModules(std::string& out, const Application& app) {
     tag.attribute("id", module.id).attribute("package", module.package);
     tag.attribute("type", module.type);
     if (!module.host.empty()) tag.attributeUnless("host", module.host, firstHost);
+    tag.attributeUnless("endit", toString(module.endIt), "after-iteration");
     if (module.params.empty() && module.inputs.empty()) {
       tag.close();
       continue;

@@ -79,6 +79,18 @@ ParamSpec stringParam(std::string name, std::string defaultValue, std::string do
   return param;
 }
 
+ParamSpec stampsParam() {
+  return stringParam("stamps", "",
+                     "how user stamps combine over the joined messages: name:first|sum|min|max, "
+                     "comma-separated; a stamp not listed keeps the first message's value");
+}
+
+std::optional<std::string> checkStamps(const std::vector<Param>& params) {
+  std::string problem;
+  if (!parseStampRules(paramString(params, "stamps", ""), problem)) return problem;
+  return std::nullopt;
+}
+
 std::vector<PortSpec> inToOut(const std::vector<Param>& /*params*/) {
   return {filterPort("in", true, "messages to forward"),
           filterPort("out", false, "the forwarded messages")};
@@ -98,12 +110,14 @@ std::vector<FilterType> builtinFilterTypes() {
   merge.doc = "Waits for one message on each of in0..in{N-1} and emits their concatenation on out.";
   merge.params.push_back(
       intParam("inputs", "2", 1, static_cast<double>(kMaxFilterPorts), "number of inputs N"));
+  merge.params.push_back(stampsParam());
   merge.ports = [](const std::vector<Param>& params) {
     auto ports =
         numberedPorts("in", portCount(params, "inputs", 2), true, "one of the merged inputs");
     ports.push_back(filterPort("out", false, "the merged messages"));
     return ports;
   };
+  merge.check = checkStamps;
   types.push_back(std::move(merge));
 
   FilterType initial;

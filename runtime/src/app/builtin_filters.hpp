@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@ ParamSpec floatParam(std::string name, std::string defaultValue, double min, dou
 ParamSpec boolParam(std::string name, std::string defaultValue, std::string doc);
 ParamSpec enumParam(std::string name, std::vector<std::string> choices, std::string doc);
 ParamSpec stringParam(std::string name, std::string defaultValue, std::string doc);
+/// Parameter `stamps` of the merging filters (merge, gather), and its check.
+ParamSpec stampsParam();
+std::optional<std::string> checkStamps(const std::vector<Param>& params);
 
 /// Ports `in` -> `out`.
 std::vector<PortSpec> inToOut(const std::vector<Param>& params);

@@ -33,7 +33,9 @@ std::string_view elementOf(std::string_view section) {
 // The attributes of a template element in canonical order, as ElementReader wants them.
 ElementReader readerFor(const ReadContext& context, const pugi::xml_node& node) {
   const std::string_view name = node.name();
-  if (name == "module") return ElementReader(context, node, {"id", "package", "type", "host"});
+  if (name == "module") {
+    return ElementReader(context, node, {"id", "package", "type", "host", "endit"});
+  }
   if (name == "filter") return ElementReader(context, node, {"id", "type", "host"});
   if (name == "instance") return ElementReader(context, node, {"id", "composite", "host"});
   if (name == "connection") {
@@ -52,7 +54,8 @@ struct TemplateShape {
 
 TemplateShape shapeOf(std::string_view name, std::string_view sectionElement) {
   if (name == "module") {
-    return {{"id", "package", "type", "host"}, {"id", "package", "type"}, {"param", "input"}};
+    return {
+        {"id", "package", "type", "host", "endit"}, {"id", "package", "type"}, {"param", "input"}};
   }
   if (name == "filter") return {{"id", "type", "host"}, {"id", "type"}, {"param"}};
   if (name == "instance") return {{"id", "composite", "host"}, {"id", "composite"}, {"param"}};

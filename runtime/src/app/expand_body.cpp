@@ -188,6 +188,15 @@ void Expander::addModule(const TemplateElement& element, Frame& frame, Level& le
   module.type = valueOf(*values, "type");
   module.host = valueOf(*values, "host");
   if (module.host.empty()) module.host = frame.host;
+  if (values->count("endit") != 0) {
+    const std::string text = valueOf(*values, "endit");
+    if (const std::optional<EndItTiming> timing = parseEndItTiming(text)) {
+      module.endIt = *timing;
+    } else {
+      error(module.loc.attribute("endit"),
+            mustBe(element, "endit", "one of after-iteration, after-wait", text));
+    }
+  }
   for (const TemplateElement& child : element.children) {
     const std::optional<Values> settings = substitute(child, frame);
     if (!settings) continue;

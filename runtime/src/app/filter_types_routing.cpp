@@ -164,11 +164,13 @@ FilterType gather() {
       "Joins the parts made by a scatter: one message from each of in0..in{N-1}, chunks "
       "concatenated in input order (the semantics of merge).";
   type.params.push_back(intParam("inputs", "2", 1, kMaxPorts, "number of inputs N"));
+  type.params.push_back(stampsParam());
   type.ports = [](const std::vector<Param>& params) {
     auto ports = numberedPorts("in", portCount(params, "inputs", 2), true, "one part");
     ports.push_back(filterPort("out", false, "the joined messages"));
     return ports;
   };
+  type.check = checkStamps;
   return type;
 }
 

@@ -95,6 +95,46 @@ std::vector<std::string> splitList(std::string_view text) {
   return items;
 }
 
+std::optional<std::vector<StampRule>> parseStampRules(std::string_view text, std::string& problem) {
+  std::vector<StampRule> rules;
+  for (const std::string& item : splitList(text)) {
+    const std::size_t colon = item.rfind(':');
+    StampRule rule;
+    rule.name = item.substr(0, colon == std::string::npos ? 0 : colon);
+    while (!rule.name.empty() && rule.name.back() == ' ') rule.name.pop_back();
+    std::string_view how =
+        colon == std::string::npos ? std::string_view() : std::string_view(item).substr(colon + 1);
+    while (!how.empty() && how.front() == ' ') how.remove_prefix(1);
+    if (how == "first") {
+      rule.combine = StampCombine::First;
+    } else if (how == "sum") {
+      rule.combine = StampCombine::Sum;
+    } else if (how == "min") {
+      rule.combine = StampCombine::Min;
+    } else if (how == "max") {
+      rule.combine = StampCombine::Max;
+    } else {
+      problem =
+          "'stamps': '" + item +
+          "' is not name:first, name:sum, name:min or name:max (a user stamp's name, then how "
+          "to combine it)";
+      return std::nullopt;
+    }
+    if (rule.name.empty()) {
+      problem = "'stamps': '" + item + "' has no stamp name before ':'";
+      return std::nullopt;
+    }
+    for (const StampRule& other : rules) {
+      if (other.name == rule.name) {
+        problem = "'stamps': stamp '" + rule.name + "' is listed twice";
+        return std::nullopt;
+      }
+    }
+    rules.push_back(std::move(rule));
+  }
+  return rules;
+}
+
 void setParam(std::vector<Param>& params, std::string_view name, std::string value) {
   for (Param& param : params) {
     if (param.name == name) {
@@ -144,6 +184,16 @@ std::string toString(InputMode mode) {
 std::optional<InputMode> parseInputMode(std::string_view text) {
   if (text == "fifo") return InputMode::Fifo;
   if (text == "latest") return InputMode::Latest;
+  return std::nullopt;
+}
+
+std::string toString(EndItTiming timing) {
+  return timing == EndItTiming::AfterWait ? "after-wait" : "after-iteration";
+}
+
+std::optional<EndItTiming> parseEndItTiming(std::string_view text) {
+  if (text == "after-iteration") return EndItTiming::AfterIteration;
+  if (text == "after-wait") return EndItTiming::AfterWait;
   return std::nullopt;
 }
 

@@ -50,9 +50,15 @@ class InitialFilter final : public Filter {
   long emitted_ = 0;
 };
 
-// One message from every input, concatenated in input order.
+// One message from every input, concatenated in input order; user stamps of the first, or
+// combined by the `stamps` rules.
 class MergeFilter final : public Filter {
  public:
+  explicit MergeFilter(std::vector<app::StampRule> rules = {}) : rules_(std::move(rules)) {}
+  /// Keeps a reference to the last message emitted (lastEmitted()).
+  void keepLast() { keepLast_ = true; }
+  const MessageRef* lastEmitted() const { return last_.valid() ? &last_ : nullptr; }
+
   void process(FilterContext& context) override {
     const std::size_t n = context.inputCount();
     if (n == 0) return;  // nothing will ever arrive
@@ -67,31 +73,46 @@ class MergeFilter final : public Filter {
         context.input(i).pop_front();
       }
       if (n == 1) {
+        if (keepLast_) last_ = parts_.front();
         context.emit(0, std::move(parts_.front()));
         continue;
       }
-      auto merged = context.concatenate(parts_);
+      auto merged = filters::join(context, parts_, rules_);
       if (!merged) {
         context.warn(merged.error().message);
         continue;
       }
+      if (keepLast_) last_ = *merged;
       context.emit(0, std::move(*merged));
     }
   }
 
- protected:
+ private:
   std::vector<MessageRef> parts_;
+  std::vector<app::StampRule> rules_;
+  bool keepLast_ = false;
+  MessageRef last_;
 };
+
+Result<std::unique_ptr<Filter>> makeMerge(const FilterContext& context) {
+  std::string problem;
+  auto rules = app::parseStampRules(context.param("stamps", ""), problem);
+  if (!rules) return makeError("filter '" + context.name() + "': " + problem);
+  return std::unique_ptr<Filter>(std::make_unique<MergeFilter>(std::move(*rules)));
+}
 
 // The default filter of a module's input port: initial messages first, then one message per
 // incoming connection merged into one. `fifo` takes the oldest pending message of each
 // connection (nothing is lost: a synchronous network keeps its data dependencies); `latest`
-// keeps only the newest of each and never blocks the producers (greedy sampling).
+// keeps only the newest of each and never blocks the producers (greedy sampling); in a run that
+// counts iterations, `latest` hands the last message again once every connection has ended,
+// as long as the module runs, so that it reaches its count.
 class PortInputFilter final : public Filter {
  public:
   Status start(FilterContext& context) override {
     initial_ = context.paramInt("initial", 0);
     latest_ = context.param("mode", "fifo") == "latest";
+    if (latest_) merge_.keepLast();
     return {};
   }
   void process(FilterContext& context) override {
@@ -105,22 +126,38 @@ class PortInputFilter final : public Filter {
       --initial_;
     }
     if (initial_ > 0) return;
-    if (latest_) {
-      for (std::size_t i = 0; i < context.inputCount(); ++i) {
-        auto& in = context.input(i);
-        while (in.size() > 1) in.pop_front();
+    if (!latest_) {
+      merge_.process(context);
+      return;
+    }
+    for (std::size_t i = 0; i < context.inputCount(); ++i) {
+      auto& in = context.input(i);
+      while (in.size() > 1) {
+        in.pop_front();
+        context.countDropped(i, 1, "replaced by a newer message");
       }
     }
     merge_.process(context);
+    if (const MessageRef* sent = merge_.lastEmitted()) last_ = *sent;
+    // The ring holds at most one message: serve the last one again whenever the module took it.
+    if (servesLastAfterEnd(context) && context.canEmit(0) && !context.outputEnded(0)) {
+      context.emit(0, last_);
+    }
   }
   bool exhausted(FilterContext& context) const override {
-    return initial_ == 0 && Filter::exhausted(context);
+    if (initial_ != 0) return false;
+    if (servesLastAfterEnd(context)) return context.outputEnded(0);
+    return Filter::exhausted(context);
   }
 
  private:
+  bool servesLastAfterEnd(FilterContext& context) const {
+    return latest_ && last_.valid() && context.runCountsIterations() && Filter::exhausted(context);
+  }
   long initial_ = 0;
   long emittedInitial_ = 0;
   bool latest_ = false;
+  MessageRef last_;
   MergeFilter merge_;
 };
 
@@ -141,8 +178,8 @@ void registerBuiltinFilters(FilterRegistry& registry) {
   registry.add("passthrough", factoryOf<PassthroughFilter>());
   registry.add("broadcast", factoryOf<PassthroughFilter>());
   registry.add("initial", factoryOf<InitialFilter>());
-  registry.add("merge", factoryOf<MergeFilter>());
-  registry.add("gather", factoryOf<MergeFilter>());
+  registry.add("merge", makeMerge);
+  registry.add("gather", makeMerge);
   registry.add("port-input", factoryOf<PortInputFilter>());
   registry.add("port-output", factoryOf<PortOutputFilter>());
   filters::registerMultiplex(registry);

@@ -7,8 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "builtin_filters.hpp"
@@ -54,6 +56,9 @@ struct Daemon::Impl {
   // Per module and port index: the node fed by that port (output filter) or feeding it.
   std::map<std::pair<int, std::string>, Node*> portNodes;
   std::map<std::string, Node*> filterNodes;
+  std::vector<std::vector<Node*>> moduleOutputs;  ///< per module: its connected data outputs' nodes
+  std::vector<bool> hasDataInputs;                ///< per module: a connected data input
+  std::map<const Queue*, Node*> queueOwners;      ///< the node each filter input queue feeds
   struct RemoteInput {
     uint32_t channel;
     Queue* queue;
@@ -70,7 +75,10 @@ struct Daemon::Impl {
   std::string fatal;  ///< first protocol violation by a module (guarded by warningsMutex)
   std::vector<ipc::TraceMerge> traceMerges;  ///< guarded by warningsMutex
   std::vector<QueueSnapshot> snapshot;  ///< guarded by warningsMutex
+  std::vector<FilterStats> filterSnapshot;  ///< guarded by warningsMutex
   void publishSnapshot();
+  std::vector<FilterStats> collectFilterStats() const;
+  void markUnneededModules();
 
   Status build(const app::Application& application, const app::Catalog& catalog);
   Result<Node*> addNode(const std::string& id, const std::string& type,
@@ -112,7 +120,7 @@ Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& ty
                                     std::vector<std::string> outputs) {
   const FilterFactory* factory = FilterRegistry::instance().find(type);
   if (factory == nullptr) return makeError("unknown filter type '" + type + "' for '" + id + "'");
-  auto node = std::make_unique<Node>(*graph, id, std::move(params));
+  auto node = std::make_unique<Node>(*graph, id, type, std::move(params));
   node->inputNames = std::move(inputs);
   node->outputNames = std::move(outputs);
   // Named inputs get their queues when connected; a factory already sees how many there are.
@@ -139,6 +147,9 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
   table->modulesOffset = slotsOffset;
   slots = segment.at<ipc::ModuleSlot>(slotsOffset);
   ended = std::vector<std::atomic<bool>>(application.modules.size());
+  moduleOutputs.resize(application.modules.size());
+  hasDataInputs.resize(application.modules.size());
+  graph->countsIterations = options.iterationLimit != 0 || !options.moduleIterationLimits.empty();
 
   // Which ports are connected.
   std::map<std::pair<std::string, std::string>, int> fanIn;
@@ -178,6 +189,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
       if (slot->traceOffset == 0) return makeError("shared-memory segment too small for tracing");
       new (segment.at<void>(slot->traceOffset)) ipc::TraceRing();
     }
+    slot->endItAfterWait = module.endIt == app::EndItTiming::AfterWait ? 1 : 0;
     modules.push_back({module.id, host, type->executable, static_cast<int>(m)});
 
     // Parameters: manifest defaults, overridden by the file.
@@ -250,6 +262,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         if (!node) return node.error();
         (*node)->outputs[0].push_back(
             std::make_unique<RingSink>(rings[m][p], *slot, static_cast<int>(p), latest, ended[m]));
+        if (!spec.stampsOnly) hasDataInputs[m] = true;
         portNodes[{static_cast<int>(m), spec.name}] = *node;
       } else {
         auto node = addNode(nodeId, "port-output", {}, {"in"}, {"out"});
@@ -261,6 +274,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         (*node)->inputs[0] = &queue;
         graph->sources.push_back({static_cast<int>(m), static_cast<int>(p), rings[m][p], &queue, false});
         portNodes[{static_cast<int>(m), spec.name}] = *node;
+        if (!spec.stampsOnly) moduleOutputs[m].push_back(*node);
         outputFilters.emplace_back(nodeId, static_cast<PortOutputFilter*>((*node)->filter.get()));
       }
     }
@@ -378,6 +392,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         queue.closed = true;
         input = &queue;
       }
+      queueOwners[input] = node.get();
     }
   }
   segment.header().controlOffset = tableOffset;
@@ -446,6 +461,7 @@ void Daemon::Impl::loop() {
     const uint64_t now = nowNs();
     if (now - lastFullCheck > 100'000'000) {
       checkFullQueues(now);
+      markUnneededModules();
       lastFullCheck = now;
     }
     if (now - lastSnapshot > 500'000'000) {
@@ -530,9 +546,11 @@ bool Daemon::Impl::pass() {
   for (auto& node : graph->nodes) {
     if (node->closed) {
       // Nothing will ever consume these: drop them so that producers are not held back.
-      for (auto* queue : node->inputs) {
+      for (std::size_t input = 0; input < node->inputs.size(); ++input) {
+        Queue* queue = node->inputs[input];
         if (!queue->items.empty()) {
           queue->dropped += queue->items.size();
+          node->countDropped(input, queue->items.size(), "filter ended");
           queue->items.clear();
           ++graph->operations;
         }
@@ -591,8 +609,150 @@ void Daemon::Impl::publishSnapshot() {
     next.push_back({queue.from, queue.to, queue.items.size(), queue.capacity, queue.messages,
                     queue.bytes, queue.dropped});
   }
+  auto filters = collectFilterStats();
   std::lock_guard lock(warningsMutex);
   snapshot = std::move(next);
+  filterSnapshot = std::move(filters);
+}
+
+std::vector<FilterStats> Daemon::Impl::collectFilterStats() const {
+  std::vector<FilterStats> all;
+  for (const auto& node : graph->nodes) {
+    FilterStats stats{node->name(), node->type, {}, {}};
+    for (std::size_t i = 0; i < node->inputs.size(); ++i) {
+      FilterPortStats port;
+      port.port = i < node->inputNames.size() ? node->inputNames[i] : node->inputs[i]->from;
+      port.messages = node->inputs[i]->messages;
+      if (i < node->dropped.size()) {
+        for (const auto& [reason, count] : node->dropped[i]) port.dropped[reason] = count;
+      }
+      stats.inputs.push_back(std::move(port));
+    }
+    for (std::size_t o = 0; o < node->outputs.size(); ++o) {
+      FilterPortStats port;
+      port.port = o < node->outputNames.size() ? node->outputNames[o] : "out";
+      port.messages = o < node->sent.size() ? node->sent[o] : 0;
+      if (o < node->sentNowhere.size() && node->sentNowhere[o] != 0) {
+        port.dropped["not connected"] = node->sentNowhere[o];
+      }
+      stats.outputs.push_back(std::move(port));
+    }
+    all.push_back(std::move(stats));
+  }
+  return all;
+}
+
+// A module without data inputs (a source, a capture device) whose data outputs reach only
+// modules that have ended is asked to end (wait() returns false, EndCause::Unneeded): what it
+// sends would be dropped. A module with data inputs is never asked: it goes on with what is
+// buffered for it and ends with its input; for the modules feeding it, it counts as ended when
+// its own data outputs reach only ended modules. Signals (stamps-only ports: beginIt, endIt)
+// do not count, and neither does a connection to another host, which counts as running.
+void Daemon::Impl::markUnneededModules() {
+  enum Reach { Nothing = 0, OnlyEnded = 1, Running = 2 };
+  std::map<const Node*, Reach> nodeMemo;
+  std::map<std::size_t, Reach> moduleMemo;
+  std::function<Reach(const Node*)> reachOfNode;
+  // What a module's data outputs reach, seen from a producer of it.
+  const auto reachOfModule = [&](std::size_t m) -> Reach {
+    if (ended[m].load(std::memory_order_acquire) ||
+        slots[m].state.load(std::memory_order_acquire) ==
+            static_cast<uint32_t>(ipc::ModuleState::Finished)) {
+      return OnlyEnded;
+    }
+    if (const auto found = moduleMemo.find(m); found != moduleMemo.end()) return found->second;
+    moduleMemo[m] = Nothing;  // a cycle back to this module adds nothing
+    Reach reach = Nothing;
+    for (const Node* output : moduleOutputs[m]) reach = std::max(reach, reachOfNode(output));
+    // A module that sends no data anywhere (a viewer, a recorder) does useful work.
+    if (reach == Nothing) reach = Running;
+    moduleMemo[m] = reach;
+    return reach;
+  };
+  reachOfNode = [&](const Node* node) -> Reach {
+    if (const auto found = nodeMemo.find(node); found != nodeMemo.end()) return found->second;
+    nodeMemo[node] = Nothing;  // a cycle back to this node adds nothing
+    Reach reach = Nothing;
+    if (!node->closed) {
+      for (const auto& sinks : node->outputs) {
+        for (const auto& sink : sinks) {
+          Reach one = Running;
+          if (const auto* ring = dynamic_cast<const RingSink*>(sink.get())) {
+            one = reachOfModule(static_cast<std::size_t>(&ring->slot() - slots));
+          } else if (const auto* queue = dynamic_cast<const QueueSink*>(sink.get())) {
+            const auto owner = queueOwners.find(&queue->queue());
+            one = owner == queueOwners.end() ? Running : reachOfNode(owner->second);
+          }
+          reach = std::max(reach, one);
+        }
+      }
+    }
+    nodeMemo[node] = reach;
+    return reach;
+  };
+  for (std::size_t m = 0; m < moduleOutputs.size(); ++m) {
+    ipc::ModuleSlot& slot = slots[m];
+    if (moduleOutputs[m].empty() || hasDataInputs[m] ||
+        slot.unneeded.load(std::memory_order_relaxed) != 0 || reachOfModule(m) != OnlyEnded ||
+        ended[m].load(std::memory_order_acquire) ||
+        slot.state.load(std::memory_order_acquire) ==
+            static_cast<uint32_t>(ipc::ModuleState::Finished)) {
+      continue;
+    }
+    slot.unneeded.store(1, std::memory_order_release);
+    slot.bell.ring();
+  }
+}
+
+bool Daemon::droppedUpstreamOf(int index) const {
+  const Impl& d = *impl_;
+  std::map<const Queue*, const Node*> producers;  // the node that pushes into each queue
+  for (const auto& node : d.graph->nodes) {
+    for (const auto& sinks : node->outputs) {
+      for (const auto& sink : sinks) {
+        if (const auto* queue = dynamic_cast<const QueueSink*>(sink.get())) {
+          producers[&queue->queue()] = node.get();
+        }
+      }
+    }
+  }
+  std::set<const Node*> seen;
+  std::vector<const Node*> pending;
+  const auto addInputsOf = [&](int module) {
+    for (const auto& [key, node] : d.portNodes) {
+      if (key.first == module && node->type == "port-input") pending.push_back(node);
+    }
+  };
+  addInputsOf(index);
+  while (!pending.empty()) {
+    const Node* node = pending.back();
+    pending.pop_back();
+    if (!seen.insert(node).second) continue;
+    for (const auto& byReason : node->dropped) {
+      for (const auto& entry : byReason) {
+        if (entry.second != 0) return true;
+      }
+    }
+    for (const Queue* queue : node->inputs) {
+      if (queue->dropped != 0) return true;
+      if (const auto found = producers.find(queue); found != producers.end()) {
+        pending.push_back(found->second);
+      }
+      for (const auto& source : d.graph->sources) {
+        if (source.queue == queue) addInputsOf(source.module);
+      }
+    }
+  }
+  return false;
+}
+
+std::vector<FilterStats> Daemon::filterSnapshot() {
+  std::lock_guard lock(impl_->warningsMutex);
+  return impl_->filterSnapshot;
+}
+
+std::vector<FilterStats> Daemon::filterStats() const {
+  return impl_->collectFilterStats();
 }
 
 std::vector<QueueSnapshot> Daemon::queueSnapshot() {

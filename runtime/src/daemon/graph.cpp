@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "../module/shm_sink.hpp"
+#include "filters/filters.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow::daemon {
@@ -55,6 +56,28 @@ std::string Node::param(const std::string& key, const std::string& fallback) con
   return it == params_.end() ? fallback : it->second;
 }
 
+void Node::countDropped(std::size_t i, uint64_t count, std::string_view reason) {
+  if (count == 0) return;
+  if (dropped.size() < inputs.size()) dropped.resize(inputs.size());
+  auto& byReason = dropped[i];
+  const auto found = byReason.find(reason);
+  if (found != byReason.end()) {
+    found->second += count;
+  } else {
+    byReason.emplace(std::string(reason), count);
+  }
+}
+
+bool Node::outputEnded(std::size_t o) const {
+  const auto& sinks = outputs[o];
+  return !sinks.empty() &&
+         std::all_of(sinks.begin(), sinks.end(), [](const auto& sink) { return sink->ended(); });
+}
+
+bool Node::runCountsIterations() const {
+  return graph_->countsIterations;
+}
+
 bool Node::canEmit(std::size_t o) const {
   return std::all_of(outputs[o].begin(), outputs[o].end(),
                      [](const auto& sink) { return sink->hasSpace(); });
@@ -63,8 +86,16 @@ bool Node::canEmit(std::size_t o) const {
 void Node::emit(std::size_t o, MessageRef message) {
   ++emitted;
   ++graph_->operations;
+  if (sent.size() < outputs.size()) {
+    sent.resize(outputs.size());
+    sentNowhere.resize(outputs.size());
+  }
+  ++sent[o];
   auto& sinks = outputs[o];
-  if (sinks.empty()) return;  // nothing connected: dropped here, as in FlowVR
+  if (sinks.empty()) {  // nothing connected: dropped here, as in FlowVR
+    ++sentNowhere[o];
+    return;
+  }
   for (std::size_t i = 0; i + 1 < sinks.size(); ++i) sinks[i]->push(message);
   sinks.back()->push(std::move(message));
 }
@@ -77,44 +108,20 @@ Result<MessageRef> Node::makeEmpty(uint64_t iteration, bool stampsOnly) {
 }
 
 Result<MessageRef> Node::concatenate(std::span<const MessageRef> parts) {
-  std::size_t total = 128;
-  std::vector<msg::MessageView> views;
-  views.reserve(parts.size());
-  for (const auto& part : parts) {
-    auto view = part.view();
-    if (!view) return makeError("filter '" + id_ + "': malformed message: " + view.error().message);
-    views.push_back(*view);
-    total += part.size();
+  return filters::join(*this, parts, {});
+}
+
+void Node::recordMerge(std::span<const msg::MessageView> views) {
+  if (!graph_->traceMerges || views.size() < 2) return;
+  // The merged message is stamped with the first part's source and the largest iteration.
+  uint64_t mergedIteration = 0;
+  for (const auto& view : views) mergedIteration = std::max(mergedIteration, view.stamps().iteration);
+  const uint32_t mergedHash = msg::fnv1a32(views.front().stamps().source);
+  for (const auto& view : views) {
+    const auto stamps = view.stamps();
+    graph_->merges.push_back(
+        {mergedHash, msg::fnv1a32(stamps.source), mergedIteration, stamps.iteration});
   }
-  if (graph_->traceMerges && views.size() > 1) {
-    // The merged message is stamped with the first part's source and the largest iteration.
-    uint64_t mergedIteration = 0;
-    for (const auto& view : views)
-      mergedIteration = std::max(mergedIteration, view.stamps().iteration);
-    const uint32_t mergedHash = msg::fnv1a32(views.front().stamps().source);
-    for (const auto& view : views) {
-      const auto stamps = view.stamps();
-      graph_->merges.push_back(
-          {mergedHash, msg::fnv1a32(stamps.source), mergedIteration, stamps.iteration});
-    }
-  }
-  return compose(total, [&](msg::MessageBuilder& builder) {
-    uint64_t iteration = 0;
-    double simTime = 0.0;
-    for (std::size_t i = 0; i < views.size(); ++i) {
-      const auto stamps = views[i].stamps();
-      if (i == 0) {
-        builder.setSource(stamps.source);
-        builder.setTimeStep(stamps.timeStep);
-        builder.setSendTimeNs(stamps.sendTimeNs);
-      }
-      iteration = std::max(iteration, stamps.iteration);
-      simTime = std::max(simTime, stamps.simTime);
-      builder.appendChunks(views[i]);
-    }
-    builder.setIteration(iteration);
-    builder.setSimTime(simTime);
-  });
 }
 
 Result<MessageRef> Node::compose(std::size_t sizeHint,

@@ -37,6 +37,8 @@ class Sink {
   virtual bool hasSpace() const = 0;
   virtual void push(MessageRef message) = 0;
   virtual void close() = 0;
+  /// True when the destination is a module that has ended (what is pushed is dropped).
+  virtual bool ended() const { return false; }
 };
 
 /// A sink that appends to a queue, honouring its capacity and policy.
@@ -48,6 +50,8 @@ class QueueSink final : public Sink {
   }
   void push(MessageRef message) override;
   void close() override { queue_->closed = true; }
+  /// The queue it appends to.
+  const Queue& queue() const { return *queue_; }
 
  private:
   Queue* queue_;
@@ -78,13 +82,15 @@ class RingSink final : public Sink {
   }
   void push(MessageRef message) override;
   void close() override;
-
- private:
-  bool ended() const {
+  bool ended() const override {
     return moduleEnded_->load(std::memory_order_acquire) ||
            slot_->state.load(std::memory_order_acquire) ==
                static_cast<uint32_t>(ipc::ModuleState::Finished);
   }
+  /// The module slot it feeds.
+  const ipc::ModuleSlot& slot() const { return *slot_; }
+
+ private:
   ipc::RingRef ring_;
   ipc::ModuleSlot* slot_;
   int port_;
@@ -97,19 +103,25 @@ class Graph;
 /// A filter with its inputs (queues) and outputs (sinks); also its FilterContext.
 class Node final : public FilterContext {
  public:
-  Node(Graph& graph, std::string id, std::map<std::string, std::string> params)
-      : graph_(&graph), id_(std::move(id)), params_(std::move(params)) {}
+  Node(Graph& graph, std::string id, std::string typeName,
+       std::map<std::string, std::string> params)
+      : type(std::move(typeName)), graph_(&graph), id_(std::move(id)), params_(std::move(params)) {}
 
   const std::string& name() const override { return id_; }
   std::string param(const std::string& key, const std::string& fallback) const override;
   std::size_t inputCount() const override { return inputs.size(); }
   std::deque<MessageRef>& input(std::size_t i) override { return inputs[i]->items; }
   bool inputClosed(std::size_t i) const override { return inputs[i]->closed; }
+  void countDropped(std::size_t i, uint64_t count, std::string_view reason) override;
   std::size_t outputCount() const override { return outputs.size(); }
   bool canEmit(std::size_t o) const override;
   void emit(std::size_t o, MessageRef message) override;
+  bool outputEnded(std::size_t o) const override;
+  bool runCountsIterations() const override;
   Result<MessageRef> makeEmpty(uint64_t iteration, bool stampsOnly) override;
   Result<MessageRef> concatenate(std::span<const MessageRef> parts) override;
+  /// When the run is traced, records which parts a joined message was made of (trace arrows).
+  void recordMerge(std::span<const msg::MessageView> views);
   Result<MessageRef> compose(std::size_t sizeHint,
                              const std::function<void(msg::MessageBuilder&)>& fill) override;
   uint64_t nowNs() const override;
@@ -122,6 +134,10 @@ class Node final : public FilterContext {
   std::vector<std::vector<std::unique_ptr<Sink>>> outputs;
   bool closed = false;
   uint64_t emitted = 0;
+  std::string type;  ///< the filter type ("port-input" / "port-output" for a module's ports)
+  std::vector<uint64_t> sent;         ///< per output: messages emitted
+  std::vector<uint64_t> sentNowhere;  ///< per output: emitted with nothing connected (dropped)
+  std::vector<std::map<std::string, uint64_t, std::less<>>> dropped;  ///< per input, by reason
 
  private:
   Graph* graph_;
@@ -149,9 +165,10 @@ class Graph {
   std::vector<std::unique_ptr<Node>> nodes;
   std::vector<ModuleSource> sources;
   std::vector<std::string> warnings;
-  bool traceMerges = false;             ///< the run is traced: concatenate() records `merges`
+  bool traceMerges = false;             ///< the run is traced: joins record `merges`
   std::vector<ipc::TraceMerge> merges;  ///< taken with the warnings (Daemon::takeTraceMerges)
   uint64_t operations = 0;  ///< bumped on every move, to detect progress
+  bool countsIterations = false;  ///< every module has an iteration count (--iterations)
   uint64_t wakeAtNs = 0;    ///< earliest time a filter asked to be run again; 0 = none
 };
 

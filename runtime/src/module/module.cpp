@@ -128,10 +128,10 @@ struct Module::Impl {
   std::vector<Message> current;         // by port slot index
   std::vector<int> waitOrder;           // connected input slots, in port order
   int endItSlot = -1;
-  bool started = false;
   bool finished = false;
   bool initialized = false;
   bool failed = false;
+  bool inIteration = false;  // wait() returned true and the module has not called it again
   uint64_t iteration = 0;
   uint64_t iterationStartNs = 0;
   ipc::TraceRing* trace = nullptr;  ///< set when the run is traced
@@ -164,6 +164,8 @@ struct Module::Impl {
   bool stopRequested() const {
     return segment.header().stopRequested.load(std::memory_order_acquire) != 0;
   }
+  // The daemon found that every module this one's outputs reach has ended.
+  bool unneeded() const { return slot->unneeded.load(std::memory_order_acquire) != 0; }
   int findPort(std::string_view name, bool input) const {
     for (uint32_t i = 0; i < slot->portCount; ++i) {
       const auto& port = slot->ports[i];
@@ -204,12 +206,20 @@ struct Module::Impl {
     setState(ipc::ModuleState::Computing);
     return true;
   }
+  // Closes the iteration in progress (at the next wait(), or as the module leaves its loop).
   void endIteration() {
     const uint64_t now = nowNs();
     const uint64_t took = now - iterationStartNs;
     slot->computeNs.fetch_add(took, std::memory_order_relaxed);
     slot->histogram[ipc::histogramBucket(took)].fetch_add(1, std::memory_order_relaxed);
     traceEvent(ipc::TraceKind::Compute, iterationStartNs, now);
+    if (slot->endItAfterWait == 0) sendEndIt();
+    inIteration = false;
+    ++iteration;
+    slot->iterations.store(iteration, std::memory_order_release);
+  }
+  // The endIt signal of the iteration in progress, when the port is connected.
+  void sendEndIt() {
     if (endItSlot >= 0 && slot->ports[endItSlot].connected) {
       detail::ShmSink sink(segment, 64);
       msg::MessageBuilder builder(sink);
@@ -227,17 +237,16 @@ struct Module::Impl {
         if (!push(endItSlot, handle)) segment.release(handle);
       }
     }
-    ++iteration;
-    slot->iterations.store(iteration, std::memory_order_release);
   }
   // Reports an error once; the module's exit status becomes non-zero.
   void fail(const std::string& message) {
     if (!failed) std::fprintf(stderr, "vrflow: module '%s': %s\n", id.c_str(), message.c_str());
     failed = true;
   }
-  void finish() {
+  void finish(ipc::EndCause cause) {
     if (finished) return;
     finished = true;
+    slot->endCause.store(static_cast<uint32_t>(cause), std::memory_order_release);
     current.clear();
     setState(ipc::ModuleState::Finished);
     segment.header().daemonBell.ring();
@@ -254,7 +263,10 @@ bool OutputPort::connected() const {
 Module::Module() : impl_(std::make_unique<Impl>()) {}
 
 Module::~Module() {
-  if (impl_->slot != nullptr) impl_->finish();
+  if (impl_->slot == nullptr) return;
+  // Leaving the loop ends the iteration in progress: it counts (docs/module-api.md).
+  if (impl_->inIteration) impl_->endIteration();
+  impl_->finish(ipc::EndCause::LeftLoop);
 }
 
 InputPort& Module::addInput(std::string name) {
@@ -375,16 +387,15 @@ bool Module::wait() {
   Impl& m = *impl_;
   VRFLOW_ASSERT(m.initialized, "call init() before wait()");
   if (m.finished) return false;
-  if (m.started) m.endIteration();
-  m.started = true;
+  if (m.inIteration) m.endIteration();
   if (m.slot->iterationLimit != 0 && m.iteration >= m.slot->iterationLimit) {
-    m.finish();
+    m.finish(ipc::EndCause::IterationLimit);
     return false;
   }
   // Waiting on an input sees a stop request; a module without connected inputs sees it here
   // (or it would run until killed).
-  if (m.waitOrder.empty() && m.stopRequested()) {
-    m.finish();
+  if (m.waitOrder.empty() && (m.stopRequested() || m.unneeded())) {
+    m.finish(m.stopRequested() ? ipc::EndCause::RunStopped : ipc::EndCause::Unneeded);
     return false;
   }
   const uint64_t waitStart = nowNs();
@@ -395,13 +406,13 @@ bool Module::wait() {
     uint64_t handle = 0;
     for (;;) {
       const uint32_t seen = m.slot->bell.prepare();
-      if (m.stopRequested()) {
-        m.finish();
+      if (m.stopRequested() || m.unneeded()) {
+        m.finish(m.stopRequested() ? ipc::EndCause::RunStopped : ipc::EndCause::Unneeded);
         return false;
       }
       if (in.pop(handle)) break;
       if (port.closed.load(std::memory_order_acquire) != 0 && in.empty()) {
-        m.finish();  // end of input: every upstream module has ended
+        m.finish(ipc::EndCause::EndOfInput);  // every upstream module has ended
         return false;
       }
       m.slot->bell.sleep(seen, kPollNs);
@@ -434,6 +445,10 @@ bool Module::wait() {
     m.simTime = stamps.simTime;
     m.timeStep = stamps.timeStep;
   }
+  m.inIteration = true;
+  // FlowVR's timing: the signal leaves as the iteration begins, so that a producer paced by it
+  // computes its next iteration while this one runs.
+  if (m.slot->endItAfterWait != 0) m.sendEndIt();
   m.setState(ipc::ModuleState::Computing);
   return true;
 }

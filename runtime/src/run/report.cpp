@@ -28,6 +28,78 @@ std::string hex(uint64_t value) {
 
 }  // namespace
 
+std::string endCauseName(uint32_t cause) {
+  switch (static_cast<ipc::EndCause>(cause)) {
+    case ipc::EndCause::IterationLimit:
+      return "iteration count";
+    case ipc::EndCause::EndOfInput:
+      return "end of input";
+    case ipc::EndCause::LeftLoop:
+      return "left its loop";
+    case ipc::EndCause::RunStopped:
+      return "run stopped";
+    case ipc::EndCause::Unneeded:
+      return "outputs unneeded";
+    case ipc::EndCause::Running:
+      break;
+  }
+  return "none";
+}
+
+nlohmann::ordered_json filterStatsJson(const std::vector<daemon::FilterStats>& filters) {
+  using nlohmann::ordered_json;
+  const auto ports = [](const std::vector<daemon::FilterPortStats>& list) {
+    ordered_json array = ordered_json::array();
+    for (const auto& p : list) {
+      ordered_json dropped = ordered_json::object();
+      uint64_t total = 0;
+      for (const auto& [reason, count] : p.dropped) {
+        dropped[reason] = count;
+        total += count;
+      }
+      array.push_back({{"port", p.port},
+                       {"messages", p.messages},
+                       {"dropped", total},
+                       {"dropped_by_reason", dropped}});
+    }
+    return array;
+  };
+  ordered_json array = ordered_json::array();
+  for (const auto& f : filters) {
+    if (f.type == "port-output") continue;  // forwards every message: see "outputs"
+    ordered_json j;
+    j["id"] = f.id;
+    j["type"] = f.type;
+    j["inputs"] = ports(f.inputs);
+    j["outputs"] = ports(f.outputs);
+    array.push_back(j);
+  }
+  return array;
+}
+
+std::string shortModules(daemon::Daemon& daemon) {
+  std::string text;
+  for (const auto& module : daemon.modules()) {
+    const ipc::ModuleSlot& slot = daemon.slot(module.slotIndex);
+    const uint64_t done = slot.iterations.load();
+    const uint32_t cause = slot.endCause.load();
+    // Stopped by the run (an error or Ctrl-C, reported as such) or unneeded: not short.
+    const bool counts = cause == static_cast<uint32_t>(ipc::EndCause::EndOfInput) ||
+                        cause == static_cast<uint32_t>(ipc::EndCause::LeftLoop);
+    if (slot.iterationLimit == 0 || done >= slot.iterationLimit || !counts) continue;
+    // A filter or connection that dropped messages on the way explains a short input (a gate,
+    // decimate; the report's "filters" and "connections" count them).
+    if (cause == static_cast<uint32_t>(ipc::EndCause::EndOfInput) &&
+        daemon.droppedUpstreamOf(module.slotIndex)) {
+      continue;
+    }
+    text += (text.empty() ? "" : "; ") + std::string("module '") + module.id + "' did " +
+            std::to_string(done) + " of " + std::to_string(slot.iterationLimit) + " iterations (" +
+            endCauseName(cause) + ")";
+  }
+  return text;
+}
+
 std::string reportJson(const app::Application& application, daemon::Daemon& daemon,
                        const std::vector<ModuleEnd>& ends, const RunOutcome& outcome,
                        const RunOptions& options, double wallSeconds,
@@ -56,6 +128,7 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
       m["exit"] = ends[i].exit;
       if (!ends[i].cause.empty()) m["cause"] = ends[i].cause;
     }
+    m["end"] = endCauseName(slot.endCause.load());
     ordered_json timing;
     const double computeS = static_cast<double>(slot.computeNs.load()) / 1e9;
     timing["iteration_ms_mean"] = iterations ? computeS * 1e3 / static_cast<double>(iterations) : 0.0;
@@ -79,6 +152,7 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
     connections.push_back(j);
   }
   report["connections"] = connections;
+  report["filters"] = filterStatsJson(daemon.filterStats());
 
   ordered_json outputs = ordered_json::array();
   for (const auto& o : daemon.outputStats()) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,18 @@ struct ModuleEnd {
   std::string exit;   ///< "status 0", "signal 9", "running" (killed at stop)
   std::string cause;  ///< why it ended, when the runtime knows more than `exit` (empty if not)
 };
+
+/// Why a module ended, in words ("iteration count", "end of input", ...; ipc::EndCause).
+std::string endCauseName(uint32_t cause);
+
+/// The per-port counters of the application's filters and of the modules' default input
+/// filters (the report's "filters" and the live statistics' "filters").
+nlohmann::ordered_json filterStatsJson(const std::vector<daemon::FilterStats>& filters);
+
+/// The modules that ended short of their iteration count (--iterations) because an input ended
+/// (with no drop upstream to explain it) or because they left their loop, as one sentence
+/// naming each with its count and cause; empty when there is none.
+std::string shortModules(daemon::Daemon& daemon);
 
 /// The run report as JSON text (what writeReport() writes).
 std::string reportJson(const app::Application& application, daemon::Daemon& daemon,

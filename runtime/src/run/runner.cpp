@@ -217,6 +217,7 @@ class Supervisor {
                              {"bytes", q.bytes}, {"dropped", q.dropped}});
     }
     j["connections"] = connections;
+    j["filters"] = filterStatsJson(daemon_.filterSnapshot());
     return j.dump();
   }
   Clock::time_point lastStats_{};
@@ -785,6 +786,10 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   std::vector<std::string> drainWarnings;
   if (options.hostLink != nullptr) drainWarnings = options.hostLink->drain(outcome);
   (*daemon)->shutdown();
+  // --iterations N: a module short of its count fails the run, naming it and why.
+  if (const std::string cut = shortModules(**daemon); outcome.exitCode == kExitOk && !cut.empty()) {
+    outcome = {kExitRunFailed, "short", "ended short of --iterations: " + cut};
+  }
   supervisor.drainTraces();
   for (std::size_t i = 0; i < (*daemon)->modules().size(); ++i) {
     const auto& slot = (*daemon)->slot((*daemon)->modules()[i].slotIndex);

@@ -40,12 +40,19 @@ struct InputConfig {
   SourceLocation loc;
 };
 
+/// When a module sends its `endIt` signal: as it calls wait() again, at the end of the
+/// iteration (vrflow's default: a producer paced by it alternates with this module), or as
+/// wait() returns, at the start of the iteration (FlowVR's timing: the producer computes its
+/// next iteration while this module computes).
+enum class EndItTiming { AfterIteration, AfterWait };
+
 /// A module instance: one OS process running `package/type` on `host`.
 struct Module {
   std::string id;
   std::string package;
   std::string type;
   std::string host;
+  EndItTiming endIt = EndItTiming::AfterIteration;  ///< attribute `endit`
   std::vector<Param> params;
   std::vector<InputConfig> inputs;
   SourceLocation loc;
@@ -156,6 +163,17 @@ void setParam(std::vector<Param>& params, std::string_view name, std::string val
 /// items dropped.
 std::vector<std::string> splitList(std::string_view text);
 
+/// How a merging filter (merge, gather) combines a user stamp over the messages it joins:
+/// the first message's value, or the sum, minimum or maximum of the numeric values.
+enum class StampCombine { First, Sum, Min, Max };
+/// One user stamp's combination (parameter `stamps` of merge and gather).
+struct StampRule {
+  std::string name;
+  StampCombine combine = StampCombine::First;
+};
+/// The rules written "name:first|sum|min|max, ..."; nullopt with `problem` set when malformed.
+std::optional<std::vector<StampRule>> parseStampRules(std::string_view text, std::string& problem);
+
 /// The "node.port" text of an endpoint.
 std::string toString(const Endpoint& endpoint);
 /// Splits "node.port" at its first '.'; nullopt when either side would be empty.
@@ -169,6 +187,10 @@ std::optional<QueuePolicy> parseQueuePolicy(std::string_view text);
 std::string toString(InputMode mode);
 /// The mode written `text`, or nullopt.
 std::optional<InputMode> parseInputMode(std::string_view text);
+/// "after-iteration" or "after-wait".
+std::string toString(EndItTiming timing);
+/// The timing written `text`, or nullopt.
+std::optional<EndItTiming> parseEndItTiming(std::string_view text);
 
 /// The host a module or filter runs on: `host`, or the first host when empty.
 std::string effectiveHost(const Application& app, const std::string& host);

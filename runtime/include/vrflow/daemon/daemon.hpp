@@ -65,6 +65,21 @@ struct OutputStats {
   uint64_t lastIteration = 0;
 };
 
+/// One port of a filter (or of a module port's default filter) and what went through it.
+struct FilterPortStats {
+  std::string port;       ///< the port's name; a variadic input: the connection's source
+  uint64_t messages = 0;  ///< input: messages that reached the filter; output: messages emitted
+  /// Input: messages the filter consumed without passing them on, by reason; output: messages
+  /// emitted with nothing connected ("not connected").
+  std::map<std::string, uint64_t, std::less<>> dropped;
+};
+
+/// Per-port counters of one filter, for the run report and the live statistics.
+struct FilterStats {
+  std::string id, type;
+  std::vector<FilterPortStats> inputs, outputs;
+};
+
 /// A connection's live counters, published by the routing thread about twice a second.
 struct QueueSnapshot {
   std::string from, to;
@@ -106,9 +121,15 @@ class Daemon {
   std::vector<ipc::TraceMerge> takeTraceMerges();
   /// Live queue lengths and counters (thread-safe; at most about 0.5 s old).
   std::vector<QueueSnapshot> queueSnapshot();
+  /// Live per-port counters of every filter (thread-safe; at most about 0.5 s old).
+  std::vector<FilterStats> filterSnapshot();
   /// Statistics; call after shutdown().
   std::vector<ConnectionStats> connectionStats() const;
   std::vector<OutputStats> outputStats() const;
+  std::vector<FilterStats> filterStats() const;
+  /// True when a filter or connection upstream of module `index` (through filters and other
+  /// modules) dropped messages: a reason for it to receive fewer than its producers sent.
+  bool droppedUpstreamOf(int index) const;
 
  private:
   struct Impl;

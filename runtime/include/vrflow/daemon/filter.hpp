@@ -7,6 +7,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "vrflow/base/result.hpp"
@@ -36,12 +37,23 @@ class FilterContext {
   virtual std::deque<MessageRef>& input(std::size_t i) = 0;
   /// True when input `i` will never receive another message (its buffer may still hold some).
   virtual bool inputClosed(std::size_t i) const = 0;
+  /// Counts `count` messages of input `i` that the filter consumed without passing them on
+  /// (whole or merged into what it emits), for the run report's per-port counters; `reason`
+  /// says why in a few words ("gate closed", "replaced by a newer message").
+  virtual void countDropped(std::size_t i, uint64_t count, std::string_view reason) = 0;
 
   virtual std::size_t outputCount() const = 0;
   /// True when every destination of output `o` can take one more message now.
   virtual bool canEmit(std::size_t o) const = 0;
   /// Sends a message to every destination of output `o`.
   virtual void emit(std::size_t o, MessageRef message) = 0;
+  /// True when output `o` has destinations and every one of them is a module that has ended
+  /// (it takes and drops everything): emitting there is pointless.
+  virtual bool outputEnded(std::size_t o) const = 0;
+  /// True when the run gives every module an iteration count (`--iterations`). Sampling filters
+  /// then serve their newest message again after their data has ended, so that their consumer
+  /// reaches its count (docs/filters.md).
+  virtual bool runCountsIterations() const = 0;
 
   /// A new message with no chunk (for initial messages and signals).
   virtual Result<MessageRef> makeEmpty(uint64_t iteration, bool stampsOnly) = 0;

@@ -14,6 +14,16 @@ inline constexpr int kHistogramBuckets = 256;
 /// What a module is doing, as seen by the daemon (for deadlock reports and monitoring).
 enum class ModuleState : uint32_t { Starting = 0, Waiting, Computing, Putting, Finished };
 
+/// Why a module left the run (ModuleSlot::endCause), for the run report.
+enum class EndCause : uint32_t {
+  Running = 0,     ///< not ended, or ended without a word (killed, crashed)
+  IterationLimit,  ///< wait() returned false at the module's iteration count (--iterations)
+  EndOfInput,      ///< wait() returned false: an input ended (every producer of it ended)
+  LeftLoop,        ///< the module left its loop by itself (its Module was destroyed)
+  RunStopped,      ///< wait() returned false: the run stopped (Ctrl-C, --timeout, an error)
+  Unneeded,        ///< wait() returned false: every module its outputs reach has ended
+};
+
 /// One port of a module, shared between the module and the daemon.
 struct PortSlot {
   char name[kNameBytes] = {};
@@ -48,6 +58,9 @@ struct ModuleSlot {
   std::atomic<uint64_t> histogram[kHistogramBuckets];  ///< iteration durations, log-linear buckets
   uint64_t traceOffset = 0;                   ///< a TraceRing when the run is traced; 0: not traced
   std::atomic<uint32_t> outOfMemory{0};       ///< set by the module when an allocation failed
+  uint32_t endItAfterWait = 0;                ///< 1: endIt leaves as wait() returns (FlowVR)
+  std::atomic<uint32_t> unneeded{0};          ///< 1: the daemon asks it to end (EndCause::Unneeded)
+  std::atomic<uint32_t> endCause{0};          ///< an EndCause, written once as the module ends
 };
 
 /// What a module records when the run is traced (`--trace`), in steady-clock ns.

@@ -75,7 +75,11 @@ class Module {
   Status init();
 
   /// Ends the previous iteration and waits for one message on every connected input port.
-  /// False when the run stops (iteration limit, end of input, Ctrl-C): leave the loop then.
+  /// False when the module must end (its iteration count, end of input, the run stops, or
+  /// every module its outputs reach has ended): leave the loop then. Each true return begins
+  /// an iteration, which counts once the module calls wait() again or leaves its loop
+  /// (destroys the Module): call wait() only for an iteration you will do
+  /// (docs/module-api.md).
   bool wait();
 
   /// The message received on `port` in this iteration (invalid if the port is unconnected).
@@ -96,7 +100,8 @@ class Module {
   /// Simulation time and step of this iteration: from the first input message's stamps.
   double simTime() const;
   double timeStep() const;
-  /// True once the run asked every module to stop.
+  /// True once the run asked every module to stop (not set when only this module is asked to
+  /// end because nothing needs its outputs: wait() returns false then).
   bool stopRequested() const;
 
   /// Parameters from the application file (defaults from the manifest filled in).

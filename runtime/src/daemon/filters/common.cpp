@@ -1,3 +1,7 @@
+#include <algorithm>
+#include <variant>
+
+#include "../graph.hpp"
 #include "filters.hpp"
 
 namespace vrflow::daemon::filters {
@@ -17,6 +21,93 @@ std::optional<msg::MessageView> viewOrWarn(FilterContext& context, const Message
     return std::nullopt;
   }
   return *view;
+}
+
+namespace {
+
+// The combination of `rule` over the parts' values of that stamp; nullopt when no part has a
+// numeric one. Integers stay integers unless a part holds a float.
+std::optional<std::variant<std::int64_t, double, std::string>> combine(
+    const app::StampRule& rule, const std::vector<msg::MessageView>& views) {
+  bool any = false, allInt = true;
+  std::int64_t intValue = 0;
+  double floatValue = 0.0;
+  for (const auto& view : views) {
+    const auto stamp = view.stamps().user.find(rule.name);
+    if (!stamp) continue;
+    const auto asInt = stamp->asInt64();
+    const auto asFloat =
+        asInt ? std::optional<double>(static_cast<double>(*asInt)) : stamp->asDouble();
+    if (!asFloat) continue;
+    if (!asInt) allInt = false;
+    if (!any) {
+      intValue = asInt.value_or(0);
+      floatValue = *asFloat;
+      any = true;
+      continue;
+    }
+    switch (rule.combine) {
+      case app::StampCombine::Sum:
+        intValue += asInt.value_or(0);
+        floatValue += *asFloat;
+        break;
+      case app::StampCombine::Min:
+        intValue = std::min(intValue, asInt.value_or(intValue));
+        floatValue = std::min(floatValue, *asFloat);
+        break;
+      case app::StampCombine::Max:
+        intValue = std::max(intValue, asInt.value_or(intValue));
+        floatValue = std::max(floatValue, *asFloat);
+        break;
+      case app::StampCombine::First:
+        break;
+    }
+  }
+  if (!any) return std::nullopt;
+  if (allInt) return intValue;
+  return floatValue;
+}
+
+}  // namespace
+
+Result<MessageRef> join(FilterContext& context, std::span<const MessageRef> parts,
+                        const std::vector<app::StampRule>& rules) {
+  std::size_t total = 128;
+  std::vector<msg::MessageView> views;
+  views.reserve(parts.size());
+  for (const auto& part : parts) {
+    auto view = part.view();
+    if (!view) {
+      return makeError("filter '" + context.name() +
+                       "': malformed message: " + view.error().message);
+    }
+    views.push_back(*view);
+    total += part.size();
+  }
+  if (views.empty()) return makeError("filter '" + context.name() + "': nothing to join");
+  // A traced run draws an arrow from every part of a joined message (the daemon's nodes only).
+  if (auto* node = dynamic_cast<Node*>(&context)) node->recordMerge(views);
+  msg::Stamps stamps = views.front().stamps().toStamps();
+  for (const auto& view : views) {
+    stamps.iteration = std::max(stamps.iteration, view.stamps().iteration);
+    stamps.simTime = std::max(stamps.simTime, view.stamps().simTime);
+  }
+  for (const app::StampRule& rule : rules) {
+    if (rule.combine == app::StampCombine::First) continue;
+    const auto value = combine(rule, views);
+    if (!value) continue;
+    const auto found = std::find_if(stamps.user.begin(), stamps.user.end(),
+                                    [&](const msg::UserStamp& s) { return s.name == rule.name; });
+    if (found != stamps.user.end()) {
+      found->value = *value;
+    } else {
+      stamps.user.push_back({rule.name, *value});
+    }
+  }
+  return context.compose(total + 64 * stamps.user.size(), [&](msg::MessageBuilder& builder) {
+    builder.setStamps(stamps);
+    for (const auto& view : views) builder.appendChunks(view);
+  });
 }
 
 Result<MessageRef> restamp(FilterContext& context, const msg::MessageView& message,

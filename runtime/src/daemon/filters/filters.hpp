@@ -3,7 +3,10 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
+#include <vector>
 
+#include "vrflow/app/model.hpp"
 #include "vrflow/daemon/filter.hpp"
 #include "vrflow/message/reader.hpp"
 
@@ -36,6 +39,12 @@ bool allInputsDone(FilterContext& context);
 
 /// The message's parsed view, or nullopt after warning that it is malformed.
 std::optional<msg::MessageView> viewOrWarn(FilterContext& context, const MessageRef& message);
+
+/// One message joining `parts`: their chunks in order, the stamps of the first (user stamps
+/// included), the largest iteration and simulation time; each of `rules` combines a user stamp
+/// over the parts that carry it (FilterContext::concatenate is join with no rule).
+Result<MessageRef> join(FilterContext& context, std::span<const MessageRef> parts,
+                        const std::vector<app::StampRule>& rules);
 
 /// A copy of `message` (stamps, flag, chunks) with its iteration stamp replaced.
 Result<MessageRef> restamp(FilterContext& context, const msg::MessageView& message,

@@ -24,6 +24,7 @@ class GateFilter final : public Filter {
         if (!context.canEmit(0)) return;
         context.emit(0, std::move(in.front()));
       }
+      if (!open_) context.countDropped(kIn, 1, "gate closed");
       in.pop_front();  // closed: dropped, so the producer is never held back
     }
   }

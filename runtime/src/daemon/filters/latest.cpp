@@ -1,4 +1,6 @@
 // latest: greedy sampling. Keeps the newest message of `in`; each `sync` message forwards it.
+// In a run that counts iterations, the newest message is served again once `in` has ended, so
+// that the consumer reaches its count.
 #include "filters.hpp"
 
 namespace vrflow::daemon::filters {
@@ -20,16 +22,20 @@ class LatestFilter final : public Filter {
 
   void process(FilterContext& context) override {
     auto& in = context.input(kIn);
-    while (in.size() > 1) in.pop_front();  // only the newest matters: the producer never waits
+    while (in.size() > 1) {  // only the newest matters: the producer never waits
+      in.pop_front();
+      context.countDropped(kIn, 1, "replaced by a newer message");
+    }
     auto& sync = context.input(kSync);
     triggers_ += sync.size();
     sync.clear();
+    const bool again = repeat_ || servesLastAfterEnd(context);
     while (triggers_ > 0 && context.canEmit(0)) {
       if (!in.empty()) {
-        if (repeat_) last_ = in.front();
+        last_ = in.front();
         context.emit(0, std::move(in.front()));
         in.pop_front();
-      } else if (repeat_ && last_.valid()) {
+      } else if (again && last_.valid() && !context.outputEnded(0)) {
         context.emit(0, last_);
       } else {
         return;  // the trigger waits for the next message
@@ -38,15 +44,23 @@ class LatestFilter final : public Filter {
     }
   }
 
-  // Ends with the data (no new message will come) or with the triggers.
+  // Ends with the data (no new message will come) or with the triggers; when it serves its
+  // last message after the data, with the triggers or the consumer.
   bool exhausted(FilterContext& context) const override {
     const bool dataDone = context.inputClosed(kIn) && context.input(kIn).empty();
     const bool syncDone =
         context.inputClosed(kSync) && context.input(kSync).empty() && triggers_ == 0;
+    if (dataDone && last_.valid() && servesLastAfterEnd(context)) {
+      return syncDone || context.outputEnded(0);
+    }
     return dataDone || syncDone;
   }
 
  private:
+  static bool servesLastAfterEnd(FilterContext& context) {
+    return context.runCountsIterations() && context.inputClosed(kIn) && context.input(kIn).empty();
+  }
+
   bool repeat_;
   uint64_t triggers_ = 0;
   MessageRef last_;

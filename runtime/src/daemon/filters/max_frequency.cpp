@@ -14,7 +14,10 @@ class MaxFrequencyFilter final : public Filter {
   void process(FilterContext& context) override {
     auto& in = context.input(0);
     if (keepLatest_) {
-      while (in.size() > 1) in.pop_front();
+      while (in.size() > 1) {
+        in.pop_front();
+        context.countDropped(0, 1, "replaced by a newer message");
+      }
     }
     if (in.empty()) return;
     const uint64_t now = context.nowNs();

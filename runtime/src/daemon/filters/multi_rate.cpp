@@ -221,6 +221,7 @@ class DecimateFilter final : public Filter {
           stepSum_ += view->stamps().timeStep;
           if (merge_) group_.fold(*view);
         }
+        if (!merge_) context.countDropped(0, 1, "decimated");
         in.pop_front();
         ++seen_;
         continue;

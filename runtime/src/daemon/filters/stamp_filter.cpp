@@ -33,6 +33,7 @@ class StampFilter final : public Filter {
           break;
         }
         in.pop_front();
+        context.countDropped(kIn, 1, "not ordered");
       }
       if (in.empty()) {
         if (!context.inputClosed(kIn)) return;  // wait for the ordered message
