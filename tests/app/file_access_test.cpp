@@ -246,7 +246,12 @@ TEST(Executables, RelativePathIsResolvedFromTheManifestFolderEvenWhenMissing) {
 
   Application app;
   app.hosts.push_back(Host{"localhost", "127.0.0.1", {}});
-  app.modules.push_back(Module{"m1", "pkg", "m", "localhost", {}, {}, {}});
+  Module module;
+  module.id = "m1";
+  module.package = "pkg";
+  module.type = "m";
+  module.host = "localhost";
+  app.modules.push_back(module);
   const auto problems = checkModuleFiles(app, catalog, ModuleFileChecks{.executables = true});
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems[0].message, "module 'm1' (pkg/m): cannot start its executable '" +
