@@ -47,14 +47,17 @@ struct Context {
   int hosts = 1;      // > 1: `vrflow launch --backend local` over 127.0.0.1 ... 127.0.0.H
 };
 
-std::string hostId(int h) { return "h" + std::to_string(h); }
+std::string hostId(int h) {
+  return "h" + std::to_string(h);
+}
 
 // The <hosts> element of ctx.hosts loopback hosts, or nothing for one host.
 std::string hostsXml(const Context& ctx) {
   if (ctx.hosts < 2) return "";
   std::string xml = "  <hosts>\n";
   for (int h = 0; h < ctx.hosts; ++h) {
-    xml += "    <host id=\"" + hostId(h) + "\" address=\"127.0.0." + std::to_string(h + 1) + "\"/>\n";
+    xml +=
+        "    <host id=\"" + hostId(h) + "\" address=\"127.0.0." + std::to_string(h + 1) + "\"/>\n";
   }
   return xml + "  </hosts>\n";
 }
@@ -75,12 +78,12 @@ bool runApp(const Context& ctx, const std::string& name, const std::string& xml,
   const fs::path reportFile = ctx.work / (name + ".json");
   std::ofstream(app) << xml;
   fs::remove(reportFile);
-  const std::string command = "cd " + q(ctx.work.string()) + " && " +
-                              q((ctx.bin / "vrflow").string()) + " --packages " +
-                              q(ctx.packages.string()) +
-                              (ctx.hosts > 1 ? " launch --backend local " : " run --no-progress --shm-size 1024 ") +
-                              q(app.string()) + " --timeout 120 --report " +
-                              q(reportFile.string()) + " > " + q(name + ".log") + " 2>&1";
+  const std::string command =
+      "cd " + q(ctx.work.string()) + " && " + q((ctx.bin / "vrflow").string()) + " --packages " +
+      q(ctx.packages.string()) +
+      (ctx.hosts > 1 ? " launch --backend local " : " run --no-progress --shm-size 1024 ") +
+      q(app.string()) + " --timeout 120 --report " + q(reportFile.string()) + " > " +
+      q(name + ".log") + " 2>&1";
   const int status = std::system(command.c_str());
   if (status != 0) {
     std::fprintf(stderr, "vrflow-bench-patterns: %s failed (status %d); see %s\n", name.c_str(),
@@ -128,14 +131,14 @@ int filterHost(const Context& ctx, int x, int m, int n, int fanout) {
 }
 
 bool broadcast(const Context& ctx, const std::string& mode, int n, int messages, int fanout) {
-  std::string modules = "  <modules>\n    <module id=\"src\" package=\"core\" type=\"source\"" + onHost(ctx, 0) + ">\n" +
-                        param("size", "1048576") + param("count", std::to_string(messages)) +
-                        "    </module>\n";
+  std::string modules = "  <modules>\n    <module id=\"src\" package=\"core\" type=\"source\"" +
+                        onHost(ctx, 0) + ">\n" + param("size", "1048576") +
+                        param("count", std::to_string(messages)) + "    </module>\n";
   std::string filters, connections;
   for (int i = 0; i < n; ++i) {
     modules += "    <module id=\"r" + std::to_string(i) +
-               "\" package=\"broadcast\" type=\"checker\"" + onHost(ctx, receiverHost(ctx, i, n)) + ">\n" +
-               param("file", "received" + std::to_string(i) + ".csv") + "    </module>\n";
+               "\" package=\"broadcast\" type=\"checker\"" + onHost(ctx, receiverHost(ctx, i, n)) +
+               ">\n" + param("file", "received" + std::to_string(i) + ".csv") + "    </module>\n";
   }
   if (mode == "flat") {
     for (int i = 0; i < n; ++i)
@@ -184,7 +187,8 @@ bool broadcast(const Context& ctx, const std::string& mode, int n, int messages,
   std::sort(toLast.begin(), toLast.end());
   const double median = toLast.empty() ? 0 : toLast[toLast.size() / 2];
   std::printf(
-      "{\"pattern\":\"broadcast\",\"mode\":\"%s\",\"receivers\":%d,\"hosts\":%d,\"ms_to_last\":%.3f,"
+      "{\"pattern\":\"broadcast\",\"mode\":\"%s\",\"receivers\":%d,\"hosts\":%d,\"ms_to_last\":%."
+      "3f,"
       "\"source_host_bytes\":%.0f}\n",
       mode.c_str(), n, ctx.hosts, median / 1e6, bytesFrom(report, "src.out"));
   std::fflush(stdout);
@@ -256,7 +260,8 @@ bool demoRouting(const Context& ctx, const std::string& scene, const std::string
   std::stringstream text;
   text << in.rdbuf();
   std::string xml = text.str();
-  replaceAll(xml, "\"../paper_scene/", "\"" + (folder.parent_path() / "paper_scene").string() + "/");
+  replaceAll(xml, "\"../paper_scene/",
+             "\"" + (folder.parent_path() / "paper_scene").string() + "/");
   replaceAll(xml, param("width", "480"), param("width", "96"));
   replaceAll(xml, param("height", "270"), param("height", "54"));
   const std::string frames = (ctx.work / ("frames-" + scene + "-" + mode)).string();
@@ -365,7 +370,8 @@ int main(int argc, char** argv) {
   if (only.empty() || only == "routing") {
     Context oneHost = ctx;
     oneHost.hosts = 1;  // the routing cases count bytes, which hosts do not change
-    for (const char* mode : {"none", "dynamic"}) ok = routing(oneHost, mode, bodies, iterations) && ok;
+    for (const char* mode : {"none", "dynamic"})
+      ok = routing(oneHost, mode, bodies, iterations) && ok;
     if (fs::exists(ctx.bin / "vrflow-viewer")) {
       for (const char* mode : {"none", "dynamic"})
         ok = demoRouting(oneHost, "demo", mode, demoIterations) && ok;

@@ -12,6 +12,7 @@
 // the rigid package's `boxes:N` scenes (rigid bodies only, in all three forms).
 // One JSON line per result: {"variant": V, "objects": N, "iterations_per_s": X, ...}.
 #include <btBulletDynamicsCommon.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -21,9 +22,8 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <set>
-#include <unistd.h>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -45,12 +45,14 @@ constexpr double kDt = 0.01;
 const msg::Vec3 kGravity{0, -9.81, 0};
 
 struct Context {
-  fs::path bin;      // build/bin
-  fs::path source;   // the repository
-  fs::path work;     // scratch folder
+  fs::path bin;     // build/bin
+  fs::path source;  // the repository
+  fs::path work;    // scratch folder
 };
 
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+std::string quote(const std::string& s) {
+  return "'" + s + "'";
+}
 
 // The parameters of the demo's net, as examples/paper_scene/paper_scene.xml sets them.
 massspring::GridParams demoGrid() {
@@ -66,7 +68,8 @@ massspring::GridParams demoGrid() {
 }
 
 Result<std::vector<rigid::Body>> bodiesFor(const Context& ctx, int objects) {
-  if (objects == 20) return rigid::loadScene((ctx.source / "examples/paper_scene/scene.json").string());
+  if (objects == 20)
+    return rigid::loadScene((ctx.source / "examples/paper_scene/scene.json").string());
   return rigid::generateScene("boxes:" + std::to_string(objects));
 }
 
@@ -75,12 +78,13 @@ Result<std::vector<rigid::Body>> bodiesFor(const Context& ctx, int objects) {
 // `sequential`: the net's interactors get no initial message either, so every interactor runs
 // after its animators within the iteration (the monolithic loop's order) instead of beside them.
 Result<std::string> networkApp(const Context& ctx, int objects, bool sequential) {
-  auto loaded = app::loadApplicationFile((ctx.source / "examples/paper_scene/paper_scene.xml").string());
+  auto loaded =
+      app::loadApplicationFile((ctx.source / "examples/paper_scene/paper_scene.xml").string());
   if (!loaded) return loaded.error();
   app::Application application = std::move(loaded).value();
   const std::set<std::string> keep =
-      objects == 20 ? std::set<std::string>{"bodies", "contacts", "field", "net", "springs",
-                                            "net-collisions", "net-contacts"}
+      objects == 20 ? std::set<std::string>{"bodies",  "contacts",       "field",       "net",
+                                            "springs", "net-collisions", "net-contacts"}
                     : std::set<std::string>{"bodies", "contacts", "field"};
   std::erase_if(application.modules, [&](const app::Module& m) { return !keep.contains(m.id); });
   std::erase_if(application.connections, [&](const app::Connection& c) {
@@ -91,13 +95,16 @@ Result<std::string> networkApp(const Context& ctx, int objects, bool sequential)
     if (sequential && module.id != "bodies" && module.id != "net") module.inputs.clear();
     if (module.id != "bodies") continue;
     for (auto& p : module.params) {
-      if (p.name == "scene" && objects != 20) p = {"generate", "boxes:" + std::to_string(objects), p.loc};
-      if (p.name == "scene" && objects == 20) p.value = (ctx.source / "examples/paper_scene/scene.json").string();
+      if (p.name == "scene" && objects != 20)
+        p = {"generate", "boxes:" + std::to_string(objects), p.loc};
+      if (p.name == "scene" && objects == 20)
+        p.value = (ctx.source / "examples/paper_scene/scene.json").string();
     }
   }
   const fs::path file =
       ctx.work / ("scene-" + std::to_string(objects) + (sequential ? "-sequential" : "") + ".xml");
-  if (auto saved = app::saveApplicationFile(application, file.string()); !saved) return saved.error();
+  if (auto saved = app::saveApplicationFile(application, file.string()); !saved)
+    return saved.error();
   return file.string();
 }
 
@@ -107,8 +114,8 @@ Result<double> runNetwork(const Context& ctx, const std::string& appFile, int it
   fs::remove(report);
   const std::string command = "cd " + quote(ctx.work.string()) + " && " +
                               quote((ctx.bin / "vrflow").string()) + " run " + quote(appFile) +
-                              " -n " + std::to_string(iterations) +
-                              " --no-progress --report " + quote(report.string()) + " > run.log 2>&1";
+                              " -n " + std::to_string(iterations) + " --no-progress --report " +
+                              quote(report.string()) + " > run.log 2>&1";
   if (const int status = std::system(command.c_str()); status != 0) {
     return makeError("vrflow run failed (status " + std::to_string(status) + "); see " +
                      (ctx.work / "run.log").string());
@@ -121,7 +128,8 @@ Result<double> runNetwork(const Context& ctx, const std::string& appFile, int it
 
 // Steady-state rate of the network: the difference of two runs of different lengths cancels the
 // start-up (spawning processes, loading the scene) and the shutdown.
-Result<double> networkRate(const Context& ctx, int objects, bool sequential, int warm, int measured) {
+Result<double> networkRate(const Context& ctx, int objects, bool sequential, int warm,
+                           int measured) {
   auto appFile = networkApp(ctx, objects, sequential);
   if (!appFile) return appFile.error();
   auto shorter = runNetwork(ctx, *appFile, warm);
@@ -161,8 +169,12 @@ class Monolithic {
     if (!nets_.empty()) {
       std::map<std::uint64_t, massspring::RigidBody> rigids;
       for (const rigid::Body& b : world_->state().bodies()) {
-        rigids[b.id] = {b.position, b.orientation, b.linearVelocity, b.angularVelocity,
-                        b.kinematic ? 0.0 : b.mass, b.shape};
+        rigids[b.id] = {b.position,
+                        b.orientation,
+                        b.linearVelocity,
+                        b.angularVelocity,
+                        b.kinematic ? 0.0 : b.mass,
+                        b.shape};
       }
       massspring::Net& net = nets_[kNetId];
       std::vector<double> forces(net.positions.size(), 0.0);
@@ -197,7 +209,8 @@ class BulletWorld {
   BulletWorld()
       : dispatcher_(&configuration_),
         world_(&dispatcher_, &broadphase_, &solver_, &configuration_) {
-    world_.setGravity(btVector3(btScalar(kGravity[0]), btScalar(kGravity[1]), btScalar(kGravity[2])));
+    world_.setGravity(
+        btVector3(btScalar(kGravity[0]), btScalar(kGravity[1]), btScalar(kGravity[2])));
     world_.getSolverInfo().m_numIterations = 20;
   }
   ~BulletWorld() {
@@ -212,8 +225,8 @@ class BulletWorld {
         shape = std::make_unique<btSphereShape>(btScalar(s.radius));
         break;
       case msg::ShapeKind::Box:
-        shape = std::make_unique<btBoxShape>(
-            btVector3(btScalar(s.halfExtents[0]), btScalar(s.halfExtents[1]), btScalar(s.halfExtents[2])));
+        shape = std::make_unique<btBoxShape>(btVector3(
+            btScalar(s.halfExtents[0]), btScalar(s.halfExtents[1]), btScalar(s.halfExtents[2])));
         break;
       case msg::ShapeKind::Capsule:
         shape = std::make_unique<btCapsuleShape>(btScalar(s.radius), btScalar(2 * s.halfHeight));
@@ -231,13 +244,16 @@ class BulletWorld {
     }
     const btScalar mass = b.kinematic ? btScalar(0) : btScalar(b.mass);
     btVector3 inertia(0, 0, 0);
-    if (mass > 0) inertia = btVector3(btScalar(b.inertia[0]), btScalar(b.inertia[4]), btScalar(b.inertia[8]));
+    if (mass > 0)
+      inertia = btVector3(btScalar(b.inertia[0]), btScalar(b.inertia[4]), btScalar(b.inertia[8]));
     btTransform pose;
-    pose.setOrigin(btVector3(btScalar(b.position[0]), btScalar(b.position[1]), btScalar(b.position[2])));
+    pose.setOrigin(
+        btVector3(btScalar(b.position[0]), btScalar(b.position[1]), btScalar(b.position[2])));
     pose.setRotation(btQuaternion(btScalar(b.orientation[0]), btScalar(b.orientation[1]),
                                   btScalar(b.orientation[2]), btScalar(b.orientation[3])));
     motions_.push_back(std::make_unique<btDefaultMotionState>(pose));
-    btRigidBody::btRigidBodyConstructionInfo info(mass, motions_.back().get(), shape.get(), inertia);
+    btRigidBody::btRigidBodyConstructionInfo info(mass, motions_.back().get(), shape.get(),
+                                                  inertia);
     info.m_friction = btScalar(0.6);
     info.m_restitution = btScalar(0.3);
     bodies_.push_back(std::make_unique<btRigidBody>(info));
@@ -293,7 +309,10 @@ int main(int argc, char** argv) {
   int failures = 0;
   for (const int objects : sizes) {
     // Steps before and during the measurement; the window covers falling, impacts and rest.
-    const int measured = quick ? (objects <= 20 ? 200 : 60) : objects <= 20 ? 600 : objects <= 200 ? 200 : 30;
+    const int measured = quick            ? (objects <= 20 ? 200 : 60)
+                         : objects <= 20  ? 600
+                         : objects <= 200 ? 200
+                                          : 30;
     const int warm = quick ? 10 : objects <= 200 ? 50 : 10;
     auto bodies = bodiesFor(ctx, objects);
     if (!bodies) {
@@ -307,7 +326,8 @@ int main(int argc, char** argv) {
     }
     const double monoRate = loopRate([&] { mono.step(); }, warm, measured);
     // The demo scene as shipped, and (20 objects) with every interactor sequential.
-    for (const bool sequential : objects == 20 ? std::vector<bool>{false, true} : std::vector<bool>{false}) {
+    for (const bool sequential :
+         objects == 20 ? std::vector<bool>{false, true} : std::vector<bool>{false}) {
       auto network = networkRate(ctx, objects, sequential, warm, measured);
       if (!network) {
         std::fprintf(stderr, "vrflow-bench-scene: network, %d objects: %s\n", objects,

@@ -93,8 +93,8 @@ int run(int argc, char** argv) {
     start = comma + 1;
   }
   for (const auto& name : chosen) {
-    static const std::vector<std::string> known{"all", "zeromq-ipc", "mpi-shm", "vrflow-shm",
-                                                "zeromq-tcp", "raw-tcp", "vrflow-tcp"};
+    static const std::vector<std::string> known{
+        "all", "zeromq-ipc", "mpi-shm", "vrflow-shm", "zeromq-tcp", "raw-tcp", "vrflow-tcp"};
     if (std::find(known.begin(), known.end(), name) == known.end()) {
       std::cerr << "--transport: unknown transport '" << name << "'\n";
       return 2;

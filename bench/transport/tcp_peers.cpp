@@ -142,7 +142,8 @@ Result<BenchResult> rawTcpSize(std::size_t bytes, const BenchSettings& settings)
   close(fd);
   if (!status) return status.error();
   if (*status != 0) return makeError("raw-tcp: peer " + ChildProcess::describeExit(*status));
-  const double rate = static_cast<double>(plan.streamMessages) / (static_cast<double>(end - start) * 1e-9);
+  const double rate =
+      static_cast<double>(plan.streamMessages) / (static_cast<double>(end - start) * 1e-9);
   return makeResult("raw-tcp", bytes, samples, rate,
                     "plain TCP socket pair on 127.0.0.1, TCP_NODELAY, blocking read/write, "
                     "2 processes (fork); receiver reads into one reused buffer");
@@ -158,7 +159,8 @@ void writeManifest(const fs::path& dir) {
   fs::create_directories(dir / "bench");
   std::ofstream out(dir / "bench" / "vrflow-package.xml");
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<package name=\"bench\" version=\"1\">\n"
-      << "  <module type=\"peer\" executable=\"" << selfFolder() << "/vrflow-bench-peer\" kind=\"other\">\n"
+      << "  <module type=\"peer\" executable=\"" << selfFolder()
+      << "/vrflow-bench-peer\" kind=\"other\">\n"
       << "    <doc>Transport benchmark peer.</doc>\n"
       << "    <input name=\"in\" data=\"any\"/>\n    <output name=\"out\" data=\"any\"/>\n";
   for (const char* p : {"role", "size", "warmup", "results", "count"}) {
@@ -171,8 +173,9 @@ std::string twoHosts(const std::string& name, const std::string& modules,
                      const std::string& connections) {
   return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"" + name +
          "\" version=\"1\">\n  <hosts>\n    <host id=\"a\" address=\"127.0.0.1\"/>\n"
-         "    <host id=\"b\" address=\"127.0.0.2\"/>\n  </hosts>\n  <modules>\n" + modules +
-         "  </modules>\n  <connections>\n" + connections + "  </connections>\n</application>\n";
+         "    <host id=\"b\" address=\"127.0.0.2\"/>\n  </hosts>\n  <modules>\n" +
+         modules + "  </modules>\n  <connections>\n" + connections +
+         "  </connections>\n</application>\n";
 }
 
 Status launch(const fs::path& app, const fs::path& packages, const BenchSettings& settings) {
@@ -181,7 +184,8 @@ Status launch(const fs::path& app, const fs::path& packages, const BenchSettings
   if (!child) return child.error();
   auto status = child->wait(settings.peerTimeout);
   if (!status) return status.error();
-  if (*status != 0) return makeError("vrflow-tcp: vrflow launch " + ChildProcess::describeExit(*status));
+  if (*status != 0)
+    return makeError("vrflow-tcp: vrflow launch " + ChildProcess::describeExit(*status));
   return {};
 }
 
@@ -212,25 +216,39 @@ Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {
     std::ofstream(dir / "pingpong.xml") << twoHosts(
         "bench-tcp-ping-pong",
         "    <module id=\"ping\" package=\"bench\" type=\"peer\" host=\"a\">\n"
-        "      <param name=\"role\" value=\"ping\"/>\n      <param name=\"size\" value=\"" + size + "\"/>\n"
-        "      <param name=\"warmup\" value=\"" + warmup + "\"/>\n"
-        "      <param name=\"results\" value=\"" + rtt.string() + "\"/>\n"
-        "      <param name=\"count\" value=\"" + pingCount + "\"/>\n"
-        "      <input port=\"in\" initial-messages=\"1\"/>\n    </module>\n"
-        "    <module id=\"pong\" package=\"bench\" type=\"peer\" host=\"b\">\n"
-        "      <param name=\"role\" value=\"pong\"/>\n    </module>\n",
+        "      <param name=\"role\" value=\"ping\"/>\n      <param name=\"size\" value=\"" +
+            size +
+            "\"/>\n"
+            "      <param name=\"warmup\" value=\"" +
+            warmup +
+            "\"/>\n"
+            "      <param name=\"results\" value=\"" +
+            rtt.string() +
+            "\"/>\n"
+            "      <param name=\"count\" value=\"" +
+            pingCount +
+            "\"/>\n"
+            "      <input port=\"in\" initial-messages=\"1\"/>\n    </module>\n"
+            "    <module id=\"pong\" package=\"bench\" type=\"peer\" host=\"b\">\n"
+            "      <param name=\"role\" value=\"pong\"/>\n    </module>\n",
         "    <connection from=\"ping.out\" to=\"pong.in\"/>\n"
         "    <connection from=\"pong.out\" to=\"ping.in\"/>\n");
     if (failure = launch(dir / "pingpong.xml", dir / "packages", settings); !failure) break;
     std::ofstream(dir / "stream.xml") << twoHosts(
         "bench-tcp-stream",
         "    <module id=\"send\" package=\"bench\" type=\"peer\" host=\"a\">\n"
-        "      <param name=\"role\" value=\"send\"/>\n      <param name=\"size\" value=\"" + size + "\"/>\n"
-        "      <param name=\"count\" value=\"" +
-            std::to_string(plan.warmupMessages + plan.streamMessages) + "\"/>\n    </module>\n"
-        "    <module id=\"recv\" package=\"bench\" type=\"peer\" host=\"b\">\n"
-        "      <param name=\"role\" value=\"recv\"/>\n      <param name=\"warmup\" value=\"" + warmup + "\"/>\n"
-        "      <param name=\"results\" value=\"" + rate.string() + "\"/>\n    </module>\n",
+        "      <param name=\"role\" value=\"send\"/>\n      <param name=\"size\" value=\"" +
+            size +
+            "\"/>\n"
+            "      <param name=\"count\" value=\"" +
+            std::to_string(plan.warmupMessages + plan.streamMessages) +
+            "\"/>\n    </module>\n"
+            "    <module id=\"recv\" package=\"bench\" type=\"peer\" host=\"b\">\n"
+            "      <param name=\"role\" value=\"recv\"/>\n      <param name=\"warmup\" value=\"" +
+            warmup +
+            "\"/>\n"
+            "      <param name=\"results\" value=\"" +
+            rate.string() + "\"/>\n    </module>\n",
         "    <connection from=\"send.out\" to=\"recv.in\" capacity=\"" +
             std::to_string(streamQueueDepth(bytes)) + "\"/>\n");
     if (failure = launch(dir / "stream.xml", dir / "packages", settings); !failure) break;

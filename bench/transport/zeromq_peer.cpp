@@ -407,9 +407,8 @@ Result<std::vector<BenchResult>> runZeromqOn(const BenchSettings& settings, bool
     const std::string where = std::string(kTransport) + ", " + std::to_string(bytes) + " B: ";
     std::vector<unsigned char> payload = makePayload(bytes);
     const IterationPlan plan = iterationPlan(bytes, settings.quick);
-    auto roundTrips =
-        measureRoundTrips(payload, plan, tcp ? freeTcpAddress() : dir->address("pingpong"),
-                          settings.peerTimeout);
+    auto roundTrips = measureRoundTrips(
+        payload, plan, tcp ? freeTcpAddress() : dir->address("pingpong"), settings.peerTimeout);
     if (!roundTrips) {
       return makeError(where + roundTrips.error().message);
     }
@@ -418,8 +417,9 @@ Result<std::vector<BenchResult>> runZeromqOn(const BenchSettings& settings, bool
     if (!rate) {
       return makeError(where + rate.error().message);
     }
-    results.push_back(makeResult(kTransport, bytes, *roundTrips, *rate,
-                                 (tcp ? "tcp://127.0.0.1 (TCP_NODELAY), " : "") + describeSetup(bytes)));
+    results.push_back(
+        makeResult(kTransport, bytes, *roundTrips, *rate,
+                   (tcp ? "tcp://127.0.0.1 (TCP_NODELAY), " : "") + describeSetup(bytes)));
   }
   return results;
 }

@@ -3,9 +3,9 @@
 #include <QContextMenuEvent>
 #include <QGraphicsPathItem>
 #include <QGraphicsRectItem>
-#include <QGraphicsSimpleTextItem>
 #include <QGraphicsScene>
 #include <QGraphicsSceneHoverEvent>
+#include <QGraphicsSimpleTextItem>
 #include <QKeyEvent>
 #include <QMimeData>
 #include <QMouseEvent>
@@ -30,9 +30,13 @@ constexpr double kFilterWidth = 130;
 constexpr double kPortRadius = 5;
 constexpr double kGrid = 10;
 
-QString q(const std::string& text) { return QString::fromStdString(text); }
+QString q(const std::string& text) {
+  return QString::fromStdString(text);
+}
 
-double snap(double v) { return std::round(v / kGrid) * kGrid; }
+double snap(double v) {
+  return std::round(v / kGrid) * kGrid;
+}
 
 QPainterPath curve(QPointF from, QPointF to) {
   QPainterPath path(from);
@@ -82,7 +86,8 @@ QColor colorOfHost(std::size_t index) {
 PortItem::PortItem(QGraphicsItem* parent, std::string node, app::PortSpec spec)
     : QGraphicsItem(parent), node_(std::move(node)), spec_(std::move(spec)) {
   setAcceptHoverEvents(true);
-  QString tip = q(spec_.name) + (spec_.isInput ? " (input)" : " (output)") + "\ndata: " + q(spec_.data);
+  QString tip =
+      q(spec_.name) + (spec_.isInput ? " (input)" : " (output)") + "\ndata: " + q(spec_.data);
   if (spec_.stampsOnly) tip += ", stamps only";
   if (spec_.required) tip += "\nrequired";
   if (!spec_.doc.empty()) tip += "\n" + q(spec_.doc);
@@ -127,7 +132,8 @@ NodeItem::NodeItem(std::string id, NodeKind kind, QString title, QString subtitl
     const double cy = h / 2;
     auto place = [&](const std::vector<app::PortSpec>& list, bool input) {
       for (std::size_t i = 0; i < list.size(); ++i) {
-        const double offset = (static_cast<double>(i) - (static_cast<double>(list.size()) - 1) / 2) * kRow;
+        const double offset =
+            (static_cast<double>(i) - (static_cast<double>(list.size()) - 1) / 2) * kRow;
         const double y = cy + offset;
         const double inset = cx * std::abs(offset) / cy;
         auto* port = new PortItem(this, id_, list[i]);
@@ -139,7 +145,8 @@ NodeItem::NodeItem(std::string id, NodeKind kind, QString title, QString subtitl
     place(ins, true);
     place(outs, false);
   } else {
-    size_ = {kModuleWidth, kHeader + static_cast<double>(std::max<std::size_t>(rows, 1)) * kRow + 8};
+    size_ = {kModuleWidth,
+             kHeader + static_cast<double>(std::max<std::size_t>(rows, 1)) * kRow + 8};
     for (std::size_t i = 0; i < ins.size(); ++i) {
       auto* port = new PortItem(this, id_, ins[i]);
       port->setPos(0, kHeader + static_cast<double>(i) * kRow + kRow / 2);
@@ -237,18 +244,22 @@ void NodeItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
   painter->setFont(smallFont);
   for (const PortItem* port : ports_) {
     const QPointF p = port->pos();
-    const bool implicit = port->spec().name == app::kBeginItPort || port->spec().name == app::kEndItPort;
+    const bool implicit =
+        port->spec().name == app::kBeginItPort || port->spec().name == app::kEndItPort;
     painter->setPen(implicit ? QColor(150, 155, 165) : QColor(230, 232, 236));
     const QString name = QString::fromStdString(port->spec().name);
     if (kind_ == NodeKind::Filter) {
       QRectF r = port->spec().isInput ? QRectF(p.x() - 88, p.y() - 8, 80, 16)
                                       : QRectF(p.x() + 8, p.y() - 8, 80, 16);
       painter->setPen(QColor(60, 64, 72));
-      painter->drawText(r, (port->spec().isInput ? Qt::AlignRight : Qt::AlignLeft) | Qt::AlignVCenter, name);
+      painter->drawText(
+          r, (port->spec().isInput ? Qt::AlignRight : Qt::AlignLeft) | Qt::AlignVCenter, name);
     } else if (port->spec().isInput) {
-      painter->drawText(QRectF(p.x() + 9, p.y() - 8, w / 2 - 12, 16), Qt::AlignLeft | Qt::AlignVCenter, name);
+      painter->drawText(QRectF(p.x() + 9, p.y() - 8, w / 2 - 12, 16),
+                        Qt::AlignLeft | Qt::AlignVCenter, name);
     } else {
-      painter->drawText(QRectF(p.x() - w / 2 + 3, p.y() - 8, w / 2 - 12, 16), Qt::AlignRight | Qt::AlignVCenter, name);
+      painter->drawText(QRectF(p.x() - w / 2 + 3, p.y() - 8, w / 2 - 12, 16),
+                        Qt::AlignRight | Qt::AlignVCenter, name);
     }
   }
   painter->setPen(outline);
@@ -266,7 +277,8 @@ void NodeItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
     painter->drawText(r, Qt::AlignCenter, badge_);
   }
   if (problemLevel_ > 0) {
-    const QPointF c(kind_ == NodeKind::Filter ? w / 2 + 22 : w - 4, kind_ == NodeKind::Filter ? 14 : 2);
+    const QPointF c(kind_ == NodeKind::Filter ? w / 2 + 22 : w - 4,
+                    kind_ == NodeKind::Filter ? 14 : 2);
     painter->setPen(QPen(Qt::white, 1.5));
     painter->setBrush(problemLevel_ >= 2 ? QColor(220, 30, 30) : QColor(240, 170, 0));
     painter->drawEllipse(c, 9, 9);
@@ -279,14 +291,15 @@ void NodeItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
   if (!runInfo_.isEmpty()) {
     painter->setFont(smallFont);
     painter->setPen(failed_ ? QColor(200, 20, 20) : QColor(30, 110, 50));
-    painter->drawText(QRectF(-40, h + 4, w + 80, 30), Qt::AlignHCenter | Qt::AlignTop | Qt::TextWordWrap,
-                      runInfo_);
+    painter->drawText(QRectF(-40, h + 4, w + 80, 30),
+                      Qt::AlignHCenter | Qt::AlignTop | Qt::TextWordWrap, runInfo_);
   }
 }
 
 // ---- ConnectionItem ----------------------------------------------------------------------
 
-ConnectionItem::ConnectionItem(std::size_t index, QPointF from, QPointF to, QColor color, bool stampsOnly)
+ConnectionItem::ConnectionItem(std::size_t index, QPointF from, QPointF to, QColor color,
+                               bool stampsOnly)
     : index_(index), path_(curve(from, to)), color_(color), stampsOnly_(stampsOnly) {
   setFlags(ItemIsSelectable);
   setZValue(0);
@@ -294,7 +307,9 @@ ConnectionItem::ConnectionItem(std::size_t index, QPointF from, QPointF to, QCol
 }
 
 QRectF ConnectionItem::boundingRect() const {
-  return path_.boundingRect().adjusted(-8, -8, 8, 8).united(QRectF(mid_ - QPointF(90, 22), QSizeF(180, 44)));
+  return path_.boundingRect()
+      .adjusted(-8, -8, 8, 8)
+      .united(QRectF(mid_ - QPointF(90, 22), QSizeF(180, 44)));
 }
 
 QPainterPath ConnectionItem::shape() const {
@@ -427,13 +442,15 @@ void Canvas::rebuild() {
   for (const auto& m : app.modules) {
     const auto* type = catalog.findModule(m.package, m.type);
     const QString sub = q(m.package + "/" + m.type) + (type == nullptr ? " (unknown)" : "");
-    place(new NodeItem(m.id, NodeKind::Module, q(m.id), sub, colorFor(m.host), q(app::effectiveHost(app, m.host)),
+    place(new NodeItem(m.id, NodeKind::Module, q(m.id), sub, colorFor(m.host),
+                       q(app::effectiveHost(app, m.host)),
                        type == nullptr ? portsFromConnections(m.id) : catalog.portsOf(m)));
   }
   for (const auto& f : app.filters) {
     const auto* type = catalog.findFilter(f.type);
-    place(new NodeItem(f.id, NodeKind::Filter, q(f.id), q(f.type) + (type == nullptr ? " (unknown)" : ""),
-                       colorFor(f.host), q(app::effectiveHost(app, f.host)),
+    place(new NodeItem(f.id, NodeKind::Filter, q(f.id),
+                       q(f.type) + (type == nullptr ? " (unknown)" : ""), colorFor(f.host),
+                       q(app::effectiveHost(app, f.host)),
                        type == nullptr ? portsFromConnections(f.id) : catalog.portsOf(f)));
   }
   // Instances: how many modules they expand to, and on which hosts.
@@ -457,7 +474,10 @@ void Canvas::rebuild() {
     if (auto it = spread.find(i.id); it != spread.end()) {
       QStringList hosts;
       for (const auto& h : it->second.second) hosts << q(h);
-      item->setBadge(QString("%1 modules on %2").arg(it->second.first).arg(hosts.size() <= 2 ? hosts.join(", ") : QString("%1 hosts").arg(hosts.size())));
+      item->setBadge(
+          QString("%1 modules on %2")
+              .arg(it->second.first)
+              .arg(hosts.size() <= 2 ? hosts.join(", ") : QString("%1 hosts").arg(hosts.size())));
       item->setToolTip(QString("%1 modules on %2").arg(it->second.first).arg(hosts.join(", ")));
     }
     place(item);
@@ -472,7 +492,8 @@ void Canvas::rebuild() {
     if (dataType == app::kAnyData) dataType = to->spec().data;
     auto* item = new ConnectionItem(c, from->scenePos(), to->scenePos(), colorOfData(dataType),
                                     from->spec().stampsOnly);
-    item->setToolTip(q(app::toString(conn.from) + " \u2192 " + app::toString(conn.to) + "\ndata: " + dataType));
+    item->setToolTip(
+        q(app::toString(conn.from) + " \u2192 " + app::toString(conn.to) + "\ndata: " + dataType));
     scene_->addItem(item);
     connections_.push_back(item);
   }
@@ -486,7 +507,8 @@ void Canvas::rebuild() {
         if (auto* item = connectionItem(c)) {
           item->setProblem(3);
           item->setToolTip(item->toolTip() + "\n" + q(p.message));
-          auto* label = makeLabel("deadlock", item->midPoint(), QColor(220, 30, 30), QColor(200, 20, 20));
+          auto* label =
+              makeLabel("deadlock", item->midPoint(), QColor(220, 30, 30), QColor(200, 20, 20));
           label->setToolTip(q(p.message));
           scene_->addItem(label);
           decorations_.push_back(label);
@@ -511,7 +533,8 @@ void Canvas::rebuild() {
     QString about = item->toolTip();  // instances: how many modules, where
     if (const auto* m = app::findModule(app, id)) {
       const auto* type = catalog.findModule(m->package, m->type);
-      about = q(m->id + ": module " + m->package + "/" + m->type + " on " + app::effectiveHost(app, m->host)) +
+      about = q(m->id + ": module " + m->package + "/" + m->type + " on " +
+                app::effectiveHost(app, m->host)) +
               (type != nullptr && !type->doc.empty() ? "\n" + q(type->doc) : QString());
     } else if (const auto* f = app::findFilter(app, id)) {
       const auto* type = catalog.findFilter(f->type);
@@ -538,7 +561,9 @@ void Canvas::rebuild() {
         continue;
       }
       QString text = QString("%1 it").arg(it->second.iterations);
-      if (wall > 0) text += QString(" \u00b7 %1 it/s").arg(static_cast<double>(it->second.iterations) / wall, 0, 'f', 1);
+      if (wall > 0)
+        text += QString(" \u00b7 %1 it/s")
+                    .arg(static_cast<double>(it->second.iterations) / wall, 0, 'f', 1);
       if (failed) text += "\nfailed: " + q(it->second.exit);
       item->setRunInfo(text, failed);
     }
@@ -546,7 +571,9 @@ void Canvas::rebuild() {
       for (auto* item : connections_) {
         const auto& conn = app.connections[item->index()];
         if (app::toString(conn.from) != stats.from || app::toString(conn.to) != stats.to) continue;
-        QString total = QString("%1 msg, %2").arg(stats.messages).arg(humanBytes(static_cast<double>(stats.bytes)));
+        QString total = QString("%1 msg, %2")
+                            .arg(stats.messages)
+                            .arg(humanBytes(static_cast<double>(stats.bytes)));
         if (stats.dropped > 0) total += QString(", %1 dropped").arg(stats.dropped);
         // On the canvas: the averages over the run; the totals in the tooltip.
         QString shown = total;
@@ -556,7 +583,8 @@ void Canvas::rebuild() {
                       .arg(humanBytes(static_cast<double>(stats.bytes) / wall));
         }
         item->setLabel(total);
-        item->setToolTip(item->toolTip() + "\nlast run: " + total + (wall > 0 ? "\naverage: " + shown : QString()));
+        item->setToolTip(item->toolTip() + "\nlast run: " + total +
+                         (wall > 0 ? "\naverage: " + shown : QString()));
         auto* back = makeLabel(shown, item->midPoint(), item->color(), QColor(30, 60, 120));
         back->setToolTip(item->toolTip());
         scene_->addItem(back);
@@ -580,7 +608,8 @@ void Canvas::setLiveRates(const std::map<std::string, double>& rates) {
   state_.live = rates;
   for (auto& [id, item] : nodes_) {
     auto it = rates.find(id);
-    if (it != rates.end()) item->setRunInfo(QString("running \u00b7 %1 it/s").arg(it->second, 0, 'f', 0), false);
+    if (it != rates.end())
+      item->setRunInfo(QString("running \u00b7 %1 it/s").arg(it->second, 0, 'f', 0), false);
   }
 }
 
@@ -602,7 +631,8 @@ std::vector<std::size_t> Canvas::selectedConnections() const {
   return result;
 }
 
-void Canvas::selectOnly(const std::vector<std::string>& ids, std::optional<std::size_t> connection) {
+void Canvas::selectOnly(const std::vector<std::string>& ids,
+                        std::optional<std::size_t> connection) {
   {
     const QSignalBlocker block(scene_);
     scene_->clearSelection();
@@ -677,19 +707,23 @@ Positions Canvas::nodeSizes() const {
 }
 
 std::optional<std::string> Canvas::refusalBetween(const PortItem* from, const PortItem* to) const {
-  if (from == nullptr || to == nullptr || state_.app == nullptr) return std::string("no port there");
+  if (from == nullptr || to == nullptr || state_.app == nullptr)
+    return std::string("no port there");
   if (from == to) return std::string("a port cannot be connected to itself");
   // Dragging may start at either end: the output is the source.
   const PortItem* out = from->spec().isInput ? to : from;
   const PortItem* in = from->spec().isInput ? from : to;
   if (out->spec().isInput == in->spec().isInput) {
-    return std::string(out->spec().isInput ? "both ports are inputs: connect an output to an input"
-                                           : "both ports are outputs: connect an output to an input");
+    return std::string(out->spec().isInput
+                           ? "both ports are inputs: connect an output to an input"
+                           : "both ports are outputs: connect an output to an input");
   }
   return connectionRefusal(*state_.app, *state_.catalog, out->endpoint(), in->endpoint());
 }
 
-QPointF Canvas::dropPoint() const { return mapToScene(viewport()->rect().center()); }
+QPointF Canvas::dropPoint() const {
+  return mapToScene(viewport()->rect().center());
+}
 
 PortItem* Canvas::portAt(QPoint viewPos) const {
   const QPointF scenePos = mapToScene(viewPos);
@@ -754,11 +788,13 @@ void Canvas::mouseMoveEvent(QMouseEvent* event) {
     for (const auto& [id, node] : nodes_) {
       for (PortItem* port : node->ports()) port->setHighlight(0);
     }
-    if (PortItem* target = portAt(event->position().toPoint()); target != nullptr && target != dragFrom_) {
+    if (PortItem* target = portAt(event->position().toPoint());
+        target != nullptr && target != dragFrom_) {
       const auto why = refusalBetween(dragFrom_, target);
       target->setHighlight(why ? -1 : 1);
       if (why) {
-        QToolTip::showText(event->globalPosition().toPoint(), QString::fromStdString(*why), viewport());
+        QToolTip::showText(event->globalPosition().toPoint(), QString::fromStdString(*why),
+                           viewport());
       } else {
         QToolTip::hideText();
       }
@@ -875,7 +911,8 @@ void Canvas::dropEvent(QDropEvent* event) {
   const QMimeData* mime = event->mimeData();
   if (mime->hasFormat(kNodeMime)) {
     const QPointF at = mapToScene(event->position().toPoint());
-    Q_EMIT addRequested(QString::fromUtf8(mime->data(kNodeMime)), QPointF(snap(at.x()), snap(at.y())));
+    Q_EMIT addRequested(QString::fromUtf8(mime->data(kNodeMime)),
+                        QPointF(snap(at.x()), snap(at.y())));
     acceptAsCopy(event);
   } else if (mime->hasFormat(kHostMime)) {
     if (NodeItem* node = nodeAt(event->position().toPoint())) {
@@ -894,8 +931,10 @@ void Canvas::drawBackground(QPainter* painter, const QRectF& rect) {
   const double top = std::floor(rect.top() / step) * step;
   if (transform().m11() < 0.4) return;
   QVector<QLineF> lines;
-  for (double x = left; x < rect.right(); x += step) lines.append(QLineF(x, rect.top(), x, rect.bottom()));
-  for (double y = top; y < rect.bottom(); y += step) lines.append(QLineF(rect.left(), y, rect.right(), y));
+  for (double x = left; x < rect.right(); x += step)
+    lines.append(QLineF(x, rect.top(), x, rect.bottom()));
+  for (double y = top; y < rect.bottom(); y += step)
+    lines.append(QLineF(rect.left(), y, rect.right(), y));
   painter->drawLines(lines);
 }
 

@@ -11,21 +11,25 @@ int main(int argc, char** argv) {
   QApplication::setApplicationName("vrflow-editor");
   QApplication::setOrganizationName("vrflow");
   QCommandLineParser parser;
-  parser.setApplicationDescription("vrflow node editor: lay out, validate, save and run applications");
+  parser.setApplicationDescription(
+      "vrflow node editor: lay out, validate, save and run applications");
   parser.addHelpOption();
   parser.addPositionalArgument("APP.xml", "Application file to open");
   QCommandLineOption screenshot("screenshot", "Render the window to OUT.png and exit", "OUT.png");
   QCommandLineOption packages("packages", "Extra folder of node packages (repeatable)", "DIR");
-  QCommandLineOption runFirst("run", "With --screenshot: run the application N iterations first", "N");
+  QCommandLineOption runFirst("run", "With --screenshot: run the application N iterations first",
+                              "N");
   parser.addOption(screenshot);
-  QCommandLineOption select("select", "With --screenshot: select this node first (its properties show)", "ID");
+  QCommandLineOption select(
+      "select", "With --screenshot: select this node first (its properties show)", "ID");
   parser.addOption(runFirst);
   parser.addOption(select);
   parser.addOption(packages);
   parser.process(application);
 
   vrflow::editor::gui::EditorOptions options;
-  for (const QString& dir : parser.values(packages)) options.packageDirs.push_back(dir.toStdString());
+  for (const QString& dir : parser.values(packages))
+    options.packageDirs.push_back(dir.toStdString());
   // A screenshot must never wait on a dialog: messages go to stderr.
   struct StderrReporter : vrflow::editor::gui::Reporter {
     void error(QWidget*, const QString& title, const QString& text) override {
@@ -51,7 +55,8 @@ int main(int argc, char** argv) {
   if (!opened) return 1;
   if (parser.isSet(runFirst)) {
     QEventLoop loop;
-    QObject::connect(&window, &vrflow::editor::gui::MainWindow::runFinished, &loop, &QEventLoop::quit);
+    QObject::connect(&window, &vrflow::editor::gui::MainWindow::runFinished, &loop,
+                     &QEventLoop::quit);
     window.runApplication(parser.value(runFirst).toInt());
     if (window.running()) loop.exec();
   }

@@ -1,5 +1,10 @@
 #include "main_window.hpp"
 
+#include <fcntl.h>
+#include <sys/ioctl.h>
+#include <termios.h>
+#include <unistd.h>
+
 #include <QAction>
 #include <QApplication>
 #include <QClipboard>
@@ -28,11 +33,6 @@
 #include <QToolBar>
 #include <QUndoCommand>
 #include <QUndoStack>
-#include <fcntl.h>
-#include <sys/ioctl.h>
-#include <termios.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
@@ -47,8 +47,12 @@ namespace vrflow::editor::gui {
 
 namespace {
 
-QString q(const std::string& text) { return QString::fromStdString(text); }
-std::string s(const QString& text) { return text.toStdString(); }
+QString q(const std::string& text) {
+  return QString::fromStdString(text);
+}
+std::string s(const QString& text) {
+  return text.toStdString();
+}
 
 constexpr int kMaxRecent = 8;
 constexpr const char* kFileFilter = "vrflow applications (*.xml);;All files (*)";
@@ -85,17 +89,18 @@ void Reporter::warning(QWidget* parent, const QString& title, const QString& tex
 }
 
 Reporter::Choice Reporter::askToSave(QWidget* parent, const QString& text) {
-  const auto answer = QMessageBox::warning(parent, "Unsaved changes", text,
-                                           QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel,
-                                           QMessageBox::Save);
+  const auto answer = QMessageBox::warning(
+      parent, "Unsaved changes", text,
+      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
   if (answer == QMessageBox::Save) return Choice::Save;
   if (answer == QMessageBox::Discard) return Choice::Discard;
   return Choice::Cancel;
 }
 
 QString Reporter::fileName(QWidget* parent, bool forSaving, const QString& suggestion) {
-  return forSaving ? QFileDialog::getSaveFileName(parent, "Save application", suggestion, kFileFilter)
-                   : QFileDialog::getOpenFileName(parent, "Open", suggestion, kFileFilter);
+  return forSaving
+             ? QFileDialog::getSaveFileName(parent, "Save application", suggestion, kFileFilter)
+             : QFileDialog::getOpenFileName(parent, "Open", suggestion, kFileFilter);
 }
 
 bool Reporter::newHost(QWidget* parent, QString& id, QString& address) {
@@ -173,23 +178,28 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   connect(canvas_, &Canvas::nodesMoved, this, [this](const Positions& positions) {
     if (!apply(moveNodes(app_, positions))) refresh();
   });
-  connect(canvas_, &Canvas::addRequested, this, [this](const QString& spec, QPointF at) { addNode(spec, at); });
+  connect(canvas_, &Canvas::addRequested, this,
+          [this](const QString& spec, QPointF at) { addNode(spec, at); });
   connect(canvas_, &Canvas::hostDropped, this,
-          [this](const QString& host, const std::string& node) { apply(assignHost(app_, {node}, s(host))); });
+          [this](const QString& host, const std::string& node) {
+            apply(assignHost(app_, {node}, s(host)));
+          });
   connect(canvas_, &Canvas::deleteRequested, this, &MainWindow::deleteSelection);
   connect(canvas_, &Canvas::selectionChangedIds, this, &MainWindow::showSelection);
-  connect(canvas_, &Canvas::contextMenuForNodes, this, [this](const std::vector<std::string>& ids, QPoint at) {
-    QMenu menu;
-    QMenu* hostsMenu = menu.addMenu("Run on host");
-    for (const auto& h : app_.hosts) {
-      const std::string id = h.id;
-      hostsMenu->addAction(q(id), this, [this, ids, id] { apply(assignHost(app_, ids, id)); });
-    }
-    menu.addAction("Duplicate", this, &MainWindow::duplicateSelection);
-    menu.addAction("Copy", this, &MainWindow::copySelection);
-    menu.addAction("Delete", this, &MainWindow::deleteSelection);
-    menu.exec(at);
-  });
+  connect(canvas_, &Canvas::contextMenuForNodes, this,
+          [this](const std::vector<std::string>& ids, QPoint at) {
+            QMenu menu;
+            QMenu* hostsMenu = menu.addMenu("Run on host");
+            for (const auto& h : app_.hosts) {
+              const std::string id = h.id;
+              hostsMenu->addAction(q(id), this,
+                                   [this, ids, id] { apply(assignHost(app_, ids, id)); });
+            }
+            menu.addAction("Duplicate", this, &MainWindow::duplicateSelection);
+            menu.addAction("Copy", this, &MainWindow::copySelection);
+            menu.addAction("Delete", this, &MainWindow::deleteSelection);
+            menu.exec(at);
+          });
   connect(palette_, &Palette::addRequested, this,
           [this](const QString& spec) { addNode(spec, canvas_->dropPoint()); });
   connect(properties_, &PropertiesPanel::parameterEdited, this,
@@ -201,7 +211,9 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
             apply(setInitialMessages(app_, node, port, count));
           });
   connect(properties_, &PropertiesPanel::hostChosen, this,
-          [this](const std::string& node, const std::string& host) { apply(assignHost(app_, {node}, host)); });
+          [this](const std::string& node, const std::string& host) {
+            apply(assignHost(app_, {node}, host));
+          });
   connect(properties_, &PropertiesPanel::renameRequested, this,
           [this](const std::string& node, const std::string& newId) {
             if (apply(renameNode(app_, node, newId), false)) canvas_->selectOnly({newId});
@@ -213,12 +225,14 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   });
   connect(hosts_, &HostsPanel::removeRequested, this,
           [this](const std::string& host) { apply(removeHost(app_, host), false); });
-  connect(hosts_, &HostsPanel::renameRequested, this, [this](const std::string& host, const std::string& newId) {
-    if (!apply(renameHost(app_, host, newId), false)) hosts_->show(app_);
-  });
-  connect(hosts_, &HostsPanel::addressChanged, this, [this](const std::string& host, const std::string& address) {
-    if (!apply(setHostAddress(app_, host, address), false)) hosts_->show(app_);
-  });
+  connect(hosts_, &HostsPanel::renameRequested, this,
+          [this](const std::string& host, const std::string& newId) {
+            if (!apply(renameHost(app_, host, newId), false)) hosts_->show(app_);
+          });
+  connect(hosts_, &HostsPanel::addressChanged, this,
+          [this](const std::string& host, const std::string& address) {
+            if (!apply(setHostAddress(app_, host, address), false)) hosts_->show(app_);
+          });
   connect(hosts_, &HostsPanel::importRequested, this, [this] {
     const QString file = reporter().fileName(this, false, QDir::homePath());
     if (file.isEmpty()) return;
@@ -250,7 +264,8 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
 MainWindow::~MainWindow() {
   closeTerminal();
   // The panels outlive this object's members (Qt deletes children last): no more signals here.
-  for (QObject* child : std::initializer_list<QObject*>{canvas_, palette_, properties_, hosts_, problemList_, undo_}) {
+  for (QObject* child : std::initializer_list<QObject*>{canvas_, palette_, properties_, hosts_,
+                                                        problemList_, undo_}) {
     child->disconnect(this);
     disconnect(child, nullptr, this, nullptr);
   }
@@ -269,7 +284,8 @@ void MainWindow::buildMenus() {
   });
   file->addAction("&Open\u2026", QKeySequence::Open, this, [this] {
     if (!maybeSave()) return;
-    const QString path = reporter().fileName(this, false, path_.isEmpty() ? QDir::currentPath() : QFileInfo(path_).path());
+    const QString path = reporter().fileName(
+        this, false, path_.isEmpty() ? QDir::currentPath() : QFileInfo(path_).path());
     if (!path.isEmpty()) openFile(path);
   });
   recentMenu_ = file->addMenu("Open &recent");
@@ -292,21 +308,25 @@ void MainWindow::buildMenus() {
   edit->addSeparator();
   edit->addAction("&Copy", QKeySequence::Copy, this, &MainWindow::copySelection);
   edit->addAction("&Paste", QKeySequence::Paste, this, &MainWindow::paste);
-  edit->addAction("&Duplicate", QKeySequence(Qt::CTRL | Qt::Key_D), this, &MainWindow::duplicateSelection);
+  edit->addAction("&Duplicate", QKeySequence(Qt::CTRL | Qt::Key_D), this,
+                  &MainWindow::duplicateSelection);
   edit->addAction("De&lete", QKeySequence::Delete, this, &MainWindow::deleteSelection);
-  edit->addAction("Select &all", QKeySequence::SelectAll, this, [this] {
-    canvas_->selectOnly(nodeIds(app_));
-  });
+  edit->addAction("Select &all", QKeySequence::SelectAll, this,
+                  [this] { canvas_->selectOnly(nodeIds(app_)); });
 
   QMenu* view = menuBar()->addMenu("&View");
-  view->addAction("&Automatic layout", QKeySequence(Qt::CTRL | Qt::Key_L), this, &MainWindow::autoLayout);
+  view->addAction("&Automatic layout", QKeySequence(Qt::CTRL | Qt::Key_L), this,
+                  &MainWindow::autoLayout);
   view->addAction("&Fit all", QKeySequence(Qt::CTRL | Qt::Key_0), canvas_, &Canvas::fitAll);
   view->addAction("Zoom &in", QKeySequence::ZoomIn, this, [this] { canvas_->scale(1.2, 1.2); });
-  view->addAction("Zoom &out", QKeySequence::ZoomOut, this, [this] { canvas_->scale(1 / 1.2, 1 / 1.2); });
+  view->addAction("Zoom &out", QKeySequence::ZoomOut, this,
+                  [this] { canvas_->scale(1 / 1.2, 1 / 1.2); });
 
   QMenu* runMenu = menuBar()->addMenu("&Run");
-  runAction_ = runMenu->addAction("&Run on this machine", QKeySequence(Qt::Key_F5), this, [this] { runApplication(); });
-  stopAction_ = runMenu->addAction("&Stop", QKeySequence(Qt::SHIFT | Qt::Key_F5), this, &MainWindow::stopRun);
+  runAction_ = runMenu->addAction("&Run on this machine", QKeySequence(Qt::Key_F5), this,
+                                  [this] { runApplication(); });
+  stopAction_ =
+      runMenu->addAction("&Stop", QKeySequence(Qt::SHIFT | Qt::Key_F5), this, &MainWindow::stopRun);
   stopAction_->setEnabled(false);
 
   QToolBar* tools = addToolBar("Main");
@@ -342,7 +362,8 @@ void MainWindow::setDocument(app::Application app, OpenedText opened, const QStr
 void MainWindow::newFile() {
   app::Application app;
   app.name = "untitled";
-  app.hosts.push_back({std::string(app::kDefaultHostId), std::string(app::kDefaultHostAddress), {}});
+  app.hosts.push_back(
+      {std::string(app::kDefaultHostId), std::string(app::kDefaultHostAddress), {}});
   setDocument(std::move(app), OpenedText{}, QString());
 }
 
@@ -357,13 +378,14 @@ bool MainWindow::openFile(const QString& path) {
   const std::string absolute = s(QFileInfo(path).absoluteFilePath());
   auto loaded = app::loadApplicationString(text, absolute, &problems);
   // Not well-formed, or not an application at all (a manifest, a composite): nothing to edit.
-  const bool notAnApplication = std::any_of(problems.begin(), problems.end(), [](const app::Diagnostic& d) {
-    return d.message.rfind("root element must be", 0) == 0;
-  });
+  const bool notAnApplication = std::any_of(
+      problems.begin(), problems.end(),
+      [](const app::Diagnostic& d) { return d.message.rfind("root element must be", 0) == 0; });
   if (!loaded || notAnApplication) {
-    reporter().error(this, "Cannot open file",
-                     QFileInfo(path).fileName() + " is not a valid vrflow application file:\n\n" +
-                         (loaded ? q(app::formatDiagnostics(problems)) : q(loaded.error().message)));
+    reporter().error(
+        this, "Cannot open file",
+        QFileInfo(path).fileName() + " is not a valid vrflow application file:\n\n" +
+            (loaded ? q(app::formatDiagnostics(problems)) : q(loaded.error().message)));
     return false;
   }
   OpenedText opened{text, app::saveApplication(*loaded)};
@@ -380,7 +402,8 @@ bool MainWindow::openFile(const QString& path) {
 
 bool MainWindow::save() {
   if (path_.isEmpty()) {
-    const QString path = reporter().fileName(this, true, QDir::currentPath() + "/" + q(app_.name) + ".xml");
+    const QString path =
+        reporter().fileName(this, true, QDir::currentPath() + "/" + q(app_.name) + ".xml");
     if (path.isEmpty()) return false;
     return saveAs(path);
   }
@@ -390,8 +413,8 @@ bool MainWindow::save() {
 bool MainWindow::saveAs(const QString& path) {
   const std::string text = textToSave(app_, opened_);
   QSaveFile out(path);
-  if (!out.open(QIODevice::WriteOnly) || out.write(text.data(), static_cast<qint64>(text.size())) < 0 ||
-      !out.commit()) {
+  if (!out.open(QIODevice::WriteOnly) ||
+      out.write(text.data(), static_cast<qint64>(text.size())) < 0 || !out.commit()) {
     reporter().error(this, "Cannot save", "Cannot write " + path + ": " + out.errorString());
     return false;
   }
@@ -405,19 +428,27 @@ bool MainWindow::saveAs(const QString& path) {
   return true;
 }
 
-bool MainWindow::modified() const { return !undo_->isClean(); }
+bool MainWindow::modified() const {
+  return !undo_->isClean();
+}
 
 bool MainWindow::maybeSave() {
   if (!modified()) return true;
-  switch (reporter().askToSave(this, "The application \"" + q(app_.name) + "\" has unsaved changes. Save them?")) {
-    case Reporter::Choice::Save: return save();
-    case Reporter::Choice::Discard: return true;
-    case Reporter::Choice::Cancel: break;
+  switch (reporter().askToSave(
+      this, "The application \"" + q(app_.name) + "\" has unsaved changes. Save them?")) {
+    case Reporter::Choice::Save:
+      return save();
+    case Reporter::Choice::Discard:
+      return true;
+    case Reporter::Choice::Cancel:
+      break;
   }
   return false;
 }
 
-QStringList MainWindow::recentFiles() const { return settings_->value("recentFiles").toStringList(); }
+QStringList MainWindow::recentFiles() const {
+  return settings_->value("recentFiles").toStringList();
+}
 
 void MainWindow::addRecent(const QString& path) {
   if (!options_.rememberRecent) return;
@@ -506,10 +537,14 @@ void MainWindow::applicationChanged() {
 
 void MainWindow::refresh() {
   const std::size_t filterTypes = catalog_->filterTypes().size();
-  problems_ = findProblems(app_, *catalog_, [this](const app::Application& loaded) {
-    return daemon::loadApplicationPlugins(loaded, *catalog_);
-  }, &opened_);
-  if (catalog_->filterTypes().size() != filterTypes) palette_->setCatalog(*catalog_);  // a plugin added some
+  problems_ = findProblems(
+      app_, *catalog_,
+      [this](const app::Application& loaded) {
+        return daemon::loadApplicationPlugins(loaded, *catalog_);
+      },
+      &opened_);
+  if (catalog_->filterTypes().size() != filterTypes)
+    palette_->setCatalog(*catalog_);  // a plugin added some
   CanvasState& state = canvas_->state();
   state.app = &app_;
   state.catalog = catalog_.get();
@@ -529,9 +564,9 @@ void MainWindow::refresh() {
       where = q(app::toString(c.from) + " \u2192 " + app::toString(c.to));
     }
     if (!p.cycle.empty()) where = "deadlock";
-    auto* item = new QListWidgetItem(style()->standardIcon(error ? QStyle::SP_MessageBoxCritical
-                                                                 : QStyle::SP_MessageBoxWarning),
-                                     (where.isEmpty() ? QString() : where + ": ") + q(p.message));
+    auto* item = new QListWidgetItem(
+        style()->standardIcon(error ? QStyle::SP_MessageBoxCritical : QStyle::SP_MessageBoxWarning),
+        (where.isEmpty() ? QString() : where + ": ") + q(p.message));
     item->setToolTip(q(p.text));
     problemList_->addItem(item);
   }
@@ -624,7 +659,8 @@ void MainWindow::copySelection() {
 
 void MainWindow::paste() {
   std::vector<std::string> ids;
-  if (apply(pasteXml(app_, s(QApplication::clipboard()->text()), 40, 40, &ids), false)) canvas_->selectOnly(ids);
+  if (apply(pasteXml(app_, s(QApplication::clipboard()->text()), 40, 40, &ids), false))
+    canvas_->selectOnly(ids);
 }
 
 void MainWindow::duplicateSelection() {
@@ -654,7 +690,9 @@ void MainWindow::assignSelectionToHost(const std::string& host) {
 
 // ---- Run ---------------------------------------------------------------------------------
 
-bool MainWindow::running() const { return process_ != nullptr && process_->state() != QProcess::NotRunning; }
+bool MainWindow::running() const {
+  return process_ != nullptr && process_->state() != QProcess::NotRunning;
+}
 
 void MainWindow::runApplication(int iterations) {
   if (running()) return;
@@ -705,8 +743,10 @@ void MainWindow::runApplication(int iterations) {
     args << "--no-progress";
     log_->appendPlainText("(no pseudo-terminal: live rates unavailable for this run)");
   }
-  connect(process_, &QProcess::readyRead, this, [this] { handleRunOutput(QString::fromUtf8(process_->readAll())); });
-  connect(process_, &QProcess::finished, this, [this](int code, QProcess::ExitStatus) { finishRun(code); });
+  connect(process_, &QProcess::readyRead, this,
+          [this] { handleRunOutput(QString::fromUtf8(process_->readAll())); });
+  connect(process_, &QProcess::finished, this,
+          [this](int code, QProcess::ExitStatus) { finishRun(code); });
   connect(process_, &QProcess::errorOccurred, this, [this, program](QProcess::ProcessError error) {
     if (error == QProcess::FailedToStart) {
       log_->appendPlainText("Cannot start " + program + ": " + process_->errorString());
@@ -817,7 +857,8 @@ void MainWindow::finishRun(int exitCode) {
     summary = QString("Run failed (exit %1)").arg(exitCode);
     if (lastRun_ && !lastRun_->error.empty()) summary += ": " + q(lastRun_->error);
   }
-  if (lastRun_ && lastRun_->wallSeconds > 0) summary += QString(" after %1 s").arg(lastRun_->wallSeconds, 0, 'f', 2);
+  if (lastRun_ && lastRun_->wallSeconds > 0)
+    summary += QString(" after %1 s").arg(lastRun_->wallSeconds, 0, 'f', 2);
   log_->appendPlainText(summary);
   runError_ = exitCode == 0 ? QString() : summary;
   refresh();

@@ -30,16 +30,25 @@ namespace vrflow::editor::gui {
 
 namespace {
 
-QString q(const std::string& text) { return QString::fromStdString(text); }
-std::string s(const QString& text) { return text.toStdString(); }
+QString q(const std::string& text) {
+  return QString::fromStdString(text);
+}
+std::string s(const QString& text) {
+  return text.toStdString();
+}
 
 QString kindGroup(app::ModuleKind kind) {
   switch (kind) {
-    case app::ModuleKind::Animator: return "Animators";
-    case app::ModuleKind::Interactor: return "Interactors";
-    case app::ModuleKind::Viewer: return "Viewers";
-    case app::ModuleKind::Input: return "Inputs";
-    case app::ModuleKind::Other: break;
+    case app::ModuleKind::Animator:
+      return "Animators";
+    case app::ModuleKind::Interactor:
+      return "Interactors";
+    case app::ModuleKind::Viewer:
+      return "Viewers";
+    case app::ModuleKind::Input:
+      return "Inputs";
+    case app::ModuleKind::Other:
+      break;
   }
   return "Other modules";
 }
@@ -67,7 +76,8 @@ class HostTable : public QTableWidget {
 
 // ---- Palette -----------------------------------------------------------------------------
 
-Palette::Palette(QWidget* parent) : QWidget(parent), search_(new QLineEdit), tree_(new PaletteTree) {
+Palette::Palette(QWidget* parent)
+    : QWidget(parent), search_(new QLineEdit), tree_(new PaletteTree) {
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(4, 4, 4, 4);
   search_->setPlaceholderText("Search node types\u2026");
@@ -88,7 +98,8 @@ Palette::Palette(QWidget* parent) : QWidget(parent), search_(new QLineEdit), tre
 void Palette::setCatalog(const app::Catalog& catalog) {
   tree_->clear();
   std::map<QString, QTreeWidgetItem*> groups;
-  const QStringList order = {"Animators", "Interactors", "Viewers", "Inputs", "Other modules", "Filters"};
+  const QStringList order = {"Animators", "Interactors",   "Viewers",
+                             "Inputs",    "Other modules", "Filters"};
   for (const auto& name : order) {
     auto* group = new QTreeWidgetItem(tree_, QStringList{name});
     group->setFlags(Qt::ItemIsEnabled);
@@ -101,7 +112,8 @@ void Palette::setCatalog(const app::Catalog& catalog) {
     auto* item = new QTreeWidgetItem(groups[kindGroup(type->kind)],
                                      QStringList{q(type->type) + "  (" + q(type->package) + ")"});
     item->setData(0, kSpecRole, "module " + q(type->package) + " " + q(type->type));
-    item->setToolTip(0, q(type->package + "/" + type->type) + (type->doc.empty() ? "" : "\n" + q(type->doc)));
+    item->setToolTip(
+        0, q(type->package + "/" + type->type) + (type->doc.empty() ? "" : "\n" + q(type->doc)));
     item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsDragEnabled);
   }
   for (const app::FilterType* type : catalog.filterTypes()) {
@@ -158,7 +170,8 @@ QMimeData* PaletteTree::mimeData(const QList<QTreeWidgetItem*>& items) const {
 
 // ---- Properties --------------------------------------------------------------------------
 
-PropertiesPanel::PropertiesPanel(QWidget* parent) : QWidget(parent), layout_(new QVBoxLayout(this)) {
+PropertiesPanel::PropertiesPanel(QWidget* parent)
+    : QWidget(parent), layout_(new QVBoxLayout(this)) {
   layout_->setContentsMargins(0, 0, 0, 0);
   clear();
 }
@@ -193,7 +206,8 @@ QWidget* PropertiesPanel::initialMessagesWidget(const QString& port) const {
   return body_ == nullptr ? nullptr : body_->findChild<QWidget*>("initial:" + port);
 }
 
-QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::string& value, bool set) {
+QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::string& value,
+                                    bool set) {
   const std::string node = node_;
   const std::string name = spec.name;
   const std::string shown = set ? value : spec.defaultValue;
@@ -220,10 +234,12 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
     case app::ParamType::Int: {
       auto* box = new QSpinBox;
       const double lo = spec.min.value_or(-1e9), hi = spec.max.value_or(1e9);
-      box->setRange(static_cast<int>(std::max(lo, -2147483647.0)), static_cast<int>(std::min(hi, 2147483647.0)));
+      box->setRange(static_cast<int>(std::max(lo, -2147483647.0)),
+                    static_cast<int>(std::min(hi, 2147483647.0)));
       box->setValue(static_cast<int>(std::strtoll(shown.c_str(), nullptr, 10)));
       box->setKeyboardTracking(false);
-      connect(box, &QSpinBox::editingFinished, this, [box, emitValue] { emitValue(std::to_string(box->value())); });
+      connect(box, &QSpinBox::editingFinished, this,
+              [box, emitValue] { emitValue(std::to_string(box->value())); });
       widget = box;
       break;
     }
@@ -244,7 +260,8 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
     case app::ParamType::Bool: {
       auto* box = new QCheckBox;
       box->setChecked(shown == "true" || shown == "1");
-      connect(box, &QCheckBox::toggled, this, [emitValue](bool on) { emitValue(on ? "true" : "false"); });
+      connect(box, &QCheckBox::toggled, this,
+              [emitValue](bool on) { emitValue(on ? "true" : "false"); });
       widget = box;
       break;
     }
@@ -252,7 +269,8 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
       auto* box = new QComboBox;
       for (const auto& choice : spec.choices) box->addItem(q(choice));
       box->setCurrentText(q(shown));
-      connect(box, &QComboBox::activated, this, [box, emitValue] { emitValue(s(box->currentText())); });
+      connect(box, &QComboBox::activated, this,
+              [box, emitValue] { emitValue(s(box->currentText())); });
       widget = box;
       break;
     }
@@ -277,7 +295,8 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
       for (auto* box : boxes) {
         connect(box, &QDoubleSpinBox::editingFinished, this, [boxes, emitValue] {
           std::ostringstream text;
-          text << std::setprecision(12) << boxes[0]->value() << ' ' << boxes[1]->value() << ' ' << boxes[2]->value();
+          text << std::setprecision(12) << boxes[0]->value() << ' ' << boxes[1]->value() << ' '
+               << boxes[2]->value();
           emitValue(text.str());
         });
       }
@@ -294,10 +313,12 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
       browse->setText("\u2026");
       h->addWidget(edit);
       h->addWidget(browse);
-      connect(edit, &QLineEdit::editingFinished, this, [edit, emitValue] { emitValue(s(edit->text())); });
+      connect(edit, &QLineEdit::editingFinished, this,
+              [edit, emitValue] { emitValue(s(edit->text())); });
       connect(browse, &QToolButton::clicked, this, [this, edit, emitValue] {
-        const QString file = QFileDialog::getSaveFileName(this, "Choose a file", edit->text(), QString(), nullptr,
-                                                          QFileDialog::DontConfirmOverwrite);
+        const QString file =
+            QFileDialog::getSaveFileName(this, "Choose a file", edit->text(), QString(), nullptr,
+                                         QFileDialog::DontConfirmOverwrite);
         if (!file.isEmpty()) {
           edit->setText(file);
           emitValue(s(file));
@@ -308,15 +329,18 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
     }
     case app::ParamType::String: {
       auto* edit = new QLineEdit(q(shown));
-      connect(edit, &QLineEdit::editingFinished, this, [edit, emitValue] { emitValue(s(edit->text())); });
+      connect(edit, &QLineEdit::editingFinished, this,
+              [edit, emitValue] { emitValue(s(edit->text())); });
       widget = edit;
       break;
     }
   }
   widget->setObjectName("param:" + q(name));
   // Spin boxes with wide ranges ask for much width: let them shrink to the panel.
-  for (auto* box : widget->findChildren<QAbstractSpinBox*>()) box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
-  if (auto* box = qobject_cast<QAbstractSpinBox*>(widget)) box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+  for (auto* box : widget->findChildren<QAbstractSpinBox*>())
+    box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+  if (auto* box = qobject_cast<QAbstractSpinBox*>(widget))
+    box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
   widget->setMinimumWidth(60);
   QString tip = q(spec.doc);
   tip += (tip.isEmpty() ? "" : "\n") + QString("type: ") + q(app::toString(spec.type));
@@ -327,7 +351,8 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
   return widget;
 }
 
-void PropertiesPanel::show(const app::Application& app, const app::Catalog& catalog, const std::string& node) {
+void PropertiesPanel::show(const app::Application& app, const app::Catalog& catalog,
+                           const std::string& node) {
   node_ = node;
   dropLater(body_);
   if (node.empty() || nodeKind(app, node) == NodeKind::None) {
@@ -398,7 +423,8 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
   hosts->setObjectName("host");
   for (const auto& h : app.hosts) hosts->addItem(q(h.id));
   hosts->setCurrentText(q(app::effectiveHost(app, host)));
-  connect(hosts, &QComboBox::activated, this, [this, hosts, node] { Q_EMIT hostChosen(node, s(hosts->currentText())); });
+  connect(hosts, &QComboBox::activated, this,
+          [this, hosts, node] { Q_EMIT hostChosen(node, s(hosts->currentText())); });
   form->addRow("Host", hosts);
 
   auto* heading = new QLabel("<b>Parameters</b>");
@@ -417,7 +443,8 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
       reset->setToolTip("Reset to the default (" + q(spec.defaultValue) + ")");
       reset->setEnabled(p != nullptr);
       const std::string name = spec.name;
-      connect(reset, &QToolButton::clicked, this, [this, node, name] { Q_EMIT parameterEdited(node, name, ""); });
+      connect(reset, &QToolButton::clicked, this,
+              [this, node, name] { Q_EMIT parameterEdited(node, name, ""); });
       h->addWidget(reset);
       auto* label = new QLabel(q(spec.name) + (p == nullptr ? "" : " \u2022"));
       label->setToolTip(editor->toolTip());
@@ -446,10 +473,12 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
         box->setRange(0, 1000);
         box->setValue(app::inputConfigOrDefault(*module, port.name).initialMessages);
         box->setKeyboardTracking(false);
-        box->setToolTip("Messages the input holds before the first iteration (what breaks a cycle)");
+        box->setToolTip(
+            "Messages the input holds before the first iteration (what breaks a cycle)");
         const std::string portName = port.name;
-        connect(box, &QSpinBox::editingFinished, this,
-                [this, box, node, portName] { Q_EMIT initialMessagesEdited(node, portName, box->value()); });
+        connect(box, &QSpinBox::editingFinished, this, [this, box, node, portName] {
+          Q_EMIT initialMessagesEdited(node, portName, box->value());
+        });
         form->addRow(q(port.name), box);
       }
     }

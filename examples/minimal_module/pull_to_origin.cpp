@@ -12,8 +12,8 @@ int main() {
     return 2;
   }
   const double k = module.paramDouble("stiffness", 10);
-  while (module.wait()) {                      // false when the run stops
-    auto out = module.newMessage();            // written straight into shared memory
+  while (module.wait()) {            // false when the run stops
+    auto out = module.newMessage();  // written straight into shared memory
     for (const auto chunk : module.get(objects).view()) {
       auto object = chunk.asObject();
       if (!object) continue;
@@ -23,5 +23,5 @@ int main() {
     }
     if (!module.put(forces, std::move(out))) break;
   }
-  return module.exitStatus();                  // non-zero if put() reported an error
+  return module.exitStatus();  // non-zero if put() reported an error
 }

@@ -43,21 +43,25 @@ Result<std::vector<HostEntry>> readHostfile(const std::string& path,
         } catch (...) {
           entry.sshPort = -1;
         }
-        if (entry.sshPort <= 0 || entry.sshPort > 65535) return fail("bad ssh-port '" + value + "'");
+        if (entry.sshPort <= 0 || entry.sshPort > 65535)
+          return fail("bad ssh-port '" + value + "'");
       } else if (key == "identity") {
         entry.identity = value;
       } else if (key == "ssh-option") {
-        if (value.find('=') == std::string::npos) return fail("ssh-option needs KEY=VALUE, got '" + value + "'");
+        if (value.find('=') == std::string::npos)
+          return fail("ssh-option needs KEY=VALUE, got '" + value + "'");
         entry.sshOptions.push_back(value);
       } else if (key == "dir") {
         entry.directory = value;
       } else if (key == "daemon") {
         entry.daemon = value;
       } else if (key == "env") {
-        if (value.find('=') == std::string::npos) return fail("env needs NAME=VALUE, got '" + value + "'");
+        if (value.find('=') == std::string::npos)
+          return fail("env needs NAME=VALUE, got '" + value + "'");
         entry.environment.push_back(value);
       } else {
-        return fail("unknown key '" + key + "' (allowed: address, user, ssh-port, identity, ssh-option, dir, daemon, env)");
+        return fail("unknown key '" + key +
+                    "' (allowed: address, user, ssh-port, identity, ssh-option, dir, daemon, env)");
       }
     }
     entries.push_back(entry);

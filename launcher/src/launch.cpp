@@ -38,7 +38,8 @@ constexpr double kStopAnswerSeconds = 0.5;
 constexpr double kStopExitSeconds = 8;
 
 int64_t steadyNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+      .count();
 }
 
 double secondsSince(Clock::time_point t) {
@@ -79,7 +80,9 @@ struct HostDaemon {
   }
   std::string name() const {
     return "daemon of host '" + host + "' (" + bind +
-           (viaSsh ? ", ssh pid " : viaMpirun ? ", mpirun pid " : ", pid ") +
+           (viaSsh      ? ", ssh pid "
+            : viaMpirun ? ", mpirun pid "
+                        : ", pid ") +
            std::to_string(pid) + ")";
   }
 };
@@ -98,8 +101,8 @@ std::string shellQuote(const std::string& word) {
 }
 
 Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
-                          const std::vector<std::string>& environment, int& toChild,
-                          int& fromChild, bool stdoutToStderr = false) {
+                          const std::vector<std::string>& environment, int& toChild, int& fromChild,
+                          bool stdoutToStderr = false) {
   int in[2], out[2];
   if (pipe2(in, O_CLOEXEC) != 0 || pipe2(out, O_CLOEXEC) != 0) {
     return makeError(std::string("pipe: ") + std::strerror(errno));
@@ -240,9 +243,10 @@ void Launcher::pump(int timeoutMs) {
     while (read(signalFd_, &info, sizeof info) == sizeof info) {
       if ((info.ssi_signo == SIGINT || info.ssi_signo == SIGTERM) && !interrupted_) {
         interrupted_ = true;
-        failWith({run::kExitInterrupted, "interrupted",
-                  std::string("interrupted by ") + (info.ssi_signo == SIGINT ? "SIGINT" : "SIGTERM")},
-                 true);
+        failWith(
+            {run::kExitInterrupted, "interrupted",
+             std::string("interrupted by ") + (info.ssi_signo == SIGINT ? "SIGINT" : "SIGTERM")},
+            true);
       }
     }
   }
@@ -262,7 +266,9 @@ void Launcher::pump(int timeoutMs) {
         // Under mpirun every daemon has the same process (mpirun): the control channel's end
         // is what names the host that died.
         if (d.viaMpirun && !d.finished) {
-          failWith({run::kExitRunFailed, "failed", d.name() + " closed its control channel: it died"}, true);
+          failWith(
+              {run::kExitRunFailed, "failed", d.name() + " closed its control channel: it died"},
+              true);
         }
       }
       break;
@@ -317,7 +323,8 @@ void Launcher::appendDaemonOptions(std::vector<std::string>& argv) const {
   char timeout[32];
   std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
   argv.insert(argv.end(), {"--peer-timeout", timeout});
-  if (options_.iterations > 0) argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
+  if (options_.iterations > 0)
+    argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
   if (options_.moduleMemoryBytes > 0) {
     argv.insert(argv.end(), {"--module-memory-limit", std::to_string(options_.moduleMemoryBytes)});
   }
@@ -336,7 +343,8 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   if (inet_pton(AF_INET, options_.controlAddress.c_str(), &addr.sin_addr) != 1 ||
-      bind(listenFd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 || listen(listenFd, 64) != 0) {
+      bind(listenFd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 ||
+      listen(listenFd, 64) != 0) {
     close(listenFd);
     return makeError("cannot listen for the daemons on " + options_.controlAddress + ": " +
                      std::strerror(errno));
@@ -411,7 +419,8 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
       if (word != "hello" || index < 0 || static_cast<std::size_t>(index) >= n ||
           daemons_[static_cast<std::size_t>(index)].toDaemon >= 0 ||
           proof != net::controlProof(secret, index, nonce)) {
-        std::fprintf(stderr, "vrflow: refused a control connection that did not prove the run secret\n");
+        std::fprintf(stderr,
+                     "vrflow: refused a control connection that did not prove the run secret\n");
         close(fd);
         continue;
       }
@@ -468,23 +477,32 @@ Status Launcher::start() {
     }
     std::error_code ec;
     const std::string appFile = std::filesystem::absolute(options_.appFile, ec).string();
-    std::vector<std::string> argv{entry != nullptr && !entry->daemon.empty() ? entry->daemon : daemonPath,
-                                  appFile, "--host", host.id, "--control", "--bind", d.bind};
+    std::vector<std::string> argv{
+        entry != nullptr && !entry->daemon.empty() ? entry->daemon : daemonPath,
+        appFile,
+        "--host",
+        host.id,
+        "--control",
+        "--bind",
+        d.bind};
     appendDaemonOptions(argv);
     if (ssh) {
       // ssh carries nothing of our environment: the search paths and the hostfile's env go
       // explicitly on the remote command line (the secret does not: it goes on stdin).
-      std::string remote = "cd " + shellQuote(entry->directory.empty()
-                                                  ? std::filesystem::current_path(ec).string()
-                                                  : entry->directory) +
-                           " && exec env";
-      for (const char* name : {"VRFLOW_PACKAGE_PATH", "VRFLOW_COMPOSITE_PATH", "VRFLOW_FILTER_PATH"}) {
-        if (const char* value = std::getenv(name)) remote += " " + shellQuote(std::string(name) + "=" + value);
+      std::string remote =
+          "cd " +
+          shellQuote(entry->directory.empty() ? std::filesystem::current_path(ec).string()
+                                              : entry->directory) +
+          " && exec env";
+      for (const char* name :
+           {"VRFLOW_PACKAGE_PATH", "VRFLOW_COMPOSITE_PATH", "VRFLOW_FILTER_PATH"}) {
+        if (const char* value = std::getenv(name))
+          remote += " " + shellQuote(std::string(name) + "=" + value);
       }
       for (const auto& e : environment) remote += " " + shellQuote(e);
       for (const auto& a : argv) remote += " " + shellQuote(a);
-      std::vector<std::string> sshArgv{"ssh", "-T", "-o", "BatchMode=yes", "-p",
-                                       std::to_string(entry->sshPort)};
+      std::vector<std::string> sshArgv{"ssh",           "-T", "-o",
+                                       "BatchMode=yes", "-p", std::to_string(entry->sshPort)};
       if (!entry->identity.empty()) sshArgv.insert(sshArgv.end(), {"-i", entry->identity});
       for (const auto& o : entry->sshOptions) sshArgv.insert(sshArgv.end(), {"-o", o});
       sshArgv.push_back(entry->user.empty() ? d.bind : entry->user + "@" + d.bind);
@@ -522,7 +540,8 @@ Status Launcher::start() {
   if (auto s = waitFor([](const HostDaemon& d) { return d.port > 0; }, "listening"); !s) return s;
   for (const auto& d : daemons_) {
     for (const auto& peer : daemons_) {
-      d.send("peer " + std::to_string(peer.index) + " " + peer.bind + " " + std::to_string(peer.port));
+      d.send("peer " + std::to_string(peer.index) + " " + peer.bind + " " +
+             std::to_string(peer.port));
     }
     d.send("connect");
   }
@@ -545,8 +564,9 @@ void Launcher::publish() {
   for (std::size_t i = 0; i < daemons_.size(); ++i) {
     const auto& d = daemons_[i];
     text += (i ? "," : "") + std::string("{\"host\":") + nlohmann::json(d.host).dump() +
-            ",\"address\":" + nlohmann::json(d.bind).dump() + ",\"daemon_pid\":" +
-            std::to_string(d.pid) + ",\"now\":" + (d.stats.empty() ? "null" : d.stats) +
+            ",\"address\":" + nlohmann::json(d.bind).dump() +
+            ",\"daemon_pid\":" + std::to_string(d.pid) +
+            ",\"now\":" + (d.stats.empty() ? "null" : d.stats) +
             ",\"before\":" + (d.previousStats.empty() ? "null" : d.previousStats) + "}";
   }
   text += "]}";
@@ -648,9 +668,11 @@ run::RunOutcome Launcher::run() {
       if (!d.report.empty()) parts.push_back(d.report);
     }
     std::ofstream out(options_.reportPath);
-    out << mergeReports(application_, parts, outcome, options_.iterations, secondsSince(begin)) << "\n";
+    out << mergeReports(application_, parts, outcome, options_.iterations, secondsSince(begin))
+        << "\n";
     if (!out && outcome.exitCode == run::kExitOk) {
-      outcome = {run::kExitRunFailed, "failed", "cannot write the report '" + options_.reportPath + "'"};
+      outcome = {run::kExitRunFailed, "failed",
+                 "cannot write the report '" + options_.reportPath + "'"};
     }
   }
   if (!options_.tracePath.empty()) {
@@ -666,7 +688,8 @@ run::RunOutcome Launcher::run() {
     std::ofstream out(options_.tracePath);
     out << run::chromeTrace(application_, traces) << "\n";
     if (!out && outcome.exitCode == run::kExitOk) {
-      outcome = {run::kExitRunFailed, "failed", "cannot write the trace '" + options_.tracePath + "'"};
+      outcome = {run::kExitRunFailed, "failed",
+                 "cannot write the trace '" + options_.tracePath + "'"};
     }
   }
   close(signalFd_);

@@ -31,7 +31,8 @@ std::string mergeReports(const app::Application& application, const std::vector<
   auto connectionRank = [&](const ordered_json& c) {
     for (std::size_t i = 0; i < application.connections.size(); ++i) {
       const auto& k = application.connections[i];
-      if (app::toString(k.from) == c.value("from", "") && app::toString(k.to) == c.value("to", "")) {
+      if (app::toString(k.from) == c.value("from", "") &&
+          app::toString(k.to) == c.value("to", "")) {
         return i;
       }
     }
@@ -42,8 +43,9 @@ std::string mergeReports(const app::Application& application, const std::vector<
     return moduleRank(a.value("id", "")) < moduleRank(b.value("id", ""));
   });
   auto connections = collect("connections");
-  std::stable_sort(connections.begin(), connections.end(),
-                   [&](const auto& a, const auto& b) { return connectionRank(a) < connectionRank(b); });
+  std::stable_sort(connections.begin(), connections.end(), [&](const auto& a, const auto& b) {
+    return connectionRank(a) < connectionRank(b);
+  });
   auto outputs = collect("outputs");
   std::stable_sort(outputs.begin(), outputs.end(), [&](const auto& a, const auto& b) {
     return moduleRank(a.value("module", "")) < moduleRank(b.value("module", ""));

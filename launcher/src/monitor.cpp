@@ -24,8 +24,8 @@ using nlohmann::json;
 
 double rate(const json& now, const json& before, const char* key, double seconds) {
   if (before.is_null() || seconds <= 0 || !now.contains(key) || !before.contains(key)) return 0.0;
-  return static_cast<double>(now[key].get<uint64_t>() - std::min(now[key].get<uint64_t>(),
-                                                                  before[key].get<uint64_t>())) /
+  return static_cast<double>(now[key].get<uint64_t>() -
+                             std::min(now[key].get<uint64_t>(), before[key].get<uint64_t>())) /
          seconds;
 }
 
@@ -39,8 +39,8 @@ const json* findById(const json& list, const char* key, const std::string& value
 std::string render(const json& launch) {
   std::ostringstream out;
   char line[256];
-  out << launch.value("application", "?") << "  (" << launch.value("file", "")
-      << ", launcher pid " << launch.value("launcher_pid", 0) << ")\n";
+  out << launch.value("application", "?") << "  (" << launch.value("file", "") << ", launcher pid "
+      << launch.value("launcher_pid", 0) << ")\n";
   std::snprintf(line, sizeof line, "%-8s %-16s %10s %6s %-16s %6s %10s\n", "HOST", "MODULE", "IT/S",
                 "WAIT%", "STATE", "CPU%", "RSS MiB");
   out << line;
@@ -53,9 +53,10 @@ std::string render(const json& launch) {
       out << line;
       continue;
     }
-    const double dt = before.is_null() ? 0.0
-                                       : static_cast<double>(now["t_ns"].get<int64_t>() -
-                                                             before["t_ns"].get<int64_t>()) / 1e9;
+    const double dt =
+        before.is_null()
+            ? 0.0
+            : static_cast<double>(now["t_ns"].get<int64_t>() - before["t_ns"].get<int64_t>()) / 1e9;
     for (const auto& m : now["modules"]) {
       const json* b = before.is_null() ? nullptr : findById(before["modules"], "id", m["id"]);
       const json prev = b ? *b : json();
@@ -64,7 +65,8 @@ std::string render(const json& launch) {
                     host.value("host", "?").c_str(), m.value("id", "?").c_str(),
                     rate(m, prev, "iterations", dt),
                     wait + compute > 0 ? 100.0 * wait / (wait + compute) : 0.0,
-                    m.value("state", "?").c_str(), dt > 0 ? 100.0 * rate(m, prev, "cpu_ns", dt) / 1e9 : 0.0,
+                    m.value("state", "?").c_str(),
+                    dt > 0 ? 100.0 * rate(m, prev, "cpu_ns", dt) / 1e9 : 0.0,
                     static_cast<double>(m.value("rss_bytes", uint64_t{0})) / 1048576.0);
       out << line;
     }
@@ -84,7 +86,8 @@ std::string render(const json& launch) {
     }
     const json noLinks = json::array();
     const json& nowLinks = now.contains("links") ? now["links"] : noLinks;
-    const json& beforeLinks = !before.is_null() && before.contains("links") ? before["links"] : noLinks;
+    const json& beforeLinks =
+        !before.is_null() && before.contains("links") ? before["links"] : noLinks;
     for (const auto& l : nowLinks) {
       const json* b = nullptr;
       for (const auto& item : beforeLinks) {
@@ -96,15 +99,17 @@ std::string render(const json& launch) {
       if (peer >= 0 && static_cast<std::size_t>(peer) < launch["hosts"].size()) {
         peerName = launch["hosts"][static_cast<std::size_t>(peer)].value("host", peerName);
       }
-      std::snprintf(line, sizeof line, "  %-8s -> %-8s %10.1f msg/s out %10.3f MiB/s out %10.1f msg/s in %10.3f MiB/s in\n",
-                    host.value("host", "?").c_str(), peerName.c_str(),
-                    rate(l, prev, "messages_sent", dt), rate(l, prev, "bytes_sent", dt) / 1048576.0,
-                    rate(l, prev, "messages_received", dt),
-                    rate(l, prev, "bytes_received", dt) / 1048576.0);
+      std::snprintf(
+          line, sizeof line,
+          "  %-8s -> %-8s %10.1f msg/s out %10.3f MiB/s out %10.1f msg/s in %10.3f MiB/s in\n",
+          host.value("host", "?").c_str(), peerName.c_str(), rate(l, prev, "messages_sent", dt),
+          rate(l, prev, "bytes_sent", dt) / 1048576.0, rate(l, prev, "messages_received", dt),
+          rate(l, prev, "bytes_received", dt) / 1048576.0);
       links << line;
     }
   }
-  std::snprintf(line, sizeof line, "%-46s %11s %10s %10s\n", "CONNECTION", "QUEUE", "MSG/S", "MIB/S");
+  std::snprintf(line, sizeof line, "%-46s %11s %10s %10s\n", "CONNECTION", "QUEUE", "MSG/S",
+                "MIB/S");
   out << line << connections.str();
   if (!links.str().empty()) out << "LINKS\n" << links.str();
   return out.str();
@@ -167,7 +172,8 @@ Result<std::vector<json>> liveLaunches() {
 
 Result<std::string> monitorDirectory() {
   std::string dir;
-  if (const char* runtime = std::getenv("XDG_RUNTIME_DIR"); runtime != nullptr && *runtime != '\0') {
+  if (const char* runtime = std::getenv("XDG_RUNTIME_DIR");
+      runtime != nullptr && *runtime != '\0') {
     dir = std::string(runtime) + "/vrflow";
   } else {
     dir = "/tmp/vrflow-" + std::to_string(getuid());

@@ -43,8 +43,8 @@ int hostIndex(const app::Application& application, const std::string& host) {
 Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application& application,
                                                          const std::string& host,
                                                          const std::string& bindAddress,
-                                                         double peerTimeoutSeconds, int in,
-                                                         int out, std::optional<net::Secret> given) {
+                                                         double peerTimeoutSeconds, int in, int out,
+                                                         std::optional<net::Secret> given) {
   std::unique_ptr<ControlLink> link(new ControlLink(in, out));
   Result<net::Secret> secret = net::Secret{};
   if (given) {
@@ -127,8 +127,8 @@ Result<int> ControlLink::connectBack(const std::string& address, const net::Secr
     close(fd);
     return makeError("the launcher at " + address + " did not send its nonce");
   }
-  const std::string hello =
-      "hello " + std::to_string(hostIndex) + " " + net::controlProof(secret, hostIndex, line.substr(6)) + "\n";
+  const std::string hello = "hello " + std::to_string(hostIndex) + " " +
+                            net::controlProof(secret, hostIndex, line.substr(6)) + "\n";
   if (write(fd, hello.data(), hello.size()) != static_cast<ssize_t>(hello.size())) {
     close(fd);
     return makeError("the launcher at " + address + " closed the control channel");
@@ -263,8 +263,10 @@ std::optional<run::RunOutcome> ControlLink::poll() {
   }
   const std::string line = next(0);
   if (line == "stop" || line == "eof") stopped_ = true;
-  if (line == "stop") return run::RunOutcome{run::kExitInterrupted, "stopped", "stopped by the launcher"};
-  if (line == "eof") return run::RunOutcome{run::kExitInterrupted, "stopped", "the launcher went away"};
+  if (line == "stop")
+    return run::RunOutcome{run::kExitInterrupted, "stopped", "stopped by the launcher"};
+  if (line == "eof")
+    return run::RunOutcome{run::kExitInterrupted, "stopped", "the launcher went away"};
   return std::nullopt;
 }
 
@@ -316,15 +318,18 @@ std::vector<std::string> ControlLink::settle() {
           "; the report may miss their last messages"};
 }
 
-void ControlLink::trace(const std::string& json) { send("trace " + json); }
+void ControlLink::trace(const std::string& json) {
+  send("trace " + json);
+}
 
 void ControlLink::stats(const std::string& json) {
   // The links' counters join the modules' and connections'.
   std::string links = "[";
   for (const auto& l : transport_->linkStats()) {
     if (links.size() > 1) links += ",";
-    links += "{\"peer\":" + std::to_string(l.peer) + ",\"messages_sent\":" +
-             std::to_string(l.messagesSent) + ",\"bytes_sent\":" + std::to_string(l.bytesSent) +
+    links += "{\"peer\":" + std::to_string(l.peer) +
+             ",\"messages_sent\":" + std::to_string(l.messagesSent) +
+             ",\"bytes_sent\":" + std::to_string(l.bytesSent) +
              ",\"messages_received\":" + std::to_string(l.messagesReceived) +
              ",\"bytes_received\":" + std::to_string(l.bytesReceived) + "}";
   }

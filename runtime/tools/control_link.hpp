@@ -30,7 +30,8 @@ class ControlLink final : public run::HostLink {
                                                      std::optional<net::Secret> secret = {});
   /// mpirun: the daemon connects back to the launcher at `address` (HOST:PORT), proves it holds
   /// the run secret, and returns the socket (the control channel both ways).
-  static Result<int> connectBack(const std::string& address, const net::Secret& secret, int hostIndex);
+  static Result<int> connectBack(const std::string& address, const net::Secret& secret,
+                                 int hostIndex);
   ~ControlLink() override;
 
   void configure(daemon::DaemonOptions& options) override;

@@ -87,11 +87,10 @@ TEST(Catalog, RegistersTheBuiltinFilters) {
   const Catalog catalog;
   std::vector<std::string> names;
   for (const FilterType* type : catalog.filterTypes()) names.push_back(type->name);
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"broadcast", "decimate", "gate", "gather", "initial",
-                                      "latest", "maxfrequency", "merge", "multiplex",
-                                      "passthrough", "repeat", "rotate", "route", "scatter",
-                                      "stampfilter", "typefilter", "unrotate"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"broadcast", "decimate", "gate", "gather", "initial",
+                                             "latest", "maxfrequency", "merge", "multiplex",
+                                             "passthrough", "repeat", "rotate", "route", "scatter",
+                                             "stampfilter", "typefilter", "unrotate"}));
   const FilterType* merge = catalog.findFilter("merge");
   EXPECT_EQ(namesOf(merge->portsFor({})), (std::vector<std::string>{"in0", "in1", "out"}));
   EXPECT_EQ(namesOf(merge->portsFor({Param{"inputs", "3", {}}})),
@@ -215,12 +214,13 @@ TEST(Catalog, EnumParameterNeedsChoices) {
 // through mpirun); naming anything else is an error at the attribute.
 TEST(Catalog, MpiRanksNamesAnIntParameter) {
   Catalog catalog;
-  ASSERT_TRUE(catalog
-                  .addPackageString("<package name=\"p\">\n  <module type=\"m\" executable=\"x\" "
-                                    "mpi-ranks=\"blocks\">\n    <param name=\"blocks\" "
-                                    "type=\"int\" default=\"1\" min=\"1\"/>\n  </module>\n</package>\n",
-                                    "pkg.xml")
-                  .ok());
+  ASSERT_TRUE(
+      catalog
+          .addPackageString("<package name=\"p\">\n  <module type=\"m\" executable=\"x\" "
+                            "mpi-ranks=\"blocks\">\n    <param name=\"blocks\" "
+                            "type=\"int\" default=\"1\" min=\"1\"/>\n  </module>\n</package>\n",
+                            "pkg.xml")
+          .ok());
   const auto* type = catalog.findModule("p", "m");
   ASSERT_NE(type, nullptr);
   EXPECT_EQ(type->mpiRanksParam, "blocks");
@@ -233,8 +233,9 @@ TEST(Catalog, MpiRanksNamesAnIntParameter) {
         "bad.xml");
     ASSERT_FALSE(status.ok());
     EXPECT_EQ(status.error().message.rfind("bad.xml:2:", 0), 0u) << status.error().message;
-    EXPECT_NE(status.error().message.find("mpi-ranks names 'blocks', which is not an int parameter"),
-              std::string::npos)
+    EXPECT_NE(
+        status.error().message.find("mpi-ranks names 'blocks', which is not an int parameter"),
+        std::string::npos)
         << status.error().message;
   }
 }

@@ -244,8 +244,8 @@ TEST(CompositeErrors, HugeAttributeTextIsRefusedBeforeMemoryRunsOut) {
 TEST(CompositeErrors, AProblemRepeatedByEveryIterationIsReportedOnce) {
   const std::vector<Diagnostic> found = checkComposed(oneInstance(R"(
       <modules><repeat var="i" count="5000"><module id="m${j}" package="core" type="relay"/></repeat></modules>)"));
-  EXPECT_ONLY_ERROR_AT(found, 4, 53,
-                       "attribute 'id' of <module>: unknown name 'j' in '${j}' (known: i, instance)");
+  EXPECT_ONLY_ERROR_AT(
+      found, 4, 53, "attribute 'id' of <module>: unknown name 'j' in '${j}' (known: i, instance)");
 }
 
 TEST(CompositeErrors, IdsInsideACompositeMustNotHoldTheSeparator) {

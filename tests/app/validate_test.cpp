@@ -732,7 +732,8 @@ TEST(Validate, BadEndpointIsReportedNotTheInputItMeantToFeed) {
   </connections>
 </application>
 )");
-  EXPECT_ONLY_ERROR_AT(wrongPort, 7, 30, "has no input 'inn' (inputs: in, beginIt); did you mean 'in'?");
+  EXPECT_ONLY_ERROR_AT(wrongPort, 7, 30,
+                       "has no input 'inn' (inputs: in, beginIt); did you mean 'in'?");
   const std::vector<Diagnostic> wrongNode = check(R"(<application>
   <modules>
     <module id="a" package="core" type="source"/>

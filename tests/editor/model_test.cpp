@@ -17,8 +17,8 @@ namespace fs = std::filesystem;
 
 app::Catalog coreCatalog() {
   app::Catalog catalog;
-  const auto status =
-      catalog.addPackageFile(std::string(VRFLOW_TEST_SOURCE_DIR) + "/runtime/modules/core/vrflow-package.xml");
+  const auto status = catalog.addPackageFile(std::string(VRFLOW_TEST_SOURCE_DIR) +
+                                             "/runtime/modules/core/vrflow-package.xml");
   EXPECT_TRUE(status.ok()) << status.error().message;
   return catalog;
 }
@@ -84,8 +84,10 @@ TEST(EditorModel, RefusesIncompatibleConnectionsSayingWhy) {
   EXPECT_NE(why->find("port data types differ"), std::string::npos) << *why;
   EXPECT_NE(why->find("'objects'"), std::string::npos) << *why;
   // input to input, output to output
-  EXPECT_TRUE(connectionRefusal(app, catalog, {"spring", "objects"}, {"points", "events"}).has_value());
-  EXPECT_TRUE(connectionRefusal(app, catalog, {"spring", "forces"}, {"points", "objects"}).has_value());
+  EXPECT_TRUE(
+      connectionRefusal(app, catalog, {"spring", "objects"}, {"points", "events"}).has_value());
+  EXPECT_TRUE(
+      connectionRefusal(app, catalog, {"spring", "forces"}, {"points", "objects"}).has_value());
   // twice the same
   why = connectionRefusal(app, catalog, {"points", "objects"}, {"spring", "objects"});
   ASSERT_TRUE(why.has_value());
@@ -96,7 +98,8 @@ TEST(EditorModel, RefusesIncompatibleConnectionsSayingWhy) {
   EXPECT_NE(why->find("stamps-only"), std::string::npos) << *why;
   // and the edit itself refuses
   EXPECT_FALSE(connect(app, catalog, {"points", "objects"}, {"points", "events"}).ok());
-  EXPECT_FALSE(connectionRefusal(app, catalog, {"points", "endIt"}, {"spring", "beginIt"}).has_value());
+  EXPECT_FALSE(
+      connectionRefusal(app, catalog, {"points", "endIt"}, {"spring", "beginIt"}).has_value());
 }
 
 TEST(EditorModel, EditsParametersAndInitialMessages) {
@@ -104,13 +107,19 @@ TEST(EditorModel, EditsParametersAndInitialMessages) {
   History history;
   chain(history, catalog);
   history.push(*setParameter(history.application(), "spring", "stiffness", "123"));
-  EXPECT_EQ(app::paramString(app::findModule(history.application(), "spring")->params, "stiffness", ""), "123");
+  EXPECT_EQ(
+      app::paramString(app::findModule(history.application(), "spring")->params, "stiffness", ""),
+      "123");
   history.push(*setInitialMessages(history.application(), "points", "events", 1));
-  EXPECT_EQ(app::inputConfigOrDefault(*app::findModule(history.application(), "points"), "events").initialMessages, 1);
+  EXPECT_EQ(app::inputConfigOrDefault(*app::findModule(history.application(), "points"), "events")
+                .initialMessages,
+            1);
   ASSERT_TRUE(history.undo());
-  EXPECT_EQ(app::findInputConfig(*app::findModule(history.application(), "points"), "events"), nullptr);
+  EXPECT_EQ(app::findInputConfig(*app::findModule(history.application(), "points"), "events"),
+            nullptr);
   ASSERT_TRUE(history.undo());
-  EXPECT_EQ(app::findParam(app::findModule(history.application(), "spring")->params, "stiffness"), nullptr);
+  EXPECT_EQ(app::findParam(app::findModule(history.application(), "spring")->params, "stiffness"),
+            nullptr);
   EXPECT_FALSE(setParameter(history.application(), "nobody", "x", "1").ok());
 }
 
@@ -127,7 +136,8 @@ TEST(EditorModel, HostsAddRenameAssignRemoveAndImport) {
   history.push(*removeHost(history.application(), "gpu"));
   EXPECT_EQ(app::findModule(history.application(), "spring")->host, "localhost");
   EXPECT_FALSE(removeHost(history.application(), "localhost").ok());  // the last one
-  history.push(*importHostfile(history.application(), "# cluster\nwall1 192.168.0.11\nwall2 slots=4\n\n"));
+  history.push(
+      *importHostfile(history.application(), "# cluster\nwall1 192.168.0.11\nwall2 slots=4\n\n"));
   ASSERT_EQ(history.application().hosts.size(), 3u);
   EXPECT_EQ(history.application().hosts[1].address, "192.168.0.11");
   EXPECT_EQ(history.application().hosts[2].id, "wall2");
@@ -192,9 +202,12 @@ TEST(EditorModel, EveryExampleSavedUnchangedGivesTheSameBytes) {
   const auto catalog = coreCatalog();
   int count = 0;
   int canonical = 0;
-  for (const auto& entry : fs::recursive_directory_iterator(fs::path(VRFLOW_TEST_SOURCE_DIR) / "examples")) {
+  for (const auto& entry :
+       fs::recursive_directory_iterator(fs::path(VRFLOW_TEST_SOURCE_DIR) / "examples")) {
     const std::string name = entry.path().filename().string();
-    if (entry.path().extension() != ".xml" || name.ends_with(".vrc.xml") || name == "vrflow-package.xml") continue;
+    if (entry.path().extension() != ".xml" || name.ends_with(".vrc.xml") ||
+        name == "vrflow-package.xml")
+      continue;
     const std::string text = readFile(entry.path());
     auto app = app::loadApplicationString(text, entry.path().string());
     ASSERT_TRUE(app.ok()) << entry.path() << ": " << app.error().message;
@@ -205,7 +218,8 @@ TEST(EditorModel, EveryExampleSavedUnchangedGivesTheSameBytes) {
     History history(*app);
     if (!app->modules.empty()) {
       history.push(*setParameter(history.application(), app->modules[0].id, "editor-test", "1"));
-      EXPECT_EQ(textToSave(history.application(), opened), app::saveApplication(history.application()));
+      EXPECT_EQ(textToSave(history.application(), opened),
+                app::saveApplication(history.application()));
       ASSERT_TRUE(history.undo());
       EXPECT_EQ(textToSave(history.application(), opened), text);
     }
@@ -296,7 +310,8 @@ TEST(EditorModel, AutoLayoutGoesLeftToRight) {
 }
 
 TEST(EditorModel, ParsesRunReportsAndFindsTheFailingModule) {
-  const auto report = parseRunReport(R"({"status":"failed","error":"module 'springs' (host local, pid 12) exited with status 3",
+  const auto report = parseRunReport(
+      R"({"status":"failed","error":"module 'springs' (host local, pid 12) exited with status 3",
     "modules":[{"id":"springs","iterations":7,"exit":"status 3"}],
     "connections":[{"from":"a.out","to":"b.in","messages":5,"bytes":640,"dropped":0}],
     "timing":{"wall_s":2.5}})");

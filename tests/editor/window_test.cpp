@@ -32,13 +32,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-QString sourceDir() { return QString(VRFLOW_TEST_SOURCE_DIR); }
+QString sourceDir() {
+  return QString(VRFLOW_TEST_SOURCE_DIR);
+}
 
 // Records what the window would show in dialogs, and answers for the user.
 class RecordingReporter : public Reporter {
  public:
-  void error(QWidget*, const QString& title, const QString& text) override { errors << title + ": " + text; }
-  void warning(QWidget*, const QString& title, const QString& text) override { warnings << title + ": " + text; }
+  void error(QWidget*, const QString& title, const QString& text) override {
+    errors << title + ": " + text;
+  }
+  void warning(QWidget*, const QString& title, const QString& text) override {
+    warnings << title + ": " + text;
+  }
   Choice askToSave(QWidget*, const QString& text) override {
     questions << text;
     return answer;
@@ -69,9 +75,9 @@ class EditorWindow : public ::testing::Test {
     EditorOptions options;
     options.settingsFile = dir_.filePath("settings.ini");
     options.reporter = &reporter_;
-    options.packageDirs.push_back((fs::path(QCoreApplication::applicationDirPath().toStdString()) /
-                                   ".." / "test-packages")
-                                      .string());
+    options.packageDirs.push_back(
+        (fs::path(QCoreApplication::applicationDirPath().toStdString()) / ".." / "test-packages")
+            .string());
     window_ = std::make_unique<MainWindow>(options);
     window_->resize(1400, 860);
     window_->show();
@@ -83,7 +89,8 @@ class EditorWindow : public ::testing::Test {
 
   void mouse(QEvent::Type type, QPoint pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
     QWidget* viewport = canvas()->viewport();
-    QMouseEvent event(type, QPointF(pos), viewport->mapToGlobal(QPointF(pos)), button, buttons, Qt::NoModifier);
+    QMouseEvent event(type, QPointF(pos), viewport->mapToGlobal(QPointF(pos)), button, buttons,
+                      Qt::NoModifier);
     QApplication::sendEvent(viewport, &event);
   }
 
@@ -107,7 +114,8 @@ class EditorWindow : public ::testing::Test {
     QDragMoveEvent move(at, Qt::CopyAction, mime, Qt::LeftButton, Qt::NoModifier);
     QApplication::sendEvent(viewport, &move);
     // Offered as a move too: the canvas must take a copy, or the panel would lose the row.
-    QDropEvent dropped(QPointF(at), Qt::CopyAction | Qt::MoveAction, mime, Qt::LeftButton, Qt::NoModifier);
+    QDropEvent dropped(QPointF(at), Qt::CopyAction | Qt::MoveAction, mime, Qt::LeftButton,
+                       Qt::NoModifier);
     dropped.setDropAction(Qt::MoveAction);
     QApplication::sendEvent(viewport, &dropped);
     EXPECT_TRUE(dropped.isAccepted());
@@ -174,7 +182,8 @@ TEST_F(EditorWindow, AddsNodesFromThePaletteAndUndoesAndRedoes) {
   NodeItem* merge = canvas()->nodeItem("merge");
   ASSERT_NE(merge, nullptr);
   EXPECT_FALSE(merge->shape().contains(QPointF(2, 2)));
-  EXPECT_TRUE(merge->shape().contains(QPointF(merge->size().width() / 2, merge->size().height() / 2)));
+  EXPECT_TRUE(
+      merge->shape().contains(QPointF(merge->size().width() / 2, merge->size().height() / 2)));
   // Double click in the palette adds at the centre of the view.
   auto* tree = window_->palette()->tree();
   QTreeWidgetItem* item = window_->palette()->findEntry("module core relay");
@@ -227,7 +236,8 @@ TEST_F(EditorWindow, RefusesAnIncompatibleConnectionSayingWhy) {
       << window_->canvas()->lastRefusal().toStdString();
   dragConnect("points.objects", "spring.forces");  // output to output
   EXPECT_TRUE(app().connections.empty());
-  EXPECT_TRUE(window_->canvas()->lastRefusal().contains("outputs")) << window_->canvas()->lastRefusal().toStdString();
+  EXPECT_TRUE(window_->canvas()->lastRefusal().contains("outputs"))
+      << window_->canvas()->lastRefusal().toStdString();
   EXPECT_EQ(window_->undoStack()->count(), edits);  // nothing to undo from a refusal
   // Undo then takes back the last real edit, and redo restores it.
   window_->undoStack()->undo();
@@ -256,8 +266,8 @@ TEST_F(EditorWindow, ZoomsPansAndSelectsWithARubberBand) {
   canvas()->centerOn(200, 50);
   QApplication::processEvents();
   const QPoint centre = canvas()->viewport()->rect().center();
-  QWheelEvent wheel(QPointF(centre), canvas()->viewport()->mapToGlobal(QPointF(centre)), QPoint(), QPoint(0, 240),
-                    Qt::NoButton, Qt::NoModifier, Qt::NoScrollPhase, false);
+  QWheelEvent wheel(QPointF(centre), canvas()->viewport()->mapToGlobal(QPointF(centre)), QPoint(),
+                    QPoint(0, 240), Qt::NoButton, Qt::NoModifier, Qt::NoScrollPhase, false);
   QApplication::sendEvent(canvas()->viewport(), &wheel);
   EXPECT_GT(canvas()->transform().m11(), 1.2);
   // Middle button drag pans.
@@ -280,7 +290,8 @@ TEST_F(EditorWindow, ZoomsPansAndSelectsWithARubberBand) {
 TEST_F(EditorWindow, EditsAParameterAndInitialMessagesInThePropertiesPanel) {
   pointsAndSpring();
   canvas()->selectOnly({"spring"});
-  auto* stiffness = qobject_cast<QDoubleSpinBox*>(window_->properties()->parameterWidget("stiffness"));
+  auto* stiffness =
+      qobject_cast<QDoubleSpinBox*>(window_->properties()->parameterWidget("stiffness"));
   ASSERT_NE(stiffness, nullptr);
   EXPECT_DOUBLE_EQ(stiffness->value(), 50);  // the manifest's default
   EXPECT_TRUE(stiffness->toolTip().contains("Spring stiffness"));
@@ -323,7 +334,8 @@ TEST_F(EditorWindow, EditsAParameterAndInitialMessagesInThePropertiesPanel) {
   initial->selectAll();
   QTest::keyClicks(initial, "1");
   QTest::keyClick(initial, Qt::Key_Return);
-  EXPECT_EQ(app::inputConfigOrDefault(*app::findModule(app(), "points"), "events").initialMessages, 1);
+  EXPECT_EQ(app::inputConfigOrDefault(*app::findModule(app(), "points"), "events").initialMessages,
+            1);
 }
 
 TEST_F(EditorWindow, AssignsHostsFromThePanelThePropertiesAndByDrop) {
@@ -419,9 +431,12 @@ TEST_F(EditorWindow, SavesAndReloadsAnEqualModel) {
 
 TEST_F(EditorWindow, EveryExampleOpensAndSavesUnchangedToTheSameBytes) {
   int count = 0;
-  for (const auto& entry : fs::recursive_directory_iterator(fs::path(VRFLOW_TEST_SOURCE_DIR) / "examples")) {
+  for (const auto& entry :
+       fs::recursive_directory_iterator(fs::path(VRFLOW_TEST_SOURCE_DIR) / "examples")) {
     const std::string name = entry.path().filename().string();
-    if (entry.path().extension() != ".xml" || name.ends_with(".vrc.xml") || name == "vrflow-package.xml") continue;
+    if (entry.path().extension() != ".xml" || name.ends_with(".vrc.xml") ||
+        name == "vrflow-package.xml")
+      continue;
     const QString path = QString::fromStdString(entry.path().string());
     ASSERT_TRUE(window_->openFile(path)) << name << reporter_.errors.join("\n").toStdString();
     EXPECT_FALSE(window_->modified());
@@ -466,11 +481,12 @@ TEST_F(EditorWindow, NodesOfUnknownTypesKeepThePortsTheirConnectionsName) {
   {
     QFile out(file);
     ASSERT_TRUE(out.open(QIODevice::WriteOnly));
-    out.write("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"u\" version=\"1\">\n"
-              "  <modules>\n    <module id=\"a\" package=\"nowhere\" type=\"thing\"/>\n"
-              "    <module id=\"r\" package=\"core\" type=\"recorder\"/>\n  </modules>\n"
-              "  <connections>\n    <connection from=\"a.out\" to=\"r.in\"/>\n  </connections>\n"
-              "</application>\n");
+    out.write(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"u\" version=\"1\">\n"
+        "  <modules>\n    <module id=\"a\" package=\"nowhere\" type=\"thing\"/>\n"
+        "    <module id=\"r\" package=\"core\" type=\"recorder\"/>\n  </modules>\n"
+        "  <connections>\n    <connection from=\"a.out\" to=\"r.in\"/>\n  </connections>\n"
+        "</application>\n");
   }
   ASSERT_TRUE(window_->openFile(file));
   EXPECT_NE(canvas()->portItem("a", "out"), nullptr);
@@ -484,7 +500,9 @@ TEST_F(EditorWindow, AMalformedFileGivesAClearMessageAndKeepsTheDocument) {
   {
     QFile file(bad);
     ASSERT_TRUE(file.open(QIODevice::WriteOnly));
-    file.write("<?xml version=\"1.0\"?>\n<application name=\"x\" version=\"1\">\n  <modules>\n    <module id=\"a\"\n");
+    file.write(
+        "<?xml version=\"1.0\"?>\n<application name=\"x\" version=\"1\">\n  <modules>\n    <module "
+        "id=\"a\"\n");
   }
   EXPECT_FALSE(window_->openFile(bad));
   ASSERT_EQ(reporter_.errors.size(), 1);
@@ -496,7 +514,8 @@ TEST_F(EditorWindow, AMalformedFileGivesAClearMessageAndKeepsTheDocument) {
   // A manifest is not an application either.
   EXPECT_FALSE(window_->openFile(sourceDir() + "/runtime/modules/core/vrflow-package.xml"));
   ASSERT_EQ(reporter_.errors.size(), 3);
-  EXPECT_TRUE(reporter_.errors[2].contains("root element must be <application>")) << reporter_.errors[2].toStdString();
+  EXPECT_TRUE(reporter_.errors[2].contains("root element must be <application>"))
+      << reporter_.errors[2].toStdString();
   EXPECT_EQ(app().modules.size(), 2u);
 }
 
@@ -606,7 +625,8 @@ TEST_F(EditorWindow, AFailedRunShowsTheFailingModule) {
   ASSERT_TRUE(window_->lastRun().has_value());
   EXPECT_EQ(window_->lastRun()->failedModule, "crash");
   EXPECT_EQ(canvas()->selectedNodes(), std::vector<std::string>{"crash"});
-  EXPECT_TRUE(window_->log()->toPlainText().contains("module 'crash'")) << window_->log()->toPlainText().toStdString();
+  EXPECT_TRUE(window_->log()->toPlainText().contains("module 'crash'"))
+      << window_->log()->toPlainText().toStdString();
 }
 
 TEST_F(EditorWindow, TheScreenshotCommandRendersTheWindowOffscreen) {
@@ -629,7 +649,8 @@ TEST_F(EditorWindow, TheScreenshotCommandRendersTheWindowOffscreen) {
     ASSERT_TRUE(file.open(QIODevice::WriteOnly));
     file.write("<application");
   }
-  editor.start(QCoreApplication::applicationDirPath() + "/vrflow-editor", {bad, "--screenshot", out + "2"});
+  editor.start(QCoreApplication::applicationDirPath() + "/vrflow-editor",
+               {bad, "--screenshot", out + "2"});
   ASSERT_TRUE(editor.waitForFinished(60000));
   EXPECT_EQ(editor.exitCode(), 1);
   EXPECT_TRUE(editor.readAllStandardError().contains("bad.xml"));

@@ -44,10 +44,13 @@ std::string twoBlockTank(const std::string& stats, const Tank& tank) {
   const std::string params = R"(      <param name="nx" value="8"/>
       <param name="ny" value="8"/>
       <param name="nz" value="8"/>
-      <param name="cell)" + dash + R"(size" value="0.1"/>
-      <param name="fill)" + dash + R"(max" value="0.8 0.4 0.8"/>
+      <param name="cell)" + dash +
+                             R"(size" value="0.1"/>
+      <param name="fill)" + dash +
+                             R"(max" value="0.8 0.4 0.8"/>
       <param name="blocks" value="2"/>
-      <param name="stats" value=")" + stats + R"("/>
+      <param name="stats" value=")" +
+                             stats + R"("/>
 )";
   const std::string box = R"(    <module id="box" package="fluidtest" type="box" host="local">
       <param name="half" value=")" +

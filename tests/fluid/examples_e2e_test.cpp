@@ -191,8 +191,7 @@ void expectOneModulePerBlockEqualsOwnBlocks(int blockCount) {
     const auto app = run == 0
                          ? exampleForTest("dam_break", "dam_break.xml", {{"water.blocks", blocks}})
                          : exampleForTest("dam_break", "dam_break_blocks.xml", {});
-    const auto result =
-        runApp(dir, app, 100, 120, run == 0 ? "" : "--set water.blocks=" + blocks);
+    const auto result = runApp(dir, app, 100, 120, run == 0 ? "" : "--set water.blocks=" + blocks);
     ASSERT_EQ(result.exitCode, 0) << (run == 0 ? "blocks = " : "fluid_blocks ") << blocks << ": "
                                   << result.err;
     const std::string prefix = run == 0 ? "dam_break" : "dam_break_blocks";

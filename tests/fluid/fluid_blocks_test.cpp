@@ -52,7 +52,8 @@ TEST(FluidBlocksComposite, ExpandsToOneFluidModulePerBlockInOneJob) {
   for (const char* id : {"water:block0", "water:block1"}) {
     EXPECT_NE(flat.find(std::string("<module id=\"") + id + "\" package=\"fluid\" type=\"fluid\""),
               std::string::npos)
-        << id << "\n" << flat;
+        << id << "\n"
+        << flat;
   }
   EXPECT_EQ(flat.find("water:block2"), std::string::npos);
   // Both blocks name the instance as their job, so vrflow starts them as one mpirun.
@@ -64,8 +65,7 @@ TEST(FluidBlocksComposite, ExpandsToOneFluidModulePerBlockInOneJob) {
   EXPECT_EQ(jobs, 2u) << flat;
   EXPECT_NE(flat.find(R"(<filter id="water:feed" type="route")"), std::string::npos) << flat;
   EXPECT_NE(flat.find(R"(from="bodies.objects" to="water:feed.in")"), std::string::npos) << flat;
-  EXPECT_NE(flat.find(R"(from="water:forces.out" to="bodies.events")"), std::string::npos)
-      << flat;
+  EXPECT_NE(flat.find(R"(from="water:forces.out" to="bodies.events")"), std::string::npos) << flat;
   EXPECT_NE(flat.find(R"(from="water:block1.interest" to="water:feed.interest1")"),
             std::string::npos)
       << flat;

@@ -114,8 +114,8 @@ TEST(FluidModule, LightBoxFloatsThroughTheAnimatorInteractorCycle) {
 // An mpirun for VRFLOW_MPIRUN in `dir`: it appends its arguments to dir/mpirun.log and runs the
 // real mpirun.
 std::string loggingMpirun(const TempDir& dir) {
-  const auto wrapper = dir.write("mpirun", "#!/bin/sh\necho \"$@\" >> '" +
-                                               dir.file("mpirun.log") + "'\nexec mpirun \"$@\"\n");
+  const auto wrapper = dir.write(
+      "mpirun", "#!/bin/sh\necho \"$@\" >> '" + dir.file("mpirun.log") + "'\nexec mpirun \"$@\"\n");
   EXPECT_EQ(chmod(wrapper.c_str(), 0755), 0);
   return wrapper;
 }
@@ -305,7 +305,8 @@ TEST(FluidModule, ParticleRegionsLetARouteFilterSendEachViewerOnlyWhatItSees) {
       "    <connection from=\"water.fluid\" to=\"wall.in\" capacity=\"1\"/>\n";
   for (int k = 0; k < 2; ++k) {
     const std::string id = "v" + std::to_string(k);
-    modules += "    <module id=\"" + id + "\" package=\"routing\" type=\"tile-viewer\" host=\"local\">\n" +
+    modules += "    <module id=\"" + id +
+               "\" package=\"routing\" type=\"tile-viewer\" host=\"local\">\n" +
                "      <param name=\"box\" value=\"" + boxes[k] + "\"/>\n" +
                "      <param name=\"file\" value=\"" + dir.file(id + ".csv") + "\"/>\n" +
                "    </module>\n";
@@ -317,10 +318,10 @@ TEST(FluidModule, ParticleRegionsLetARouteFilterSendEachViewerOnlyWhatItSees) {
   app.replace(app.find("  <connections>"), 0,
               "  <filters>\n    <filter id=\"wall\" type=\"route\" host=\"local\">\n"
               "      <param name=\"outputs\" value=\"2\"/>\n    </filter>\n  </filters>\n");
-  const auto result = runVrflow({"--packages", binDir() + "/../share/vrflow/example-packages",
-                                 "run", dir.write("regions.xml", app), "--iterations", "40",
-                                 "--no-progress"},
-                                120);
+  const auto result =
+      runVrflow({"--packages", binDir() + "/../share/vrflow/example-packages", "run",
+                 dir.write("regions.xml", app), "--iterations", "40", "--no-progress"},
+                120);
   ASSERT_EQ(result.exitCode, 0) << result.err;
   // iteration -> resource id -> vertex count, from iteration,kind,id,op,mask,x,ref lines
   const auto meshes = [](const std::vector<std::string>& lines) {

@@ -26,7 +26,7 @@ for f in "${files[@]}"; do
   if ! diff -q "$f" <("$tool" "$f") >/dev/null; then
     bad=$((bad + 1))
     echo "not formatted: $f"
-    diff -u "$f" <("$tool" "$f") | sed -n '3,12p'
+    diff -u "$f" <("$tool" "$f") | sed -n '3,12p' || true
   fi
 done
 if [ "$bad" -gt 0 ]; then

@@ -36,7 +36,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
         storage.assign(header.length, std::byte{0});
         return std::span<std::byte>(storage);
       },
-      [&](const vrflow::net::FrameHeader& header, std::span<const std::byte> payload) -> vrflow::Status {
+      [&](const vrflow::net::FrameHeader& header,
+          std::span<const std::byte> payload) -> vrflow::Status {
         check(payload.size() == header.length);
         if (header.type == vrflow::net::FrameType::Message) check(payload.size() == announced);
         ++delivered;

@@ -1,20 +1,19 @@
 #include <dirent.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <gtest/gtest.h>
-
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
-#include <nlohmann/json.hpp>
-#include <csignal>
 #include <thread>
 
 #include "process_helpers.hpp"
@@ -22,8 +21,12 @@
 namespace vrflow::testing {
 namespace {
 
-std::string pipelineFile() { return sourceDir() + "/examples/pipeline/pipeline.xml"; }
-std::string threeHostsFile() { return sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml"; }
+std::string pipelineFile() {
+  return sourceDir() + "/examples/pipeline/pipeline.xml";
+}
+std::string threeHostsFile() {
+  return sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml";
+}
 
 // The report without timings and without what names the file or the hosts.
 nlohmann::json deterministicPart(const std::string& path) {
@@ -108,7 +111,8 @@ Launched launchAndKill(const std::string& victim, const std::string& report,
     dup2(fd, 2);
     const int null = open("/dev/null", O_WRONLY);
     dup2(null, 1);
-    std::vector<std::string> args{binDir() + "/vrflow", "launch", threeHostsFile(), "--report", report};
+    std::vector<std::string> args{binDir() + "/vrflow", "launch", threeHostsFile(), "--report",
+                                  report};
     args.insert(args.end(), extra.begin(), extra.end());
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
@@ -146,9 +150,8 @@ Launched launchAndKill(const std::string& victim, const std::string& report,
 
 TEST(Launch, ThreeHostsGiveTheSameDigestsAsOneHost) {
   TempDir dir;
-  const auto one = runVrflow({"run", pipelineFile(), "-n", "150", "--no-progress", "--report",
-                              dir.file("one.json")},
-                             120);
+  const auto one = runVrflow(
+      {"run", pipelineFile(), "-n", "150", "--no-progress", "--report", dir.file("one.json")}, 120);
   ASSERT_EQ(one.exitCode, 0) << one.err;
   const auto three = runVrflow({"launch", threeHostsFile(), "--backend", "local", "-n", "150",
                                 "--report", dir.file("three.json")},
@@ -213,7 +216,8 @@ TEST(Launch, MessagesStillCrossingHostsAtTheEndAreCountedOnABusyCpu) {
     const auto got = deterministicPart(dir.file("three.json"));
     ASSERT_EQ(expected, got) << "launch " << i << ":\n"
                              << expected.dump(1) << "\n---\n"
-                             << got.dump(1) << "\n" << three.err;
+                             << got.dump(1) << "\n"
+                             << three.err;
   }
   EXPECT_TRUE(leftoverProcesses().empty());
 }
@@ -222,12 +226,13 @@ TEST(Launch, SetParametersReachTheDaemonOfEveryHost) {
   // springs runs on host b: its daemon reads the file itself, so --set must travel to it.
   TempDir dir;
   const std::vector<std::string> set{"--set", "springs.stiffness=90", "--set", "chain.count=5"};
-  auto one = std::vector<std::string>{"run", pipelineFile(), "-n", "60", "--no-progress",
+  auto one = std::vector<std::string>{"run",      pipelineFile(),      "-n", "60", "--no-progress",
                                       "--report", dir.file("one.json")};
   one.insert(one.end(), set.begin(), set.end());
   ASSERT_EQ(runVrflow(one, 120).exitCode, 0);
-  auto three = std::vector<std::string>{"launch", threeHostsFile(), "--backend", "local", "-n",
-                                        "60", "--report", dir.file("three.json")};
+  auto three =
+      std::vector<std::string>{"launch", threeHostsFile(), "--backend",           "local", "-n",
+                               "60",     "--report",       dir.file("three.json")};
   three.insert(three.end(), set.begin(), set.end());
   const auto launched = runVrflow(three, 120);
   ASSERT_EQ(launched.exitCode, 0) << launched.err;
@@ -269,7 +274,8 @@ TEST(Launch, KillingAModuleStopsEveryHostAndNamesItsHost) {
 TEST(Launch, AFrozenDaemonIsDeclaredLostByHeartbeatTimeoutAndEverythingStops) {
   // SIGSTOP: the daemon's sockets stay open but nothing comes out, as when a network is cut.
   TempDir dir;
-  const auto result = launchAndKill("--host b", dir.file("r.json"), {"--peer-timeout", "1"}, SIGSTOP);
+  const auto result =
+      launchAndKill("--host b", dir.file("r.json"), {"--peer-timeout", "1"}, SIGSTOP);
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find("lost the link to host 'b'"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("heartbeat timeout"), std::string::npos) << result.err;
@@ -304,7 +310,8 @@ TEST(Launch, AFrozenDaemonIsKilledAndEveryHostStopsSoonAfterTheLinkLoss) {
 
 TEST(Launch, TraceHoldsSpansOfEveryModuleAndFlowsAcrossHosts) {
   TempDir dir;
-  const auto result = runVrflow({"launch", threeHostsFile(), "-n", "20", "--trace", dir.file("t.json")}, 120);
+  const auto result =
+      runVrflow({"launch", threeHostsFile(), "-n", "20", "--trace", dir.file("t.json")}, 120);
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto trace = nlohmann::json::parse(readFile(dir.file("t.json")));
   std::map<std::pair<int, int>, std::string> threads;
@@ -401,9 +408,8 @@ bool mpirunUsable() {
 TEST(LaunchMpirun, ThreeHostsThroughMpirunGiveTheSameDigestsAsOneHost) {
   if (!mpirunUsable()) GTEST_SKIP() << "mpirun is not installed";
   TempDir dir;
-  const auto one = runVrflow({"run", pipelineFile(), "-n", "100", "--no-progress", "--report",
-                              dir.file("one.json")},
-                             120);
+  const auto one = runVrflow(
+      {"run", pipelineFile(), "-n", "100", "--no-progress", "--report", dir.file("one.json")}, 120);
   ASSERT_EQ(one.exitCode, 0) << one.err;
   const auto three = runVrflow({"launch", threeHostsFile(), "--backend", "mpirun", "-n", "100",
                                 "--report", dir.file("three.json")},
@@ -416,7 +422,8 @@ TEST(LaunchMpirun, ThreeHostsThroughMpirunGiveTheSameDigestsAsOneHost) {
 TEST(LaunchMpirun, KillingADaemonStopsEveryHostAndNamesItsHost) {
   if (!mpirunUsable()) GTEST_SKIP() << "mpirun is not installed";
   TempDir dir;
-  const auto result = launchAndKill("comm:vrflow-daemon", dir.file("r.json"), {"--backend", "mpirun"});
+  const auto result =
+      launchAndKill("comm:vrflow-daemon", dir.file("r.json"), {"--backend", "mpirun"});
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find("closed its control channel"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("mpirun pid"), std::string::npos) << result.err;
@@ -438,10 +445,12 @@ TEST(Launch, ADaemonThatCannotBindItsAddressIsNamedAndNothingIsLeft) {
 
 TEST(Launch, AHostfileMistakeNamesTheFileAndLine) {
   TempDir dir;
-  const auto hosts = dir.write("hosts", "a address=127.0.0.1\n# comment\nnowhere address=1.2.3.4\n");
+  const auto hosts =
+      dir.write("hosts", "a address=127.0.0.1\n# comment\nnowhere address=1.2.3.4\n");
   const auto result = runVrflow({"launch", threeHostsFile(), "--hosts", hosts, "-n", "5"}, 60);
   EXPECT_EQ(result.exitCode, 2);
-  EXPECT_NE(result.err.find(hosts + ":3: error: no host 'nowhere'"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find(hosts + ":3: error: no host 'nowhere'"), std::string::npos)
+      << result.err;
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 

@@ -20,11 +20,14 @@
 namespace vrflow::testing {
 namespace {
 
-std::string examplePackages() { return binDir() + "/../share/vrflow/example-packages"; }
+std::string examplePackages() {
+  return binDir() + "/../share/vrflow/example-packages";
+}
 
 // The flat application of `source` with its modules and filters spread over 3 hosts, saved as
 // `dir/name`; returns the hosts each node got.
-std::map<std::string, std::string> spreadOverThreeHosts(const std::string& source, const TempDir& dir,
+std::map<std::string, std::string> spreadOverThreeHosts(const std::string& source,
+                                                        const TempDir& dir,
                                                         const std::string& name) {
   auto application = app::loadApplicationFile(source);
   EXPECT_TRUE(application) << application.error().message;
@@ -48,11 +51,12 @@ std::map<std::string, std::string> spreadOverThreeHosts(const std::string& sourc
 // `vrflow COMMAND APP ARGS` from `dir` (outputs land there), with the example packages.
 CommandResult vrflowIn(const TempDir& dir, const std::string& command, const std::string& app,
                        const std::string& args) {
-  return runCommand({"/bin/sh", "-c",
-                     "cd '" + dir.path() + "' && exec '" + binDir() + "/vrflow' --packages '" +
-                         examplePackages() + "' --packages '" + binDir() + "/../test-packages' " + command + " '" + app + "' " + args +
-                         (command == "run" ? " --no-progress" : "") + " --timeout 90"},
-                    150);
+  return runCommand(
+      {"/bin/sh", "-c",
+       "cd '" + dir.path() + "' && exec '" + binDir() + "/vrflow' --packages '" +
+           examplePackages() + "' --packages '" + binDir() + "/../test-packages' " + command +
+           " '" + app + "' " + args + (command == "run" ? " --no-progress" : "") + " --timeout 90"},
+      150);
 }
 
 // The last digest of every output, of the modules `keep` accepts. Object ids carry the host
@@ -94,7 +98,8 @@ void expectSameOnThreeHosts(const std::string& example, const TempDir& one, cons
   ASSERT_EQ(hostsUsed(placed).size(), 3u);
   const auto a = vrflowIn(one, "run", source, args + " --report one.json");
   ASSERT_EQ(a.exitCode, 0) << a.err;
-  const auto b = vrflowIn(three, "launch", three.file("three.xml"), args + " --backend local --report three.json");
+  const auto b = vrflowIn(three, "launch", three.file("three.xml"),
+                          args + " --backend local --report three.json");
   ASSERT_EQ(b.exitCode, 0) << b.err;
   std::set<std::string> onA;
   for (const auto& [node, host] : placed) {
@@ -135,7 +140,8 @@ TEST_F(PatternsOnThreeHosts, TreeBroadcastDeliversEveryMessageOnceInOrder) {
     const auto lines = readLines(three.file("received" + std::to_string(r) + ".csv"));
     ASSERT_EQ(lines.size(), 21u) << "receiver " << r;
     for (int i = 0; i < 20; ++i) {
-      EXPECT_EQ(lines[static_cast<std::size_t>(i) + 1].substr(0, lines[i + 1].find(',')), std::to_string(i))
+      EXPECT_EQ(lines[static_cast<std::size_t>(i) + 1].substr(0, lines[i + 1].find(',')),
+                std::to_string(i))
           << "receiver " << r;
     }
   }
@@ -160,7 +166,8 @@ TEST_F(PatternsOnThreeHosts, DynamicRoutingSendsEachTileTheSameAsOnOneHost) {
     // The parsed report outlives the loop (a range over a member of a temporary would not).
     const auto parsed = nlohmann::json::parse(readFile(dir.file(report)));
     for (const auto& c : parsed["connections"]) {
-      bytes[c["from"].get<std::string>() + "->" + c["to"].get<std::string>()] = c["bytes"].get<uint64_t>();
+      bytes[c["from"].get<std::string>() + "->" + c["to"].get<std::string>()] =
+          c["bytes"].get<uint64_t>();
     }
     return bytes;
   };
@@ -168,9 +175,11 @@ TEST_F(PatternsOnThreeHosts, DynamicRoutingSendsEachTileTheSameAsOnOneHost) {
 }
 
 TEST_F(PatternsOnThreeHosts, DuplicatedInteractorGivesTheDigestOfOneCopy) {
-  expectSameOnThreeHosts("duplicated_interactor/duplicated_gravity.xml", one, three, "--iterations 100");
-  const auto single = vrflowIn(one, "run", sourceDir() + "/examples/duplicated_interactor/one_gravity.xml",
-                               "--iterations 100 --report single.json");
+  expectSameOnThreeHosts("duplicated_interactor/duplicated_gravity.xml", one, three,
+                         "--iterations 100");
+  const auto single =
+      vrflowIn(one, "run", sourceDir() + "/examples/duplicated_interactor/one_gravity.xml",
+               "--iterations 100 --report single.json");
   ASSERT_EQ(single.exitCode, 0) << single.err;
   EXPECT_EQ(lastDigests(one, "single.json").at("chain.objects"),
             lastDigests(three, "three.json").at("chain.objects"));
@@ -208,7 +217,8 @@ TEST_F(PatternsOnThreeHosts, TypeFilterKeepsTheSameChunksAcrossHosts) {
   }
   const auto a = vrflowIn(one, "run", one.file("types.xml"), "--iterations 30 --report one.json");
   ASSERT_EQ(a.exitCode, 0) << a.err;
-  const auto b = vrflowIn(three, "launch", three.file("types.xml"), "--iterations 30 --backend local --report three.json");
+  const auto b = vrflowIn(three, "launch", three.file("types.xml"),
+                          "--iterations 30 --backend local --report three.json");
   ASSERT_EQ(b.exitCode, 0) << b.err;
   const auto kept = withoutIds(three.file("kept.csv"));
   EXPECT_EQ(withoutIds(one.file("kept.csv")), kept);

@@ -1,11 +1,10 @@
 // The ssh backend against a real sshd that this test starts on loopback, with keys it makes.
 #include <dirent.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdio>
@@ -32,7 +31,8 @@ bool hasChildren(pid_t parent) {
     if (close == std::string::npos) continue;
     char state = 0;
     int ppid = 0;
-    if (std::sscanf(text.c_str() + close + 1, " %c %d", &state, &ppid) == 2 && ppid == parent) any = true;
+    if (std::sscanf(text.c_str() + close + 1, " %c %d", &state, &ppid) == 2 && ppid == parent)
+      any = true;
   }
   closedir(dir);
   return any;
@@ -52,9 +52,8 @@ class Sshd {
       mkdir("/run/sshd", 0755);
     }
     for (const char* key : {"host_key", "user_key"}) {
-      const auto made = runCommand({"/usr/bin/ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f",
-                                    dir_.file(key)},
-                                   30);
+      const auto made = runCommand(
+          {"/usr/bin/ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f", dir_.file(key)}, 30);
       if (made.exitCode != 0) return "ssh-keygen failed: " + made.err;
     }
     dir_.write("authorized_keys", readFile(dir_.file("user_key.pub")));
@@ -62,9 +61,10 @@ class Sshd {
     port_ = 20000 + static_cast<int>(getpid() % 20000);
     dir_.write("sshd_config", "Port " + std::to_string(port_) +
                                   "\nListenAddress 127.0.0.1\nListenAddress 127.0.0.2\n"
-                                  "ListenAddress 127.0.0.3\nHostKey " + dir_.file("host_key") +
-                                  "\nAuthorizedKeysFile " + dir_.file("authorized_keys") +
-                                  "\nPidFile " + dir_.file("sshd.pid") +
+                                  "ListenAddress 127.0.0.3\nHostKey " +
+                                  dir_.file("host_key") + "\nAuthorizedKeysFile " +
+                                  dir_.file("authorized_keys") + "\nPidFile " +
+                                  dir_.file("sshd.pid") +
                                   "\nUsePAM no\nStrictModes no\nPasswordAuthentication no\n"
                                   "KbdInteractiveAuthentication no\nPubkeyAuthentication yes\n"
                                   "PermitRootLogin prohibit-password\nLogLevel ERROR\n");
@@ -77,11 +77,11 @@ class Sshd {
     // Ready when a login works.
     for (int i = 0; i < 50; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      const auto probe = runCommand({"/usr/bin/ssh", "-T", "-o", "BatchMode=yes", "-o",
-                                     "StrictHostKeyChecking=no", "-o", "UserKnownHostsFile=/dev/null",
-                                     "-o", "LogLevel=ERROR", "-i", dir_.file("user_key"), "-p",
-                                     std::to_string(port_), "127.0.0.2", "true"},
-                                    20);
+      const auto probe =
+          runCommand({"/usr/bin/ssh", "-T", "-o", "BatchMode=yes", "-o", "StrictHostKeyChecking=no",
+                      "-o", "UserKnownHostsFile=/dev/null", "-o", "LogLevel=ERROR", "-i",
+                      dir_.file("user_key"), "-p", std::to_string(port_), "127.0.0.2", "true"},
+                     20);
       if (probe.exitCode == 0) return {};
       int status = 0;
       if (waitpid(pid_, &status, WNOHANG) == pid_) {
@@ -105,8 +105,8 @@ class Sshd {
     }
   }
   std::string hostLine(const std::string& host, const std::string& address) const {
-    return host + " address=" + address + " ssh-port=" + std::to_string(port_) + " identity=" +
-           dir_.file("user_key") +
+    return host + " address=" + address + " ssh-port=" + std::to_string(port_) +
+           " identity=" + dir_.file("user_key") +
            " ssh-option=StrictHostKeyChecking=no ssh-option=UserKnownHostsFile=/dev/null"
            " ssh-option=LogLevel=ERROR\n";
   }
@@ -132,9 +132,9 @@ TEST(LaunchSsh, ThreeHostsThroughSshdGiveTheSameDigestsAsOneHost) {
   TempDir dir;
   Sshd sshd(dir);
   if (const std::string why = sshd.start(); !why.empty()) GTEST_SKIP() << why;
-  const auto hosts = dir.write("hosts", sshd.hostLine("a", "127.0.0.1") +
-                                            sshd.hostLine("b", "127.0.0.2") +
-                                            sshd.hostLine("c", "127.0.0.3"));
+  const auto hosts =
+      dir.write("hosts", sshd.hostLine("a", "127.0.0.1") + sshd.hostLine("b", "127.0.0.2") +
+                             sshd.hostLine("c", "127.0.0.3"));
   const std::string app = sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml";
   const auto three = runVrflow({"launch", app, "--backend", "ssh", "--hosts", hosts, "-n", "100",
                                 "--report", dir.file("three.json")},
@@ -153,11 +153,13 @@ TEST(LaunchSsh, ThreeHostsThroughSshdGiveTheSameDigestsAsOneHost) {
 TEST(LaunchSsh, AnUnreachableHostIsNamed) {
   TempDir dir;
   // Nothing listens on port 1: ssh fails, and the launcher names the host's daemon.
-  const auto hosts = dir.write("hosts", "a address=127.0.0.1 ssh-port=1\nb address=127.0.0.2 ssh-port=1\n"
-                                        "c address=127.0.0.3 ssh-port=1\n");
-  const auto result = runVrflow({"launch", sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml",
-                                 "--backend", "ssh", "--hosts", hosts, "-n", "5"},
-                                60);
+  const auto hosts = dir.write("hosts",
+                               "a address=127.0.0.1 ssh-port=1\nb address=127.0.0.2 ssh-port=1\n"
+                               "c address=127.0.0.3 ssh-port=1\n");
+  const auto result =
+      runVrflow({"launch", sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml",
+                 "--backend", "ssh", "--hosts", hosts, "-n", "5"},
+                60);
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find("daemon of host '"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("ssh pid"), std::string::npos) << result.err;

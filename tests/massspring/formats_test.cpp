@@ -102,17 +102,23 @@ TEST(MassSpringFormats, BadFilesGiveClearErrors) {
   expectError(loadNet("/nonexistent/net.txt"),
               "/nonexistent/net.txt: net file: cannot read file (No such file or directory)");
   expectError(parseNet("springy 1\n"), "<text>:1: expected the header 'massspring 1'");
-  expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n"), "<text>:3: the file ends after 1 of 2 nodes");
-  expectError(parseNet("massspring 1\nnodes 1\n0 0 zero 1 0\nsprings 0\n"), "<text>:3: 'zero' is not a number");
+  expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n"),
+              "<text>:3: the file ends after 1 of 2 nodes");
+  expectError(parseNet("massspring 1\nnodes 1\n0 0 zero 1 0\nsprings 0\n"),
+              "<text>:3: 'zero' is not a number");
   expectError(parseNet("massspring 1\nnodes 1\n0 0 0 1 2\nsprings 0\n"), "pinned must be 0 or 1");
   expectError(parseNet("massspring 1\nnodes 1\n0 0 0 -1 0\nsprings 0\n"), "node 0 has mass -1");
   expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n1 0 0 1 0\nsprings 1\n0 2 1 1 0 0\n"),
               "<text>:6: spring node indices must be integers below 2");
-  expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n1 0 0 1 0\nsprings 1\n0 0 1 1 0 0\n"), "joins node 0 to itself");
-  expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n1 0 0 1 0\nsprings 1\n0 1 1 1 0 0.5\n"), "maxStretch must be 0");
-  expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n1 0 0 1 0\nsprings 1\n0 1 1 -5 0 0\n"), "stiffness must be");
+  expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n1 0 0 1 0\nsprings 1\n0 0 1 1 0 0\n"),
+              "joins node 0 to itself");
+  expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n1 0 0 1 0\nsprings 1\n0 1 1 1 0 0.5\n"),
+              "maxStretch must be 0");
+  expectError(parseNet("massspring 1\nnodes 2\n0 0 0 1 0\n1 0 0 1 0\nsprings 1\n0 1 1 -5 0 0\n"),
+              "stiffness must be");
   expectError(parseNet("massspring 1\nnodes 1\nnan 0 0 1 0\nsprings 0\n"), "non-finite");
-  expectError(parseNet("massspring 1\nnodes 1\n0 0 0 1 0\nsprings 0\nextra 3\n"), "<text>:5: expected 'triangles T'");
+  expectError(parseNet("massspring 1\nnodes 1\n0 0 0 1 0\nsprings 0\nextra 3\n"),
+              "<text>:5: expected 'triangles T'");
 }
 
 // A net is read only from a regular file of at most 256 MiB: a device, a FIFO (without
@@ -202,7 +208,8 @@ TEST(MassSpringFormats, NodeForceEvents) {
   auto bad = payload;
   bad[0] = std::byte{3};
   EXPECT_FALSE(decodeNodeForces(bad));
-  EXPECT_EQ(sparseForces(std::vector<double>{0, 0, 0, 1, 0, 0}), (std::vector<NodeForce>{{1, {1, 0, 0}}}));
+  EXPECT_EQ(sparseForces(std::vector<double>{0, 0, 0, 1, 0, 0}),
+            (std::vector<NodeForce>{{1, {1, 0, 0}}}));
 }
 
 TEST(MassSpringFormats, NetsTravelAsObjectChunksIntoASceneCopy) {
@@ -248,7 +255,8 @@ TEST(MassSpringFormats, RigidsAndTheirShapeResourcesIntoASceneCopy) {
       .set(P::kMass, 2.5)
       .set(P::kShape, std::uint64_t{99});
   builder.addRawResource(99, false, shapeBytes);
-  builder.addRawResource(100, false, std::vector<std::byte>(5, std::byte{1}));  // not a shape: ignored
+  builder.addRawResource(100, false,
+                         std::vector<std::byte>(5, std::byte{1}));  // not a shape: ignored
   builder.finish();
   auto view = msg::MessageView::parse(builder.bytes());
   ASSERT_TRUE(view) << view.error().message;
@@ -265,7 +273,9 @@ TEST(MassSpringFormats, RigidsAndTheirShapeResourcesIntoASceneCopy) {
   // A rigid whose shape has not arrived is left out until it does.
   msg::VectorSink sink2;
   msg::MessageBuilder second(sink2);
-  second.addObject(8, msg::rigidType(), msg::ObjectOp::Add).set(P::kMass, 1.0).set(P::kShape, std::uint64_t{101});
+  second.addObject(8, msg::rigidType(), msg::ObjectOp::Add)
+      .set(P::kMass, 1.0)
+      .set(P::kShape, std::uint64_t{101});
   second.finish();
   auto view2 = msg::MessageView::parse(second.bytes());
   ASSERT_TRUE(view2);
@@ -282,7 +292,8 @@ TEST(MassSpringFormats, RigidsAndTheirShapeResourcesIntoASceneCopy) {
   ASSERT_TRUE(view3);
   const auto status = scene.apply(*view3);
   ASSERT_FALSE(status);
-  EXPECT_NE(status.error().message.find("net 9: springs: 41 bytes"), std::string::npos) << status.error().message;
+  EXPECT_NE(status.error().message.find("net 9: springs: 41 bytes"), std::string::npos)
+      << status.error().message;
 }
 
 }  // namespace

@@ -15,10 +15,11 @@ using testing::TempDir;
 
 testing::CommandResult run(const TempDir& dir, const std::string& app, int iterations) {
   const auto file = dir.write("app.xml", app);
-  return testing::runCommand({"/bin/sh", "-c",
-                              "cd " + dir.path() + " && " + testing::binDir() + "/vrflow run " + file + " -n " +
-                                  std::to_string(iterations) + " --report " + dir.file("report.json")},
-                             90);
+  return testing::runCommand(
+      {"/bin/sh", "-c",
+       "cd " + dir.path() + " && " + testing::binDir() + "/vrflow run " + file + " -n " +
+           std::to_string(iterations) + " --report " + dir.file("report.json")},
+      90);
 }
 
 const char* kHeader = R"(<?xml version="1.0" encoding="UTF-8"?>
@@ -154,7 +155,8 @@ TEST(MassSpringNetwork, CollisionInteractorKeepsTwoNetsApart) {
       const double dist = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
       if (dist >= best) continue;
       best = dist;
-      const msg::Vec3 e1{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const msg::Vec3 e1{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+          e2{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
       side = d[0] * (e1[1] * e2[2] - e1[2] * e2[1]) + d[1] * (e1[2] * e2[0] - e1[0] * e2[2]) +
              d[2] * (e1[0] * e2[1] - e1[1] * e2[0]);
     }
@@ -194,8 +196,9 @@ TEST(MassSpringNetwork, BadParameterFailsTheRunWithAClearMessage) {
 )";
   const auto result = run(dir, app, 10);
   EXPECT_NE(result.exitCode, 0);
-  EXPECT_NE((result.out + result.err).find("parameter 'orientation' = '0 0 1' must be 4 finite numbers"),
-            std::string::npos)
+  EXPECT_NE(
+      (result.out + result.err).find("parameter 'orientation' = '0 0 1' must be 4 finite numbers"),
+      std::string::npos)
       << result.out << result.err;
 }
 

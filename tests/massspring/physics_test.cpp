@@ -30,7 +30,8 @@ double measuredPeriod(double m, double k, const StepOptions& options, int steps)
   for (int s = 1; s <= steps; ++s) {
     step(net, {}, options);
     const double x = net.positions[3] - 1.0;
-    if (previous < 0 && x >= 0) crossings.push_back(options.dt * (s - 1 + previous / (previous - x)));
+    if (previous < 0 && x >= 0)
+      crossings.push_back(options.dt * (s - 1 + previous / (previous - x)));
     previous = x;
   }
   if (crossings.size() < 2) return 0;
@@ -45,7 +46,8 @@ TEST(MassSpringPhysics, OscillatorPeriodWithinOnePercent) {
   options.substeps = 10;
   const double period = measuredPeriod(m, k, options, 1000);  // 10 s, about 32 periods
   const double error = std::abs(period - expected) / expected;
-  std::printf("oscillator: period %.6f s, expected %.6f s, relative error %.2e\n", period, expected, error);
+  std::printf("oscillator: period %.6f s, expected %.6f s, relative error %.2e\n", period, expected,
+              error);
   EXPECT_LT(error, 0.01);
   // The sub-steps matter: one step per outer step of 0.05 s (omega dt = 1) is visibly off.
   options.dt = 0.05;
@@ -71,7 +73,8 @@ TEST(MassSpringPhysics, MaximumStretchNeverExceededUnderHeavyLoad) {
   options.gravity = {0, -9.81, 0};
   std::vector<double> load(3 * net->nodeCount(), 0.0);
   for (std::size_t j = 5; j <= 7; ++j) {
-    for (std::size_t i = 5; i <= 7; ++i) load[3 * (j * 12 + i) + 1] = -5.0;  // 45 N: 4.6 times the net's weight
+    for (std::size_t i = 5; i <= 7; ++i)
+      load[3 * (j * 12 + i) + 1] = -5.0;  // 45 N: 4.6 times the net's weight
   }
   double worst = 0, worstStretch = 0;
   for (int s = 0; s < 300; ++s) {
@@ -79,7 +82,8 @@ TEST(MassSpringPhysics, MaximumStretchNeverExceededUnderHeavyLoad) {
     worst = std::max(worst, maxConstraintRatio(*net));
     worstStretch = std::max(worstStretch, maxStretchRatio(*net));
   }
-  std::printf("max stretch: largest length/rest %.12f (limit 1.1), length/limit %.12f\n", worstStretch, worst);
+  std::printf("max stretch: largest length/rest %.12f (limit 1.1), length/limit %.12f\n",
+              worstStretch, worst);
   EXPECT_LE(worst, 1.0 + 1e-9);
   EXPECT_GT(worstStretch, 1.09);  // the constraint was active
   // Without the constraint the same load stretches a spring far beyond the limit.
@@ -104,7 +108,9 @@ TEST(MassSpringPhysics, EnergyDoesNotGrowForAnUndampedNet) {
   options.dt = 0.01;
   options.substeps = 40;
   options.gravity = {0, -9.81, 0};
-  auto energy = [&] { return kineticEnergy(*net) + elasticEnergy(*net) + gravityEnergy(*net, options.gravity); };
+  auto energy = [&] {
+    return kineticEnergy(*net) + elasticEnergy(*net) + gravityEnergy(*net, options.gravity);
+  };
   const double e0 = energy();
   // Symplectic Euler's energy oscillates (O(h)) without a trend: compare the mean energy of the
   // first and last 5 s, and bound the largest excess over the start.
@@ -120,8 +126,10 @@ TEST(MassSpringPhysics, EnergyDoesNotGrowForAnUndampedNet) {
   }
   const double drift = (last - first) / scale;
   const double peak = (highest - e0) / scale;
-  std::printf("undamped net: 30 s, mean energy last 5 s - first 5 s = %.3e, highest excess %.3e "
-              "(of the largest kinetic energy %.4f J)\n", drift, peak, scale);
+  std::printf(
+      "undamped net: 30 s, mean energy last 5 s - first 5 s = %.3e, highest excess %.3e "
+      "(of the largest kinetic energy %.4f J)\n",
+      drift, peak, scale);
   ASSERT_GT(scale, 0.1);  // it really moved
   EXPECT_LT(peak, 0.01);
   EXPECT_LT(drift, 0.002);

@@ -47,7 +47,7 @@ TEST(Shape, EveryKindRoundTripsThroughItsBytes) {
 
 TEST(Shape, DecodeRejectsForgedBytes) {
   auto bytes = encodeShape(cubeHull());
-  EXPECT_FALSE(decodeShape(std::span(bytes).first(40)).ok());        // truncated header
+  EXPECT_FALSE(decodeShape(std::span(bytes).first(40)).ok());                 // truncated header
   EXPECT_FALSE(decodeShape(std::span(bytes).first(bytes.size() - 48)).ok());  // truncated body
   auto badMagic = bytes;
   badMagic[0] = std::byte{'X'};

@@ -29,7 +29,8 @@ TEST_F(BuffersTest, EndItThroughInitialMessagesKeepsTheProducerAtMostNAhead) {
                  moduleXml("consumer", "core/spring", paramXml("log", log)),
              filterXml("pace", "initial", paramXml("count", std::to_string(kAhead))),
              connectXml("producer.objects", "consumer.objects") +
-                 connectXml("consumer.endIt", "pace.in") + connectXml("pace.out", "producer.beginIt")));
+                 connectXml("consumer.endIt", "pace.in") +
+                 connectXml("pace.out", "producer.beginIt")));
   const auto result = runVrflow({"run", file, "-n", "300"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   int produced = 0, consumed = 0, worst = 0;
@@ -50,10 +51,12 @@ class DropPolicy : public BuffersTest, public ::testing::WithParamInterface<cons
 TEST_P(DropPolicy, FastProducerRunsWithFlatMemory) {
   const auto report = dir.file("report.json");
   const auto file = dir.write(
-      "app.xml",
-      appXml(moduleXml("fast", "core/source", paramXml("size", "4096") + paramXml("count", "100000")) +
-                 moduleXml("slow", "testing/slow", paramXml("delay-ms", "1")),
-             "", connectXml("fast.out", "slow.in", std::string("capacity=\"8\" policy=\"") + GetParam() + "\"")));
+      "app.xml", appXml(moduleXml("fast", "core/source",
+                                  paramXml("size", "4096") + paramXml("count", "100000")) +
+                            moduleXml("slow", "testing/slow", paramXml("delay-ms", "1")),
+                        "",
+                        connectXml("fast.out", "slow.in",
+                                   std::string("capacity=\"8\" policy=\"") + GetParam() + "\"")));
   const auto result = runVrflow({"run", file, "--report", report});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto json = nlohmann::json::parse(readFile(report));
@@ -62,8 +65,9 @@ TEST_P(DropPolicy, FastProducerRunsWithFlatMemory) {
   // drop-newest refuses the newcomer (not counted as queued); drop-oldest queues it and
   // evicts the oldest: either way every message is accounted for.
   const bool newest = std::string(GetParam()) == "drop-newest";
-  EXPECT_EQ(connection["messages"].get<uint64_t>() + (newest ? connection["dropped"].get<uint64_t>() : 0),
-            100000u);
+  EXPECT_EQ(
+      connection["messages"].get<uint64_t>() + (newest ? connection["dropped"].get<uint64_t>() : 0),
+      100000u);
   EXPECT_GT(connection["dropped"].get<uint64_t>(), 90000u) << "the consumer is ~1000x slower";
   // 8 queued + 36 in rings and the output filter, 8 KiB blocks each: well under 1 MiB.
   EXPECT_LT(json["timing"]["segment_peak_bytes"].get<uint64_t>(), 1u << 20);
@@ -73,11 +77,11 @@ INSTANTIATE_TEST_SUITE_P(Policies, DropPolicy, ::testing::Values("drop-oldest", 
 
 TEST_F(BuffersTest, BlockingPolicyHoldsTheProducerBackWithFlatMemory) {
   const auto report = dir.file("report.json");
-  const auto file = dir.write(
-      "app.xml",
-      appXml(moduleXml("fast", "core/source", paramXml("size", "4096") + paramXml("count", "3000")) +
-                 moduleXml("slow", "testing/slow", paramXml("delay-ms", "1")),
-             "", connectXml("fast.out", "slow.in", "capacity=\"8\"")));
+  const auto file =
+      dir.write("app.xml", appXml(moduleXml("fast", "core/source",
+                                            paramXml("size", "4096") + paramXml("count", "3000")) +
+                                      moduleXml("slow", "testing/slow", paramXml("delay-ms", "1")),
+                                  "", connectXml("fast.out", "slow.in", "capacity=\"8\"")));
   const auto result = runVrflow({"run", file, "--report", report});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto json = nlohmann::json::parse(readFile(report));
@@ -90,7 +94,8 @@ TEST_F(BuffersTest, BlockingPolicyHoldsTheProducerBackWithFlatMemory) {
   EXPECT_EQ(json["warnings"][0],
             "connection fast.out -> slow.in stayed full (8 messages, policy block): 'slow' takes "
             "messages slower than 'fast' sends them, so 'slow' paces 'fast'");
-  EXPECT_NE(result.err.find("warning: connection fast.out -> slow.in stayed full"), std::string::npos);
+  EXPECT_NE(result.err.find("warning: connection fast.out -> slow.in stayed full"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -43,7 +43,8 @@ std::string repeatApp(const std::string& count, const std::string& body,
          count + "\">\n          " + body +
          "\n        </repeat>\n"
          "      </" +
-         section + ">\n"
+         section +
+         ">\n"
          "    </composite>\n"
          "  </composites>\n"
          "  <instances>\n"
@@ -122,8 +123,8 @@ TEST_F(CommandLineTest, ValidatePrintsAScreenfulOfProblemsThenHowManyMore) {
   // 20,000 relays without input: 20,000 problems at one place (the cap is 100,000 items,
   // repeat iterations included).
   const std::string file = dir.write(
-      "app.xml", repeatApp("20000", "<module id=\"r${i}\" package=\"core\" type=\"relay\"/>",
-                           "modules"));
+      "app.xml",
+      repeatApp("20000", "<module id=\"r${i}\" package=\"core\" type=\"relay\"/>", "modules"));
   const auto begin = std::chrono::steady_clock::now();
   const auto result = runVrflow({"validate", file}, 120);
   const double seconds = secondsSince(begin);

@@ -22,9 +22,10 @@ TEST(Examples, PipelineDemoIsDeterministicAndRecordsEveryIteration) {
   std::string digests[2];
   for (int run = 0; run < 2; ++run) {
     const auto report = dir.file("report" + std::to_string(run) + ".json");
-    const auto result = runCommand({"/bin/sh", "-c",
-                                    "cd " + dir.path() + " && " + binDir() + "/vrflow run " +
-                                        sourceDir() + "/examples/pipeline/pipeline.xml -n 50 --report " + report});
+    const auto result =
+        runCommand({"/bin/sh", "-c",
+                    "cd " + dir.path() + " && " + binDir() + "/vrflow run " + sourceDir() +
+                        "/examples/pipeline/pipeline.xml -n 50 --report " + report});
     ASSERT_EQ(result.exitCode, 0) << result.err;
     const auto json = nlohmann::json::parse(readFile(report));
     for (const auto& o : json["outputs"]) digests[run] += o["last_digest"].dump();
@@ -38,11 +39,11 @@ TEST(Examples, PipelineDemoIsDeterministicAndRecordsEveryIteration) {
 // The README's module, coupled with core/points: x(t) = x0 cos(sqrt(k/m) t).
 TEST(Examples, MinimalModuleOscillatesWithTheSpringPeriod) {
   TempDir dir;
-  const auto result = runCommand(
-      {"/bin/sh", "-c",
-       "cd " + dir.path() + " && " + binDir() + "/vrflow run " + sourceDir() +
-           "/examples/minimal_module/oscillator.xml -n 1000 --packages " + binDir() +
-           "/../share/vrflow/example-packages"});
+  const auto result =
+      runCommand({"/bin/sh", "-c",
+                  "cd " + dir.path() + " && " + binDir() + "/vrflow run " + sourceDir() +
+                      "/examples/minimal_module/oscillator.xml -n 1000 --packages " + binDir() +
+                      "/../share/vrflow/example-packages"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto lines = readLines(dir.file("oscillator.csv"));
   ASSERT_EQ(lines.size(), 1u + 1000u * 3u);

@@ -41,9 +41,9 @@ class Patterns : public ::testing::Test {
   // routing/movers (with `params`, paced by the viewers) through one route filter `wall` to a
   // routing/tile-viewer per box, v0 ... (each logging to vK.csv in the temporary folder).
   std::string moversWall(const std::string& params, const std::vector<std::string>& boxes) {
-    std::string modules = moduleXml(
-        "scene", "routing/movers",
-        params + "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
+    std::string modules =
+        moduleXml("scene", "routing/movers",
+                  params + "      <input port=\"beginIt\" initial-messages=\"1\"/>\n");
     std::string connections = connectXml("scene.objects", "wall.in");
     for (std::size_t k = 0; k < boxes.size(); ++k) {
       const std::string id = "v" + std::to_string(k);
@@ -398,10 +398,10 @@ TEST_F(Patterns, RouteForwardsExactlyTheIntersectingObjectsAndTheirStateOnEntry)
 // a body; a delete reaches only the viewers that hold the body.
 TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
   const auto result = run(dir.write(
-      "late.xml", moversWall(paramXml("count", "16") + paramXml("meshes", "8") +
-                                 paramXml("iterations", "12") + paramXml("meshes-at", "3") +
-                                 paramXml("delete-at", "6"),
-                             {"0 -1 -1 10 12 1", "20 -1 -1 30 12 1", "all"})));
+      "late.xml",
+      moversWall(paramXml("count", "16") + paramXml("meshes", "8") + paramXml("iterations", "12") +
+                     paramXml("meshes-at", "3") + paramXml("delete-at", "6"),
+                 {"0 -1 -1 10 12 1", "20 -1 -1 30 12 1", "all"})));
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto all = byIteration(dir.file("v2.csv"));
   std::string first;  // body 0: the first body added
@@ -460,12 +460,11 @@ TEST_F(Patterns, RouteSendsLateResourcesToTheirHoldersAndDeletesWhereHeld) {
 // copy.
 TEST_F(Patterns, RouteSendsDynamicResourcesOnlyWhileTheirObjectsAreInTheVolume) {
   const auto result = run(dir.write(
-      "dynamic.xml",
-      moversWall(paramXml("count", "1") + paramXml("meshes", "1") +
-                     paramXml("mesh-triangles", "4") + paramXml("width", "4") +
-                     paramXml("dt", "0.1") + paramXml("iterations", "120") +
-                     paramXml("dynamic-meshes", "true"),
-                 {"0 -1 -1 1 1 1", "all"})));
+      "dynamic.xml", moversWall(paramXml("count", "1") + paramXml("meshes", "1") +
+                                    paramXml("mesh-triangles", "4") + paramXml("width", "4") +
+                                    paramXml("dt", "0.1") + paramXml("iterations", "120") +
+                                    paramXml("dynamic-meshes", "true"),
+                                {"0 -1 -1 1 1 1", "all"})));
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto all = byIteration(dir.file("v1.csv"));
   const auto got = byIteration(dir.file("v0.csv"));

@@ -15,7 +15,8 @@ std::string app(const std::string& modules, const std::string& connections,
                 const std::string& filters = "") {
   return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"test\" version=\"1\">\n"
          "  <hosts>\n    <host id=\"h1\" address=\"127.0.0.1\"/>\n  </hosts>\n"
-         "  <modules>\n" + modules + "  </modules>\n" +
+         "  <modules>\n" +
+         modules + "  </modules>\n" +
          (filters.empty() ? "" : "  <filters>\n" + filters + "  </filters>\n") +
          "  <connections>\n" + connections + "  </connections>\n</application>\n";
 }
@@ -32,14 +33,17 @@ std::string param(const std::string& name, const std::string& value) {
 }
 
 std::string initial(const std::string& port, int count) {
-  return "      <input port=\"" + port + "\" initial-messages=\"" + std::to_string(count) + "\"/>\n";
+  return "      <input port=\"" + port + "\" initial-messages=\"" + std::to_string(count) +
+         "\"/>\n";
 }
 
 std::string connect(const std::string& from, const std::string& to) {
   return "    <connection from=\"" + from + "\" to=\"" + to + "\"/>\n";
 }
 
-nlohmann::json readJson(const std::string& path) { return nlohmann::json::parse(readFile(path)); }
+nlohmann::json readJson(const std::string& path) {
+  return nlohmann::json::parse(readFile(path));
+}
 
 class RunTest : public ::testing::Test {
  protected:
@@ -52,10 +56,11 @@ class RunTest : public ::testing::Test {
 
 TEST_F(RunTest, PipelineOfThreeModulesDeliversEveryMessageInOrder) {
   const auto csv = dir.file("out.csv");
-  const auto file = dir.write(
-      "app.xml", app(module("src", "core/source", param("size", "4096")) + module("mid", "core/relay") +
-                         module("rec", "core/recorder", param("file", csv)),
-                     connect("src.out", "mid.in") + connect("mid.out", "rec.in")));
+  const auto file =
+      dir.write("app.xml", app(module("src", "core/source", param("size", "4096")) +
+                                   module("mid", "core/relay") +
+                                   module("rec", "core/recorder", param("file", csv)),
+                               connect("src.out", "mid.in") + connect("mid.out", "rec.in")));
   const auto report = dir.file("report.json");
   const auto result = runVrflow({"run", file, "--iterations", "50", "--report", report});
   ASSERT_EQ(result.exitCode, 0) << result.err;
@@ -63,9 +68,11 @@ TEST_F(RunTest, PipelineOfThreeModulesDeliversEveryMessageInOrder) {
   ASSERT_EQ(lines.size(), 51u);
   for (int i = 0; i < 50; ++i) {
     // iteration,source,source_iteration,sim_time,kind,id,counter,size
-    EXPECT_NE(lines[i + 1].find(",src," + std::to_string(i) + ","), std::string::npos) << lines[i + 1];
+    EXPECT_NE(lines[i + 1].find(",src," + std::to_string(i) + ","), std::string::npos)
+        << lines[i + 1];
     EXPECT_NE(lines[i + 1].find("resource,"), std::string::npos);
-    EXPECT_NE(lines[i + 1].find("," + std::to_string(i) + ",4096,"), std::string::npos) << lines[i + 1];
+    EXPECT_NE(lines[i + 1].find("," + std::to_string(i) + ",4096,"), std::string::npos)
+        << lines[i + 1];
   }
   const auto json = readJson(report);
   EXPECT_EQ(json["status"], "ok");
@@ -77,10 +84,9 @@ TEST_F(RunTest, PipelineOfThreeModulesDeliversEveryMessageInOrder) {
 
 TEST_F(RunTest, SetOverridesAParameterOfTheFileForThisRunOnly) {
   const auto csv = dir.file("out.csv");
-  const auto file = dir.write(
-      "app.xml", app(module("src", "core/source", param("size", "4096")) +
-                         module("rec", "core/recorder", param("file", csv)),
-                     connect("src.out", "rec.in")));
+  const auto file = dir.write("app.xml", app(module("src", "core/source", param("size", "4096")) +
+                                                 module("rec", "core/recorder", param("file", csv)),
+                                             connect("src.out", "rec.in")));
   const auto result = runVrflow({"run", file, "-n", "5", "--no-progress", "--set", "src.size=128"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto lines = readLines(csv);
@@ -98,9 +104,9 @@ TEST_F(RunTest, SetOverridesAParameterOfTheFileForThisRunOnly) {
 }
 
 TEST_F(RunTest, SetWithABadValueAnUnknownModuleOrNoDotIsAClearError) {
-  const auto file = dir.write(
-      "app.xml", app(module("src", "core/source") + module("rec", "core/recorder"),
-                     connect("src.out", "rec.in")));
+  const auto file =
+      dir.write("app.xml", app(module("src", "core/source") + module("rec", "core/recorder"),
+                               connect("src.out", "rec.in")));
   const auto bad = runVrflow({"run", file, "-n", "5", "--set", "src.size=big"});
   EXPECT_EQ(bad.exitCode, 2);
   EXPECT_NE(bad.err.find("--set src.size=big: error: parameter 'size' of module 'src'"),
@@ -144,10 +150,10 @@ TEST_F(RunTest, ReportDigestsAreTheSameForTwoRuns) {
 TEST_F(RunTest, CycleWithInitialMessageOnAnimatorOnlyAlternates) {
   const auto log = dir.file("order.log");
   const auto file = dir.write(
-      "app.xml", app(module("anim", "core/points", initial("events", 1) + param("log", log)) +
-                         module("spring", "core/spring", param("log", log)),
-                     connect("anim.objects", "spring.objects") +
-                         connect("spring.forces", "anim.events")));
+      "app.xml",
+      app(module("anim", "core/points", initial("events", 1) + param("log", log)) +
+              module("spring", "core/spring", param("log", log)),
+          connect("anim.objects", "spring.objects") + connect("spring.forces", "anim.events")));
   const auto result = runVrflow({"run", file, "-n", "20"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   int animLines = 0;
@@ -175,10 +181,10 @@ TEST_F(RunTest, CycleWithInitialMessageOnAnimatorOnlyAlternates) {
 TEST_F(RunTest, CycleWithInitialMessagesOnBothSidesRunsInParallel) {
   const auto log = dir.file("order.log");
   const auto file = dir.write(
-      "app.xml", app(module("anim", "core/points", initial("events", 1) + param("log", log)) +
-                         module("spring", "core/spring", initial("objects", 1) + param("log", log)),
-                     connect("anim.objects", "spring.objects") +
-                         connect("spring.forces", "anim.events")));
+      "app.xml",
+      app(module("anim", "core/points", initial("events", 1) + param("log", log)) +
+              module("spring", "core/spring", initial("objects", 1) + param("log", log)),
+          connect("anim.objects", "spring.objects") + connect("spring.forces", "anim.events")));
   const auto result = runVrflow({"run", file, "-n", "20"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   int springLines = 0;
@@ -206,10 +212,10 @@ TEST_F(RunTest, CycleWithInitialMessagesOnBothSidesRunsInParallel) {
 // The default input filter merges one message of each incoming connection into one.
 TEST_F(RunTest, DefaultInputFilterMergesOneMessageFromEachConnection) {
   const auto csv = dir.file("out.csv");
-  const auto file = dir.write(
-      "app.xml", app(module("a", "core/source") + module("b", "core/source") +
-                         module("rec", "core/recorder", param("file", csv)),
-                     connect("a.out", "rec.in") + connect("b.out", "rec.in")));
+  const auto file =
+      dir.write("app.xml", app(module("a", "core/source") + module("b", "core/source") +
+                                   module("rec", "core/recorder", param("file", csv)),
+                               connect("a.out", "rec.in") + connect("b.out", "rec.in")));
   const auto result = runVrflow({"run", file, "-n", "30"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto lines = readLines(csv);
@@ -231,11 +237,12 @@ TEST_F(RunTest, DefaultInputFilterMergesOneMessageFromEachConnection) {
 // have done their 200: the newest is then delivered again until the reader has its 200 too.
 TEST_F(RunTest, LatestModeDeliversOnlyNewerMessagesAndEndsWithTheNewest) {
   const auto csv = dir.file("out.csv");
-  const auto file = dir.write(
-      "app.xml", app(module("a", "core/source") + module("b", "core/source") +
-                         module("rec", "core/recorder",
-                                param("file", csv) + "      <input port=\"in\" mode=\"latest\"/>\n"),
-                     connect("a.out", "rec.in") + connect("b.out", "rec.in")));
+  const auto file =
+      dir.write("app.xml",
+                app(module("a", "core/source") + module("b", "core/source") +
+                        module("rec", "core/recorder",
+                               param("file", csv) + "      <input port=\"in\" mode=\"latest\"/>\n"),
+                    connect("a.out", "rec.in") + connect("b.out", "rec.in")));
   const auto result = runVrflow({"run", file, "-n", "200"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto lines = readLines(csv);
@@ -266,10 +273,12 @@ TEST_F(RunTest, MergeFilterConcatenatesItsInputsInOrder) {
   const auto csv = dir.file("out.csv");
   const auto file = dir.write(
       "app.xml",
-      app(module("a", "core/source", param("size", "16")) + module("b", "core/source", param("size", "32")) +
+      app(module("a", "core/source", param("size", "16")) +
+              module("b", "core/source", param("size", "32")) +
               module("rec", "core/recorder", param("file", csv)),
           connect("a.out", "m.in0") + connect("b.out", "m.in1") + connect("m.out", "rec.in"),
-          "    <filter id=\"m\" type=\"merge\" host=\"h1\">\n      <param name=\"inputs\" value=\"2\"/>\n    </filter>\n"));
+          "    <filter id=\"m\" type=\"merge\" host=\"h1\">\n      <param name=\"inputs\" "
+          "value=\"2\"/>\n    </filter>\n"));
   const auto result = runVrflow({"run", file, "-n", "10"});
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto lines = readLines(csv);
@@ -306,10 +315,10 @@ TEST_F(RunTest, ModuleKilledBySignalIsReportedWithTheSignal) {
 }
 
 TEST_F(RunTest, SigtermStopsEveryProcess) {
-  const auto file = dir.write(
-      "app.xml", app(module("src", "core/source") + module("mid", "core/relay") +
-                         module("rec", "core/recorder", param("file", dir.file("x.csv"))),
-                     connect("src.out", "mid.in") + connect("mid.out", "rec.in")));
+  const auto file =
+      dir.write("app.xml", app(module("src", "core/source") + module("mid", "core/relay") +
+                                   module("rec", "core/recorder", param("file", dir.file("x.csv"))),
+                               connect("src.out", "mid.in") + connect("mid.out", "rec.in")));
   const auto result = runVrflow({"run", file}, 30, 1.0, SIGTERM);
   EXPECT_EQ(result.exitCode, 130) << result.err;
   EXPECT_NE(result.err.find("interrupted by SIGTERM"), std::string::npos) << result.err;
@@ -317,29 +326,33 @@ TEST_F(RunTest, SigtermStopsEveryProcess) {
 
 TEST_F(RunTest, SigintStopsEveryProcess) {
   const auto file = dir.write(
-      "app.xml", app(module("anim", "core/points", initial("events", 1)) + module("g", "core/gravity"),
-                     connect("anim.objects", "g.objects") + connect("g.forces", "anim.events")));
+      "app.xml",
+      app(module("anim", "core/points", initial("events", 1)) + module("g", "core/gravity"),
+          connect("anim.objects", "g.objects") + connect("g.forces", "anim.events")));
   const auto result = runVrflow({"run", file}, 30, 1.0, SIGINT);
   EXPECT_EQ(result.exitCode, 130) << result.err;
 }
 
 TEST_F(RunTest, RuntimeDeadlockIsReportedWithWhoWaitsOnWhat) {
   const auto file = dir.write(
-      "app.xml", app(module("anim", "core/points", initial("events", 1)) + module("m", "testing/mute"),
-                     connect("anim.objects", "m.in") + connect("m.out", "anim.events")));
+      "app.xml",
+      app(module("anim", "core/points", initial("events", 1)) + module("m", "testing/mute"),
+          connect("anim.objects", "m.in") + connect("m.out", "anim.events")));
   const auto result = runVrflow({"run", file, "--deadlock-timeout", "1"});
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find("deadlock"), std::string::npos) << result.err;
-  EXPECT_NE(result.err.find("module 'anim' waits on input 'events' (from m.out)"), std::string::npos)
+  EXPECT_NE(result.err.find("module 'anim' waits on input 'events' (from m.out)"),
+            std::string::npos)
       << result.err;
-  EXPECT_NE(result.err.find("module 'm' waits on input 'in' (from anim.objects)"), std::string::npos)
+  EXPECT_NE(result.err.find("module 'm' waits on input 'in' (from anim.objects)"),
+            std::string::npos)
       << result.err;
 }
 
 TEST_F(RunTest, TimeoutBoundsARun) {
-  const auto file = dir.write(
-      "app.xml", app(module("src", "core/source") + module("mid", "core/relay"),
-                     connect("src.out", "mid.in")));
+  const auto file =
+      dir.write("app.xml", app(module("src", "core/source") + module("mid", "core/relay"),
+                               connect("src.out", "mid.in")));
   const auto result = runVrflow({"run", file, "--timeout", "1"});
   EXPECT_EQ(result.exitCode, 3) << result.err;
   EXPECT_NE(result.err.find("timed out after 1 s"), std::string::npos) << result.err;
@@ -379,11 +392,13 @@ TEST_F(RunTest, ProgramThatNeverJoinsTheRunFailsIt) {
 
 TEST_F(RunTest, ExhaustedSharedMemoryFailsTheRunWithAClearMessage) {
   const auto file = dir.write(
-      "app.xml", app(module("src", "core/source", param("size", "4000000")) + module("r", "core/relay"),
-                     connect("src.out", "r.in")));
+      "app.xml",
+      app(module("src", "core/source", param("size", "4000000")) + module("r", "core/relay"),
+          connect("src.out", "r.in")));
   const auto result = runVrflow({"run", file, "-n", "10", "--shm-size", "2"});
   EXPECT_EQ(result.exitCode, 1) << result.err;
-  EXPECT_NE(result.err.find("module 'src': shared memory exhausted"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("module 'src': shared memory exhausted"), std::string::npos)
+      << result.err;
 }
 
 TEST_F(RunTest, InvalidApplicationIsRefusedBeforeStartingAnything) {
@@ -400,7 +415,8 @@ TEST_F(RunTest, ValidateReportsEachProblemAsFileLineColumn) {
                      connect("a.objects", "b.objects") + connect("b.forces", "a.events")));
   const auto result = runVrflow({"validate", file});
   EXPECT_EQ(result.exitCode, 1);
-  EXPECT_TRUE(std::regex_search(result.err, std::regex(file + R"(:\d+:\d+: error: cycle without initial message)")))
+  EXPECT_TRUE(std::regex_search(
+      result.err, std::regex(file + R"(:\d+:\d+: error: cycle without initial message)")))
       << result.err;
   const auto good = dir.write(
       "good.xml", app(module("a", "core/points", initial("events", 1)) + module("b", "core/spring"),
@@ -413,7 +429,8 @@ TEST_F(RunTest, BadCommandLineExitsWithUsageError) {
   EXPECT_EQ(runVrflow({"run"}).exitCode, 2);
   EXPECT_EQ(runVrflow({"frobnicate"}).exitCode, 2);
   EXPECT_EQ(runVrflow({"run", "/nonexistent.xml"}).exitCode, 2);
-  EXPECT_EQ(runVrflow({"run", dir.write("a.xml", "<application"), "--iterations", "x"}).exitCode, 2);
+  EXPECT_EQ(runVrflow({"run", dir.write("a.xml", "<application"), "--iterations", "x"}).exitCode,
+            2);
 }
 
 TEST_F(RunTest, ModuleStartedByHandExplainsHowToStartIt) {

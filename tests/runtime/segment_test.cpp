@@ -1,3 +1,5 @@
+#include "vrflow/ipc/segment.hpp"
+
 #include <gtest/gtest.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
@@ -10,7 +12,6 @@
 
 #include "vrflow/ipc/doorbell.hpp"
 #include "vrflow/ipc/ring.hpp"
-#include "vrflow/ipc/segment.hpp"
 
 namespace vrflow::ipc {
 namespace {

@@ -69,10 +69,14 @@ class TraceTest : public ::testing::Test {
 TEST_F(TraceTest, EveryArrowEndsAfterItStarts) {
   // Each relay wakes as soon as its sender rings the daemon: a send time taken after that
   // ring was later than the receipt now and then, more often on a busy machine (two threads
-  // spin here meanwhile).
+  // spin here meanwhile). r1 sleeps 1 ms per message so that the modules' trace rings (8192
+  // events, drained every 50 ms) never overflow and every arrow is there; r2, r3 and rec still
+  // wake on the doorbell at once.
+  constexpr int kIterations = 3000;
   const auto file = dir.write(
       "app.xml",
-      application(module("src", "core/source") + module("r1", "core/relay") +
+      application(module("src", "core/source") +
+                      module("r1", "core/relay", "      <param name=\"delay-ms\" value=\"1\"/>\n") +
                       module("r2", "core/relay") + module("r3", "core/relay") +
                       module("rec", "core/recorder",
                              "      <param name=\"file\" value=\"" + dir.file("x.csv") + "\"/>\n"),
@@ -86,12 +90,15 @@ TEST_F(TraceTest, EveryArrowEndsAfterItStarts) {
       }
     });
   }
-  const auto result = runVrflow({"run", file, "-n", "5000", "--trace", dir.file("t.json")}, 120);
+  const auto result = runVrflow(
+      {"run", file, "-n", std::to_string(kIterations), "--trace", dir.file("t.json")}, 120);
   busy = false;
   for (auto& t : spinners) t.join();
   ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto trace = nlohmann::json::parse(readFile(dir.file("t.json")));
+  ASSERT_EQ(trace["otherData"]["dropped_events"], 0) << "the rings overflowed: arrows are missing";
   const auto arrows = arrowsOf(dir.file("t.json"));
-  EXPECT_EQ(arrows.total, 4 * 5000);
+  EXPECT_EQ(arrows.total, 4 * kIterations);
   EXPECT_EQ(arrows.backwards, 0) << "of " << arrows.total << " arrows";
 }
 

@@ -113,8 +113,9 @@ TEST(PaperSceneFluid, OneFluidModulePerBlockGivesTheSceneOfTheFluidsOwnTwoBlocks
   nlohmann::json fluid[2];
   for (int run = 0; run < 2; ++run) {
     TempDir dir;
-    const auto app = exampleForTest("paper_scene", files[run],
-                                    run == 0 ? ParamOverrides{{"water.blocks", "2"}} : ParamOverrides{});
+    const auto app =
+        exampleForTest("paper_scene", files[run],
+                       run == 0 ? ParamOverrides{{"water.blocks", "2"}} : ParamOverrides{});
     const auto result = runApp(dir, app, kIterations, 200);
     ASSERT_EQ(result.exitCode, 0) << files[run] << ": " << result.err;
     bodies[run] = readFile(dir.file("bodies-final.json"));

@@ -19,14 +19,16 @@ const std::string kApp = "/examples/paper_scene/paper_scene.xml";
 
 // Runs the scene in `dir` (its outputs land there) for `iterations`.
 CommandResult runScene(const TempDir& dir, int iterations) {
-  return runCommand({"/bin/sh", "-c",
-                     "cd '" + dir.path() + "' && exec '" + binDir() + "/vrflow' run '" +
-                         sourceDir() + kApp + "' -n " + std::to_string(iterations) +
-                         " --report report.json"},
-                    240);
+  return runCommand(
+      {"/bin/sh", "-c",
+       "cd '" + dir.path() + "' && exec '" + binDir() + "/vrflow' run '" + sourceDir() + kApp +
+           "' -n " + std::to_string(iterations) + " --report report.json"},
+      240);
 }
 
-double norm(const std::vector<double>& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+double norm(const std::vector<double>& v) {
+  return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
 
 TEST(PaperScene, AfterTwoHundredIterationsEverythingRestsAboveTheGroundAndApart) {
   TempDir dir;
@@ -66,7 +68,8 @@ TEST(PaperScene, AfterTwoHundredIterationsEverythingRestsAboveTheGroundAndApart)
     EXPECT_LT(norm(velocity), 0.1) << "body " << i << " still moves";
     EXPECT_LT(norm(b["angularVelocity"].get<std::vector<double>>()), 2.0) << "body " << i;
     // The ground's top face is at y = -0.002.
-    EXPECT_GT(b["boundsMin"][1].get<double>(), -0.002 - 0.01) << "body " << i << " below the ground";
+    EXPECT_GT(b["boundsMin"][1].get<double>(), -0.002 - 0.01)
+        << "body " << i << " below the ground";
   }
   EXPECT_EQ(dynamic, 20);
   overlap.solve(0.01);

@@ -71,8 +71,10 @@ TEST(ScenePatterns, TheNetAtTenTimesTheRateStaysStableWhereOneStepExplodes) {
   const auto one = runPattern(slow, "stiff_net_1x", 300);
   ASSERT_EQ(one.exitCode, 0) << one.err;
   net = massspring::loadNet(slow.file("net-final.txt"));
-  if (net) EXPECT_GT(fastestNode(*net), 1e3) << "one step of 0.01 s: explodes";
-  else SUCCEED() << "the exploded net could not even be written back: " << net.error().message;
+  if (net)
+    EXPECT_GT(fastestNode(*net), 1e3) << "one step of 0.01 s: explodes";
+  else
+    SUCCEED() << "the exploded net could not even be written back: " << net.error().message;
 }
 
 // Two copies of the rigid interactor, one per region (x < 0: the box of 16 crates; x >= 0: the
@@ -92,8 +94,10 @@ TEST(ScenePatterns, TheRigidInteractorDuplicatedOverTwoRegionsGivesTheSameStates
   // Each copy saw only its region's bodies: the west copy's forces never touch the net's.
   const auto report = nlohmann::json::parse(readFile(two.file("report.json")));
   std::map<std::string, uint64_t> bytes;
-  for (const auto& c : report["connections"]) bytes[c["to"].get<std::string>()] += c["bytes"].get<uint64_t>();
-  EXPECT_GT(bytes["contacts-west.objects"], bytes["contacts-east.objects"]) << "16 crates against 4 objects";
+  for (const auto& c : report["connections"])
+    bytes[c["to"].get<std::string>()] += c["bytes"].get<uint64_t>();
+  EXPECT_GT(bytes["contacts-west.objects"], bytes["contacts-east.objects"])
+      << "16 crates against 4 objects";
 }
 
 }  // namespace

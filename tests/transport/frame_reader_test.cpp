@@ -38,7 +38,8 @@ TEST(FrameReader, DeliversFramesSplitAtEveryByte) {
   Collected c;
   auto r = reader(c);
   r.setAuthenticated(true);
-  std::vector<std::byte> stream = frame(FrameType::Message, 7, std::vector<std::byte>(100, std::byte{5}));
+  std::vector<std::byte> stream =
+      frame(FrameType::Message, 7, std::vector<std::byte>(100, std::byte{5}));
   const auto credit = frame(FrameType::Credit, 7, std::vector<std::byte>(4, std::byte{1}));
   stream.insert(stream.end(), credit.begin(), credit.end());
   for (const std::byte b : stream) ASSERT_TRUE(r.feed({&b, 1}).ok());

@@ -253,7 +253,8 @@ TEST(Transport, APeerWithoutTheSecretIsRefused) {
   auto waitB = std::async(std::launch::async, [&] { return (*b)->connectPeers({}); });
   const Status status = (*forged)->connectPeers(peers);
   ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.error().message.find("challenge-response"), std::string::npos) << status.error().message;
+  EXPECT_NE(status.error().message.find("challenge-response"), std::string::npos)
+      << status.error().message;
   (*forged)->stop();
   (*b)->stop();
   EXPECT_FALSE(waitB.get().ok());  // b never got its authenticated peer

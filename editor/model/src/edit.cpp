@@ -50,7 +50,8 @@ std::string firstHost(const app::Application& app) {
 
 void ensureHost(app::Application& app) {
   if (app.hosts.empty()) {
-    app.hosts.push_back({std::string(app::kDefaultHostId), std::string(app::kDefaultHostAddress), {}});
+    app.hosts.push_back(
+        {std::string(app::kDefaultHostId), std::string(app::kDefaultHostAddress), {}});
   }
 }
 
@@ -86,7 +87,8 @@ std::optional<app::Composite> compositeFor(const app::Application& app, const ap
   if (const auto* c = app::findComposite(app, inst.composite)) return *c;
   const auto sources = app::defaultCompositeSources(app);
   for (const auto& dir : sources.searchPath) {
-    const auto path = std::filesystem::path(dir) / (inst.composite + std::string(app::kCompositeFileSuffix));
+    const auto path =
+        std::filesystem::path(dir) / (inst.composite + std::string(app::kCompositeFileSuffix));
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) continue;
     auto loaded = app::loadCompositeFile(path.string());
@@ -143,8 +145,10 @@ std::vector<app::PortSpec> nodePorts(const app::Application& app, const app::Cat
   if (const auto* i = app::findInstance(app, id)) {
     std::vector<app::PortSpec> ports;
     if (auto composite = compositeFor(app, *i)) {
-      for (const auto& p : composite->inputs) ports.push_back({.name = p.name, .isInput = true, .data = "any", .doc = p.doc});
-      for (const auto& p : composite->outputs) ports.push_back({.name = p.name, .isInput = false, .data = "any", .doc = p.doc});
+      for (const auto& p : composite->inputs)
+        ports.push_back({.name = p.name, .isInput = true, .data = "any", .doc = p.doc});
+      for (const auto& p : composite->outputs)
+        ports.push_back({.name = p.name, .isInput = false, .data = "any", .doc = p.doc});
     }
     return ports;
   }
@@ -161,8 +165,8 @@ std::string uniqueId(const app::Application& app, std::string_view base) {
 }
 
 std::optional<std::string> connectionRefusal(const app::Application& app,
-                                             const app::Catalog& catalog,
-                                             const app::Endpoint& from, const app::Endpoint& to) {
+                                             const app::Catalog& catalog, const app::Endpoint& from,
+                                             const app::Endpoint& to) {
   const NodeKind fromKind = nodeKind(app, from.node);
   const NodeKind toKind = nodeKind(app, to.node);
   if (fromKind == NodeKind::None) return "no module or filter '" + from.node + "'";
@@ -173,14 +177,18 @@ std::optional<std::string> connectionRefusal(const app::Application& app,
   const app::PortSpec* in = app::findPort(toPorts, to.port);
   if (out == nullptr) return "'" + from.node + "' has no port '" + from.port + "'";
   if (in == nullptr) return "'" + to.node + "' has no port '" + to.port + "'";
-  if (out->isInput && !in->isInput) return "connect an output to an input, not an input to an output";
-  if (out->isInput) return "'" + app::toString(from) + "' is an input: a connection starts at an output";
-  if (!in->isInput) return "'" + app::toString(to) + "' is an output: a connection ends at an input";
+  if (out->isInput && !in->isInput)
+    return "connect an output to an input, not an input to an output";
+  if (out->isInput)
+    return "'" + app::toString(from) + "' is an input: a connection starts at an output";
+  if (!in->isInput)
+    return "'" + app::toString(to) + "' is an output: a connection ends at an input";
   if (out->data != in->data && out->data != app::kAnyData && in->data != app::kAnyData) {
     return "port data types differ: '" + app::toString(from) + "' sends '" + out->data + "' but '" +
            app::toString(to) + "' expects '" + in->data + "'";
   }
-  if (toKind == NodeKind::Module && !in->stampsOnly && fromKind == NodeKind::Module && out->stampsOnly) {
+  if (toKind == NodeKind::Module && !in->stampsOnly && fromKind == NodeKind::Module &&
+      out->stampsOnly) {
     return "'" + app::toString(from) + "' sends stamps-only messages but '" + app::toString(to) +
            "' expects full messages";
   }
@@ -216,7 +224,8 @@ Result<Edit> addModule(const app::Application& app, const app::Catalog& catalog,
 
 Result<Edit> addFilter(const app::Application& app, const app::Catalog& catalog,
                        std::string_view type, double x, double y, std::string* newId) {
-  if (catalog.findFilter(type) == nullptr) return makeError("no filter type '" + std::string(type) + "'");
+  if (catalog.findFilter(type) == nullptr)
+    return makeError("no filter type '" + std::string(type) + "'");
   app::Application after = app;
   ensureHost(after);
   app::Filter filter;
@@ -244,8 +253,9 @@ Result<Edit> removeNodes(const app::Application& app, const std::vector<std::str
     return gone.count(c.from.node) != 0 || gone.count(c.to.node) != 0;
   });
   std::erase_if(after.editor, [&](const app::EditorNode& n) { return gone.count(n.ref) != 0; });
-  return makeEdit(removed == 1 ? "Delete " + *gone.begin() : "Delete " + std::to_string(removed) + " nodes",
-                  app, std::move(after));
+  return makeEdit(
+      removed == 1 ? "Delete " + *gone.begin() : "Delete " + std::to_string(removed) + " nodes",
+      app, std::move(after));
 }
 
 Result<Edit> connect(const app::Application& app, const app::Catalog& catalog,
@@ -256,18 +266,21 @@ Result<Edit> connect(const app::Application& app, const app::Catalog& catalog,
   c.from = from;
   c.to = to;
   after.connections.push_back(c);
-  return makeEdit("Connect " + app::toString(from) + " to " + app::toString(to), app, std::move(after));
+  return makeEdit("Connect " + app::toString(from) + " to " + app::toString(to), app,
+                  std::move(after));
 }
 
 Result<Edit> disconnect(const app::Application& app, std::vector<std::size_t> indexes) {
   std::sort(indexes.begin(), indexes.end());
   indexes.erase(std::unique(indexes.begin(), indexes.end()), indexes.end());
-  if (indexes.empty() || indexes.back() >= app.connections.size()) return makeError("no such connection");
+  if (indexes.empty() || indexes.back() >= app.connections.size())
+    return makeError("no such connection");
   app::Application after = app;
   for (auto it = indexes.rbegin(); it != indexes.rend(); ++it) {
     after.connections.erase(after.connections.begin() + static_cast<std::ptrdiff_t>(*it));
   }
-  return makeEdit(indexes.size() == 1 ? "Delete connection" : "Delete connections", app, std::move(after));
+  return makeEdit(indexes.size() == 1 ? "Delete connection" : "Delete connections", app,
+                  std::move(after));
 }
 
 Result<Edit> setParameter(const app::Application& app, std::string_view node, std::string_view name,
@@ -278,7 +291,8 @@ Result<Edit> setParameter(const app::Application& app, std::string_view node, st
   if (value.empty()) {
     const auto before = params->size();
     std::erase_if(*params, [&](const app::Param& p) { return p.name == name; });
-    if (params->size() == before) return makeError("parameter '" + std::string(name) + "' is not set");
+    if (params->size() == before)
+      return makeError("parameter '" + std::string(name) + "' is not set");
   } else {
     const auto* current = app::findParam(*params, name);
     if (current != nullptr && current->value == value) return makeError("unchanged");
@@ -328,7 +342,8 @@ Result<Edit> moveNodes(const app::Application& app,
 
 Result<Edit> renameNode(const app::Application& app, std::string_view id, std::string newId) {
   if (nodeKind(app, id) == NodeKind::None) return makeError("no node '" + std::string(id) + "'");
-  if (!validId(newId)) return makeError("'" + newId + "' is not a valid id (no '.', ':' or spaces)");
+  if (!validId(newId))
+    return makeError("'" + newId + "' is not a valid id (no '.', ':' or spaces)");
   if (newId == id) return makeError("unchanged");
   if (nodeKind(app, newId) != NodeKind::None) return makeError("'" + newId + "' is already used");
   app::Application after = app;
@@ -371,7 +386,8 @@ Result<Edit> addHost(const app::Application& app, std::string id, std::string ad
   if (app::findHost(app, id) != nullptr) return makeError("host '" + id + "' exists already");
   app::Application after = app;
   ensureHost(after);
-  after.hosts.push_back({id, address.empty() ? std::string(app::kDefaultHostAddress) : address, {}});
+  after.hosts.push_back(
+      {id, address.empty() ? std::string(app::kDefaultHostAddress) : address, {}});
   return makeEdit("Add host " + id, app, std::move(after));
 }
 
@@ -448,7 +464,8 @@ Result<Edit> importHostfile(const app::Application& app, std::string_view text) 
       // A host named by its address ("10.0.0.2") becomes id "10-0-0-2".
       std::replace(name.begin(), name.end(), '.', '-');
       std::replace(name.begin(), name.end(), ':', '-');
-      if (!validId(name)) return makeError("hostfile line " + std::to_string(lineNumber) + ": bad host name");
+      if (!validId(name))
+        return makeError("hostfile line " + std::to_string(lineNumber) + ": bad host name");
     }
     bool found = false;
     for (auto& h : after.hosts) {
@@ -481,7 +498,8 @@ std::string copyAsXml(const app::Application& app, const std::vector<std::string
     if (chosen.count(i.id) != 0) part.instances.push_back(i);
   }
   for (const auto& c : app.connections) {
-    if (chosen.count(c.from.node) != 0 && chosen.count(c.to.node) != 0) part.connections.push_back(c);
+    if (chosen.count(c.from.node) != 0 && chosen.count(c.to.node) != 0)
+      part.connections.push_back(c);
   }
   for (const auto& n : app.editor) {
     if (chosen.count(n.ref) != 0) part.editor.push_back(n);
@@ -538,8 +556,9 @@ Result<Edit> pasteXml(const app::Application& app, std::string_view xml, double 
     after.editor.emplace_back(renamed[n.ref], n.x + dx, n.y + dy);
   }
   if (pastedIds != nullptr) *pastedIds = ids;
-  return makeEdit(ids.size() == 1 ? "Paste " + ids.front() : "Paste " + std::to_string(ids.size()) + " nodes",
-                  app, std::move(after));
+  return makeEdit(
+      ids.size() == 1 ? "Paste " + ids.front() : "Paste " + std::to_string(ids.size()) + " nodes",
+      app, std::move(after));
 }
 
 std::string textToSave(const app::Application& app, const OpenedText& opened) {

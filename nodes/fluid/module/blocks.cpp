@@ -438,7 +438,8 @@ Result<BlockResult> JobBlock::step(const BlockStep& s) {
     finalizeTogetherAtExit();
     return result;
   }
-  std::fprintf(stderr, "vrflow-fluid: MPI block %d of %d (job '%s') failed alone: %s; aborting the job\n",
+  std::fprintf(stderr,
+               "vrflow-fluid: MPI block %d of %d (job '%s') failed alone: %s; aborting the job\n",
                impl_->rank, impl_->size, impl_->job.c_str(), result.error().message.c_str());
   MPI_Abort(impl_->world, 1);
   return result;  // not reached
@@ -468,8 +469,8 @@ void JobBlock::gatherBodies(std::vector<RigidBody>& bodies, std::vector<BodyForc
     }
     all.resize(static_cast<std::size_t>(total));
   }
-  MPI_Gatherv(w.bytes.data(), count, MPI_CHAR, all.data(), counts.data(), offsets.data(),
-              MPI_CHAR, 0, impl_->world);
+  MPI_Gatherv(w.bytes.data(), count, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR,
+              0, impl_->world);
   bodies.clear();
   forces.clear();
   if (impl_->rank != 0) return;

@@ -177,7 +177,7 @@ int main(int argc, char** argv) {
   }
   fluid::FluidSolver& solver = serial ? *serial : group ? group->solver() : jobBlock->solver();
   auto stepBlocks = [&](const fluid::BlockStep& request) {
-    return group ? group->step(request)
+    return group      ? group->step(request)
            : jobBlock ? jobBlock->step(request)
                       : fluid::stepBlock(solver, request);
   };
@@ -311,10 +311,11 @@ int main(int argc, char** argv) {
       // particles, sent with every copy of them (the meshes first, as a route filter wants).
       if (module.iteration() == 0 || (split && sendParticles)) {
         const bool add = module.iteration() == 0;
-        const msg::Aabb bounds = !split             ? ownBounds
+        const msg::Aabb bounds = !split                    ? ownBounds
                                  : !regions.bounds.empty() ? regions.bounds[r]
                                                            : regions.box(static_cast<int>(r));
-        if (sendParticles) out.builder().addMesh(particlesIds[r], true, split ? regions.xyz[r] : xyz, {});
+        if (sendParticles)
+          out.builder().addMesh(particlesIds[r], true, split ? regions.xyz[r] : xyz, {});
         auto object = out.builder().addObject(fluidIds[r], msg::fluidType(),
                                               add ? msg::ObjectOp::Add : msg::ObjectOp::Update);
         object.set(msg::FluidParam::kBounds, bounds);

@@ -90,8 +90,8 @@ void FluidSolver::Impl::uniteBodies(const std::vector<PreparedBody>& bodies) {
   std::vector<Held> held;
   held.reserve(all.size() / kRecord);
   for (std::size_t r = 0; r + kRecord <= all.size(); r += kRecord) {
-    const auto id = (static_cast<std::uint64_t>(all[r + 1]) << 32) |
-                    static_cast<std::uint64_t>(all[r + 2]);
+    const auto id =
+        (static_cast<std::uint64_t>(all[r + 1]) << 32) | static_cast<std::uint64_t>(all[r + 2]);
     held.push_back({{id, static_cast<std::uint32_t>(all[r + 3])}, static_cast<int>(all[r])});
   }
   std::sort(held.begin(), held.end(), [](const Held& a, const Held& b) {

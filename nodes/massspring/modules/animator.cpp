@@ -34,8 +34,10 @@ int main() {
   const std::string file = params.text("file");
   if (!file.empty()) {
     auto loaded = loadNet(file);
-    if (!loaded) params.fail(loaded.error().message);
-    else net = std::move(*loaded);
+    if (!loaded)
+      params.fail(loaded.error().message);
+    else
+      net = std::move(*loaded);
   } else {
     GridParams grid;
     grid.n = params.integer("n", 20, 2, 4096);
@@ -54,8 +56,10 @@ int main() {
     grid.orientation = {q[0], q[1], q[2], q[3]};
     if (!params.report()) {
       auto generated = generateGrid(grid);
-      if (!generated) params.fail(generated.error().message);
-      else net = std::move(*generated);
+      if (!generated)
+        params.fail(generated.error().message);
+      else
+        net = std::move(*generated);
     }
   }
   if (auto status = validateStepOptions(options); !status) params.fail(status.error().message);
@@ -84,7 +88,8 @@ int main() {
           if (!force || totalFreeMass <= 0) continue;
           for (std::size_t i = 0; i < net.nodeCount(); ++i) {
             if (net.pinned[i]) continue;
-            for (int k = 0; k < 3; ++k) external[3 * i + k] += force->force[k] * net.masses[i] / totalFreeMass;
+            for (int k = 0; k < 3; ++k)
+              external[3 * i + k] += force->force[k] * net.masses[i] / totalFreeMass;
           }
         } else if (event->kind() == kNodeForcesEvent) {
           auto forces = decodeNodeForces(event->payload());
@@ -109,12 +114,18 @@ int main() {
       const double worst = step(net, external, options);
       if (worst > 1 + 1e-6 && !warnedStretch) {
         warnedStretch = true;
-        warnings.warn("a spring is beyond its maximum stretch (worst length/limit " + std::to_string(worst) +
-                      "): the net started beyond its limits; the projection pulls it back over the next steps");
+        warnings.warn("a spring is beyond its maximum stretch (worst length/limit " +
+                      std::to_string(worst) +
+                      "): the net started beyond its limits; the projection pulls it back over the "
+                      "next steps");
       }
       time += options.dt;
     }
-    auto out = module.newMessage(256 + net.nodeCount() * 56 + (module.iteration() == 0 ? net.springs.size() * 40 + net.surface.size() * 4 + net.nodeCount() * 9 : 0));
+    auto out = module.newMessage(
+        256 + net.nodeCount() * 56 +
+        (module.iteration() == 0
+             ? net.springs.size() * 40 + net.surface.size() * 4 + net.nodeCount() * 9
+             : 0));
     auto& builder = out.builder();
     builder.setSimTime(time);
     builder.setTimeStep(options.dt);

@@ -34,15 +34,16 @@ inline std::optional<std::vector<double>> numbers(const std::string& text, std::
 /// A parameter read by a module, with the first error kept for the module to report.
 class Params {
  public:
-  Params(const Module& module, std::string program) : module_(module), program_(std::move(program)) {}
+  Params(const Module& module, std::string program)
+      : module_(module), program_(std::move(program)) {}
 
   double number(const char* name, double fallback, double min, double max) {
     const auto text = module_.param(name);
     if (text.empty()) return fallback;
     const auto v = numbers(text, 1);
     if (!v || (*v)[0] < min || (*v)[0] > max) {
-      fail(std::string("parameter '") + name + "' = '" + text + "' must be a number in [" + format(min) + ", " +
-           format(max) + "]");
+      fail(std::string("parameter '") + name + "' = '" + text + "' must be a number in [" +
+           format(min) + ", " + format(max) + "]");
       return fallback;
     }
     return (*v)[0];
@@ -68,7 +69,8 @@ class Params {
     if (text.empty()) text = fallback;
     const auto v = numbers(text, count);
     if (!v) {
-      fail(std::string("parameter '") + name + "' = '" + text + "' must be " + std::to_string(count) + " finite numbers");
+      fail(std::string("parameter '") + name + "' = '" + text + "' must be " +
+           std::to_string(count) + " finite numbers");
       return std::vector<double>(count, 0.0);
     }
     return *v;
@@ -97,7 +99,8 @@ class Params {
 };
 
 /// Adds one node-forces event per net with a non-zero force (nets in id order).
-inline void addNodeForces(msg::MessageBuilder& builder, const std::map<std::uint64_t, std::vector<double>>& forces) {
+inline void addNodeForces(msg::MessageBuilder& builder,
+                          const std::map<std::uint64_t, std::vector<double>>& forces) {
   for (const auto& [id, dense] : forces) {
     const auto sparse = sparseForces(dense);
     if (sparse.empty()) continue;

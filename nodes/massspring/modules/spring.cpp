@@ -29,7 +29,8 @@ int main() {
   modules::Warnings warnings(program);
   while (module.wait()) {
     if (const Message& received = module.get(objects); received.valid()) {
-      if (auto status = scene.apply(received.view()); !status) warnings.warn(status.error().message);
+      if (auto status = scene.apply(received.view()); !status)
+        warnings.warn(status.error().message);
     }
     std::map<std::uint64_t, std::vector<double>> total;
     std::size_t nodes = 0;

@@ -18,12 +18,15 @@ std::vector<std::byte> encodeNodeForces(std::span<const NodeForce> forces) {
 }
 
 Result<std::vector<NodeForce>> decodeNodeForces(std::span<const std::byte> payload) {
-  if (payload.size() < 8) return makeError("node forces event: payload shorter than its 8-byte header");
+  if (payload.size() < 8)
+    return makeError("node forces event: payload shorter than its 8-byte header");
   std::uint32_t count = 0;
   std::memcpy(&count, payload.data(), 4);
-  if ((payload.size() - 8) / kNodeForceRecordSize != count || (payload.size() - 8) % kNodeForceRecordSize != 0) {
-    return makeError("node forces event: header says " + std::to_string(count) + " records but the payload holds " +
-                     std::to_string(payload.size() - 8) + " bytes after it (32 per record)");
+  if ((payload.size() - 8) / kNodeForceRecordSize != count ||
+      (payload.size() - 8) % kNodeForceRecordSize != 0) {
+    return makeError("node forces event: header says " + std::to_string(count) +
+                     " records but the payload holds " + std::to_string(payload.size() - 8) +
+                     " bytes after it (32 per record)");
   }
   std::vector<NodeForce> forces(count);
   for (std::size_t i = 0; i < count; ++i) {
@@ -31,7 +34,9 @@ Result<std::vector<NodeForce>> decodeNodeForces(std::span<const std::byte> paylo
     std::memcpy(&forces[i].node, record, 4);
     std::memcpy(forces[i].force.data(), record + 8, 24);
     for (double f : forces[i].force) {
-      if (!std::isfinite(f)) return makeError("node forces event: non-finite force on node " + std::to_string(forces[i].node));
+      if (!std::isfinite(f))
+        return makeError("node forces event: non-finite force on node " +
+                         std::to_string(forces[i].node));
     }
   }
   return forces;

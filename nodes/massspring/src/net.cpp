@@ -16,7 +16,9 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "the wire layout is little-endian");
 
-bool finite3(const double* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+bool finite3(const double* p) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
 
 template <typename T>
 void put(std::vector<std::byte>& out, T value) {
@@ -43,36 +45,44 @@ std::string formatDouble(double v) {
 Status validateNet(const Net& net) {
   const std::size_t n = net.masses.size();
   if (net.positions.size() != 3 * n || net.velocities.size() != 3 * n || net.pinned.size() != n) {
-    return makeError("net: " + std::to_string(n) + " masses but " + std::to_string(net.positions.size()) +
-                     " position, " + std::to_string(net.velocities.size()) + " velocity and " +
-                     std::to_string(net.pinned.size()) + " pinned values (want 3, 3 and 1 per mass)");
+    return makeError(
+        "net: " + std::to_string(n) + " masses but " + std::to_string(net.positions.size()) +
+        " position, " + std::to_string(net.velocities.size()) + " velocity and " +
+        std::to_string(net.pinned.size()) + " pinned values (want 3, 3 and 1 per mass)");
   }
   if (n > std::numeric_limits<std::uint32_t>::max()) return makeError("net: too many nodes");
   for (std::size_t i = 0; i < n; ++i) {
     if (!(net.masses[i] > 0) || !std::isfinite(net.masses[i])) {
-      return makeError("net: node " + std::to_string(i) + " has mass " + formatDouble(net.masses[i]) +
-                       " (must be finite and > 0)");
+      return makeError("net: node " + std::to_string(i) + " has mass " +
+                       formatDouble(net.masses[i]) + " (must be finite and > 0)");
     }
     if (!finite3(&net.positions[3 * i]) || !finite3(&net.velocities[3 * i])) {
       return makeError("net: node " + std::to_string(i) + " has a non-finite position or velocity");
     }
-    if (net.pinned[i] > 1) return makeError("net: node " + std::to_string(i) + " pinned flag must be 0 or 1");
+    if (net.pinned[i] > 1)
+      return makeError("net: node " + std::to_string(i) + " pinned flag must be 0 or 1");
   }
   for (std::size_t s = 0; s < net.springs.size(); ++s) {
     const auto& sp = net.springs[s];
     const std::string name = "net: spring " + std::to_string(s) + " ";
-    if (sp.a >= n || sp.b >= n) return makeError(name + "joins a node out of range (" + std::to_string(n) + " nodes)");
+    if (sp.a >= n || sp.b >= n)
+      return makeError(name + "joins a node out of range (" + std::to_string(n) + " nodes)");
     if (sp.a == sp.b) return makeError(name + "joins node " + std::to_string(sp.a) + " to itself");
-    if (!(sp.restLength > 0) || !std::isfinite(sp.restLength)) return makeError(name + "rest length must be finite and > 0");
-    if (!(sp.stiffness >= 0) || !std::isfinite(sp.stiffness)) return makeError(name + "stiffness must be finite and >= 0");
-    if (!(sp.damping >= 0) || !std::isfinite(sp.damping)) return makeError(name + "damping must be finite and >= 0");
+    if (!(sp.restLength > 0) || !std::isfinite(sp.restLength))
+      return makeError(name + "rest length must be finite and > 0");
+    if (!(sp.stiffness >= 0) || !std::isfinite(sp.stiffness))
+      return makeError(name + "stiffness must be finite and >= 0");
+    if (!(sp.damping >= 0) || !std::isfinite(sp.damping))
+      return makeError(name + "damping must be finite and >= 0");
     if (!(sp.maxStretch == 0 || (sp.maxStretch >= 1 && std::isfinite(sp.maxStretch)))) {
       return makeError(name + "maxStretch must be 0 (no limit) or >= 1");
     }
   }
-  if (net.surface.size() % 3 != 0) return makeError("net: surface index count is not a multiple of 3");
+  if (net.surface.size() % 3 != 0)
+    return makeError("net: surface index count is not a multiple of 3");
   for (auto index : net.surface) {
-    if (index >= n) return makeError("net: surface index " + std::to_string(index) + " out of range");
+    if (index >= n)
+      return makeError("net: surface index " + std::to_string(index) + " out of range");
   }
   return {};
 }
@@ -93,18 +103,24 @@ msg::Aabb bounds(const Net& net) {
 
 Result<Net> generateGrid(const GridParams& p) {
   if (p.n < 2 || p.m < 2 || p.n > 4096 || p.m > 4096) {
-    return makeError("net generator: n and m must be in [2, 4096] (got " + std::to_string(p.n) + " x " +
-                     std::to_string(p.m) + ")");
+    return makeError("net generator: n and m must be in [2, 4096] (got " + std::to_string(p.n) +
+                     " x " + std::to_string(p.m) + ")");
   }
-  if (!(p.spacing > 0) || !std::isfinite(p.spacing)) return makeError("net generator: spacing must be > 0");
+  if (!(p.spacing > 0) || !std::isfinite(p.spacing))
+    return makeError("net generator: spacing must be > 0");
   if (!(p.mass > 0) || !std::isfinite(p.mass)) return makeError("net generator: mass must be > 0");
-  if (!(p.stiffness >= 0) || !std::isfinite(p.stiffness)) return makeError("net generator: stiffness must be >= 0");
-  if (!(p.shearFactor >= 0) || !(p.bendFactor >= 0)) return makeError("net generator: shear and bend factors must be >= 0");
-  if (!(p.damping >= 0) || !std::isfinite(p.damping)) return makeError("net generator: damping must be >= 0");
-  if (!(p.maxStretch == 0 || p.maxStretch >= 1)) return makeError("net generator: max stretch must be 0 or >= 1");
+  if (!(p.stiffness >= 0) || !std::isfinite(p.stiffness))
+    return makeError("net generator: stiffness must be >= 0");
+  if (!(p.shearFactor >= 0) || !(p.bendFactor >= 0))
+    return makeError("net generator: shear and bend factors must be >= 0");
+  if (!(p.damping >= 0) || !std::isfinite(p.damping))
+    return makeError("net generator: damping must be >= 0");
+  if (!(p.maxStretch == 0 || p.maxStretch >= 1))
+    return makeError("net generator: max stretch must be 0 or >= 1");
   double qn = 0;
   for (double c : p.orientation) qn += c * c;
-  if (!(std::abs(qn - 1) < 1e-6)) return makeError("net generator: orientation must be a unit quaternion (x y z w)");
+  if (!(std::abs(qn - 1) < 1e-6))
+    return makeError("net generator: orientation must be a unit quaternion (x y z w)");
 
   Net net;
   const auto n = static_cast<std::uint32_t>(p.n);
@@ -190,7 +206,8 @@ Result<Net> parseNet(const std::string& text, const std::string& origin) {
   };
   auto count = [&](const std::string& word, std::uint64_t limit, std::uint64_t& out) {
     double v = 0;
-    if (!number(word, v) || v < 0 || v != std::floor(v) || v > static_cast<double>(limit)) return false;
+    if (!number(word, v) || v < 0 || v != std::floor(v) || v > static_cast<double>(limit))
+      return false;
     out = static_cast<std::uint64_t>(v);
     return true;
   };
@@ -200,13 +217,17 @@ Result<Net> parseNet(const std::string& text, const std::string& origin) {
   }
   Net net;
   std::uint64_t nodes = 0;
-  if (!next(words) || words.size() != 2 || words[0] != "nodes" || !count(words[1], 1u << 24, nodes)) {
+  if (!next(words) || words.size() != 2 || words[0] != "nodes" ||
+      !count(words[1], 1u << 24, nodes)) {
     return fail("expected 'nodes N' (N at most 16777216)");
   }
   net.masses.reserve(nodes);
   for (std::uint64_t i = 0; i < nodes; ++i) {
-    if (!next(words)) return fail("the file ends after " + std::to_string(i) + " of " + std::to_string(nodes) + " nodes");
-    if (words.size() != 5 && words.size() != 8) return fail("a node is 'x y z mass pinned [vx vy vz]'");
+    if (!next(words))
+      return fail("the file ends after " + std::to_string(i) + " of " + std::to_string(nodes) +
+                  " nodes");
+    if (words.size() != 5 && words.size() != 8)
+      return fail("a node is 'x y z mass pinned [vx vy vz]'");
     double v[8] = {0, 0, 0, 0, 0, 0, 0, 0};
     for (std::size_t k = 0; k < words.size(); ++k) {
       if (!number(words[k], v[k])) return fail("'" + words[k] + "' is not a number");
@@ -218,25 +239,32 @@ Result<Net> parseNet(const std::string& text, const std::string& origin) {
     net.velocities.insert(net.velocities.end(), {v[5], v[6], v[7]});
   }
   std::uint64_t springs = 0;
-  if (!next(words) || words.size() != 2 || words[0] != "springs" || !count(words[1], 1u << 26, springs)) {
+  if (!next(words) || words.size() != 2 || words[0] != "springs" ||
+      !count(words[1], 1u << 26, springs)) {
     return fail("expected 'springs S' (S at most 67108864)");
   }
   for (std::uint64_t s = 0; s < springs; ++s) {
-    if (!next(words)) return fail("the file ends after " + std::to_string(s) + " of " + std::to_string(springs) + " springs");
+    if (!next(words))
+      return fail("the file ends after " + std::to_string(s) + " of " + std::to_string(springs) +
+                  " springs");
     if (words.size() != 6) return fail("a spring is 'a b restLength stiffness damping maxStretch'");
     std::uint64_t a = 0, b = 0;
-    if (!count(words[0], nodes == 0 ? 0 : nodes - 1, a) || !count(words[1], nodes == 0 ? 0 : nodes - 1, b)) {
+    if (!count(words[0], nodes == 0 ? 0 : nodes - 1, a) ||
+        !count(words[1], nodes == 0 ? 0 : nodes - 1, b)) {
       return fail("spring node indices must be integers below " + std::to_string(nodes));
     }
     double v[4];
     for (int k = 0; k < 4; ++k) {
-      if (!number(words[static_cast<std::size_t>(k) + 2], v[k])) return fail("'" + words[static_cast<std::size_t>(k) + 2] + "' is not a number");
+      if (!number(words[static_cast<std::size_t>(k) + 2], v[k]))
+        return fail("'" + words[static_cast<std::size_t>(k) + 2] + "' is not a number");
     }
-    Spring spring{static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b), v[0], v[1], v[2], v[3]};
+    Spring spring{
+        static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b), v[0], v[1], v[2], v[3]};
     if (spring.restLength < 0) {
       const auto pa = net.position(a), pb = net.position(b);
-      spring.restLength = std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
-                                    (pa[2] - pb[2]) * (pa[2] - pb[2]));
+      spring.restLength =
+          std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
+                    (pa[2] - pb[2]) * (pa[2] - pb[2]));
     }
     net.springs.push_back(spring);
   }
@@ -250,13 +278,15 @@ Result<Net> parseNet(const std::string& text, const std::string& origin) {
       if (words.size() != 3) return fail("a triangle is 'a b c'");
       for (const auto& w : words) {
         std::uint64_t index = 0;
-        if (!count(w, nodes == 0 ? 0 : nodes - 1, index)) return fail("triangle indices must be integers below " + std::to_string(nodes));
+        if (!count(w, nodes == 0 ? 0 : nodes - 1, index))
+          return fail("triangle indices must be integers below " + std::to_string(nodes));
         net.surface.push_back(static_cast<std::uint32_t>(index));
       }
     }
     if (next(words)) return fail("unexpected text after the triangles");
   }
-  if (auto status = validateNet(net); !status) return makeError(origin + ": " + status.error().message);
+  if (auto status = validateNet(net); !status)
+    return makeError(origin + ": " + status.error().message);
   return net;
 }
 
@@ -276,8 +306,9 @@ std::string formatNet(const Net& net) {
   }
   out += "springs " + std::to_string(net.springs.size()) + "\n";
   for (const auto& s : net.springs) {
-    out += std::to_string(s.a) + " " + std::to_string(s.b) + " " + formatDouble(s.restLength) + " " +
-           formatDouble(s.stiffness) + " " + formatDouble(s.damping) + " " + formatDouble(s.maxStretch) + "\n";
+    out += std::to_string(s.a) + " " + std::to_string(s.b) + " " + formatDouble(s.restLength) +
+           " " + formatDouble(s.stiffness) + " " + formatDouble(s.damping) + " " +
+           formatDouble(s.maxStretch) + "\n";
   }
   if (!net.surface.empty()) {
     out += "triangles " + std::to_string(net.surface.size() / 3) + "\n";
@@ -314,13 +345,15 @@ std::vector<std::byte> encodeSprings(std::span<const Spring> springs) {
 
 Result<std::vector<Spring>> decodeSprings(std::span<const std::byte> bytes) {
   if (bytes.size() % kSpringRecordSize != 0) {
-    return makeError("springs: " + std::to_string(bytes.size()) + " bytes is not a whole number of 40-byte records");
+    return makeError("springs: " + std::to_string(bytes.size()) +
+                     " bytes is not a whole number of 40-byte records");
   }
   std::vector<Spring> springs(bytes.size() / kSpringRecordSize);
   for (std::size_t i = 0; i < springs.size(); ++i) {
     const std::size_t o = i * kSpringRecordSize;
-    springs[i] = {get<std::uint32_t>(bytes, o), get<std::uint32_t>(bytes, o + 4), get<double>(bytes, o + 8),
-                  get<double>(bytes, o + 16), get<double>(bytes, o + 24), get<double>(bytes, o + 32)};
+    springs[i] = {get<std::uint32_t>(bytes, o), get<std::uint32_t>(bytes, o + 4),
+                  get<double>(bytes, o + 8),    get<double>(bytes, o + 16),
+                  get<double>(bytes, o + 24),   get<double>(bytes, o + 32)};
   }
   return springs;
 }
@@ -332,7 +365,8 @@ std::vector<std::byte> encodeIndices(std::span<const std::uint32_t> indices) {
 }
 
 Result<std::vector<std::uint32_t>> decodeIndices(std::span<const std::byte> bytes) {
-  if (bytes.size() % 12 != 0) return makeError("surface: byte count is not a whole number of u32 triangles");
+  if (bytes.size() % 12 != 0)
+    return makeError("surface: byte count is not a whole number of u32 triangles");
   std::vector<std::uint32_t> out(bytes.size() / 4);
   if (!out.empty()) std::memcpy(out.data(), bytes.data(), bytes.size());
   return out;

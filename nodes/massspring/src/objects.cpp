@@ -8,7 +8,8 @@ namespace vrflow::massspring {
 
 void writeNet(msg::MessageBuilder& builder, std::uint64_t id, const Net& net, bool full) {
   using P = msg::MassSpringParam;
-  auto writer = builder.addObject(id, msg::massSpringType(), full ? msg::ObjectOp::Add : msg::ObjectOp::Update);
+  auto writer = builder.addObject(id, msg::massSpringType(),
+                                  full ? msg::ObjectOp::Add : msg::ObjectOp::Update);
   writer.set(P::kPositions, std::span<const double>(net.positions))
       .set(P::kVelocities, std::span<const double>(net.velocities))
       .set(P::kBounds, bounds(net));
@@ -36,7 +37,8 @@ Status SceneCopy::apply(const msg::MessageView& message) {
       for (const auto& [id, entry] : rigids_) named = named || entry.shapeId == resource->id();
       if (!named) {
         // A shape may arrive before the rigid that names it: keep it if it decodes as a shape.
-        if (auto shape = msg::decodeShape(resource->raw())) shapes_[resource->id()] = std::move(*shape);
+        if (auto shape = msg::decodeShape(resource->raw()))
+          shapes_[resource->id()] = std::move(*shape);
         continue;
       }
       auto shape = msg::decodeShape(resource->raw());
@@ -70,7 +72,8 @@ Status SceneCopy::apply(const msg::MessageView& message) {
       }
       if (auto b = object->bytes(P::kPinned)) {
         net.pinned.resize(b->size());
-        for (std::size_t i = 0; i < b->size(); ++i) net.pinned[i] = static_cast<std::uint8_t>((*b)[i]);
+        for (std::size_t i = 0; i < b->size(); ++i)
+          net.pinned[i] = static_cast<std::uint8_t>((*b)[i]);
       }
       if (auto b = object->bytes(P::kSprings)) {
         auto springs = decodeSprings(*b);

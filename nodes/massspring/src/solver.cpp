@@ -7,9 +7,12 @@
 namespace vrflow::massspring {
 
 Status validateStepOptions(const StepOptions& o) {
-  if (!(o.dt > 0) || !std::isfinite(o.dt)) return makeError("mass-spring step: dt must be finite and > 0");
-  if (o.substeps < 1 || o.substeps > 100000) return makeError("mass-spring step: substeps must be in [1, 100000]");
-  if (o.constraintIterations < 0) return makeError("mass-spring step: constraint iterations must be >= 0");
+  if (!(o.dt > 0) || !std::isfinite(o.dt))
+    return makeError("mass-spring step: dt must be finite and > 0");
+  if (o.substeps < 1 || o.substeps > 100000)
+    return makeError("mass-spring step: substeps must be in [1, 100000]");
+  if (o.constraintIterations < 0)
+    return makeError("mass-spring step: constraint iterations must be >= 0");
   for (double g : o.gravity) {
     if (!std::isfinite(g)) return makeError("mass-spring step: gravity must be finite");
   }
@@ -26,7 +29,8 @@ void addSpringForces(const Net& net, std::span<const Spring> springs, std::span<
     if (length < 1e-12) continue;
     const double inv = 1.0 / length;
     const double u0 = d0 * inv, u1 = d1 * inv, u2 = d2 * inv;
-    const double relSpeed = (v[b] - v[a]) * u0 + (v[b + 1] - v[a + 1]) * u1 + (v[b + 2] - v[a + 2]) * u2;
+    const double relSpeed =
+        (v[b] - v[a]) * u0 + (v[b + 1] - v[a + 1]) * u1 + (v[b + 2] - v[a + 2]) * u2;
     const double magnitude = s.stiffness * (length - s.restLength) + s.damping * relSpeed;
     forces[a] += magnitude * u0;
     forces[a + 1] += magnitude * u1;
@@ -37,7 +41,9 @@ void addSpringForces(const Net& net, std::span<const Spring> springs, std::span<
   }
 }
 
-void addSpringForces(const Net& net, std::span<double> forces) { addSpringForces(net, net.springs, forces); }
+void addSpringForces(const Net& net, std::span<double> forces) {
+  addSpringForces(net, net.springs, forces);
+}
 
 double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible) {
   bool any = false;
@@ -129,13 +135,16 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
   for (int sub = 0; sub < options.substeps; ++sub) {
     for (std::size_t i = 0; i < n; ++i) {
       for (int k = 0; k < 3; ++k) {
-        forces[3 * i + k] = (externalForces.empty() ? 0.0 : externalForces[3 * i + k]) + net.masses[i] * options.gravity[k];
+        forces[3 * i + k] = (externalForces.empty() ? 0.0 : externalForces[3 * i + k]) +
+                            net.masses[i] * options.gravity[k];
       }
     }
     if (options.internalSprings) addSpringForces(net, forces);
     // The start of the sub-step, a fallback inside every limit when it was inside before.
-    if (worst <= 1.0) start = net.positions;
-    else start.clear();
+    if (worst <= 1.0)
+      start = net.positions;
+    else
+      start.clear();
     for (std::size_t i = 0; i < n; ++i) {
       if (net.pinned[i]) {
         for (int k = 0; k < 3; ++k) net.velocities[3 * i + k] = 0.0;
@@ -164,7 +173,8 @@ double kineticEnergy(const Net& net) {
 namespace {
 double springLength(const Net& net, const Spring& s) {
   const auto a = net.position(s.a), b = net.position(s.b);
-  return std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2]));
+  return std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                   (b[2] - a[2]) * (b[2] - a[2]));
 }
 }  // namespace
 
@@ -195,7 +205,8 @@ double maxStretchRatio(const Net& net) {
 double maxConstraintRatio(const Net& net) {
   double worst = 0;
   for (const auto& s : net.springs) {
-    if (s.maxStretch > 0) worst = std::max(worst, springLength(net, s) / (s.maxStretch * s.restLength));
+    if (s.maxStretch > 0)
+      worst = std::max(worst, springLength(net, s) / (s.maxStretch * s.restLength));
   }
   return worst;
 }

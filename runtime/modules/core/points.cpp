@@ -36,7 +36,8 @@ int main() {
   std::vector<Point> points;
   std::unordered_map<uint64_t, std::size_t> index;
   for (int64_t i = 0; i < count; ++i) {
-    points.push_back({module.newId(), {spacing * static_cast<double>(i), 0, 0}, {0, 0, 0}, {0, 0, 0}});
+    points.push_back(
+        {module.newId(), {spacing * static_cast<double>(i), 0, 0}, {0, 0, 0}, {0, 0, 0}});
     index[points.back().id] = points.size() - 1;
   }
   const auto& type = msg::pointType();

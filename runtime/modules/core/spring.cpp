@@ -64,7 +64,8 @@ int main() {
     }
     auto out = module.newMessage(64 + total.size() * 112);
     for (const auto& [id, f] : total) {
-      out.builder().addForce(id, msg::ForceEvent{f, {0, 0, 0}, points[id].position, module.timeStep()});
+      out.builder().addForce(id,
+                             msg::ForceEvent{f, {0, 0, 0}, points[id].position, module.timeStep()});
     }
     if (!module.put(forces, std::move(out))) break;
   }

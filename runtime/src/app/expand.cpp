@@ -10,8 +10,8 @@
 #include "file_io.hpp"
 #include "text_util.hpp"
 #include "validation.hpp"
-#include "vrflow/base/executable_dir.hpp"
 #include "vrflow/app/validate.hpp"
+#include "vrflow/base/executable_dir.hpp"
 
 namespace vrflow::app {
 namespace detail {

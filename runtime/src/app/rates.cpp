@@ -26,7 +26,8 @@ uint64_t countOf(const Filter& filter) {
   for (const Param& p : filter.params) {
     if (p.name != "count") continue;
     uint64_t value = 0;
-    const auto [end, error] = std::from_chars(p.value.data(), p.value.data() + p.value.size(), value);
+    const auto [end, error] =
+        std::from_chars(p.value.data(), p.value.data() + p.value.size(), value);
     if (error == std::errc() && end == p.value.data() + p.value.size() && value >= 1) return value;
     return 1;  // invalid: validate() reports it
   }
@@ -114,7 +115,8 @@ std::vector<IterationRate> iterationRates(const Application& app, const Resolved
     for (const std::string& id : before) {
       Node& node = nodes.at(id);
       if (!node.known) continue;
-      node.rate = reduced(node.rate.numerator * slowest.denominator, node.rate.denominator * slowest.numerator);
+      node.rate = reduced(node.rate.numerator * slowest.denominator,
+                          node.rate.denominator * slowest.numerator);
     }
   }
   std::vector<IterationRate> rates;

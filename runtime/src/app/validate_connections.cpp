@@ -106,9 +106,10 @@ void checkPortTypes(Validation& v, const Connection& connection, const NodeInfo&
   const bool sendsStampsOnly =
       fromNode.filter != nullptr ? stampsOnly.count(fromNode.id()) != 0 : from.stampsOnly;
   if (sendsStampsOnly) {
-    v.error(connection.loc, "'" + fromText + "' sends stamps-only messages" +
-                                (fromNode.filter != nullptr ? " (all its inputs are stamps-only)" : "") +
-                                " but '" + toText + "' expects full messages");
+    v.error(connection.loc,
+            "'" + fromText + "' sends stamps-only messages" +
+                (fromNode.filter != nullptr ? " (all its inputs are stamps-only)" : "") + " but '" +
+                toText + "' expects full messages");
   }
 }
 

@@ -17,7 +17,9 @@ std::atomic<AssertHandler> gHandler{&defaultHandler};
 
 }  // namespace
 
-AssertHandler setAssertHandler(AssertHandler handler) { return gHandler.exchange(handler); }
+AssertHandler setAssertHandler(AssertHandler handler) {
+  return gHandler.exchange(handler);
+}
 
 void assertFailed(const char* expression, const char* message, const char* file, int line) {
   gHandler.load()(expression, message, file, line);

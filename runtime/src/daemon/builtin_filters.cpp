@@ -130,11 +130,28 @@ class PortInputFilter final : public Filter {
       merge_.process(context);
       return;
     }
-    for (std::size_t i = 0; i < context.inputCount(); ++i) {
+    const std::size_t n = context.inputCount();
+    if (newestIn_.size() != n) newestIn_.resize(n);
+    bool anyPending = false;
+    for (std::size_t i = 0; i < n; ++i) {
       auto& in = context.input(i);
       while (in.size() > 1) {
         in.pop_front();
         context.countDropped(i, 1, "replaced by a newer message");
+      }
+      if (!in.empty()) {
+        newestIn_[i] = in.front();
+        anyPending = true;
+      }
+    }
+    // In a run that counts iterations, a connection whose producer has ended contributes its
+    // newest message again, so the others' newer messages still reach the module.
+    if (anyPending && context.runCountsIterations()) {
+      for (std::size_t i = 0; i < n; ++i) {
+        auto& in = context.input(i);
+        if (in.empty() && context.inputClosed(i) && newestIn_[i].valid()) {
+          in.push_back(newestIn_[i]);
+        }
       }
     }
     merge_.process(context);

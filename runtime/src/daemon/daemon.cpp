@@ -51,7 +51,8 @@ struct Daemon::Impl {
   std::vector<ModuleProcess> modules;
   ipc::ModuleSlot* slots = nullptr;
   std::vector<std::atomic<bool>> ended;
-  std::vector<std::vector<ipc::RingRef>> rings;  ///< per module and port, kept out of modules' reach
+  std::vector<std::vector<ipc::RingRef>>
+      rings;  ///< per module and port, kept out of modules' reach
   std::vector<std::vector<std::string>> outputNames;  ///< per module and port, for messages
   // Per module and port index: the node fed by that port (output filter) or feeding it.
   std::map<std::pair<int, std::string>, Node*> portNodes;
@@ -74,8 +75,8 @@ struct Daemon::Impl {
   std::vector<std::string> warnings;
   std::string fatal;  ///< first protocol violation by a module (guarded by warningsMutex)
   std::vector<ipc::TraceMerge> traceMerges;  ///< guarded by warningsMutex
-  std::vector<QueueSnapshot> snapshot;  ///< guarded by warningsMutex
-  std::vector<FilterStats> filterSnapshot;  ///< guarded by warningsMutex
+  std::vector<QueueSnapshot> snapshot;       ///< guarded by warningsMutex
+  std::vector<FilterStats> filterSnapshot;   ///< guarded by warningsMutex
   void publishSnapshot();
   std::vector<FilterStats> collectFilterStats() const;
   void markUnneededModules();
@@ -92,7 +93,9 @@ struct Daemon::Impl {
 
 Daemon::Daemon() : impl_(std::make_unique<Impl>()) {}
 
-Daemon::~Daemon() { shutdown(); }
+Daemon::~Daemon() {
+  shutdown();
+}
 
 Result<std::unique_ptr<Daemon>> Daemon::create(const app::Application& application,
                                                const app::Catalog& catalog,
@@ -136,7 +139,8 @@ Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& ty
 Status Daemon::Impl::build(const app::Application& application, const app::Catalog& catalog) {
   // The control table and one slot per module.
   const uint64_t tableOffset = segment.reserve(sizeof(ipc::ControlTable));
-  const uint64_t slotsOffset = segment.reserve(sizeof(ipc::ModuleSlot) * application.modules.size());
+  const uint64_t slotsOffset =
+      segment.reserve(sizeof(ipc::ModuleSlot) * application.modules.size());
   if (tableOffset == 0 || (slotsOffset == 0 && !application.modules.empty())) {
     return makeError("shared-memory segment too small for the control table");
   }
@@ -203,7 +207,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
       const auto base = std::filesystem::path(application.file).parent_path();
       for (const auto& spec : type->params) {
         auto found = values.find(spec.name);
-        if (spec.type != app::ParamType::File || found == values.end() || found->second.empty()) continue;
+        if (spec.type != app::ParamType::File || found == values.end() || found->second.empty())
+          continue;
         const std::filesystem::path path(found->second);
         std::error_code error;
         if (path.is_relative() && std::filesystem::is_regular_file(base / path, error)) {
@@ -236,11 +241,12 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
       port.stampsOnly = spec.stampsOnly ? 1 : 0;
       const auto key = std::make_pair(module.id, spec.name);
       const int fan = spec.isInput ? fanIn[key] : fanOut[key];
-      const app::InputConfig* config = spec.isInput ? app::findInputConfig(module, spec.name) : nullptr;
+      const app::InputConfig* config =
+          spec.isInput ? app::findInputConfig(module, spec.name) : nullptr;
       const int initial = config != nullptr ? config->initialMessages : 0;
       if (initial < 0 || initial > kMaxInitialMessages) {
-        return makeError("module '" + module.id + "' input '" + spec.name + "': initial-messages must be 0 to " +
-                         std::to_string(kMaxInitialMessages));
+        return makeError("module '" + module.id + "' input '" + spec.name +
+                         "': initial-messages must be 0 to " + std::to_string(kMaxInitialMessages));
       }
       // An input with only initial messages and no connection is still served: it gets them.
       port.connected = (fan > 0 || initial > 0) ? 1 : 0;
@@ -272,7 +278,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         queue.from = nodeId;
         queue.to = nodeId;
         (*node)->inputs[0] = &queue;
-        graph->sources.push_back({static_cast<int>(m), static_cast<int>(p), rings[m][p], &queue, false});
+        graph->sources.push_back(
+            {static_cast<int>(m), static_cast<int>(p), rings[m][p], &queue, false});
         portNodes[{static_cast<int>(m), spec.name}] = *node;
         if (!spec.stampsOnly) moduleOutputs[m].push_back(*node);
         outputFilters.emplace_back(nodeId, static_cast<PortOutputFilter*>((*node)->filter.get()));
@@ -317,7 +324,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     if (filterNodes.count(e.node) == 0) return {nullptr, 0};
     Node* node = filterNodes[e.node];
     const auto& names = node->outputNames;
-    const auto index = static_cast<std::size_t>(std::find(names.begin(), names.end(), e.port) - names.begin());
+    const auto index =
+        static_cast<std::size_t>(std::find(names.begin(), names.end(), e.port) - names.begin());
     return {index == names.size() ? nullptr : node, index};
   };
   // The node and input index a connection arrives at: -1 for a module port or a filter's
@@ -327,14 +335,16 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     if (filterNodes.count(e.node) == 0) return {nullptr, -1};
     Node* node = filterNodes[e.node];
     const auto& names = node->inputNames;
-    const auto index = static_cast<int>(std::find(names.begin(), names.end(), e.port) - names.begin());
+    const auto index =
+        static_cast<int>(std::find(names.begin(), names.end(), e.port) - names.begin());
     return {index == static_cast<int>(names.size()) ? nullptr : node, index};
   };
   // The connection's queue in front of `to`; `key` orders it among a variadic input's queues.
   auto attachQueue = [&](const app::Connection& c, Node* to, int toInput,
                          uint32_t key) -> Result<Queue*> {
     Queue& queue = graph->newQueue();
-    queue.capacity = c.capacity > 0 ? static_cast<std::size_t>(c.capacity) : options.defaultCapacity;
+    queue.capacity =
+        c.capacity > 0 ? static_cast<std::size_t>(c.capacity) : options.defaultCapacity;
     queue.policy = c.policy;
     queue.from = app::toString(c.from);
     queue.to = app::toString(c.to);
@@ -368,15 +378,18 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
   // Connections from or to another host: a sink that sends, or a queue fed by the transport.
   for (const net::RemoteConnection& r : options.remote) {
     const app::Connection& c = r.connection;
-    if (options.transport == nullptr) return makeError("connection crosses hosts without a transport");
+    if (options.transport == nullptr)
+      return makeError("connection crosses hosts without a transport");
     if (r.outgoing) {
       const auto [from, fromOutput] = findSource(c.from);
-      if (from == nullptr) return makeError("connection " + app::toString(c.from) + " names a missing port");
+      if (from == nullptr)
+        return makeError("connection " + app::toString(c.from) + " names a missing port");
       from->outputs[fromOutput].push_back(options.transport->makeSink(r.channel));
       continue;
     }
     const auto [to, toInput] = findTarget(c.to);
-    if (to == nullptr) return makeError("connection " + app::toString(c.to) + " names a missing port");
+    if (to == nullptr)
+      return makeError("connection " + app::toString(c.to) + " names a missing port");
     auto queue = attachQueue(c, to, toInput, r.channel);
     if (!queue) return queue.error();
     remoteInputs.push_back({r.channel, *queue, std::make_unique<QueueSink>(**queue)});
@@ -400,9 +413,15 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
   return {};
 }
 
-ipc::Segment& Daemon::segment() { return impl_->segment; }
-const std::vector<ModuleProcess>& Daemon::modules() const { return impl_->modules; }
-ipc::ModuleSlot& Daemon::slot(int index) { return impl_->slots[index]; }
+ipc::Segment& Daemon::segment() {
+  return impl_->segment;
+}
+const std::vector<ModuleProcess>& Daemon::modules() const {
+  return impl_->modules;
+}
+ipc::ModuleSlot& Daemon::slot(int index) {
+  return impl_->slots[index];
+}
 
 Status Daemon::start() {
   Impl& d = *impl_;
@@ -509,8 +528,10 @@ bool Daemon::Impl::pass() {
         // A module that breaks the protocol has a bug: the run stops, naming it.
         std::lock_guard lock(warningsMutex);
         if (fatal.empty()) {
-          fatal = "module '" + modules[static_cast<std::size_t>(source.module)].id + "' sent " + problem + " on output '" +
-                  outputNames[static_cast<std::size_t>(source.module)][static_cast<std::size_t>(source.port)] +
+          fatal = "module '" + modules[static_cast<std::size_t>(source.module)].id + "' sent " +
+                  problem + " on output '" +
+                  outputNames[static_cast<std::size_t>(source.module)]
+                             [static_cast<std::size_t>(source.port)] +
                   "'";
         }
         if (segment.validHandle(handle) && segment.block(handle).refs.load() != 0) {
@@ -583,9 +604,9 @@ void Daemon::Impl::checkFullQueues(uint64_t now) {
     if (!queue.warnedFull && now - queue.fullSinceNs > options.fullWarningNs) {
       queue.warnedFull = true;
       queue.stayedFull = true;
-      const char* policy = queue.policy == app::QueuePolicy::Block      ? "block"
+      const char* policy = queue.policy == app::QueuePolicy::Block        ? "block"
                            : queue.policy == app::QueuePolicy::DropOldest ? "drop-oldest"
-                                                                            : "drop-newest";
+                                                                          : "drop-newest";
       // What it means, in the words of the two ends (the ids before the port names).
       const auto owner = [](const std::string& port) {
         return "'" + port.substr(0, port.rfind('.')) + "'";
@@ -788,8 +809,8 @@ std::vector<ConnectionStats> Daemon::connectionStats() const {
   std::vector<ConnectionStats> stats;
   for (const auto& queue : impl_->graph->queues) {
     if (!queue.isConnection) continue;
-    stats.push_back({queue.from, queue.to, queue.messages, queue.bytes, queue.dropped,
-                     queue.stayedFull});
+    stats.push_back(
+        {queue.from, queue.to, queue.messages, queue.bytes, queue.dropped, queue.stayedFull});
   }
   return stats;
 }

@@ -115,7 +115,8 @@ void Node::recordMerge(std::span<const msg::MessageView> views) {
   if (!graph_->traceMerges || views.size() < 2) return;
   // The merged message is stamped with the first part's source and the largest iteration.
   uint64_t mergedIteration = 0;
-  for (const auto& view : views) mergedIteration = std::max(mergedIteration, view.stamps().iteration);
+  for (const auto& view : views)
+    mergedIteration = std::max(mergedIteration, view.stamps().iteration);
   const uint32_t mergedHash = msg::fnv1a32(views.front().stamps().source);
   for (const auto& view : views) {
     const auto stamps = view.stamps();
@@ -149,6 +150,8 @@ void Node::wakeAfter(uint64_t delayNs) {
   if (graph_->wakeAtNs == 0 || at < graph_->wakeAtNs) graph_->wakeAtNs = at;
 }
 
-void Node::warn(const std::string& message) { graph_->warnings.push_back(message); }
+void Node::warn(const std::string& message) {
+  graph_->warnings.push_back(message);
+}
 
 }  // namespace vrflow::daemon

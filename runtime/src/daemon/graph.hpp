@@ -167,9 +167,9 @@ class Graph {
   std::vector<std::string> warnings;
   bool traceMerges = false;             ///< the run is traced: joins record `merges`
   std::vector<ipc::TraceMerge> merges;  ///< taken with the warnings (Daemon::takeTraceMerges)
-  uint64_t operations = 0;  ///< bumped on every move, to detect progress
-  bool countsIterations = false;  ///< every module has an iteration count (--iterations)
-  uint64_t wakeAtNs = 0;    ///< earliest time a filter asked to be run again; 0 = none
+  uint64_t operations = 0;              ///< bumped on every move, to detect progress
+  bool countsIterations = false;        ///< every module has an iteration count (--iterations)
+  uint64_t wakeAtNs = 0;                ///< earliest time a filter asked to be run again; 0 = none
 };
 
 }  // namespace vrflow::daemon

@@ -1,7 +1,5 @@
 #include "vrflow/ipc/segment.hpp"
 
-#include "vrflow/message/ids.hpp"
-
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -13,6 +11,8 @@
 #include <new>
 #include <string>
 #include <utility>
+
+#include "vrflow/message/ids.hpp"
 
 #if defined(__SANITIZE_THREAD__)
 #include <sanitizer/tsan_interface.h>
@@ -38,11 +38,19 @@ void tsanAcquire([[maybe_unused]] void* address) {
 
 // A free-list head packs a 32-bit tag (bumped on every change, against ABA) with the block
 // offset divided by 64 (blocks are 64-byte aligned), so a segment may be up to 256 GiB.
-constexpr uint64_t pack(uint64_t tag, uint64_t offset) { return (tag << 32) | (offset >> 6); }
-constexpr uint64_t offsetOf(uint64_t packed) { return (packed & 0xffffffffULL) << 6; }
-constexpr uint64_t tagOf(uint64_t packed) { return packed >> 32; }
+constexpr uint64_t pack(uint64_t tag, uint64_t offset) {
+  return (tag << 32) | (offset >> 6);
+}
+constexpr uint64_t offsetOf(uint64_t packed) {
+  return (packed & 0xffffffffULL) << 6;
+}
+constexpr uint64_t tagOf(uint64_t packed) {
+  return packed >> 32;
+}
 
-std::string errnoText(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
+std::string errnoText(const char* what) {
+  return std::string(what) + ": " + std::strerror(errno);
+}
 
 int classFor(std::size_t payloadBytes) {
   const std::size_t total = payloadBytes + sizeof(BlockHeader);
@@ -157,7 +165,8 @@ uint64_t Segment::allocate(std::size_t payloadBytes) {
   header->blockClass = static_cast<uint32_t>(k);
   header->refs.store(1, std::memory_order_relaxed);
   const uint64_t inUse =
-      header_->inUseBytes.fetch_add(uint64_t{1} << k, std::memory_order_relaxed) + (uint64_t{1} << k);
+      header_->inUseBytes.fetch_add(uint64_t{1} << k, std::memory_order_relaxed) +
+      (uint64_t{1} << k);
   uint64_t peak = header_->peakInUseBytes.load(std::memory_order_relaxed);
   while (inUse > peak &&
          !header_->peakInUseBytes.compare_exchange_weak(peak, inUse, std::memory_order_relaxed)) {

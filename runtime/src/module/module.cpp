@@ -47,8 +47,9 @@ Result<long> moduleIndexFromEnvironment() {
   if (indices == nullptr) {
     const char* index = std::getenv("VRFLOW_MODULE_INDEX");
     if (index == nullptr) {
-      return makeError("this program is a vrflow module: start it through an application "
-                       "(`vrflow run APP.xml`), not by hand");
+      return makeError(
+          "this program is a vrflow module: start it through an application "
+          "(`vrflow run APP.xml`), not by hand");
     }
     return std::atol(index);
   }
@@ -88,8 +89,8 @@ Result<long> moduleIndexFromEnvironment() {
       rank >= static_cast<long>(list.size())) {
     return makeError("cannot join the run: MPI rank " + std::string(rankText) + " (" + rankName +
                      ") is not a rank of MPI job" + job + ", which has " +
-                     std::to_string(list.size()) + " module(s) (VRFLOW_MODULE_INDICES=" +
-                     indices + "): start the job with as many ranks as modules");
+                     std::to_string(list.size()) + " module(s) (VRFLOW_MODULE_INDICES=" + indices +
+                     "): start the job with as many ranks as modules");
   }
   return list[static_cast<std::size_t>(rank)];
 }
@@ -115,7 +116,9 @@ OutgoingMessage::OutgoingMessage(std::unique_ptr<Impl> impl) : impl_(std::move(i
 OutgoingMessage::OutgoingMessage(OutgoingMessage&&) noexcept = default;
 OutgoingMessage& OutgoingMessage::operator=(OutgoingMessage&&) noexcept = default;
 OutgoingMessage::~OutgoingMessage() = default;
-msg::MessageBuilder& OutgoingMessage::builder() { return impl_->builder; }
+msg::MessageBuilder& OutgoingMessage::builder() {
+  return impl_->builder;
+}
 
 struct Module::Impl {
   ipc::Segment segment;
@@ -125,8 +128,8 @@ struct Module::Impl {
   std::string id;
   std::deque<InputPort> inputs;
   std::deque<OutputPort> outputs;
-  std::vector<Message> current;         // by port slot index
-  std::vector<int> waitOrder;           // connected input slots, in port order
+  std::vector<Message> current;  // by port slot index
+  std::vector<int> waitOrder;    // connected input slots, in port order
   int endItSlot = -1;
   bool finished = false;
   bool initialized = false;
@@ -292,8 +295,9 @@ Status Module::init() {
   // descriptor by its /proc path instead.
   const char* pathText = std::getenv("VRFLOW_SEGMENT_PATH");
   if (fdText == nullptr && pathText == nullptr) {
-    return makeError("this program is a vrflow module: start it through an application "
-                     "(`vrflow run APP.xml`), not by hand");
+    return makeError(
+        "this program is a vrflow module: start it through an application "
+        "(`vrflow run APP.xml`), not by hand");
   }
   const Result<long> found = moduleIndexFromEnvironment();
   if (!found) return found.error();
@@ -436,7 +440,8 @@ bool Module::wait() {
     m.traceEvent(ipc::TraceKind::Wait, waitStart, now);
     for (const int portSlot : m.waitOrder) {
       const auto stamps = m.current[static_cast<std::size_t>(portSlot)]->stamps();
-      m.traceEvent(ipc::TraceKind::Received, now, now, msg::fnv1a32(stamps.source), stamps.iteration);
+      m.traceEvent(ipc::TraceKind::Received, now, now, msg::fnv1a32(stamps.source),
+                   stamps.iteration);
     }
   }
   m.iterationStartNs = now;
@@ -509,11 +514,21 @@ Status Module::put(const OutputPort& port, const Message& message) {
   return {};
 }
 
-const std::string& Module::id() const { return impl_->id; }
-uint64_t Module::iteration() const { return impl_->iteration; }
-double Module::simTime() const { return impl_->simTime; }
-double Module::timeStep() const { return impl_->timeStep; }
-bool Module::stopRequested() const { return impl_->stopRequested(); }
+const std::string& Module::id() const {
+  return impl_->id;
+}
+uint64_t Module::iteration() const {
+  return impl_->iteration;
+}
+double Module::simTime() const {
+  return impl_->simTime;
+}
+double Module::timeStep() const {
+  return impl_->timeStep;
+}
+bool Module::stopRequested() const {
+  return impl_->stopRequested();
+}
 
 std::string Module::param(std::string_view name, std::string_view fallback) const {
   const auto it = impl_->params.find(name);
@@ -542,6 +557,8 @@ uint64_t Module::newId() {
   return impl_->segment.newId();
 }
 
-int Module::exitStatus() const { return impl_->failed ? 1 : 0; }
+int Module::exitStatus() const {
+  return impl_->failed ? 1 : 0;
+}
 
 }  // namespace vrflow

@@ -30,9 +30,7 @@ class ShmSink final : public msg::ByteSink {
     return data();
   }
   std::byte* data() override { return handle_ ? segment_->payload(handle_) : nullptr; }
-  std::size_t capacity() const override {
-    return handle_ ? segment_->payloadCapacity(handle_) : 0;
-  }
+  std::size_t capacity() const override { return handle_ ? segment_->payloadCapacity(handle_) : 0; }
 
   /// Gives up the block (with its reference) after recording how many bytes were written.
   uint64_t take(std::size_t used) {

@@ -30,28 +30,44 @@ void encodeHeader(const FrameHeader& header, std::byte* out) {
 
 std::size_t controlPayloadBytes(FrameType type) {
   switch (type) {
-    case FrameType::Hello: return 16 + kNonceBytes;
-    case FrameType::Challenge: return kNonceBytes + kMacBytes;
-    case FrameType::Auth: return kMacBytes;
-    case FrameType::Message: return 0;
-    case FrameType::Close: return 0;
-    case FrameType::Credit: return 4;
-    case FrameType::Heartbeat: return 8;
-    case FrameType::Bye: return 0;
+    case FrameType::Hello:
+      return 16 + kNonceBytes;
+    case FrameType::Challenge:
+      return kNonceBytes + kMacBytes;
+    case FrameType::Auth:
+      return kMacBytes;
+    case FrameType::Message:
+      return 0;
+    case FrameType::Close:
+      return 0;
+    case FrameType::Credit:
+      return 4;
+    case FrameType::Heartbeat:
+      return 8;
+    case FrameType::Bye:
+      return 0;
   }
   return 0;
 }
 
 const char* frameTypeName(FrameType type) {
   switch (type) {
-    case FrameType::Hello: return "hello";
-    case FrameType::Challenge: return "challenge";
-    case FrameType::Auth: return "auth";
-    case FrameType::Message: return "message";
-    case FrameType::Close: return "close";
-    case FrameType::Credit: return "credit";
-    case FrameType::Heartbeat: return "heartbeat";
-    case FrameType::Bye: return "bye";
+    case FrameType::Hello:
+      return "hello";
+    case FrameType::Challenge:
+      return "challenge";
+    case FrameType::Auth:
+      return "auth";
+    case FrameType::Message:
+      return "message";
+    case FrameType::Close:
+      return "close";
+    case FrameType::Credit:
+      return "credit";
+    case FrameType::Heartbeat:
+      return "heartbeat";
+    case FrameType::Bye:
+      return "bye";
   }
   return "unknown";
 }
@@ -83,8 +99,8 @@ Status FrameReader::startPayload() {
   inPayload_ = true;
   if (current_.type == FrameType::Message) {
     if (current_.length > maxFrameBytes_) {
-      return makeError("frame of " + std::to_string(current_.length) + " bytes exceeds the limit of " +
-                       std::to_string(maxFrameBytes_) + " bytes");
+      return makeError("frame of " + std::to_string(current_.length) +
+                       " bytes exceeds the limit of " + std::to_string(maxFrameBytes_) + " bytes");
     }
     if (current_.length == 0) return makeError("malformed frame: empty message");
     target_ = allocate_(current_);

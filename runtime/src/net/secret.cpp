@@ -24,8 +24,10 @@ std::array<std::byte, kMacBytes> proof(const Secret& secret, const char* label, 
   putU32(ids, connector);
   putU32(ids + 4, listener);
   crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(ids), sizeof ids);
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonceC), kNonceBytes);
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonceL), kNonceBytes);
+  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonceC),
+                                kNonceBytes);
+  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonceL),
+                                kNonceBytes);
   std::array<std::byte, kMacBytes> mac{};
   crypto_auth_hmacsha256_final(&state, reinterpret_cast<unsigned char*>(mac.data()));
   return mac;
@@ -75,10 +77,12 @@ std::string controlProof(const Secret& secret, int hostIndex, const std::string&
   crypto_auth_hmacsha256_state state;
   crypto_auth_hmacsha256_init(&state, secret.data(), secret.size());
   const char label[] = "vrflow-control";
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(label), sizeof label);
+  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(label),
+                                sizeof label);
   std::byte index[4];
   detail::putU32(index, static_cast<uint32_t>(hostIndex));
-  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(index), sizeof index);
+  crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(index),
+                                sizeof index);
   crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(nonce.data()),
                                 nonce.size());
   Secret mac{};
@@ -86,6 +90,8 @@ std::string controlProof(const Secret& secret, int hostIndex, const std::string&
   return secretToHex(mac);
 }
 
-std::string newNonceHex() { return secretToHex(newSecret()); }
+std::string newNonceHex() {
+  return secretToHex(newSecret());
+}
 
 }  // namespace vrflow::net

@@ -50,7 +50,9 @@ uint64_t nowNs() {
                                    .count());
 }
 
-std::string errnoText(int err) { return std::strerror(err); }
+std::string errnoText(int err) {
+  return std::strerror(err);
+}
 
 void put32(std::byte* out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out[i] = static_cast<std::byte>((v >> (8 * i)) & 0xFFu);
@@ -130,8 +132,8 @@ struct Channel {
   RemoteConnection remote;
   std::deque<daemon::MessageRef> inbox;  ///< incoming: received, not yet routed
   bool closedByPeer = false;
-  uint32_t creditsToSend = 0;            ///< incoming: messages routed since the last Credit
-  std::atomic<int64_t> credits{0};       ///< outgoing: messages the peer can still take
+  uint32_t creditsToSend = 0;       ///< incoming: messages routed since the last Credit
+  std::atomic<int64_t> credits{0};  ///< outgoing: messages the peer can still take
   bool sentClose = false;
 };
 
@@ -262,8 +264,8 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       }
       std::memcpy(link.nonceC.data(), payload.data() + 16, kNonceBytes);
       randombytes_buf(link.nonceL.data(), kNonceBytes);
-      const auto mac = detail::proof(options.secret, "vrflow-listener", from, to, link.nonceC.data(),
-                             link.nonceL.data());
+      const auto mac = detail::proof(options.secret, "vrflow-listener", from, to,
+                                     link.nonceC.data(), link.nonceL.data());
       std::byte reply[kNonceBytes + kMacBytes];
       std::memcpy(reply, link.nonceL.data(), kNonceBytes);
       std::memcpy(reply + kNonceBytes, mac.data(), kMacBytes);
@@ -277,12 +279,13 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       const auto self = static_cast<uint32_t>(options.selfIndex);
       const auto peer = static_cast<uint32_t>(link.peer);
       const auto expected = detail::proof(options.secret, "vrflow-listener", self, peer,
-                                  link.nonceC.data(), link.nonceL.data());
+                                          link.nonceC.data(), link.nonceL.data());
       if (!detail::sameMac(expected.data(), payload.data() + kNonceBytes)) {
-        return makeError("the peer failed the challenge-response (it does not hold this run's secret)");
+        return makeError(
+            "the peer failed the challenge-response (it does not hold this run's secret)");
       }
-      const auto mac = detail::proof(options.secret, "vrflow-connector", self, peer, link.nonceC.data(),
-                             link.nonceL.data());
+      const auto mac = detail::proof(options.secret, "vrflow-connector", self, peer,
+                                     link.nonceC.data(), link.nonceL.data());
       std::lock_guard lock(mutex);
       queueControl(link, FrameType::Auth, 0, reinterpret_cast<const std::byte*>(mac.data()),
                    kMacBytes);
@@ -294,11 +297,12 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
     }
     case FrameType::Auth: {
       if (link.connector || link.peer < 0) return makeError("unexpected auth");
-      const auto expected =
-          detail::proof(options.secret, "vrflow-connector", static_cast<uint32_t>(link.peer),
-                static_cast<uint32_t>(options.selfIndex), link.nonceC.data(), link.nonceL.data());
+      const auto expected = detail::proof(
+          options.secret, "vrflow-connector", static_cast<uint32_t>(link.peer),
+          static_cast<uint32_t>(options.selfIndex), link.nonceC.data(), link.nonceL.data());
       if (!detail::sameMac(expected.data(), payload.data())) {
-        return makeError("the peer failed the challenge-response (it does not hold this run's secret)");
+        return makeError(
+            "the peer failed the challenge-response (it does not hold this run's secret)");
       }
       std::lock_guard lock(mutex);
       link.authenticated = true;
@@ -336,7 +340,8 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       auto it = channels.find(header.channel);
       if (it == channels.end() || it->second->remote.outgoing ||
           it->second->remote.peer != link.peer) {
-        return makeError("close of channel " + std::to_string(header.channel) + ", not one of this link");
+        return makeError("close of channel " + std::to_string(header.channel) +
+                         ", not one of this link");
       }
       std::lock_guard lock(mutex);
       it->second->closedByPeer = true;
@@ -347,7 +352,8 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       auto it = channels.find(header.channel);
       if (it == channels.end() || !it->second->remote.outgoing ||
           it->second->remote.peer != link.peer) {
-        return makeError("credit for channel " + std::to_string(header.channel) + ", not one of this link");
+        return makeError("credit for channel " + std::to_string(header.channel) +
+                         ", not one of this link");
       }
       it->second->credits.fetch_add(get32(payload.data()));
       return {};
@@ -380,7 +386,8 @@ void Transport::Impl::fail(Link& link, const std::string& why) {
     if (!link.byeReceived && fatal.empty() && !stopped.load()) {
       fatal = "lost the link to host '" + hostName(link.peer) + "' (" + link.address + "): " + why;
     }
-    if (linkOfPeer.count(link.peer) != 0 && linkOfPeer[link.peer] == &link) linkOfPeer.erase(link.peer);
+    if (linkOfPeer.count(link.peer) != 0 && linkOfPeer[link.peer] == &link)
+      linkOfPeer.erase(link.peer);
   } else if (link.connector && setupFailure.empty()) {
     setupFailure = "host '" + hostName(link.peer) + "' (" + link.address + "): " + why;
   }
@@ -430,7 +437,9 @@ void Transport::Impl::readFrom(Link& link) {
       return;
     }
     if (onArrival) onArrival();
-    if (static_cast<std::size_t>(n) < (direct.size() >= kDirectReadMin ? direct.size() : readBuffer.size())) return;
+    if (static_cast<std::size_t>(n) <
+        (direct.size() >= kDirectReadMin ? direct.size() : readBuffer.size()))
+      return;
   }
 }
 
@@ -497,7 +506,8 @@ void Transport::Impl::checkTimers() {
   for (auto& link : links) {
     if (link->failed) continue;
     if (!link->authenticated) {
-      if (now - link->openedNs > handshakeNs) fail(*link, "no authentication within the handshake time");
+      if (now - link->openedNs > handshakeNs)
+        fail(*link, "no authentication within the handshake time");
       continue;
     }
     if (now - link->lastReceivedNs > timeoutNs && !link->byeReceived) {
@@ -630,7 +640,9 @@ void Transport::Impl::releaseRefusedLinks() {
 
 Transport::Transport() : impl_(std::make_unique<Impl>()) {}
 
-Transport::~Transport() { stop(); }
+Transport::~Transport() {
+  stop();
+}
 
 Result<std::unique_ptr<Transport>> Transport::listen(const TransportOptions& options) {
   if (sodium_init() < 0) return makeError("libsodium failed to initialise");
@@ -658,9 +670,13 @@ Result<std::unique_ptr<Transport>> Transport::listen(const TransportOptions& opt
   return transport;
 }
 
-uint16_t Transport::port() const { return impl_->boundPort; }
+uint16_t Transport::port() const {
+  return impl_->boundPort;
+}
 
-void Transport::attachSegment(ipc::Segment& segment) { impl_->segment = &segment; }
+void Transport::attachSegment(ipc::Segment& segment) {
+  impl_->segment = &segment;
+}
 
 void Transport::setArrivalCallback(std::function<void()> callback) {
   impl_->onArrival = std::move(callback);
@@ -774,8 +790,8 @@ Status Transport::connectPeers(const std::vector<PeerAddress>& peers) {
   t.running.store(true);
   t.thread = std::thread([&t] { t.loop(); });
   std::unique_lock lock(t.mutex);
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration<double>(t.options.connectSeconds);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(t.options.connectSeconds);
   while (t.fatal.empty()) {
     if (!t.setupFailure.empty()) return makeError(t.setupFailure);
     bool all = true;
@@ -786,7 +802,8 @@ Status Transport::connectPeers(const std::vector<PeerAddress>& peers) {
   if (!t.fatal.empty()) return makeError(t.fatal);
   std::string missing;
   for (const int p : t.neededPeers) {
-    if (t.linkOfPeer.count(p) == 0) missing += (missing.empty() ? "'" : ", '") + t.hostName(p) + "'";
+    if (t.linkOfPeer.count(p) == 0)
+      missing += (missing.empty() ? "'" : ", '") + t.hostName(p) + "'";
   }
   char text[64];
   std::snprintf(text, sizeof text, "%g s", t.options.connectSeconds);
@@ -860,8 +877,7 @@ void Transport::finish(double seconds) {
   }
   t.wake();
   std::unique_lock lock(t.mutex);
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (true) {
     bool done = true;
     for (auto& [peer, link] : t.linkOfPeer) done = done && link->byeReceived && link->out.empty();

@@ -131,7 +131,8 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
     m["end"] = endCauseName(slot.endCause.load());
     ordered_json timing;
     const double computeS = static_cast<double>(slot.computeNs.load()) / 1e9;
-    timing["iteration_ms_mean"] = iterations ? computeS * 1e3 / static_cast<double>(iterations) : 0.0;
+    timing["iteration_ms_mean"] =
+        iterations ? computeS * 1e3 / static_cast<double>(iterations) : 0.0;
     timing["iteration_ms_p99"] = percentileMs(slot, 0.99);
     timing["compute_s"] = computeS;
     timing["wait_s"] = static_cast<double>(slot.waitNs.load()) / 1e9;

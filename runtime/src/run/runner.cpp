@@ -13,10 +13,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <thread>
-
-#include <nlohmann/json.hpp>
 
 #include "report.hpp"
 #include "spawn.hpp"
@@ -40,11 +39,16 @@ double secondsSince(Clock::time_point start) {
 
 const char* stateName(uint32_t state) {
   switch (static_cast<ipc::ModuleState>(state)) {
-    case ipc::ModuleState::Starting: return "starting";
-    case ipc::ModuleState::Waiting: return "waiting";
-    case ipc::ModuleState::Computing: return "computing";
-    case ipc::ModuleState::Putting: return "blocked sending";
-    case ipc::ModuleState::Finished: return "finished";
+    case ipc::ModuleState::Starting:
+      return "starting";
+    case ipc::ModuleState::Waiting:
+      return "waiting";
+    case ipc::ModuleState::Computing:
+      return "computing";
+    case ipc::ModuleState::Putting:
+      return "blocked sending";
+    case ipc::ModuleState::Finished:
+      return "finished";
   }
   return "?";
 }
@@ -179,8 +183,9 @@ class Supervisor {
   /// Live counters for `vrflow monitor`: raw totals, so that the reader computes rates.
   std::string statsJson() {
     nlohmann::json j;
-    j["t_ns"] = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                    Clock::now().time_since_epoch()).count();
+    j["t_ns"] =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+            .count();
     auto modules = nlohmann::json::array();
     const long page = sysconf(_SC_PAGESIZE);
     for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
@@ -201,7 +206,8 @@ class Supervisor {
         std::FILE* statm = std::fopen(("/proc/" + std::to_string(pid) + "/statm").c_str(), "r");
         if (statm != nullptr) {
           unsigned long size = 0, resident = 0;
-          if (std::fscanf(statm, "%lu %lu", &size, &resident) == 2) rss = resident * static_cast<unsigned long>(page);
+          if (std::fscanf(statm, "%lu %lu", &size, &resident) == 2)
+            rss = resident * static_cast<unsigned long>(page);
           std::fclose(statm);
         }
       }
@@ -212,9 +218,13 @@ class Supervisor {
     j["modules"] = modules;
     auto connections = nlohmann::json::array();
     for (const auto& q : daemon_.queueSnapshot()) {
-      connections.push_back({{"from", q.from}, {"to", q.to}, {"length", q.length},
-                             {"capacity", q.capacity}, {"messages", q.messages},
-                             {"bytes", q.bytes}, {"dropped", q.dropped}});
+      connections.push_back({{"from", q.from},
+                             {"to", q.to},
+                             {"length", q.length},
+                             {"capacity", q.capacity},
+                             {"messages", q.messages},
+                             {"bytes", q.bytes},
+                             {"dropped", q.dropped}});
     }
     j["connections"] = connections;
     j["filters"] = filterStatsJson(daemon_.filterSnapshot());
@@ -223,7 +233,6 @@ class Supervisor {
   Clock::time_point lastStats_{};
 
  private:
-
   const app::Application& application_;
   const app::Catalog& catalog_;
   const RunOptions& options_;
@@ -298,8 +307,8 @@ std::optional<std::string> Supervisor::refusedWithoutMpirun() const {
 
 // Starts every module of jobs_[jobIndex] as one mpirun; false (and `outcome` says why) when it
 // cannot start.
-bool Supervisor::startJob(std::size_t jobIndex, int segmentFd,
-                          std::vector<std::string> environment, RunOutcome& outcome) {
+bool Supervisor::startJob(std::size_t jobIndex, int segmentFd, std::vector<std::string> environment,
+                          RunOutcome& outcome) {
   const app::MpiJob& job = jobs_[jobIndex];
   std::vector<int> slots;
   for (const std::size_t m : job.modules) slots.push_back(daemon_.modules()[m].slotIndex);
@@ -336,7 +345,7 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
   pid_t pid = 0;
   while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
     // One process: a module, or the mpirun of an MPI job that all its modules share.
-    std::string notJoined;  // the first module that never joined, if any
+    std::string notJoined;    // the first module that never joined, if any
     std::string outOfMemory;  // the first module that ran out of memory, if any
     int job = -1;
     std::size_t first = children_.size();
@@ -433,10 +442,10 @@ bool Supervisor::notJoined(std::string& detail) {
       char text[64];
       std::snprintf(text, sizeof text, "%g s", options_.joinSeconds);
       const int job = children_[i].job;
-      const std::string process =
-          job < 0 ? "pid " + std::to_string(children_[i].pid)
-                  : "a rank of MPI job '" + jobs_[static_cast<std::size_t>(job)].name +
-                        "', mpirun pid " + std::to_string(children_[i].pid);
+      const std::string process = job < 0 ? "pid " + std::to_string(children_[i].pid)
+                                          : "a rank of MPI job '" +
+                                                jobs_[static_cast<std::size_t>(job)].name +
+                                                "', mpirun pid " + std::to_string(children_[i].pid);
       detail = "module '" + module.id + "' (host " + module.host + ", " + process +
                ") did not join the run within " + text + " (it never called Module::init())";
       return true;
@@ -609,7 +618,7 @@ void Supervisor::stopAll() {
           std::find(signalled.begin(), signalled.end(), child.pid) != signalled.end()) {
         continue;
       }
-      kill(-child.pid, sig);  // its whole process group: wrappers too
+      kill(-child.pid, sig);                          // its whole process group: wrappers too
       if (sig == SIGTERM) kill(-child.pid, SIGCONT);  // a stopped module takes it too
       signalled.push_back(child.pid);
     }
@@ -640,10 +649,10 @@ RunOutcome Supervisor::run() {
   for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
     if (children_[i].alive) continue;  // started with its MPI job
     const auto& module = daemon_.modules()[i];
-    std::vector<std::string> environment{
-        "VRFLOW_SEGMENT_FD=" + std::to_string(fd),
-        "VRFLOW_MODULE_INDEX=" + std::to_string(module.slotIndex), "VRFLOW_MODULE_ID=" + module.id,
-        "VRFLOW_HOST=" + module.host};
+    std::vector<std::string> environment{"VRFLOW_SEGMENT_FD=" + std::to_string(fd),
+                                         "VRFLOW_MODULE_INDEX=" + std::to_string(module.slotIndex),
+                                         "VRFLOW_MODULE_ID=" + module.id,
+                                         "VRFLOW_HOST=" + module.host};
     if (jobOf_[i] >= 0) {
       if (!startJob(static_cast<std::size_t>(jobOf_[i]), fd, environment, outcome)) break;
       continue;

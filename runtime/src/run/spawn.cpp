@@ -42,8 +42,8 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
   // Everything the child needs is prepared before fork: after it, only async-signal-safe calls.
   std::vector<std::string> envStrings;
   for (char** e = environ; *e != nullptr; ++e) {
-    if (std::strncmp(*e, "VRFLOW_SEGMENT_FD=", 18) == 0 || std::strncmp(*e, "VRFLOW_MODULE_", 14) == 0 ||
-        std::strncmp(*e, "VRFLOW_HOST=", 12) == 0) {
+    if (std::strncmp(*e, "VRFLOW_SEGMENT_FD=", 18) == 0 ||
+        std::strncmp(*e, "VRFLOW_MODULE_", 14) == 0 || std::strncmp(*e, "VRFLOW_HOST=", 12) == 0) {
       continue;  // ours are set below; inherited ones would shadow them
     }
     envStrings.emplace_back(*e);
@@ -107,9 +107,15 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, int segmentF
   // must be allowed explicitly.
   // CMA single copies need ptrace rights that containers often withhold: copy through the
   // shared-memory transport's buffers instead.
-  std::vector<std::string> args{"-np", std::to_string(ranks), "--oversubscribe",
-                                "--mca", "mpi_yield_when_idle", "1",
-                                "--mca", "btl_vader_single_copy_mechanism", "none"};
+  std::vector<std::string> args{"-np",
+                                std::to_string(ranks),
+                                "--oversubscribe",
+                                "--mca",
+                                "mpi_yield_when_idle",
+                                "1",
+                                "--mca",
+                                "btl_vader_single_copy_mechanism",
+                                "none"};
   if (!backingDir.empty()) {
     // The ranks' shared-memory files go to a folder the runtime removes, even after kill -9.
     args.insert(args.end(), {"--mca", "btl_vader_backing_directory", backingDir});

@@ -142,7 +142,9 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
   uint64_t dropped = 0;
   for (std::size_t i = 0; i < application.hosts.size(); ++i) {
     const app::Host& host = application.hosts[i];
-    events.push_back({{"ph", "M"}, {"name", "process_name"}, {"pid", static_cast<int>(i) + 1},
+    events.push_back({{"ph", "M"},
+                      {"name", "process_name"},
+                      {"pid", static_cast<int>(i) + 1},
                       {"args", {{"name", "host " + host.id + " (" + host.address + ")"}}}});
   }
   // Every put of a message, by the message's stamps (source, iteration): its sender's own put,
@@ -158,8 +160,11 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
   for (const auto& h : hosts) {
     dropped += h.dropped;
     for (const auto& m : h.modules) {
-      events.push_back({{"ph", "M"}, {"name", "thread_name"}, {"pid", pidOf(m)},
-                        {"tid", moduleIndex(m) + 1}, {"args", {{"name", m}}}});
+      events.push_back({{"ph", "M"},
+                        {"name", "thread_name"},
+                        {"pid", pidOf(m)},
+                        {"tid", moduleIndex(m) + 1},
+                        {"args", {{"name", m}}}});
     }
     for (const auto& e : h.events) {
       if (e.event.kind != static_cast<uint32_t>(ipc::TraceKind::Sent)) continue;

@@ -12,14 +12,14 @@ namespace vrflow::launcher {
 
 /// One line of a hostfile: where a host of the application really runs.
 struct HostEntry {
-  std::string host;      ///< host id, as in the application file
-  std::string address;   ///< overrides the file's address (where the daemon binds)
-  std::string user;      ///< ssh only
-  int sshPort = 22;      ///< ssh only
-  std::string identity;  ///< ssh only: private key file (ssh -i)
-  std::vector<std::string> sshOptions;   ///< ssh only: -o KEY=VALUE
-  std::string directory; ///< ssh only: working folder there (default: the launcher's)
-  std::string daemon;    ///< ssh only: vrflow-daemon there (default: the one beside `vrflow`)
+  std::string host;                     ///< host id, as in the application file
+  std::string address;                  ///< overrides the file's address (where the daemon binds)
+  std::string user;                     ///< ssh only
+  int sshPort = 22;                     ///< ssh only
+  std::string identity;                 ///< ssh only: private key file (ssh -i)
+  std::vector<std::string> sshOptions;  ///< ssh only: -o KEY=VALUE
+  std::string directory;  ///< ssh only: working folder there (default: the launcher's)
+  std::string daemon;     ///< ssh only: vrflow-daemon there (default: the one beside `vrflow`)
   std::vector<std::string> environment;  ///< NAME=VALUE given to the daemon and its modules
   int line = 0;
 };
@@ -36,11 +36,11 @@ struct LaunchOptions {
   std::string backend = "local";
   uint64_t iterations = 0;
   std::string reportPath;
-  std::string tracePath;          ///< Chrome trace of every host; empty = none
+  std::string tracePath;                     ///< Chrome trace of every host; empty = none
   std::string controlAddress = "127.0.0.1";  ///< mpirun: where daemons reach the launcher
   double timeoutSeconds = 0;
-  double peerTimeoutSeconds = 3;  ///< heartbeat timeout between daemons
-  double startSeconds = 30;       ///< every daemon must be linked within this
+  double peerTimeoutSeconds = 3;   ///< heartbeat timeout between daemons
+  double startSeconds = 30;        ///< every daemon must be linked within this
   uint64_t moduleMemoryBytes = 0;  ///< run::RunOptions::moduleMemoryBytes of every host
   std::vector<std::string> packageDirs, compositeDirs;
   std::vector<std::string> overrides;  ///< `--set ID.PARAM=VALUE`, applied by every daemon

@@ -16,8 +16,9 @@ struct Error {
 template <typename T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : state_(std::move(value)) {}        // NOLINT(google-explicit-constructor): by design
-  Result(Error error) : state_(std::move(error)) {}    // NOLINT(google-explicit-constructor): by design
+  Result(T value) : state_(std::move(value)) {}  // NOLINT(google-explicit-constructor): by design
+  Result(Error error)
+      : state_(std::move(error)) {}  // NOLINT(google-explicit-constructor): by design
 
   /// True when a value is held.
   bool ok() const { return state_.index() == 0; }
@@ -53,6 +54,8 @@ class [[nodiscard]] Status {
 };
 
 /// Shorthand to build an Error.
-inline Error makeError(std::string message) { return Error{std::move(message)}; }
+inline Error makeError(std::string message) {
+  return Error{std::move(message)};
+}
 
 }  // namespace vrflow

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "vrflow/app/model.hpp"
 #include "vrflow/app/catalog.hpp"
+#include "vrflow/app/model.hpp"
 #include "vrflow/base/result.hpp"
 #include "vrflow/ipc/control.hpp"
 #include "vrflow/ipc/segment.hpp"
@@ -18,11 +18,11 @@ namespace vrflow::daemon {
 /// Settings of a host's daemon (defaults suit a desktop run).
 struct DaemonOptions {
   std::size_t segmentBytes = std::size_t{1} << 30;  ///< sparse: only touched pages cost memory
-  uint64_t iterationLimit = 0;                        ///< per module; 0 = no limit
+  uint64_t iterationLimit = 0;                      ///< per module; 0 = no limit
   /// Per module id, replaces iterationLimit (multi-rate: see app::iterationRates).
   std::map<std::string, uint64_t, std::less<>> moduleIterationLimits;
-  std::size_t defaultCapacity = 16;                   ///< messages buffered per connection
-  uint32_t hostId = 0x7f000001;                       ///< from the host's address
+  std::size_t defaultCapacity = 16;  ///< messages buffered per connection
+  uint32_t hostId = 0x7f000001;      ///< from the host's address
   /// Warn when a connection's buffer has stayed full this long (ns).
   uint64_t fullWarningNs = 2'000'000'000;
   /// Gives every module a trace ring (ipc::TraceRing) for `--trace`.

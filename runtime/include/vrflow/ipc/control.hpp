@@ -31,9 +31,9 @@ struct PortSlot {
   uint8_t connected = 0;
   uint8_t stampsOnly = 0;
   uint8_t pad = 0;
-  std::atomic<uint32_t> closed{0};   ///< input: no message will ever come again
+  std::atomic<uint32_t> closed{0};      ///< input: no message will ever come again
   std::atomic<uint32_t> wantsSpace{0};  ///< input: the daemon waits for room on this ring
-  uint64_t ringOffset = 0;           ///< input: daemon -> module; output: module -> daemon
+  uint64_t ringOffset = 0;              ///< input: daemon -> module; output: module -> daemon
   std::atomic<uint64_t> messages{0};
   std::atomic<uint64_t> bytes{0};
 };
@@ -45,22 +45,22 @@ struct ModuleSlot {
   uint32_t portCount = 0;
   uint32_t pad = 0;
   PortSlot ports[kMaxPortsPerModule];
-  Doorbell bell;                              ///< the daemon rings it when this module may go on
-  std::atomic<uint32_t> state{0};             ///< a ModuleState
-  std::atomic<int32_t> waitingPort{-1};       ///< port index while Waiting/Putting
+  Doorbell bell;                         ///< the daemon rings it when this module may go on
+  std::atomic<uint32_t> state{0};        ///< a ModuleState
+  std::atomic<int32_t> waitingPort{-1};  ///< port index while Waiting/Putting
   std::atomic<uint64_t> iterations{0};
-  uint64_t iterationLimit = 0;                ///< 0: no limit
+  uint64_t iterationLimit = 0;  ///< 0: no limit
   std::atomic<int32_t> pid{0};
-  uint64_t paramsOffset = 0;                  ///< "name=value\n" text
+  uint64_t paramsOffset = 0;  ///< "name=value\n" text
   uint32_t paramsBytes = 0;
-  std::atomic<uint64_t> computeNs{0};         ///< total time between wait() returning and the next wait()
-  std::atomic<uint64_t> waitNs{0};            ///< total time spent in wait()
+  std::atomic<uint64_t> computeNs{0};  ///< total time between wait() returning and the next wait()
+  std::atomic<uint64_t> waitNs{0};     ///< total time spent in wait()
   std::atomic<uint64_t> histogram[kHistogramBuckets];  ///< iteration durations, log-linear buckets
-  uint64_t traceOffset = 0;                   ///< a TraceRing when the run is traced; 0: not traced
-  std::atomic<uint32_t> outOfMemory{0};       ///< set by the module when an allocation failed
-  uint32_t endItAfterWait = 0;                ///< 1: endIt leaves as wait() returns (FlowVR)
-  std::atomic<uint32_t> unneeded{0};          ///< 1: the daemon asks it to end (EndCause::Unneeded)
-  std::atomic<uint32_t> endCause{0};          ///< an EndCause, written once as the module ends
+  uint64_t traceOffset = 0;              ///< a TraceRing when the run is traced; 0: not traced
+  std::atomic<uint32_t> outOfMemory{0};  ///< set by the module when an allocation failed
+  uint32_t endItAfterWait = 0;           ///< 1: endIt leaves as wait() returns (FlowVR)
+  std::atomic<uint32_t> unneeded{0};     ///< 1: the daemon asks it to end (EndCause::Unneeded)
+  std::atomic<uint32_t> endCause{0};     ///< an EndCause, written once as the module ends
 };
 
 /// What a module records when the run is traced (`--trace`), in steady-clock ns.

@@ -58,7 +58,8 @@ namespace vrflow::ipc {
 class RingRef {
  public:
   RingRef() = default;
-  explicit RingRef(Ring* ring) : ring_(ring), capacity_(ring->capacity), mask_(ring->capacity - 1) {}
+  explicit RingRef(Ring* ring)
+      : ring_(ring), capacity_(ring->capacity), mask_(ring->capacity - 1) {}
 
   bool push(uint64_t value) const {
     const uint64_t t = ring_->tail.load(std::memory_order_relaxed);
@@ -78,8 +79,8 @@ class RingRef {
     return true;
   }
   uint64_t size() const {
-    const uint64_t n = ring_->tail.load(std::memory_order_acquire) -
-                       ring_->head.load(std::memory_order_acquire);
+    const uint64_t n =
+        ring_->tail.load(std::memory_order_acquire) - ring_->head.load(std::memory_order_acquire);
     return n > capacity_ ? capacity_ : n;
   }
   bool empty() const { return size() == 0; }

@@ -19,10 +19,10 @@ inline constexpr uint32_t kSegmentVersion = 2;
 
 /// The header in front of every message block (one cache line).
 struct alignas(64) BlockHeader {
-  std::atomic<uint32_t> refs{0};   ///< holders of this block across all processes
-  uint32_t blockClass = 0;         ///< log2 of the block size
-  uint64_t used = 0;               ///< payload bytes written
-  std::atomic<uint64_t> next{0};   ///< next free block while on a free list
+  std::atomic<uint32_t> refs{0};  ///< holders of this block across all processes
+  uint32_t blockClass = 0;        ///< log2 of the block size
+  uint64_t used = 0;              ///< payload bytes written
+  std::atomic<uint64_t> next{0};  ///< next free block while on a free list
 };
 static_assert(sizeof(BlockHeader) == 64);
 
@@ -32,14 +32,14 @@ struct alignas(64) SegmentHeader {
   uint32_t version = kSegmentVersion;
   uint64_t size = 0;
   uint32_t hostId = 0;
-  std::atomic<uint32_t> idCounter{0};   ///< per-host object id counter (ids = host id + counter)
+  std::atomic<uint32_t> idCounter{0};  ///< per-host object id counter (ids = host id + counter)
   std::atomic<uint32_t> stopRequested{0};
   Doorbell daemonBell;                  ///< modules ring it after pushing or popping
   std::atomic<uint64_t> bump{0};        ///< first never-used byte
   std::atomic<uint64_t> inUseBytes{0};  ///< bytes of blocks currently held
   std::atomic<uint64_t> peakInUseBytes{0};
   std::atomic<uint64_t> failedAllocations{0};  ///< allocate() calls that found no room
-  uint64_t controlOffset = 0;           ///< where the run's control table starts (0: none)
+  uint64_t controlOffset = 0;                  ///< where the run's control table starts (0: none)
   std::atomic<uint64_t> freeHeads[kBlockClasses];  ///< Treiber stacks, tagged against ABA
 };
 

@@ -60,7 +60,9 @@ class FrameReader {
   using Deliver = std::function<Status(const FrameHeader&, std::span<const std::byte> payload)>;
 
   FrameReader(uint32_t maxFrameBytes, Allocate allocate, Deliver deliver)
-      : maxFrameBytes_(maxFrameBytes), allocate_(std::move(allocate)), deliver_(std::move(deliver)) {}
+      : maxFrameBytes_(maxFrameBytes),
+        allocate_(std::move(allocate)),
+        deliver_(std::move(deliver)) {}
 
   /// Until authenticated, only Hello/Challenge/Auth frames are accepted.
   void setAuthenticated(bool authenticated) { authenticated_ = authenticated; }

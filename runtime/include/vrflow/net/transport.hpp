@@ -54,19 +54,19 @@ struct RemoteConnection {
 
 /// Settings of one daemon's transport.
 struct TransportOptions {
-  int selfIndex = 0;                    ///< this host's index in the application file
-  std::vector<std::string> hostNames;   ///< host ids by index, for messages
+  int selfIndex = 0;                   ///< this host's index in the application file
+  std::vector<std::string> hostNames;  ///< host ids by index, for messages
   std::string bindAddress = "127.0.0.1";
-  uint16_t port = 0;                    ///< 0: any free port (reported by port())
+  uint16_t port = 0;  ///< 0: any free port (reported by port())
   Secret secret{};
   uint32_t maxFrameBytes = kDefaultMaxFrameBytes;
-  double heartbeatSeconds = 0.2;        ///< a link silent this long gets a heartbeat
-  double peerTimeoutSeconds = 3.0;      ///< a link silent this long is declared lost
-  double handshakeSeconds = 5.0;        ///< an unauthenticated link is dropped after this
+  double heartbeatSeconds = 0.2;    ///< a link silent this long gets a heartbeat
+  double peerTimeoutSeconds = 3.0;  ///< a link silent this long is declared lost
+  double handshakeSeconds = 5.0;    ///< an unauthenticated link is dropped after this
   /// At most this many accepted connections wait for authentication at once; one more drops
   /// the oldest of them (docs/transport.md, "Unauthenticated connections").
   int maxUnauthenticatedLinks = 16;
-  double connectSeconds = 10.0;         ///< connectPeers() gives up after this
+  double connectSeconds = 10.0;  ///< connectPeers() gives up after this
 };
 
 /// Counters of one link, for monitoring.

@@ -1,8 +1,8 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,28 +28,28 @@ class HostLink;
 
 /// How to run an application on this machine.
 struct RunOptions {
-  uint64_t iterations = 0;            ///< outer iterations; 0 = until the modules end or Ctrl-C
+  uint64_t iterations = 0;  ///< outer iterations; 0 = until the modules end or Ctrl-C
   /// Iterations of each module (by id) for `iterations` outer ones: a module behind a `repeat`
   /// of count k runs k times as many (app::iterationRates). Empty: computed from the
   /// application given to runApplication(), which must then be the whole one.
   std::map<std::string, uint64_t, std::less<>> moduleIterations;
-  double timeoutSeconds = 0;          ///< 0 = no limit
-  double deadlockSeconds = 10;        ///< no progress this long with every module waiting
+  double timeoutSeconds = 0;    ///< 0 = no limit
+  double deadlockSeconds = 10;  ///< no progress this long with every module waiting
   std::size_t segmentBytes = std::size_t{1} << 30;
   /// Caps each module process's data memory (RLIMIT_DATA); 0 = no cap. A module that runs out
   /// under it is reported with the cap as the cause.
   uint64_t moduleMemoryBytes = 0;
-  std::string reportPath;             ///< JSON report; empty = none
-  bool progress = false;              ///< live iterations/s on stderr
-  double stopGraceSeconds = 2;        ///< after a stop request, before SIGTERM then SIGKILL
-  double joinSeconds = 20;            ///< a module must call Module::init() within this
-  double lingerSeconds = 5;           ///< a module that finished must exit within this
-  HostLink* hostLink = nullptr;       ///< set by vrflow-daemon under the launcher
+  std::string reportPath;        ///< JSON report; empty = none
+  bool progress = false;         ///< live iterations/s on stderr
+  double stopGraceSeconds = 2;   ///< after a stop request, before SIGTERM then SIGKILL
+  double joinSeconds = 20;       ///< a module must call Module::init() within this
+  double lingerSeconds = 5;      ///< a module that finished must exit within this
+  HostLink* hostLink = nullptr;  ///< set by vrflow-daemon under the launcher
   /// The whole application when runApplication() gets one host's share (vrflow-daemon), to
   /// name the feeders on other hosts in deadlock reports; null: the application given.
   const app::Application* wholeApplication = nullptr;
-  bool trace = false;                 ///< record modules' spans (also implied by tracePath)
-  std::string tracePath;              ///< Chrome trace-event JSON; empty = none
+  bool trace = false;     ///< record modules' spans (also implied by tracePath)
+  std::string tracePath;  ///< Chrome trace-event JSON; empty = none
 };
 
 /// What happened, for the report and the exit code.

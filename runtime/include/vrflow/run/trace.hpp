@@ -23,7 +23,7 @@ struct HostTrace {
   };
   std::vector<Event> events;
   std::vector<ipc::TraceMerge> merges;  ///< the parts of the messages this host's filters merged
-  uint64_t dropped = 0;  ///< events lost to full rings or to the per-host cap
+  uint64_t dropped = 0;                 ///< events lost to full rings or to the per-host cap
 };
 
 /// At most this many events are kept per host (the rest are counted in `dropped`).

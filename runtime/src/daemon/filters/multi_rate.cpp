@@ -141,7 +141,8 @@ class GroupState {
       if (!object || found == objects_.end()) continue;
       const Entry& entry = found->second;
       bool covered = object->op() != msg::ObjectOp::Update;
-      if (!covered && entry.type != nullptr && entry.type == object->type() && entry.op == msg::ObjectOp::Update) {
+      if (!covered && entry.type != nullptr && entry.type == object->type() &&
+          entry.op == msg::ObjectOp::Update) {
         covered = true;
         for (const auto& [index, value] : entry.params) covered = covered && object->has(index);
       }
@@ -170,7 +171,8 @@ class GroupState {
     }
     if (last.stampsOnly()) return;
     for (const msg::ChunkView chunk : last) {
-      const auto found = chunk.kind() == msg::ChunkKind::Object ? inLast.find(chunk.id()) : inLast.end();
+      const auto found =
+          chunk.kind() == msg::ChunkKind::Object ? inLast.find(chunk.id()) : inLast.end();
       if (found == inLast.end()) {
         builder.appendChunk(chunk);
       } else if (!found->second) {
@@ -186,14 +188,16 @@ class GroupState {
   static void writeEntry(msg::MessageBuilder& builder, uint64_t id, const Entry& entry) {
     const auto& types = msg::ObjectTypeRegistry::global();
     if (entry.type == nullptr) {
-      for (const auto& chunk : entry.verbatim) builder.appendChunk(msg::ChunkView(chunk, 0, 0, &types));
+      for (const auto& chunk : entry.verbatim)
+        builder.appendChunk(msg::ChunkView(chunk, 0, 0, &types));
       return;
     }
     auto writer = builder.addObject(id, *entry.type, entry.op);
     for (const auto& [index, value] : entry.params) writer.setEncoded(index, value);
   }
   struct Entry {
-    const msg::ObjectType* type = nullptr;  // nullptr: verbatim chunks (resources, deletes, unknown types)
+    const msg::ObjectType* type =
+        nullptr;  // nullptr: verbatim chunks (resources, deletes, unknown types)
     msg::ObjectOp op = msg::ObjectOp::Update;
     std::map<uint32_t, Bytes> params;
     std::vector<Bytes> verbatim;
@@ -249,15 +253,16 @@ class DecimateFilter final : public Filter {
       }
       // The group's state, then the last message's chunks (whose updates apply on top of it).
       const bool folded = !group_.empty();
-      auto copy = context.compose(view->bytes().size() + group_.bytes() + 64, [&](msg::MessageBuilder& builder) {
-        builder.setStamps(view->stamps().toStamps());
-        if (restamp_) {
-          builder.setIteration(group);
-          builder.setTimeStep(steps + view->stamps().timeStep);
-        }
-        builder.setStampsOnly(view->stampsOnly() && !folded);
-        group_.write(builder, *view);
-      });
+      auto copy = context.compose(view->bytes().size() + group_.bytes() + 64,
+                                  [&](msg::MessageBuilder& builder) {
+                                    builder.setStamps(view->stamps().toStamps());
+                                    if (restamp_) {
+                                      builder.setIteration(group);
+                                      builder.setTimeStep(steps + view->stamps().timeStep);
+                                    }
+                                    builder.setStampsOnly(view->stampsOnly() && !folded);
+                                    group_.write(builder, *view);
+                                  });
       group_.clear();
       if (!copy) {
         context.warn("filter '" + context.name() + "': " + copy.error().message);
@@ -289,7 +294,8 @@ void registerMultiRate(FilterRegistry& registry) {
     const long count = context.paramInt("count", 10);
     if (count < 1) return makeError("filter '" + context.name() + "': count must be >= 1");
     return std::unique_ptr<Filter>(std::make_unique<DecimateFilter>(
-        static_cast<uint64_t>(count), context.paramBool("restamp", true), context.paramBool("merge", true)));
+        static_cast<uint64_t>(count), context.paramBool("restamp", true),
+        context.paramBool("merge", true)));
   });
 }
 

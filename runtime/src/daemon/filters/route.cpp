@@ -3,7 +3,8 @@
 // current state of an object when it enters the volume, and the resources such objects refer
 // to, once, then their updates while it holds an object that refers to them (a receiver whose
 // objects all left stops getting a dynamic resource's updates, and gets its newest copy if one
-// comes back: a dynamic resource such as a fluid region's particles costs only the tiles that see it).
+// comes back: a dynamic resource such as a fluid region's particles costs only the tiles that see
+// it).
 #include <algorithm>
 #include <array>
 #include <cmath>

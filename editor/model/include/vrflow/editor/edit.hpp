@@ -73,8 +73,8 @@ std::string uniqueId(const app::Application& app, std::string_view base);
 /// direction, data types that differ, stamps-only into a full input, a connection already
 /// there), or nullopt when it may be made. Same rules as `vrflow validate` for one connection.
 std::optional<std::string> connectionRefusal(const app::Application& app,
-                                             const app::Catalog& catalog,
-                                             const app::Endpoint& from, const app::Endpoint& to);
+                                             const app::Catalog& catalog, const app::Endpoint& from,
+                                             const app::Endpoint& to);
 
 /// Edits. Each returns the edit (label, before, after) or why it cannot be made.
 Result<Edit> addModule(const app::Application& app, const app::Catalog& catalog,
@@ -89,8 +89,8 @@ Result<Edit> connect(const app::Application& app, const app::Catalog& catalog,
 /// Removes connections by index in app.connections.
 Result<Edit> disconnect(const app::Application& app, std::vector<std::size_t> indexes);
 /// Sets a parameter of a module, filter or instance; an empty value removes it (the default).
-Result<Edit> setParameter(const app::Application& app, std::string_view node,
-                          std::string_view name, std::string value);
+Result<Edit> setParameter(const app::Application& app, std::string_view node, std::string_view name,
+                          std::string value);
 /// Sets the initial message count of a module's input port (0 removes the setting when the
 /// mode is the default).
 Result<Edit> setInitialMessages(const app::Application& app, std::string_view module,
@@ -109,8 +109,7 @@ Result<Edit> addHost(const app::Application& app, std::string id, std::string ad
 Result<Edit> removeHost(const app::Application& app, std::string_view id);
 /// Renames a host, following the nodes on it.
 Result<Edit> renameHost(const app::Application& app, std::string_view id, std::string newId);
-Result<Edit> setHostAddress(const app::Application& app, std::string_view id,
-                            std::string address);
+Result<Edit> setHostAddress(const app::Application& app, std::string_view id, std::string address);
 /// Adds the hosts of a hostfile: one host per line, "NAME [ADDRESS]" or MPI style
 /// "NAME slots=N"; '#' starts a comment. Hosts already there get the address given.
 Result<Edit> importHostfile(const app::Application& app, std::string_view text);

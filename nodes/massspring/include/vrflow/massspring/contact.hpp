@@ -17,7 +17,8 @@
 // the other side's mass (a rigid's mass; for a net triangle, its nodes' masses weighted by the
 // barycentric coordinates; pinned nodes and kinematic rigids are infinitely heavy). That is the
 // impulse that stops the approach within one outer step plus a fraction beta of the overlap, as a
-// force held for dt: stable at any dt, no stiffness to tune. The other side gets the opposite force.
+// force held for dt: stable at any dt, no stiffness to tune. The other side gets the opposite
+// force.
 
 namespace vrflow::massspring {
 
@@ -87,6 +88,7 @@ struct TrianglePoint {
   msg::Vec3 point{};
   double wa = 0, wb = 0, wc = 0;
 };
-TrianglePoint closestPointOnTriangle(const msg::Vec3& p, const msg::Vec3& a, const msg::Vec3& b, const msg::Vec3& c);
+TrianglePoint closestPointOnTriangle(const msg::Vec3& p, const msg::Vec3& a, const msg::Vec3& b,
+                                     const msg::Vec3& c);
 
 }  // namespace vrflow::massspring

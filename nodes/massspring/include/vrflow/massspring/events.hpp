@@ -6,7 +6,8 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
-// object_type.hpp before values.hpp: its ParamKind enumerators would otherwise shadow msg::Vec3 (-Wshadow).
+// object_type.hpp before values.hpp: its ParamKind enumerators would otherwise shadow msg::Vec3
+// (-Wshadow).
 #include "vrflow/message/object_type.hpp"
 #include "vrflow/message/values.hpp"
 

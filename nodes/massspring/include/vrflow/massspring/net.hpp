@@ -7,7 +7,8 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
-// object_type.hpp before values.hpp: its ParamKind enumerators would otherwise shadow msg::Vec3 (-Wshadow).
+// object_type.hpp before values.hpp: its ParamKind enumerators would otherwise shadow msg::Vec3
+// (-Wshadow).
 #include "vrflow/message/object_type.hpp"
 #include "vrflow/message/values.hpp"
 
@@ -15,7 +16,6 @@
 // optional triangle surface over the nodes (for drawing and for net/net collision).
 
 namespace vrflow::massspring {
-
 
 /// One spring. On the wire (the massspring object's `springs` Bytes parameter) a spring is a
 /// 40-byte little-endian record, packed, in this order:
@@ -45,8 +45,12 @@ struct Net {
   std::vector<std::uint32_t> surface;  ///< three node indices per triangle (may be empty)
 
   std::size_t nodeCount() const { return masses.size(); }
-  msg::Vec3 position(std::size_t i) const { return {positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]}; }
-  msg::Vec3 velocity(std::size_t i) const { return {velocities[3 * i], velocities[3 * i + 1], velocities[3 * i + 2]}; }
+  msg::Vec3 position(std::size_t i) const {
+    return {positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]};
+  }
+  msg::Vec3 velocity(std::size_t i) const {
+    return {velocities[3 * i], velocities[3 * i + 1], velocities[3 * i + 2]};
+  }
   bool operator==(const Net&) const = default;
 };
 
@@ -66,13 +70,13 @@ struct GridParams {
   int n = 20;
   int m = 20;
   double spacing = 0.1;
-  double mass = 1.0;            ///< total mass of the net (kg), shared equally by the nodes
-  double stiffness = 500.0;     ///< structural springs (N/m)
-  double shearFactor = 0.5;     ///< shear stiffness = shearFactor * stiffness (0: no shear springs)
-  double bendFactor = 0.1;      ///< bend stiffness = bendFactor * stiffness (0: no bend springs)
-  double damping = 0.05;        ///< per spring (N s/m)
-  double maxStretch = 1.1;      ///< per spring, 0 for none
-  bool pinCorners = true;       ///< pin the four corner nodes
+  double mass = 1.0;         ///< total mass of the net (kg), shared equally by the nodes
+  double stiffness = 500.0;  ///< structural springs (N/m)
+  double shearFactor = 0.5;  ///< shear stiffness = shearFactor * stiffness (0: no shear springs)
+  double bendFactor = 0.1;   ///< bend stiffness = bendFactor * stiffness (0: no bend springs)
+  double damping = 0.05;     ///< per spring (N s/m)
+  double maxStretch = 1.1;   ///< per spring, 0 for none
+  bool pinCorners = true;    ///< pin the four corner nodes
   msg::Vec3 origin{0, 0, 0};
   msg::Quat orientation{0, 0, 0, 1};
 };

@@ -16,10 +16,10 @@
 namespace vrflow::massspring {
 
 struct StepOptions {
-  double dt = 0.01;              ///< outer step (s)
-  int substeps = 10;             ///< sub-steps per outer step (>= 1)
-  bool internalSprings = true;   ///< evaluate the net's springs at every sub-step
-  msg::Vec3 gravity{0, 0, 0};         ///< acceleration applied to every free node (m/s^2)
+  double dt = 0.01;               ///< outer step (s)
+  int substeps = 10;              ///< sub-steps per outer step (>= 1)
+  bool internalSprings = true;    ///< evaluate the net's springs at every sub-step
+  msg::Vec3 gravity{0, 0, 0};     ///< acceleration applied to every free node (m/s^2)
   int constraintIterations = 50;  ///< most Gauss-Seidel sweeps of the max-stretch projection
 };
 Status validateStepOptions(const StepOptions& options);
@@ -38,7 +38,8 @@ void addSpringForces(const Net& net, std::span<const Spring> springs, std::span<
 /// along the straight path from `feasible` to the largest fraction at which every limit holds:
 /// the limit then holds exactly (the motion of that sub-step is cut short instead).
 /// Returns the largest length / (maxStretch * restLength) left (0 if no spring has a limit).
-double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible = {});
+double enforceMaxStretch(Net& net, double h, int maxIterations,
+                         std::span<const double> feasible = {});
 
 /// Advances the net by one outer step. `externalForces` holds xyz per node (or is empty).
 /// Returns the largest constraint ratio left (see enforceMaxStretch), 0 if no spring has a limit.
