@@ -175,6 +175,7 @@ class PortInputFilter final : public Filter {
   long emittedInitial_ = 0;
   bool latest_ = false;
   MessageRef last_;
+  std::vector<MessageRef> newestIn_;  ///< latest mode: the newest message taken from each input
   MergeFilter merge_;
 };
 
