@@ -7,7 +7,9 @@ if ! command -v clang++ >/dev/null; then
   echo "clang++ not found: fuzz targets need clang (make deps installs it)" >&2
   exit 1
 fi
-cmake -S "$src/tests/fuzz/standalone" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S "$src/tests/fuzz/standalone" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ "${launcher[@]}" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 # A failed build shows its log (the fuzz run would otherwise fail without a word).
 cmake --build "$build" >"$build/build.log" 2>&1 || { cat "$build/build.log" >&2; exit 1; }
