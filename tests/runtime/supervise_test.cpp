@@ -118,6 +118,10 @@ TEST_F(SuperviseTest, ExhaustedSharedMemoryIsNamedAsTheCause) {
 }
 
 TEST_F(SuperviseTest, AModuleOverTheMemoryLimitIsReportedWithTheLimitAsTheCause) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory counts against RLIMIT_DATA: no sanitized module "
+                  "starts under a memory limit";
+#endif
   // hog holds 16 MiB more each iteration (at most 512 MiB, should the limit not hold).
   const auto file = dir.write(
       "app.xml", application(module("hog", "testing/hog", param("max-mib", "512")) +
@@ -140,6 +144,10 @@ TEST_F(SuperviseTest, AModuleOverTheMemoryLimitIsReportedWithTheLimitAsTheCause)
 }
 
 TEST_F(SuperviseTest, AModuleUnderTheMemoryLimitRunsAsWithout) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory counts against RLIMIT_DATA: no sanitized module "
+                  "starts under a memory limit";
+#endif
   const auto file = dir.write(
       "app.xml", application(module("hog", "testing/hog", param("max-mib", "32")) +
                                  module("rec", "core/recorder", param("file", dir.file("x.csv"))),
