@@ -1,7 +1,6 @@
 #include "vrflow/launcher/launch.hpp"
 
 #include <arpa/inet.h>
-#include <dirent.h>
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -29,35 +28,6 @@
 
 namespace vrflow::launcher {
 namespace {
-
-// Whether a process of group `pgid` is alive (a zombie is not: its parent or init reaps it).
-bool groupHasLiveProcess(pid_t pgid) {
-  if (pgid <= 0) return false;
-  DIR* proc = opendir("/proc");
-  if (proc == nullptr) return false;
-  bool alive = false;
-  while (const dirent* entry = readdir(proc)) {
-    if (entry->d_name[0] < '0' || entry->d_name[0] > '9') continue;
-    std::FILE* stat = std::fopen((std::string("/proc/") + entry->d_name + "/stat").c_str(), "r");
-    if (stat == nullptr) continue;
-    char line[512];
-    const bool read = std::fgets(line, sizeof line, stat) != nullptr;
-    std::fclose(stat);
-    if (!read) continue;
-    // pid (comm) state ppid pgrp ...: comm may hold spaces, so read after its last ')'.
-    const char* close = std::strrchr(line, ')');
-    char state = 0;
-    long ppid = 0, group = 0;
-    if (close == nullptr || std::sscanf(close + 1, " %c %ld %ld", &state, &ppid, &group) != 3)
-      continue;
-    if (group == pgid && state != 'Z' && state != 'X') {
-      alive = true;
-      break;
-    }
-  }
-  closedir(proc);
-  return alive;
-}
 
 using Clock = std::chrono::steady_clock;
 
@@ -641,16 +611,15 @@ void Launcher::stopAll() {
     const auto t = Clock::now();
     while (!allExited() && (round == 1 || secondsSince(t) < 2)) pump(20);
   }
-  // A daemon killed with its group (mpirun's ranks, a frozen daemon) may still be tearing down
-  // when its parent is gone: leave only once no process of any daemon's group is alive.
+  // A daemon killed under mpirun may still be tearing down when mpirun is gone: the launcher is
+  // their subreaper (run()), so it leaves only once every descendant has exited (5 s at most).
   const auto t = Clock::now();
-  auto anyGroupAlive = [&] {
-    for (const auto& d : daemons_) {
-      if (groupHasLiveProcess(d.pid)) return true;
-    }
-    return false;
-  };
-  while (anyGroupAlive() && secondsSince(t) < 5) usleep(20'000);
+  for (;;) {
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, WNOHANG);
+    if (pid < 0 || secondsSince(t) >= 5) break;  // ECHILD: nothing is left
+    if (pid == 0) usleep(20'000);
+  }
 }
 
 run::RunOutcome Launcher::run() {
@@ -665,6 +634,8 @@ run::RunOutcome Launcher::run() {
   sigaddset(&wanted, SIGINT);
   sigaddset(&wanted, SIGTERM);
   signalFd_ = signalfd(-1, &wanted, SFD_CLOEXEC | SFD_NONBLOCK);
+  // Orphans of the run (the daemons of an mpirun that died) become our children, to be reaped.
+  prctl(PR_SET_CHILD_SUBREAPER, 1);
   const auto begin = Clock::now();
 
   if (auto status = start(); !status) {
