@@ -41,6 +41,7 @@
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/plugin.hpp"
+#include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace vrflow::editor::gui {

@@ -13,13 +13,7 @@
 #include <set>
 
 #include "control_link.hpp"
-#include "vrflow/app/catalog.hpp"
-#include "vrflow/app/diagnostic.hpp"
-#include "vrflow/app/expand.hpp"
-#include "vrflow/app/loader.hpp"
-#include "vrflow/app/overrides.hpp"
-#include "vrflow/app/validate.hpp"
-#include "vrflow/daemon/plugin.hpp"
+#include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 
 int main(int argc, char** argv) {
@@ -66,36 +60,17 @@ int main(int argc, char** argv) {
     return cli.exit(e) == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
-  auto catalog = vrflow::run::loadCatalog(packageDirs);
-  if (!catalog) {
-    std::fprintf(stderr, "vrflow-daemon: %s\n", catalog.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
-  std::vector<vrflow::app::Diagnostic> problems;
-  auto application = vrflow::app::loadApplicationFile(file, &problems);
-  if (!application) {
-    std::fprintf(stderr, "%s\n", application.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
-  vrflow::app::applyInstanceOverrides(*application, overrides);  // as `vrflow` does
-  application = vrflow::app::expandComposites(
-      *application, vrflow::app::defaultCompositeSources(*application, compositeDirs), &problems);
-  if (!application) {
-    std::fprintf(stderr, "%s\n", application.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
-  if (auto set = vrflow::app::applyOverrides(*application, overrides); !set) {
-    std::fprintf(stderr, "vrflow-daemon: %s\n", set.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
-  auto loaded = vrflow::daemon::loadApplicationPlugins(*application, *catalog);
-  problems.insert(problems.end(), loaded.begin(), loaded.end());
-  auto more = vrflow::app::validate(*application, *catalog);
-  problems.insert(problems.end(), more.begin(), more.end());
-  vrflow::app::sortAndDeduplicate(problems);
-  for (const auto& d : problems)
-    std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
-  if (vrflow::app::hasErrors(problems)) return vrflow::run::kExitInvalid;
+  vrflow::run::Prepared prepared = vrflow::run::prepare({.file = file,
+                                                         .packageDirs = packageDirs,
+                                                         .compositeDirs = compositeDirs,
+                                                         .overrides = overrides,
+                                                         .validate = true,
+                                                         .files = std::nullopt,
+                                                         .program = "vrflow-daemon"});
+  vrflow::run::printProblems(prepared);
+  if (!prepared.ok()) return vrflow::run::kExitInvalid;
+  const vrflow::app::Catalog& catalog = *prepared.catalog;
+  std::optional<vrflow::app::Application> application = std::move(prepared.application);
   std::optional<vrflow::net::Secret> secret;
   if (!controlConnect.empty()) {
     const char* text = std::getenv("VRFLOW_RUN_SECRET");
@@ -211,7 +186,7 @@ int main(int argc, char** argv) {
     if (from) local.connections.push_back(c);
   }
   options.wholeApplication = &*application;
-  const auto outcome = vrflow::run::runApplication(local, *catalog, options);
+  const auto outcome = vrflow::run::runApplication(local, catalog, options);
   if (link) return outcome.exitCode;  // the launcher reports
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow-daemon: %s\n", outcome.error.c_str());
   return outcome.exitCode;

@@ -15,15 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "vrflow/app/catalog.hpp"
-#include "vrflow/app/diagnostic.hpp"
-#include "vrflow/app/expand.hpp"
-#include "vrflow/app/loader.hpp"
-#include "vrflow/app/overrides.hpp"
 #include "vrflow/app/package_files.hpp"
-#include "vrflow/app/validate.hpp"
 #include "vrflow/app/writer.hpp"
-#include "vrflow/daemon/plugin.hpp"
+#include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 #ifdef VRFLOW_HAS_LAUNCHER
 #include "vrflow/launcher/launch.hpp"
@@ -43,6 +37,17 @@ struct SharedOptions {
     compositeDirs.insert(compositeDirs.end(), other.compositeDirs.begin(),
                          other.compositeDirs.end());
     overrides.insert(overrides.end(), other.overrides.begin(), other.overrides.end());
+  }
+
+  // What run::prepare() needs to prepare `file` with these options.
+  vrflow::run::PrepareSettings settings(const std::string& file, bool validate) const {
+    return {.file = file,
+            .packageDirs = packageDirs,
+            .compositeDirs = compositeDirs,
+            .overrides = overrides,
+            .validate = validate,
+            .files = std::nullopt,
+            .program = "vrflow"};
   }
 };
 
@@ -116,53 +121,15 @@ std::optional<std::string> outputFileProblem(const std::string& path) {
   return std::nullopt;
 }
 
-// Loads the file and expands its composites (search path: the file's folder, --composites,
-// $VRFLOW_COMPOSITE_PATH), applies the --set parameters, and validates the flat application when
-// a catalog is given; with `files`, also checks the files its modules name on this machine.
-// Prints every diagnostic; returns the flat application when there is no error.
-std::optional<vrflow::app::Application> loadFlat(
-    const std::string& file, const std::vector<std::string>& compositeDirs,
-    const std::vector<std::string>& overrides, vrflow::app::Catalog* catalog,
-    std::optional<vrflow::app::ModuleFileChecks> files = std::nullopt) {
-  std::vector<vrflow::app::Diagnostic> problems;
-  auto application = vrflow::app::loadApplicationFile(file, &problems);
-  if (!application) {
-    std::fprintf(stderr, "%s\n", application.error().message.c_str());
-    return std::nullopt;
-  }
-  // Settings of the file's own composite instances change what the expansion makes.
-  std::vector<std::string> moduleSettings = overrides;
-  vrflow::app::applyInstanceOverrides(*application, moduleSettings);
-  const auto sources = vrflow::app::defaultCompositeSources(*application, compositeDirs);
-  auto flat = vrflow::app::expandComposites(*application, sources, &problems);
-  if (!flat) {
-    std::fprintf(stderr, "%s\n", flat.error().message.c_str());
-    return std::nullopt;
-  }
-  if (auto set = vrflow::app::applyOverrides(*flat, moduleSettings); !set) {
-    std::fprintf(stderr, "vrflow: %s\n", set.error().message.c_str());
-    return std::nullopt;
-  }
-  if (catalog != nullptr) {
-    auto plugins = vrflow::daemon::loadApplicationPlugins(*flat, *catalog);
-    problems.insert(problems.end(), plugins.begin(), plugins.end());
-    auto more = vrflow::app::validate(*flat, *catalog);
-    problems.insert(problems.end(), more.begin(), more.end());
-    if (files) {
-      auto named = vrflow::app::checkModuleFiles(*flat, *catalog, *files);
-      problems.insert(problems.end(), named.begin(), named.end());
-    }
-  }
-  vrflow::app::sortAndDeduplicate(problems);
-  const std::size_t printed = std::min(problems.size(), kMaxPrintedDiagnostics);
-  for (std::size_t i = 0; i < printed; ++i) {
-    std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(problems[i]).c_str());
-  }
-  if (problems.size() > printed) {
-    std::fprintf(stderr, "... and %zu more problems\n", problems.size() - printed);
-  }
-  if (vrflow::app::hasErrors(problems)) return std::nullopt;
-  return std::move(*flat);
+// Prepares the file (run::prepare) and prints its problems; the flat application when there is
+// no error.
+std::optional<vrflow::app::Application> loadFlat(vrflow::run::PrepareSettings settings,
+                                                 vrflow::run::Prepared* into = nullptr) {
+  vrflow::run::Prepared prepared = vrflow::run::prepare(settings);
+  vrflow::run::printProblems(prepared, kMaxPrintedDiagnostics);
+  std::optional<vrflow::app::Application> flat = std::move(prepared.application);
+  if (into != nullptr) *into = std::move(prepared);
+  return flat;
 }
 
 }  // namespace
@@ -273,7 +240,7 @@ int main(int argc, char** argv) {
   shared.append(launchShared);
 #endif
   if (expand->parsed()) {
-    const auto flat = loadFlat(expandFile, shared.compositeDirs, shared.overrides, nullptr);
+    const auto flat = loadFlat(shared.settings(expandFile, /*validate=*/false));
     if (!flat) return 1;
     std::fputs(vrflow::app::saveApplication(*flat).c_str(), stdout);
     return 0;
@@ -294,20 +261,19 @@ int main(int argc, char** argv) {
       return vrflow::run::kExitInvalid;
     }
   }
-  auto catalog = vrflow::run::loadCatalog(shared.packageDirs);
-  if (!catalog) {
-    std::fprintf(stderr, "vrflow: %s\n", catalog.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
+  // A catalog that cannot be loaded is a mistake in what was given (exit 2), whatever the command.
+  const auto invalid = [](const vrflow::run::Prepared& prepared, int code) {
+    return prepared.catalog ? code : vrflow::run::kExitInvalid;
+  };
+  vrflow::run::Prepared prepared;
   if (validate->parsed()) {
-    return loadFlat(validateFile, shared.compositeDirs, shared.overrides, &*catalog,
-                    vrflow::app::ModuleFileChecks{})
-               ? 0
-               : 1;
+    auto settings = shared.settings(validateFile, /*validate=*/true);
+    settings.files = vrflow::app::ModuleFileChecks{};
+    return loadFlat(settings, &prepared) ? 0 : invalid(prepared, 1);
   }
 #ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
-    auto flat = loadFlat(launchOptions.appFile, shared.compositeDirs, shared.overrides, &*catalog);
+    auto flat = loadFlat(shared.settings(launchOptions.appFile, /*validate=*/true));
     if (!flat) return vrflow::run::kExitInvalid;
     launchOptions.packageDirs = shared.packageDirs;
     launchOptions.compositeDirs = shared.compositeDirs;
@@ -317,12 +283,14 @@ int main(int argc, char** argv) {
     return outcome.exitCode;
   }
 #endif
-  auto application = loadFlat(runFile, shared.compositeDirs, shared.overrides, &*catalog,
-                              vrflow::app::ModuleFileChecks{.executables = true});
+  auto settings = shared.settings(runFile, /*validate=*/true);
+  settings.files = vrflow::app::ModuleFileChecks{.executables = true};
+  auto application = loadFlat(settings, &prepared);
   if (!application) return vrflow::run::kExitInvalid;
+  const vrflow::app::Catalog& catalog = *prepared.catalog;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
   options.progress = !noProgress && isatty(STDERR_FILENO) != 0;
-  const auto outcome = vrflow::run::runApplication(*application, *catalog, options);
+  const auto outcome = vrflow::run::runApplication(*application, catalog, options);
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
   return outcome.exitCode;
 }

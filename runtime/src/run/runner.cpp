@@ -22,9 +22,7 @@
 #include "vrflow/app/graph.hpp"
 #include "vrflow/app/mpi_job.hpp"
 #include "vrflow/base/assert.hpp"
-#include "vrflow/base/executable_dir.hpp"
 #include "vrflow/daemon/daemon.hpp"
-#include "vrflow/daemon/plugin.hpp"
 #include "vrflow/message/ids.hpp"
 #include "vrflow/run/trace.hpp"
 
@@ -729,19 +727,6 @@ RunOutcome Supervisor::run() {
 }
 
 }  // namespace
-
-Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs) {
-  std::vector<std::string> dirs = extraDirs;
-  for (const auto& d : app::searchPathFromEnvironment()) dirs.push_back(d);
-  if (const auto bin = executableDir(); !bin.empty()) {
-    dirs.push_back((bin.parent_path() / "share/vrflow/packages").string());
-  }
-  app::Catalog catalog;
-  if (auto status = catalog.loadSearchPath(dirs); !status) return status.error();
-  const auto plugins = daemon::filterPluginsFromEnvironment();
-  if (auto status = daemon::loadFilterPlugins(plugins, catalog); !status) return status.error();
-  return catalog;
-}
 
 std::map<std::string, uint64_t, std::less<>> moduleIterations(const app::Application& application,
                                                               uint64_t outer) {

@@ -81,11 +81,6 @@ class HostLink {
   virtual void stats(const std::string& json) = 0;
 };
 
-/// The node packages on the search path: `extraDirs` first, then $VRFLOW_PACKAGE_PATH, then
-/// <folder of this executable>/../share/vrflow/packages (the build tree and installs alike);
-/// plus the filter plugins of $VRFLOW_FILTER_PATH.
-Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs);
-
 /// How many iterations each module of the whole `application` runs in `outer` outer
 /// iterations (RunOptions::moduleIterations).
 std::map<std::string, uint64_t, std::less<>> moduleIterations(const app::Application& application,
