@@ -18,12 +18,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 
 #include "monitor_files.hpp"
 #include "vrflow/base/executable_dir.hpp"
 #include "vrflow/net/control.hpp"
 #include "vrflow/net/transport.hpp"
+#include "vrflow/run/process.hpp"
 #include "vrflow/run/trace.hpp"
 
 namespace vrflow::launcher {
@@ -73,9 +73,9 @@ struct HostDaemon {
   bool clockKnown = false;
   int64_t clockOffsetNs = 0;  ///< the daemon's steady clock minus ours
 
-  void send(const std::string& line) const {
+  void send(const net::ControlCommand& command) const {
     if (toDaemon < 0) return;
-    const std::string text = line + "\n";
+    const std::string text = net::toLine(command) + "\n";
     [[maybe_unused]] auto n = write(toDaemon, text.data(), text.size());
   }
   std::string name() const {
@@ -100,40 +100,36 @@ std::string shellQuote(const std::string& word) {
   return quoted + "'";
 }
 
+// Starts a daemon (or ssh, or mpirun) with a pipe on its standard input and one on its
+// standard output (the control channel), or stderr as its output when `stdoutToStderr`.
 Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
                           const std::vector<std::string>& environment, int& toChild, int& fromChild,
                           bool stdoutToStderr = false) {
   int in[2], out[2];
-  if (pipe2(in, O_CLOEXEC) != 0 || pipe2(out, O_CLOEXEC) != 0) {
-    return makeError(std::string("pipe: ") + std::strerror(errno));
+  if (pipe2(in, O_CLOEXEC) != 0) return makeError(std::string("pipe: ") + std::strerror(errno));
+  if (pipe2(out, O_CLOEXEC) != 0) {
+    const int err = errno;
+    close(in[0]);
+    close(in[1]);
+    return makeError(std::string("pipe: ") + std::strerror(err));
   }
-  const pid_t parent = getpid();
-  const pid_t pid = fork();
-  if (pid < 0) return makeError(std::string("fork: ") + std::strerror(errno));
-  if (pid == 0) {
-    setpgid(0, 0);
-    prctl(PR_SET_PDEATHSIG, SIGKILL);  // the daemon (and through it, its modules) dies with us
-    if (getppid() != parent) _exit(127);
-    sigset_t none;
-    sigemptyset(&none);
-    sigprocmask(SIG_SETMASK, &none, nullptr);
-    dup2(in[0], STDIN_FILENO);
-    dup2(out[1], STDOUT_FILENO);
-    if (stdoutToStderr) dup2(STDERR_FILENO, STDOUT_FILENO);
-    for (const auto& e : environment) putenv(const_cast<char*>(e.c_str()));
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    execvp(args[0], args.data());
-    std::fprintf(stderr, "vrflow: cannot start %s: %s\n", argv[0].c_str(), std::strerror(errno));
-    _exit(127);
-  }
+  run::ProcessSettings settings;
+  settings.argv = argv;
+  settings.environment = run::environmentWith(environment);
+  settings.stdinFd = in[0];
+  settings.stdoutFd = stdoutToStderr ? STDERR_FILENO : out[1];
+  auto pid = run::spawnProcess(settings);
   close(in[0]);
   close(out[1]);
+  if (!pid) {
+    close(in[1]);
+    close(out[0]);
+    return pid.error();
+  }
   toChild = in[1];
   fromChild = out[0];
   fcntl(fromChild, F_SETFL, fcntl(fromChild, F_GETFL) | O_NONBLOCK);
-  return pid;
+  return *pid;
 }
 
 class Launcher {
@@ -191,6 +187,8 @@ void Launcher::onLine(HostDaemon& d, const std::string& line) {
   net::ControlEvent& event = *parsed;
   using Kind = net::ControlEvent::Kind;
   switch (event.kind) {
+    case Kind::Hello:
+      break;  // only on mpirun's control socket, before the channel is the daemon's
     case Kind::Listening:
       d.port = event.port;
       break;
@@ -400,7 +398,7 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
       const int fd = accept4(listenFd, nullptr, nullptr, SOCK_CLOEXEC);
       if (fd < 0) continue;
       const std::string nonce = net::newNonceHex();
-      const std::string hello = "nonce " + nonce + "\n";
+      const std::string hello = net::toLine(net::ControlCommand::nonce(nonce)) + "\n";
       [[maybe_unused]] auto w = write(fd, hello.data(), hello.size());
       // Its answer, "hello INDEX PROOF", within 5 s.
       std::string line;
@@ -412,13 +410,12 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
         if (read(fd, &c, 1) != 1 || c == '\n') break;
         line += c;
       }
-      std::istringstream words(line);
-      std::string word, proof;
-      int index = -1;
-      words >> word >> index >> proof;
-      if (word != "hello" || index < 0 || static_cast<std::size_t>(index) >= n ||
+      const auto answer = net::parseControlEvent(line);
+      const int index = answer ? answer->hostIndex : -1;
+      if (!answer || answer->kind != net::ControlEvent::Kind::Hello || index < 0 ||
+          static_cast<std::size_t>(index) >= n ||
           daemons_[static_cast<std::size_t>(index)].toDaemon >= 0 ||
-          proof != net::controlProof(secret, index, nonce)) {
+          answer->text != net::controlProof(secret, index, nonce)) {
         std::fprintf(stderr,
                      "vrflow: refused a control connection that did not prove the run secret\n");
         close(fd);
@@ -515,7 +512,7 @@ Status Launcher::start() {
     if (!pid) return makeError("host '" + host.id + "': " + pid.error().message);
     d.pid = *pid;
     // The secret travels on the daemon's stdin: never on a command line or in a file.
-    d.send("secret " + net::secretToHex(secret));
+    d.send(net::ControlCommand::secret(net::secretToHex(secret)));
     daemons_.push_back(std::move(d));
   }
   auto waitFor = [&](auto done, const char* what) -> Status {
@@ -540,19 +537,18 @@ Status Launcher::start() {
   if (auto s = waitFor([](const HostDaemon& d) { return d.port > 0; }, "listening"); !s) return s;
   for (const auto& d : daemons_) {
     for (const auto& peer : daemons_) {
-      d.send("peer " + std::to_string(peer.index) + " " + peer.bind + " " +
-             std::to_string(peer.port));
+      d.send(net::ControlCommand::peer(peer.index, peer.bind, static_cast<uint16_t>(peer.port)));
     }
-    d.send("connect");
+    d.send(net::ControlCommand::bare(net::ControlCommand::Kind::Connect));
   }
   if (auto s = waitFor([](const HostDaemon& d) { return d.connected; }, "linked"); !s) return s;
   if (!options_.tracePath.empty()) {
-    for (const auto& d : daemons_) d.send("clock " + std::to_string(steadyNs()));
+    for (const auto& d : daemons_) d.send(net::ControlCommand::clock(steadyNs()));
     if (auto s = waitFor([](const HostDaemon& d) { return d.clockKnown; }, "clock-aligned"); !s) {
       return s;
     }
   }
-  for (const auto& d : daemons_) d.send("go");
+  for (const auto& d : daemons_) d.send(net::ControlCommand::bare(net::ControlCommand::Kind::Go));
   return {};
 }
 
@@ -587,7 +583,7 @@ void Launcher::publish() {
 void Launcher::stopAll() {
   stopping_ = true;
   for (const auto& d : daemons_) {
-    if (!d.exited) d.send("stop");
+    if (!d.exited) d.send(net::ControlCommand::bare(net::ControlCommand::Kind::Stop));
   }
   const auto begin = Clock::now();
   auto allAnswered = [&] {
@@ -662,7 +658,8 @@ run::RunOutcome Launcher::run() {
     bool allFinished = true;
     for (const auto& d : daemons_) allFinished = allFinished && d.finished;
     if (allFinished && !quitSent) {
-      for (const auto& d : daemons_) d.send("quit");
+      for (const auto& d : daemons_)
+        d.send(net::ControlCommand::bare(net::ControlCommand::Kind::Quit));
       quitSent = true;
     }
   }

@@ -28,6 +28,7 @@ vrflow_add_library(runtime
     src/net/secret.cpp
     src/net/transport.cpp
     src/run/prepare.cpp
+    src/run/process.cpp
     src/run/spawn.cpp
     src/run/report.cpp
     src/run/trace.cpp

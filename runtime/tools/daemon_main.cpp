@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -17,6 +18,9 @@
 #include "vrflow/run/runner.hpp"
 
 int main(int argc, char** argv) {
+  // The launcher gone, writes on the control channel fail (EPIPE) instead of killing the
+  // daemon before it stops its modules (spawnProcess() gives children SIGPIPE's default).
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App cli{"vrflow-daemon: serve one host of an application"};
   std::string file, host;
   std::vector<std::string> packageDirs;
