@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "launcher.hpp"
+#include "vrflow/run/events.hpp"
 
 namespace vrflow::launcher::detail {
 namespace {
@@ -58,8 +59,12 @@ void Launcher::onLine(HostDaemon& d, const std::string& line) {
       d.report = std::move(event.text);
       break;
     case Kind::Stats:
+      if (options_.events != nullptr) options_.events->stats(event.text, d.host);
       d.previousStats = std::move(d.stats);
       d.stats = std::move(event.text);
+      break;
+    case Kind::Event:
+      if (options_.events != nullptr) options_.events->relay(event.text, d.host);
       break;
     case Kind::Trace:
       d.trace = std::move(event.text);

@@ -12,6 +12,7 @@
 
 #include "launcher.hpp"
 #include "monitor_files.hpp"
+#include "vrflow/run/events.hpp"
 #include "vrflow/run/trace.hpp"
 
 namespace vrflow::launcher {
@@ -131,6 +132,8 @@ run::RunOutcome Launcher::run() {
 
   if (auto status = start(); !status) {
     failWith({run::kExitRunFailed, "failed", status.error().message}, true);
+  } else if (options_.events != nullptr) {
+    options_.events->started(application_);  // every host said "go"
   }
   bool quitSent = false;
   while (!allExited()) {
@@ -200,6 +203,7 @@ run::RunOutcome Launcher::run() {
   while (sigtimedwait(&signals, nullptr, &zero) > 0) {
   }
   sigprocmask(SIG_SETMASK, &previous, nullptr);
+  if (options_.events != nullptr) options_.events->end(outcome);
   return outcome;
 }
 

@@ -33,6 +33,10 @@ vrflow_add_library(runtime
     src/run/report.cpp
     src/run/trace.cpp
     src/run/runner.cpp
+    src/run/supervisor.cpp
+    src/run/stall_check.cpp
+    src/run/live_stats.cpp
+    src/run/events.cpp
   PUBLIC_DEPS vrflow::message vrflow::app vrflow::base Threads::Threads
   PRIVATE_DEPS nlohmann_json::nlohmann_json PkgConfig::SODIUM ${CMAKE_DL_LIBS})
 

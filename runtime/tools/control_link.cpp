@@ -342,6 +342,10 @@ void ControlLink::stats(const std::string& json) {
                                   json.substr(0, json.size() - 1) + ",\"links\":" + links + "}"));
 }
 
+void ControlLink::event(const std::string& line) {
+  send(net::ControlEvent::payload(net::ControlEvent::Kind::Event, line));
+}
+
 void ControlLink::report(const std::string& json) {
   send(net::ControlEvent::payload(net::ControlEvent::Kind::Report, json));
 }

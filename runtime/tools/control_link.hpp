@@ -41,6 +41,8 @@ class ControlLink final : public run::HostLink {
   void report(const std::string& json) override;
   void trace(const std::string& json) override;
   void stats(const std::string& json) override;
+  /// Sends a line of this host's event stream to the launcher, which merges every host's.
+  void event(const std::string& line);
 
  private:
   ControlLink(int in, int out) : in_(in), out_(out) { inbox_->out = out; }

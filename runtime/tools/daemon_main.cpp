@@ -14,6 +14,7 @@
 #include <set>
 
 #include "control_link.hpp"
+#include "vrflow/run/events.hpp"
 #include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 
@@ -116,6 +117,7 @@ int main(int argc, char** argv) {
   // Under the launcher, the control channel is this process's stdin/stdout: keep them for it,
   // and give modules (which inherit fds 0 and 1) /dev/null and stderr instead.
   std::unique_ptr<vrflow::tools::ControlLink> link;
+  std::unique_ptr<vrflow::run::EventStream> events;  // declared after `link`: destroyed before
   if (control || !controlConnect.empty()) {
     int in = -1, out = -1;
     if (control) {
@@ -149,6 +151,11 @@ int main(int argc, char** argv) {
     }
     link = std::move(*made);
     options.hostLink = link.get();
+    // This host's events go to the launcher, which writes the launch's stream; statistics
+    // travel on their own control lines (with the links' counters).
+    events = std::make_unique<vrflow::run::EventStream>(
+        [l = link.get()](const std::string& line) { l->event(line); }, /*withStats=*/false);
+    options.events = events.get();
   }
 
   // Multi-rate: the iterations of each module come from the whole network, before the split.

@@ -17,6 +17,7 @@
 
 #include "vrflow/app/package_files.hpp"
 #include "vrflow/app/writer.hpp"
+#include "vrflow/run/events.hpp"
 #include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 #ifdef VRFLOW_HAS_LAUNCHER
@@ -180,6 +181,10 @@ int main(int argc, char** argv) {
       ->transform(CLI::AsSizeValue(false));
   run->add_option("--trace", options.tracePath,
                   "Write a Chrome/Perfetto trace (modules' wait/compute spans, messages as flows)");
+  std::string eventsTarget;
+  run->add_option("--events", eventsTarget,
+                  "Write the run's events as JSON lines to FILE, or to stdout with '-' "
+                  "(docs/events.md)");
 
 #ifdef VRFLOW_HAS_LAUNCHER
   auto* launch = cli.add_subcommand(
@@ -207,6 +212,9 @@ int main(int argc, char** argv) {
                      "mpirun: this machine's address as the daemons reach it (default 127.0.0.1)");
   launch->add_option("--trace", launchOptions.tracePath,
                      "Write a Chrome/Perfetto trace of every host, clocks aligned");
+  launch->add_option("--events", eventsTarget,
+                     "Write the events of every host as JSON lines to FILE, or to stdout with '-' "
+                     "(docs/events.md)");
   launch
       ->add_option(
           "--module-memory-limit", launchOptions.moduleMemoryBytes,
@@ -248,7 +256,9 @@ int main(int argc, char** argv) {
   // Output files are checked before anything is loaded or started: a run must not end, after
   // all its work, unable to write what it was asked for.
   std::vector<std::pair<const char*, std::string>> outputs;
-  if (run->parsed()) outputs = {{"report", options.reportPath}, {"trace", options.tracePath}};
+  if (run->parsed()) {
+    outputs = {{"report", options.reportPath}, {"trace", options.tracePath}};
+  }
 #ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
     outputs = {{"report", launchOptions.reportPath}, {"trace", launchOptions.tracePath}};
@@ -261,6 +271,41 @@ int main(int argc, char** argv) {
       return vrflow::run::kExitInvalid;
     }
   }
+  std::unique_ptr<vrflow::run::EventStream> events;
+  if (!eventsTarget.empty()) {
+    if (eventsTarget != "-") {
+      if (const auto problem = outputFileProblem(eventsTarget)) {
+        std::fprintf(stderr, "vrflow: cannot write the events to '%s': %s\n", eventsTarget.c_str(),
+                     problem->c_str());
+        return vrflow::run::kExitInvalid;
+      }
+    }
+    auto opened = vrflow::run::EventStream::open(eventsTarget);
+    if (!opened) {
+      std::fprintf(stderr, "vrflow: %s\n", opened.error().message.c_str());
+      return vrflow::run::kExitInvalid;
+    }
+    events = std::move(*opened);
+    // The stream has standard output to itself: what modules print goes to stderr instead.
+    if (eventsTarget == "-") dup2(STDERR_FILENO, STDOUT_FILENO);
+    options.events = events.get();
+#ifdef VRFLOW_HAS_LAUNCHER
+    launchOptions.events = events.get();
+#endif
+  }
+  // An application that cannot run still ends its event stream, with its first problem.
+  const auto refused = [&](const vrflow::run::Prepared& prepared) {
+    if (events) {
+      std::string first = prepared.error;
+      for (const auto& d : prepared.diagnostics) {
+        if (first.empty() && d.severity == vrflow::app::Diagnostic::Error) {
+          first = vrflow::app::formatDiagnostic(d);
+        }
+      }
+      events->end({vrflow::run::kExitInvalid, "invalid", first});
+    }
+    return vrflow::run::kExitInvalid;
+  };
   // A catalog that cannot be loaded is a mistake in what was given (exit 2), whatever the command.
   const auto invalid = [](const vrflow::run::Prepared& prepared, int code) {
     return prepared.catalog ? code : vrflow::run::kExitInvalid;
@@ -273,8 +318,8 @@ int main(int argc, char** argv) {
   }
 #ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
-    auto flat = loadFlat(shared.settings(launchOptions.appFile, /*validate=*/true));
-    if (!flat) return vrflow::run::kExitInvalid;
+    auto flat = loadFlat(shared.settings(launchOptions.appFile, /*validate=*/true), &prepared);
+    if (!flat) return refused(prepared);
     launchOptions.packageDirs = shared.packageDirs;
     launchOptions.compositeDirs = shared.compositeDirs;
     launchOptions.overrides = shared.overrides;
@@ -286,7 +331,7 @@ int main(int argc, char** argv) {
   auto settings = shared.settings(runFile, /*validate=*/true);
   settings.files = vrflow::app::ModuleFileChecks{.executables = true};
   auto application = loadFlat(settings, &prepared);
-  if (!application) return vrflow::run::kExitInvalid;
+  if (!application) return refused(prepared);
   const vrflow::app::Catalog& catalog = *prepared.catalog;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
   options.progress = !noProgress && isatty(STDERR_FILENO) != 0;

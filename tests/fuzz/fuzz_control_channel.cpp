@@ -73,6 +73,7 @@ void eventLine(std::string_view line) {
     case ControlEvent::Kind::Report:
     case ControlEvent::Kind::Stats:
     case ControlEvent::Kind::Trace:
+    case ControlEvent::Kind::Event:
       check(!event->text.empty() && line.size() > event->text.size() &&
             line.substr(line.size() - event->text.size()) == event->text);
       break;

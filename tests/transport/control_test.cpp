@@ -54,7 +54,8 @@ TEST(ControlCodec, EveryEventReadsBackAsWritten) {
   const ControlEvent clock = reparsed(ControlEvent::clock(10, 20));
   EXPECT_EQ(clock.clockSentNs, 10);
   EXPECT_EQ(clock.clockDaemonNs, 20);
-  for (const auto kind : {EventKind::Report, EventKind::Stats, EventKind::Trace}) {
+  for (const auto kind :
+       {EventKind::Report, EventKind::Stats, EventKind::Trace, EventKind::Event}) {
     const ControlEvent payload = reparsed(ControlEvent::payload(kind, "{\"a\": [1, 2]}"));
     EXPECT_EQ(payload.kind, kind);
     EXPECT_EQ(payload.text, "{\"a\": [1, 2]}");

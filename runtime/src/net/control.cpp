@@ -123,6 +123,7 @@ Result<ControlEvent> parseControlEvent(std::string_view line) {
   if (word == "report") return payload(ControlEvent::Kind::Report);
   if (word == "stats") return payload(ControlEvent::Kind::Stats);
   if (word == "trace") return payload(ControlEvent::Kind::Trace);
+  if (word == "event") return payload(ControlEvent::Kind::Event);
   if (word == "hello") {
     const Split s = split(line, 3);
     if (s.words.size() != 3 || s.hasRest || !number(s.words[1], e.hostIndex) || e.hostIndex < 0 ||
@@ -290,6 +291,8 @@ std::string toLine(const ControlEvent& event) {
       return "stats " + text;
     case Kind::Trace:
       return "trace " + text;
+    case Kind::Event:
+      return "event " + text;
     case Kind::Clock:
       return "clock " + std::to_string(event.clockSentNs) + " " +
              std::to_string(event.clockDaemonNs);

@@ -45,6 +45,8 @@ struct LaunchOptions {
   std::vector<std::string> packageDirs, compositeDirs;
   std::vector<std::string> overrides;  ///< `--set ID.PARAM=VALUE`, applied by every daemon
   bool progress = false;
+  /// The launch's event stream, merged from every host's (docs/events.md); null: none.
+  run::EventStream* events = nullptr;
 };
 
 /// Merges the hosts' report shares into one report in the shape `vrflow run` writes (modules,

@@ -55,6 +55,7 @@ struct ControlEvent {
     Report,
     Stats,
     Trace,
+    Event,
     Clock
   };
   Kind kind = Kind::Connected;
@@ -62,7 +63,7 @@ struct ControlEvent {
   uint16_t port = 0;   ///< Listening: 1 to 65535
   int exitCode = 0;    ///< Finished: the host's exit status
   std::string status;  ///< Finished: one word ("ok", "failed", "stopped", ...)
-  /// Error/Finished: the message (one line); Report/Stats/Trace: the JSON (one line);
+  /// Error/Finished: the message (one line); Report/Stats/Trace/Event: the JSON (one line);
   /// Hello: the proof (controlProof(), hex).
   std::string text;
   int64_t clockSentNs = 0, clockDaemonNs = 0;  ///< Clock: the launcher's time echoed, the daemon's
@@ -77,7 +78,8 @@ struct ControlEvent {
   static ControlEvent error(std::string text);
   /// "finished CODE STATUS ERROR": this host's modules have ended.
   static ControlEvent finished(int exitCode, std::string status, std::string error);
-  /// "report JSON", "stats JSON" or "trace JSON" (`kind` says which); newlines in `json` are
+  /// "report JSON", "stats JSON", "trace JSON" or "event JSON" (a line of the host's event
+  /// stream, docs/events.md) (`kind` says which); newlines in `json` are
   /// written as spaces, which JSON allows between tokens (it holds none inside strings).
   static ControlEvent payload(Kind kind, std::string json);
   /// "clock SENT DAEMON": the launcher's time echoed, with the daemon's steady clock.

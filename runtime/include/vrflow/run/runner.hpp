@@ -25,6 +25,7 @@ enum ExitCode : int {
 };
 
 class HostLink;
+class EventStream;
 
 /// How to run an application on this machine.
 struct RunOptions {
@@ -50,6 +51,9 @@ struct RunOptions {
   const app::Application* wholeApplication = nullptr;
   bool trace = false;     ///< record modules' spans (also implied by tracePath)
   std::string tracePath;  ///< Chrome trace-event JSON; empty = none
+  /// Where the run's events go (docs/events.md): started, stats each second, warnings,
+  /// module exits, end; null: nowhere.
+  EventStream* events = nullptr;
 };
 
 /// What happened, for the report and the exit code.
