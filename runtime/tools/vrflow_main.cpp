@@ -229,6 +229,10 @@ int main(int argc, char** argv) {
   bool monitorOnce = false, monitorJson = false;
   monitorCommand->add_flag("--once", monitorOnce, "Print one snapshot and exit");
   monitorCommand->add_flag("--json", monitorJson, "Print the raw snapshots (JSON lines)");
+  std::string monitorSource;
+  monitorCommand->add_option("--events", monitorSource,
+                             "Show an event stream (FILE, or '-' for stdin) instead of the "
+                             "running launches (docs/events.md)");
 #endif
   try {
     cli.parse(argc, argv);
@@ -238,7 +242,11 @@ int main(int argc, char** argv) {
   }
 
 #ifdef VRFLOW_HAS_LAUNCHER
-  if (monitorCommand->parsed()) return vrflow::launcher::monitor(monitorOnce, monitorJson);
+  if (monitorCommand->parsed()) {
+    return monitorSource.empty()
+               ? vrflow::launcher::monitor(monitorOnce, monitorJson)
+               : vrflow::launcher::monitorEvents(monitorSource, monitorOnce, monitorJson);
+  }
 #endif
   SharedOptions shared = before;
   for (const SharedOptions* after : {&validateShared, &expandShared, &runShared}) {

@@ -63,5 +63,28 @@ TEST(LaunchEvents, ThreeHostsGiveOneStreamWithEachHostsStatsAndModuleExits) {
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 
+TEST(LaunchEvents, MonitorShowsEveryHostAndModuleOfAStreamAndHowItEnded) {
+  TempDir dir;
+  const auto events = dir.file("events.jsonl");
+  const auto launched =
+      runCommand({"/bin/sh", "-c",
+                  "cd " + dir.path() + " && " + binDir() + "/vrflow launch " + sourceDir() +
+                      "/examples/pipeline_3hosts/pipeline_3hosts.xml -n 50 --events " + events},
+                 120);
+  ASSERT_EQ(launched.exitCode, 0) << launched.err;
+  const auto shown = runCommand({binDir() + "/vrflow", "monitor", "--events", events, "--once"});
+  ASSERT_EQ(shown.exitCode, 0) << shown.err;
+  for (const char* module : {"chain", "springs", "gravity", "relay", "recorder"}) {
+    EXPECT_NE(shown.out.find(module), std::string::npos) << module << "\n" << shown.out;
+  }
+  EXPECT_NE(shown.out.find("LINKS"), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("run ended: ok (exit 0)"), std::string::npos) << shown.out;
+
+  const auto missing =
+      runCommand({binDir() + "/vrflow", "monitor", "--events", dir.file("none.jsonl"), "--once"});
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("cannot read the events"), std::string::npos) << missing.err;
+}
+
 }  // namespace
 }  // namespace vrflow::testing

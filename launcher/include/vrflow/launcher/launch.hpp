@@ -64,6 +64,11 @@ Result<std::string> monitorDirectory();
 /// bytes/s) and per link. Returns 0, or 1 when no launch is running.
 int monitor(bool once, bool json);
 
+/// `vrflow monitor --events FILE|-`: the same table from an event stream (docs/events.md),
+/// redrawn at each statistics event, until its "end" (a file still being written is followed;
+/// `-` reads standard input to its end). `once`: the state at the end of what is there now.
+int monitorEvents(const std::string& source, bool once, bool json);
+
 /// Runs `application` (loaded, expanded and validated) with one daemon per host. Exit codes as
 /// `vrflow run`.
 run::RunOutcome launch(const app::Application& application, const LaunchOptions& options);
