@@ -11,14 +11,19 @@
 namespace vrflow::testing {
 namespace {
 
+// `vrflow launch` of the three-host pipeline for `iterations`, its events written to `events`.
+CommandResult launchThreeHosts(const TempDir& dir, int iterations, const std::string& events) {
+  return runCommand({"/bin/sh", "-c",
+                     "cd " + dir.path() + " && " + binDir() + "/vrflow launch " + sourceDir() +
+                         "/examples/pipeline_3hosts/pipeline_3hosts.xml -n " +
+                         std::to_string(iterations) + " --events " + events},
+                    120);
+}
+
 TEST(LaunchEvents, ThreeHostsGiveOneStreamWithEachHostsStatsAndModuleExits) {
   TempDir dir;
   const auto events = dir.file("events.jsonl");
-  const auto result =
-      runCommand({"/bin/sh", "-c",
-                  "cd " + dir.path() + " && " + binDir() + "/vrflow launch " + sourceDir() +
-                      "/examples/pipeline_3hosts/pipeline_3hosts.xml -n 200 --events " + events},
-                 120);
+  const auto result = launchThreeHosts(dir, 200, events);
   ASSERT_EQ(result.exitCode, 0) << result.err;
   std::vector<nlohmann::json> lines;
   std::istringstream in(readFile(events));
@@ -66,11 +71,7 @@ TEST(LaunchEvents, ThreeHostsGiveOneStreamWithEachHostsStatsAndModuleExits) {
 TEST(LaunchEvents, MonitorShowsEveryHostAndModuleOfAStreamAndHowItEnded) {
   TempDir dir;
   const auto events = dir.file("events.jsonl");
-  const auto launched =
-      runCommand({"/bin/sh", "-c",
-                  "cd " + dir.path() + " && " + binDir() + "/vrflow launch " + sourceDir() +
-                      "/examples/pipeline_3hosts/pipeline_3hosts.xml -n 50 --events " + events},
-                 120);
+  const auto launched = launchThreeHosts(dir, 50, events);
   ASSERT_EQ(launched.exitCode, 0) << launched.err;
   const auto shown = runCommand({binDir() + "/vrflow", "monitor", "--events", events, "--once"});
   ASSERT_EQ(shown.exitCode, 0) << shown.err;
