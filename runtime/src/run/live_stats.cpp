@@ -28,7 +28,7 @@ void Supervisor::drainTraces() {
   }
 }
 
-std::string Supervisor::statsJson() {
+nlohmann::json Supervisor::statsSnapshot() {
   nlohmann::json j;
   j["t_ns"] =
       std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
@@ -74,13 +74,13 @@ std::string Supervisor::statsJson() {
   }
   j["connections"] = connections;
   j["filters"] = filterStatsJson(daemon_.filterSnapshot());
-  return j.dump();
+  return j;
 }
 
 void Supervisor::publishStats(bool now) {
   if (options_.hostLink == nullptr && options_.events == nullptr) return;
   if (!now && secondsSince(lastStats_) < 1.0) return;
-  const std::string snapshot = statsJson();
+  const std::string snapshot = statsSnapshot().dump();
   if (options_.hostLink != nullptr) options_.hostLink->stats(snapshot);
   if (options_.events != nullptr) options_.events->stats(snapshot);
   lastStats_ = Clock::now();
@@ -92,14 +92,16 @@ void Supervisor::showProgress(bool final) {
   const double dt = std::chrono::duration<double>(now - lastDisplay_).count();
   if (!final && dt < 1.0) return;
   std::string line = "\r[vrflow " + std::to_string(static_cast<int>(secondsSince(start_))) + "s]";
-  lastDisplayIterations_.resize(children_.size(), 0);
-  for (std::size_t i = 0; i < children_.size(); ++i) {
-    const auto& module = daemon_.modules()[i];
-    const uint64_t it = daemon_.slot(module.slotIndex).iterations.load();
+  // The same counters as the statistics of the event stream and `vrflow monitor`.
+  const nlohmann::json modules = statsSnapshot()["modules"];
+  lastDisplayIterations_.resize(modules.size(), 0);
+  for (std::size_t i = 0; i < modules.size(); ++i) {
+    const uint64_t it = modules[i]["iterations"].get<uint64_t>();
     const double rate = dt > 0 ? static_cast<double>(it - lastDisplayIterations_[i]) / dt : 0.0;
     lastDisplayIterations_[i] = it;
     char text[128];
-    std::snprintf(text, sizeof text, "  %s %.0f it/s", module.id.c_str(), rate);
+    std::snprintf(text, sizeof text, "  %s %.0f it/s", modules[i]["id"].get<std::string>().c_str(),
+                  rate);
     line += text;
   }
   winsize ws{};

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -87,9 +88,9 @@ class Supervisor {
   void drainTraces();
   HostTrace trace_;
 
-  /// Live counters for `vrflow monitor` and the event stream: raw totals, so that the reader
-  /// computes rates.
-  std::string statsJson();
+  /// Live counters for `vrflow monitor`, the event stream and the progress line: raw totals,
+  /// so that each reader computes rates.
+  nlohmann::json statsSnapshot();
   Clock::time_point lastStats_{};
 
  private:
