@@ -261,7 +261,8 @@ int main(int argc, char** argv) {
     std::fputs(vrflow::app::saveApplication(*flat).c_str(), stdout);
     return 0;
   }
-  // Output files are checked before anything is loaded or started: a run must not end, after
+  // Output files are checked before anything is loaded or started (the event stream's first,
+  // so that it can say why the others are refused): a run must not end, after
   // all its work, unable to write what it was asked for.
   std::vector<std::pair<const char*, std::string>> outputs;
   if (run->parsed()) {
@@ -272,13 +273,6 @@ int main(int argc, char** argv) {
     outputs = {{"report", launchOptions.reportPath}, {"trace", launchOptions.tracePath}};
   }
 #endif
-  for (const auto& [what, path] : outputs) {
-    if (const auto problem = outputFileProblem(path)) {
-      std::fprintf(stderr, "vrflow: cannot write the %s to '%s': %s\n", what, path.c_str(),
-                   problem->c_str());
-      return vrflow::run::kExitInvalid;
-    }
-  }
   std::unique_ptr<vrflow::run::EventStream> events;
   if (!eventsTarget.empty()) {
     if (eventsTarget != "-") {
@@ -300,6 +294,15 @@ int main(int argc, char** argv) {
 #ifdef VRFLOW_HAS_LAUNCHER
     launchOptions.events = events.get();
 #endif
+  }
+  for (const auto& [what, path] : outputs) {
+    if (const auto problem = outputFileProblem(path)) {
+      const std::string text =
+          "cannot write the " + std::string(what) + " to '" + path + "': " + *problem;
+      std::fprintf(stderr, "vrflow: %s\n", text.c_str());
+      if (events) events->end({vrflow::run::kExitInvalid, "invalid", text});
+      return vrflow::run::kExitInvalid;
+    }
   }
   // An application that cannot run still ends its event stream, with its first problem.
   const auto refused = [&](const vrflow::run::Prepared& prepared) {

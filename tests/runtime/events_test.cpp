@@ -135,5 +135,19 @@ TEST(EventStream, AnEventsFileThatCannotBeWrittenIsRefusedBeforeTheRun) {
       << result.err;
 }
 
+TEST(EventStream, AReportThatCannotBeWrittenEndsTheStreamSayingSo) {
+  const auto result = runVrflow({"run", sourceDir() + "/examples/pipeline/pipeline.xml", "-n", "1",
+                                 "--report", "/nonexistent-folder/r.json", "--events", "-"});
+  EXPECT_EQ(result.exitCode, 2);
+  const auto events = parseEvents(result.out);
+  ASSERT_EQ(events.size(), 1u) << result.out;
+  EXPECT_EQ(events[0]["event"], "end");
+  EXPECT_EQ(events[0]["status"], "invalid");
+  EXPECT_NE(events[0]["error"].get<std::string>().find(
+                "cannot write the report to '/nonexistent-folder/r.json'"),
+            std::string::npos)
+      << events[0];
+}
+
 }  // namespace
 }  // namespace vrflow::testing
