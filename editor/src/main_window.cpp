@@ -4,20 +4,14 @@
 #include <QApplication>
 #include <QClipboard>
 #include <QCloseEvent>
-#include <QDialog>
-#include <QDialogButtonBox>
 #include <QDir>
 #include <QDockWidget>
 #include <QFile>
-#include <QFileDialog>
 #include <QFileInfo>
-#include <QFormLayout>
 #include <QLabel>
-#include <QLineEdit>
 #include <QListWidget>
 #include <QMenu>
 #include <QMenuBar>
-#include <QMessageBox>
 #include <QPlainTextEdit>
 #include <QSaveFile>
 #include <QStatusBar>
@@ -47,8 +41,6 @@ std::string s(const QString& text) {
   return text.toStdString();
 }
 
-constexpr const char* kFileFilter = "vrflow applications (*.xml);;All files (*)";
-
 // One edit on the undo stack.
 class EditCommand : public QUndoCommand {
  public:
@@ -69,49 +61,6 @@ class EditCommand : public QUndoCommand {
 };
 
 }  // namespace
-
-// ---- Reporter ----------------------------------------------------------------------------
-
-void Reporter::error(QWidget* parent, const QString& title, const QString& text) {
-  QMessageBox::critical(parent, title, text);
-}
-
-void Reporter::warning(QWidget* parent, const QString& title, const QString& text) {
-  QMessageBox::warning(parent, title, text);
-}
-
-Reporter::Choice Reporter::askToSave(QWidget* parent, const QString& text) {
-  const auto answer = QMessageBox::warning(
-      parent, "Unsaved changes", text,
-      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
-  if (answer == QMessageBox::Save) return Choice::Save;
-  if (answer == QMessageBox::Discard) return Choice::Discard;
-  return Choice::Cancel;
-}
-
-QString Reporter::fileName(QWidget* parent, bool forSaving, const QString& suggestion) {
-  return forSaving
-             ? QFileDialog::getSaveFileName(parent, "Save application", suggestion, kFileFilter)
-             : QFileDialog::getOpenFileName(parent, "Open", suggestion, kFileFilter);
-}
-
-bool Reporter::newHost(QWidget* parent, QString& id, QString& address) {
-  QDialog dialog(parent);
-  dialog.setWindowTitle("Add host");
-  auto* form = new QFormLayout(&dialog);
-  auto* idEdit = new QLineEdit(id);
-  auto* addressEdit = new QLineEdit(address);
-  form->addRow("Id", idEdit);
-  form->addRow("Address", addressEdit);
-  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
-  form->addRow(buttons);
-  QObject::connect(buttons, &QDialogButtonBox::accepted, &dialog, &QDialog::accept);
-  QObject::connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
-  if (dialog.exec() != QDialog::Accepted) return false;
-  id = idEdit->text().trimmed();
-  address = addressEdit->text().trimmed();
-  return true;
-}
 
 // ---- MainWindow --------------------------------------------------------------------------
 
