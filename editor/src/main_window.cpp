@@ -1,32 +1,19 @@
 #include "main_window.hpp"
 
-#include <fcntl.h>
-#include <sys/ioctl.h>
-#include <termios.h>
-#include <unistd.h>
-
 #include <QAction>
 #include <QApplication>
 #include <QClipboard>
 #include <QCloseEvent>
-#include <QDialog>
-#include <QDialogButtonBox>
 #include <QDir>
 #include <QDockWidget>
 #include <QFile>
-#include <QFileDialog>
 #include <QFileInfo>
-#include <QFormLayout>
 #include <QLabel>
-#include <QLineEdit>
 #include <QListWidget>
 #include <QMenu>
 #include <QMenuBar>
-#include <QMessageBox>
 #include <QPlainTextEdit>
-#include <QRegularExpression>
 #include <QSaveFile>
-#include <QSocketNotifier>
 #include <QStatusBar>
 #include <QTemporaryDir>
 #include <QTimer>
@@ -34,13 +21,13 @@
 #include <QUndoCommand>
 #include <QUndoStack>
 #include <algorithm>
-#include <cerrno>
 #include <cstdlib>
 #include <set>
 
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/plugin.hpp"
+#include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace vrflow::editor::gui {
@@ -53,9 +40,6 @@ QString q(const std::string& text) {
 std::string s(const QString& text) {
   return text.toStdString();
 }
-
-constexpr int kMaxRecent = 8;
-constexpr const char* kFileFilter = "vrflow applications (*.xml);;All files (*)";
 
 // One edit on the undo stack.
 class EditCommand : public QUndoCommand {
@@ -78,49 +62,6 @@ class EditCommand : public QUndoCommand {
 
 }  // namespace
 
-// ---- Reporter ----------------------------------------------------------------------------
-
-void Reporter::error(QWidget* parent, const QString& title, const QString& text) {
-  QMessageBox::critical(parent, title, text);
-}
-
-void Reporter::warning(QWidget* parent, const QString& title, const QString& text) {
-  QMessageBox::warning(parent, title, text);
-}
-
-Reporter::Choice Reporter::askToSave(QWidget* parent, const QString& text) {
-  const auto answer = QMessageBox::warning(
-      parent, "Unsaved changes", text,
-      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
-  if (answer == QMessageBox::Save) return Choice::Save;
-  if (answer == QMessageBox::Discard) return Choice::Discard;
-  return Choice::Cancel;
-}
-
-QString Reporter::fileName(QWidget* parent, bool forSaving, const QString& suggestion) {
-  return forSaving
-             ? QFileDialog::getSaveFileName(parent, "Save application", suggestion, kFileFilter)
-             : QFileDialog::getOpenFileName(parent, "Open", suggestion, kFileFilter);
-}
-
-bool Reporter::newHost(QWidget* parent, QString& id, QString& address) {
-  QDialog dialog(parent);
-  dialog.setWindowTitle("Add host");
-  auto* form = new QFormLayout(&dialog);
-  auto* idEdit = new QLineEdit(id);
-  auto* addressEdit = new QLineEdit(address);
-  form->addRow("Id", idEdit);
-  form->addRow("Address", addressEdit);
-  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
-  form->addRow(buttons);
-  QObject::connect(buttons, &QDialogButtonBox::accepted, &dialog, &QDialog::accept);
-  QObject::connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
-  if (dialog.exec() != QDialog::Accepted) return false;
-  id = idEdit->text().trimmed();
-  address = addressEdit->text().trimmed();
-  return true;
-}
-
 // ---- MainWindow --------------------------------------------------------------------------
 
 MainWindow::MainWindow(EditorOptions options, QWidget* parent)
@@ -133,7 +74,15 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
       properties_(new PropertiesPanel),
       hosts_(new HostsPanel),
       problemList_(new QListWidget),
-      log_(new QPlainTextEdit) {
+      log_(new QPlainTextEdit),
+      console_(new RunConsole(this)),
+      ticker_(new QTimer(this)) {
+  connect(console_, &RunConsole::logLine, log_, &QPlainTextEdit::appendPlainText);
+  connect(console_, &RunConsole::liveRatesUpdated, this, &MainWindow::showLiveRates);
+  connect(console_, &RunConsole::finished, this, &MainWindow::finishRun);
+  connect(ticker_, &QTimer::timeout, this, [this] {
+    statusBar()->showMessage(QString("Running\u2026 %1 s").arg(console_->elapsedSeconds()));
+  });
   if (reporter_ == nullptr) {
     ownReporter_ = std::make_unique<Reporter>();
     reporter_ = ownReporter_.get();
@@ -262,18 +211,12 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
 }
 
 MainWindow::~MainWindow() {
-  closeTerminal();
+  console_->disconnect(this);
   // The panels outlive this object's members (Qt deletes children last): no more signals here.
   for (QObject* child : std::initializer_list<QObject*>{canvas_, palette_, properties_, hosts_,
                                                         problemList_, undo_}) {
     child->disconnect(this);
     disconnect(child, nullptr, this, nullptr);
-  }
-  if (process_ != nullptr && process_->state() != QProcess::NotRunning) {
-    process_->disconnect(this);
-    process_->terminate();
-    if (!process_->waitForFinished(5000)) process_->kill();
-    process_->waitForFinished(2000);
   }
 }
 
@@ -339,160 +282,6 @@ void MainWindow::buildMenus() {
   tools->addSeparator();
   tools->addAction(runAction_);
   tools->addAction(stopAction_);
-}
-
-// ---- File --------------------------------------------------------------------------------
-
-void MainWindow::setDocument(app::Application app, OpenedText opened, const QString& path) {
-  app_ = std::move(app);
-  opened_ = std::move(opened);
-  path_ = path;
-  lastRun_.reset();
-  {
-    const QSignalBlocker block(undo_);
-    undo_->clear();
-  }
-  undo_->setClean();
-  computeFallbackLayout();
-  refresh();
-  canvas_->fitAll();
-  updateTitle();
-}
-
-void MainWindow::newFile() {
-  app::Application app;
-  app.name = "untitled";
-  app.hosts.push_back(
-      {std::string(app::kDefaultHostId), std::string(app::kDefaultHostAddress), {}});
-  setDocument(std::move(app), OpenedText{}, QString());
-}
-
-bool MainWindow::openFile(const QString& path) {
-  QFile in(path);
-  if (!in.open(QIODevice::ReadOnly)) {
-    reporter().error(this, "Cannot open file", "Cannot read " + path + ": " + in.errorString());
-    return false;
-  }
-  const std::string text = in.readAll().toStdString();
-  std::vector<app::Diagnostic> problems;
-  const std::string absolute = s(QFileInfo(path).absoluteFilePath());
-  auto loaded = app::loadApplicationString(text, absolute, &problems);
-  // Not well-formed, or not an application at all (a manifest, a composite): nothing to edit.
-  const bool notAnApplication = std::any_of(
-      problems.begin(), problems.end(),
-      [](const app::Diagnostic& d) { return d.message.rfind("root element must be", 0) == 0; });
-  if (!loaded || notAnApplication) {
-    reporter().error(
-        this, "Cannot open file",
-        QFileInfo(path).fileName() + " is not a valid vrflow application file:\n\n" +
-            (loaded ? q(app::formatDiagnostics(problems)) : q(loaded.error().message)));
-    return false;
-  }
-  OpenedText opened{text, app::saveApplication(*loaded)};
-  setDocument(std::move(*loaded), std::move(opened), QFileInfo(path).absoluteFilePath());
-  addRecent(path_);
-  log_->appendPlainText("Opened " + path_);
-  if (!problems.empty()) {
-    reporter().warning(this, "Problems in " + QFileInfo(path).fileName(),
-                       "What could be read was loaded; saving writes it without these:\n\n" +
-                           q(app::formatDiagnostics(problems)));
-  }
-  return true;
-}
-
-bool MainWindow::save() {
-  if (path_.isEmpty()) {
-    const QString path =
-        reporter().fileName(this, true, QDir::currentPath() + "/" + q(app_.name) + ".xml");
-    if (path.isEmpty()) return false;
-    return saveAs(path);
-  }
-  return saveAs(path_);
-}
-
-bool MainWindow::saveAs(const QString& path) {
-  const std::string text = textToSave(app_, opened_);
-  QSaveFile out(path);
-  if (!out.open(QIODevice::WriteOnly) ||
-      out.write(text.data(), static_cast<qint64>(text.size())) < 0 || !out.commit()) {
-    reporter().error(this, "Cannot save", "Cannot write " + path + ": " + out.errorString());
-    return false;
-  }
-  opened_ = OpenedText{text, app::saveApplication(app_)};
-  path_ = QFileInfo(path).absoluteFilePath();
-  app_.file = s(path_);
-  undo_->setClean();
-  addRecent(path_);
-  statusBar()->showMessage("Saved " + path_, 5000);
-  refresh();
-  return true;
-}
-
-bool MainWindow::modified() const {
-  return !undo_->isClean();
-}
-
-bool MainWindow::maybeSave() {
-  if (!modified()) return true;
-  switch (reporter().askToSave(
-      this, "The application \"" + q(app_.name) + "\" has unsaved changes. Save them?")) {
-    case Reporter::Choice::Save:
-      return save();
-    case Reporter::Choice::Discard:
-      return true;
-    case Reporter::Choice::Cancel:
-      break;
-  }
-  return false;
-}
-
-QStringList MainWindow::recentFiles() const {
-  return settings_->value("recentFiles").toStringList();
-}
-
-void MainWindow::addRecent(const QString& path) {
-  if (!options_.rememberRecent) return;
-  QStringList files = recentFiles();
-  files.removeAll(path);
-  files.prepend(path);
-  while (files.size() > kMaxRecent) files.removeLast();
-  settings_->setValue("recentFiles", files);
-  rebuildRecentMenu();
-}
-
-void MainWindow::rebuildRecentMenu() {
-  if (recentMenu_ == nullptr) return;
-  recentMenu_->clear();
-  for (const QString& file : recentFiles()) {
-    recentMenu_->addAction(file, this, [this, file] {
-      if (maybeSave()) openFile(file);
-    });
-  }
-  recentMenu_->setEnabled(!recentMenu_->isEmpty());
-}
-
-void MainWindow::updateTitle() {
-  const QString name = path_.isEmpty() ? QString("untitled") : QFileInfo(path_).fileName();
-  setWindowTitle(name + "[*] \u2014 " + q(app_.name) + " \u2014 vrflow editor");
-  setWindowModified(modified());
-}
-
-void MainWindow::showEvent(QShowEvent* event) {
-  QMainWindow::showEvent(event);
-  if (shown_) return;
-  shown_ = true;
-  // Dock sizes apply once the window has its size.
-  resizeDocks({paletteDock_, propertiesDock_}, {190, 330}, Qt::Horizontal);
-  resizeDocks({propertiesDock_, hostsDock_}, {height() * 2 / 5, height() / 5}, Qt::Vertical);
-}
-
-void MainWindow::closeEvent(QCloseEvent* event) {
-  if (!maybeSave()) {
-    event->ignore();
-    return;
-  }
-  stopRun();
-  event->accept();
 }
 
 // ---- State -------------------------------------------------------------------------------
@@ -691,7 +480,7 @@ void MainWindow::assignSelectionToHost(const std::string& host) {
 // ---- Run ---------------------------------------------------------------------------------
 
 bool MainWindow::running() const {
-  return process_ != nullptr && process_->state() != QProcess::NotRunning;
+  return console_->running();
 }
 
 void MainWindow::runApplication(int iterations) {
@@ -705,148 +494,40 @@ void MainWindow::runApplication(int iterations) {
     return;
   }
   if ((path_.isEmpty() || modified()) && !save()) return;
-  runDir_ = std::make_unique<QTemporaryDir>();
-  const QString report = runDir_->filePath("report.json");
   QString program = options_.vrflowProgram;
   if (program.isEmpty()) program = QCoreApplication::applicationDirPath() + "/vrflow";
-  QStringList args{"run", path_, "--report", report};
-  if (iterations > 0) args << "--iterations" << QString::number(iterations);
-  for (const auto& dir : options_.packageDirs) args << "--packages" << q(dir);
-  delete process_;
-  process_ = new QProcess(this);
-  process_->setProcessChannelMode(QProcess::MergedChannels);
-  process_->setWorkingDirectory(QDir::currentPath());
-  // stderr goes to a pseudo-terminal: `vrflow` then prints its live per-module iterations/s
-  // (it does only on a terminal); its log comes through there too.
-  closeTerminal();
-  int slave = -1;
-  terminal_ = posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
-  if (terminal_ >= 0 && grantpt(terminal_) == 0 && unlockpt(terminal_) == 0) {
-    const char* name = ptsname(terminal_);
-    slave = name == nullptr ? -1 : ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC);
-  }
-  if (slave >= 0) {
-    termios mode{};
-    if (tcgetattr(slave, &mode) == 0) {
-      cfmakeraw(&mode);
-      tcsetattr(slave, TCSANOW, &mode);
-    }
-    winsize size{};
-    size.ws_col = 4000;  // wide enough that the progress line is never cut
-    size.ws_row = 50;
-    ioctl(slave, TIOCSWINSZ, &size);
-    process_->setChildProcessModifier([slave] { ::dup2(slave, STDERR_FILENO); });
-    terminalNotifier_ = new QSocketNotifier(terminal_, QSocketNotifier::Read, this);
-    connect(terminalNotifier_, &QSocketNotifier::activated, this, &MainWindow::readTerminal);
-  } else {
-    closeTerminal();
-    args << "--no-progress";
-    log_->appendPlainText("(no pseudo-terminal: live rates unavailable for this run)");
-  }
-  connect(process_, &QProcess::readyRead, this,
-          [this] { handleRunOutput(QString::fromUtf8(process_->readAll())); });
-  connect(process_, &QProcess::finished, this,
-          [this](int code, QProcess::ExitStatus) { finishRun(code); });
-  connect(process_, &QProcess::errorOccurred, this, [this, program](QProcess::ProcessError error) {
-    if (error == QProcess::FailedToStart) {
-      log_->appendPlainText("Cannot start " + program + ": " + process_->errorString());
-      finishRun(-1);
-    }
-  });
+  QStringList extra;
+  if (iterations > 0) extra << "--iterations" << QString::number(iterations);
+  for (const auto& dir : options_.packageDirs) extra << "--packages" << q(dir);
   lastRun_.reset();
   liveRates_.clear();
   canvas_->state().live.clear();
   runError_.clear();
-  log_->appendPlainText("$ " + program + " " + args.join(' '));
   runAction_->setEnabled(false);
   stopAction_->setEnabled(true);
-  runClock_.start();
   refresh();
-  process_->start(program, args);
-  if (slave >= 0) ::close(slave);  // the child has its copy
-  auto* ticker = new QTimer(process_);
-  connect(ticker, &QTimer::timeout, this, [this] {
-    statusBar()->showMessage(QString("Running\u2026 %1 s").arg(runClock_.elapsed() / 1000));
-  });
-  ticker->start(1000);
+  console_->start(program, path_, extra);
+  log_->appendPlainText("$ " + console_->commandLine());
+  ticker_->start(1000);
 }
 
 void MainWindow::stopRun() {
   if (!running()) return;
   log_->appendPlainText("Stopping the run (SIGTERM)");
-  process_->terminate();
+  console_->stop();
 }
 
-void MainWindow::handleRunOutput(const QString& text) {
-  terminalPending_ += text;
-  // Lines end with '\n'; the progress line is rewritten in place with '\r'.
-  for (;;) {
-    const auto end = terminalPending_.indexOf(QRegularExpression("[\r\n]"));
-    if (end < 0) break;
-    QString line = terminalPending_.left(end);
-    terminalPending_.remove(0, end + 1);
-    line.remove("\x1b[K");
-    if (line.trimmed().isEmpty()) continue;
-    if (!line.startsWith("[vrflow ")) {
-      log_->appendPlainText(line);
-      continue;
-    }
-    // "[vrflow 3s]  chain 1234 it/s  springs 1200 it/s"
-    const QStringList words = line.mid(line.indexOf(']') + 1).split(' ', Qt::SkipEmptyParts);
-    std::map<std::string, double> rates;
-    for (qsizetype i = 0; i + 2 < words.size(); i += 3) {
-      bool ok = false;
-      const double rate = words[i + 1].toDouble(&ok);
-      if (!ok || words[i + 2] != "it/s") break;
-      rates[s(words[i])] = rate;
-    }
-    if (rates.empty()) continue;
-    liveRates_ = rates;
-    canvas_->setLiveRates(liveRates_);
-    Q_EMIT liveRatesUpdated();
-  }
-}
-
-void MainWindow::readTerminal() {
-  char buffer[4096];
-  const ssize_t n = ::read(terminal_, buffer, sizeof buffer);
-  if (n <= 0) {
-    if (n < 0 && errno == EAGAIN) return;
-    closeTerminal();  // EIO: every writer is gone
-    return;
-  }
-  handleRunOutput(QString::fromUtf8(buffer, static_cast<qsizetype>(n)));
-}
-
-void MainWindow::closeTerminal() {
-  delete terminalNotifier_;
-  terminalNotifier_ = nullptr;
-  if (terminal_ >= 0) ::close(terminal_);
-  terminal_ = -1;
+void MainWindow::showLiveRates() {
+  liveRates_ = console_->liveRates();
+  canvas_->setLiveRates(liveRates_);
+  Q_EMIT liveRatesUpdated();
 }
 
 void MainWindow::finishRun(int exitCode) {
+  ticker_->stop();
   runAction_->setEnabled(true);
   stopAction_->setEnabled(false);
-  // What is left in the terminal and the pipe.
-  if (terminal_ >= 0) {
-    const int flags = fcntl(terminal_, F_GETFL);
-    fcntl(terminal_, F_SETFL, flags | O_NONBLOCK);
-    while (terminal_ >= 0) {
-      char buffer[4096];
-      const ssize_t n = ::read(terminal_, buffer, sizeof buffer);
-      if (n <= 0) break;
-      handleRunOutput(QString::fromUtf8(buffer, static_cast<qsizetype>(n)));
-    }
-    closeTerminal();
-  }
-  if (process_ != nullptr) handleRunOutput(QString::fromUtf8(process_->readAll()));
-  if (!terminalPending_.isEmpty()) handleRunOutput("\n");
-  QFile reportFile(runDir_ ? runDir_->filePath("report.json") : QString());
-  if (runDir_ && reportFile.open(QIODevice::ReadOnly)) {
-    auto report = parseRunReport(reportFile.readAll().toStdString());
-    if (report) lastRun_ = std::move(*report);
-  }
+  lastRun_ = console_->report();
   canvas_->state().live.clear();  // the report's figures replace the live ones
   QString summary;
   if (exitCode == 0) {

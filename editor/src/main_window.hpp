@@ -1,10 +1,9 @@
 #pragma once
 
-#include <QElapsedTimer>
 #include <QMainWindow>
-#include <QProcess>
 #include <QSettings>
 #include <QStringList>
+#include <QTimer>
 #include <map>
 #include <memory>
 #include <optional>
@@ -13,6 +12,7 @@
 
 #include "canvas.hpp"
 #include "panels.hpp"
+#include "run_console.hpp"
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/model.hpp"
 #include "vrflow/editor/analysis.hpp"
@@ -24,8 +24,6 @@ class QPlainTextEdit;
 class QMenu;
 class QDockWidget;
 class QAction;
-class QTemporaryDir;
-class QSocketNotifier;
 
 namespace vrflow::editor::gui {
 
@@ -101,7 +99,7 @@ class MainWindow : public QMainWindow {
   QPlainTextEdit* log() const { return log_; }
   QUndoStack* undoStack() const { return undo_; }
   const std::optional<RunReport>& lastRun() const { return lastRun_; }
-  /// Iterations/s per module from the running `vrflow`'s progress line (empty when none).
+  /// Iterations/s per module from the running `vrflow`'s event stream (empty when none).
   const std::map<std::string, double>& liveRates() const { return liveRates_; }
 
   /// Applies an edit through the undo stack; reports why when it cannot be made.
@@ -112,7 +110,7 @@ class MainWindow : public QMainWindow {
 
  Q_SIGNALS:
   void runFinished(int exitCode);
-  /// The runtime's live progress line was read: liveRates() changed.
+  /// The run's statistics were read: liveRates() changed.
   void liveRatesUpdated();
 
  protected:
@@ -128,9 +126,7 @@ class MainWindow : public QMainWindow {
   void showSelection();
   void problemActivated(int row);
   void finishRun(int exitCode);
-  void readTerminal();
-  void closeTerminal();
-  void handleRunOutput(const QString& text);
+  void showLiveRates();
   void setDocument(app::Application app, OpenedText opened, const QString& path);
   void computeFallbackLayout();
   Reporter& reporter() { return *reporter_; }
@@ -161,15 +157,10 @@ class MainWindow : public QMainWindow {
   QAction* runAction_ = nullptr;
   QAction* stopAction_ = nullptr;
 
-  QProcess* process_ = nullptr;
-  std::unique_ptr<QTemporaryDir> runDir_;
-  QElapsedTimer runClock_;
+  RunConsole* console_;  ///< the run started from the Run menu
+  QTimer* ticker_;       ///< the status bar's seconds while a run goes on
   std::optional<RunReport> lastRun_;
   QString runError_;
-  // The run's stderr is a pseudo-terminal, so that `vrflow` shows its live progress line.
-  int terminal_ = -1;
-  QSocketNotifier* terminalNotifier_ = nullptr;
-  QString terminalPending_;
   std::map<std::string, double> liveRates_;
 };
 

@@ -1,41 +1,31 @@
 #include "vrflow/launcher/launch.hpp"
 
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netinet/in.h>
-#include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/signalfd.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <cstdio>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <optional>
-#include <sstream>
 
+#include "launcher.hpp"
 #include "monitor_files.hpp"
-#include "vrflow/base/executable_dir.hpp"
-#include "vrflow/net/control.hpp"
-#include "vrflow/net/transport.hpp"
+#include "vrflow/run/events.hpp"
 #include "vrflow/run/trace.hpp"
 
 namespace vrflow::launcher {
+namespace detail {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // A daemon answers "stop" with "stopping" from its control reader at once; one that has not
 // within this time (frozen, stopped by a signal, swapping) is killed.
 constexpr double kStopAnswerSeconds = 0.5;
 // A daemon that answered must then exit within this time, or it is killed too.
 constexpr double kStopExitSeconds = 8;
+
+}  // namespace
 
 int64_t steadyNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
@@ -45,133 +35,6 @@ int64_t steadyNs() {
 double secondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
-
-std::string describeStatus(int status) {
-  if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
-  if (WIFSIGNALED(status)) {
-    return "was killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
-           strsignal(WTERMSIG(status)) + ")";
-  }
-  return "ended";
-}
-
-// One host's daemon, as the launcher sees it.
-struct HostDaemon {
-  int index = 0;
-  std::string host, bind;
-  pid_t pid = -1;
-  int toDaemon = -1, fromDaemon = -1;
-  std::string buffer;
-  int port = -1;
-  bool viaSsh = false;
-  bool viaMpirun = false;
-  bool connected = false, finished = false, exited = false;
-  bool stopAnswered = false;  ///< it answered "stop"
-  int finishedCode = 0;
-  std::string finishedStatus, finishedError, report, exitText, trace;
-  std::string stats, previousStats;  ///< the last two "stats" lines (vrflow monitor)
-  bool clockKnown = false;
-  int64_t clockOffsetNs = 0;  ///< the daemon's steady clock minus ours
-
-  void send(const std::string& line) const {
-    if (toDaemon < 0) return;
-    const std::string text = line + "\n";
-    [[maybe_unused]] auto n = write(toDaemon, text.data(), text.size());
-  }
-  std::string name() const {
-    return "daemon of host '" + host + "' (" + bind +
-           (viaSsh      ? ", ssh pid "
-            : viaMpirun ? ", mpirun pid "
-                        : ", pid ") +
-           std::to_string(pid) + ")";
-  }
-};
-
-// One word for a POSIX shell: single-quoted, with ' written as '\''.
-std::string shellQuote(const std::string& word) {
-  std::string quoted = "'";
-  for (const char c : word) {
-    if (c == '\'') {
-      quoted += "'\\''";
-    } else {
-      quoted += c;
-    }
-  }
-  return quoted + "'";
-}
-
-Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
-                          const std::vector<std::string>& environment, int& toChild, int& fromChild,
-                          bool stdoutToStderr = false) {
-  int in[2], out[2];
-  if (pipe2(in, O_CLOEXEC) != 0 || pipe2(out, O_CLOEXEC) != 0) {
-    return makeError(std::string("pipe: ") + std::strerror(errno));
-  }
-  const pid_t parent = getpid();
-  const pid_t pid = fork();
-  if (pid < 0) return makeError(std::string("fork: ") + std::strerror(errno));
-  if (pid == 0) {
-    setpgid(0, 0);
-    prctl(PR_SET_PDEATHSIG, SIGKILL);  // the daemon (and through it, its modules) dies with us
-    if (getppid() != parent) _exit(127);
-    sigset_t none;
-    sigemptyset(&none);
-    sigprocmask(SIG_SETMASK, &none, nullptr);
-    dup2(in[0], STDIN_FILENO);
-    dup2(out[1], STDOUT_FILENO);
-    if (stdoutToStderr) dup2(STDERR_FILENO, STDOUT_FILENO);
-    for (const auto& e : environment) putenv(const_cast<char*>(e.c_str()));
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    execvp(args[0], args.data());
-    std::fprintf(stderr, "vrflow: cannot start %s: %s\n", argv[0].c_str(), std::strerror(errno));
-    _exit(127);
-  }
-  close(in[0]);
-  close(out[1]);
-  toChild = in[1];
-  fromChild = out[0];
-  fcntl(fromChild, F_SETFL, fcntl(fromChild, F_GETFL) | O_NONBLOCK);
-  return pid;
-}
-
-class Launcher {
- public:
-  Launcher(const app::Application& application, const LaunchOptions& options)
-      : application_(application), options_(options) {}
-  run::RunOutcome run();
-
- private:
-  Status start();
-  Status startMpirun(const std::string& daemonPath, const net::Secret& secret);
-  // The options every daemon gets, whatever the backend: trace, peer timeout, iterations and
-  // search paths (made absolute).
-  void appendDaemonOptions(std::vector<std::string>& argv) const;
-  void pump(int timeoutMs);
-  void onLine(HostDaemon& d, const std::string& line);
-  void failWith(run::RunOutcome outcome, bool rootCause);
-  void stopAll();
-  void publish();
-  Clock::time_point lastPublish_{};
-  std::optional<std::string> monitorDir_;  ///< where publish() writes; unset: not yet chosen
-  bool allExited() const {
-    for (const auto& d : daemons_) {
-      if (!d.exited) return false;
-    }
-    return true;
-  }
-
-  const app::Application& application_;
-  const LaunchOptions& options_;
-  std::vector<HostDaemon> daemons_;
-  int signalFd_ = -1;
-  std::optional<run::RunOutcome> failure_;
-  bool failureIsRoot_ = false;
-  Clock::time_point failureAt_;
-  bool interrupted_ = false;
-  bool stopping_ = false;
-};
 
 void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
   if (stopping_) return;  // what dies while we stop everything is our doing, not a cause
@@ -183,377 +46,6 @@ void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
   std::fprintf(stderr, "vrflow: %s; stopping every host\n", outcome.error.c_str());
   failure_ = std::move(outcome);
   failureIsRoot_ = rootCause;
-}
-
-void Launcher::onLine(HostDaemon& d, const std::string& line) {
-  auto parsed = net::parseControlEvent(line);
-  if (!parsed) return;  // not a line of the protocol: nothing to act on
-  net::ControlEvent& event = *parsed;
-  using Kind = net::ControlEvent::Kind;
-  switch (event.kind) {
-    case Kind::Listening:
-      d.port = event.port;
-      break;
-    case Kind::Connected:
-      d.connected = true;
-      break;
-    case Kind::Stopping:
-      d.stopAnswered = true;
-      break;
-    case Kind::Error:
-      failWith({run::kExitRunFailed, "failed", "host '" + d.host + "': " + event.text}, true);
-      break;
-    case Kind::Finished:
-      d.finished = true;
-      d.finishedCode = event.exitCode;
-      d.finishedStatus = event.status;
-      d.finishedError = event.text;
-      if (d.finishedCode != 0 && d.finishedStatus != "stopped") {
-        const bool lostLink = d.finishedError.rfind("lost the link", 0) == 0;
-        failWith({d.finishedCode, d.finishedStatus, "host '" + d.host + "': " + d.finishedError},
-                 !lostLink);
-      }
-      break;
-    case Kind::Report:
-      d.report = std::move(event.text);
-      break;
-    case Kind::Stats:
-      d.previousStats = std::move(d.stats);
-      d.stats = std::move(event.text);
-      break;
-    case Kind::Trace:
-      d.trace = std::move(event.text);
-      break;
-    case Kind::Clock:
-      // "clock T0 Td": our send time echoed with the daemon's clock; the daemon read its clock
-      // about half-way through the round trip.
-      d.clockOffsetNs = event.clockDaemonNs - (event.clockSentNs + steadyNs()) / 2;
-      d.clockKnown = true;
-      break;
-  }
-}
-
-void Launcher::pump(int timeoutMs) {
-  std::vector<pollfd> fds;
-  fds.push_back({signalFd_, POLLIN, 0});
-  for (const auto& d : daemons_) fds.push_back({d.fromDaemon, POLLIN, 0});
-  poll(fds.data(), fds.size(), timeoutMs);
-  if (fds[0].revents & POLLIN) {
-    signalfd_siginfo info{};
-    while (read(signalFd_, &info, sizeof info) == sizeof info) {
-      if ((info.ssi_signo == SIGINT || info.ssi_signo == SIGTERM) && !interrupted_) {
-        interrupted_ = true;
-        failWith(
-            {run::kExitInterrupted, "interrupted",
-             std::string("interrupted by ") + (info.ssi_signo == SIGINT ? "SIGINT" : "SIGTERM")},
-            true);
-      }
-    }
-  }
-  for (std::size_t i = 0; i < daemons_.size(); ++i) {
-    HostDaemon& d = daemons_[i];
-    if (d.fromDaemon < 0) continue;
-    char chunk[65536];
-    while (true) {
-      const ssize_t n = read(d.fromDaemon, chunk, sizeof chunk);
-      if (n > 0) {
-        d.buffer.append(chunk, static_cast<std::size_t>(n));
-        continue;
-      }
-      if (n == 0) {
-        close(d.fromDaemon);
-        d.fromDaemon = -1;
-        // Under mpirun every daemon has the same process (mpirun): the control channel's end
-        // is what names the host that died.
-        if (d.viaMpirun && !d.finished) {
-          failWith(
-              {run::kExitRunFailed, "failed", d.name() + " closed its control channel: it died"},
-              true);
-        }
-      }
-      break;
-    }
-    std::size_t eol = 0;
-    while ((eol = d.buffer.find('\n')) != std::string::npos) {
-      const std::string line = d.buffer.substr(0, eol);
-      d.buffer.erase(0, eol + 1);
-      onLine(d, line);
-    }
-  }
-  int status = 0;
-  pid_t pid = 0;
-  while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
-    for (auto& d : daemons_) {
-      if (d.pid != pid || d.exited) continue;
-      d.exited = true;
-      d.exitText = describeStatus(status);
-      // Read what it said last (its report, its finish line) before judging.
-      if (d.fromDaemon >= 0) {
-        char chunk[65536];
-        ssize_t n = 0;
-        while ((n = read(d.fromDaemon, chunk, sizeof chunk)) > 0) {
-          d.buffer.append(chunk, static_cast<std::size_t>(n));
-        }
-        std::size_t eol = 0;
-        while ((eol = d.buffer.find('\n')) != std::string::npos) {
-          const std::string line = d.buffer.substr(0, eol);
-          d.buffer.erase(0, eol + 1);
-          onLine(d, line);
-        }
-      }
-      if (!d.finished) {
-        failWith({run::kExitRunFailed, "failed", d.name() + " " + d.exitText}, true);
-      } else if (d.report.empty()) {
-        // Without its share the merged report would silently lack this host's modules.
-        failWith({run::kExitRunFailed, "failed",
-                  d.name() + " " + d.exitText + " after its modules finished, without its report"},
-                 true);
-      }
-      if (d.toDaemon >= 0) close(d.toDaemon);
-      d.toDaemon = -1;
-    }
-  }
-}
-
-// mpirun: one process starts every daemon (rank i serves host i); each connects back to a
-// control socket here and proves it holds the run secret, handed over in mpirun's environment.
-void Launcher::appendDaemonOptions(std::vector<std::string>& argv) const {
-  std::error_code ec;
-  if (!options_.tracePath.empty()) argv.push_back("--trace");
-  char timeout[32];
-  std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);
-  argv.insert(argv.end(), {"--peer-timeout", timeout});
-  if (options_.iterations > 0)
-    argv.insert(argv.end(), {"--iterations", std::to_string(options_.iterations)});
-  if (options_.moduleMemoryBytes > 0) {
-    argv.insert(argv.end(), {"--module-memory-limit", std::to_string(options_.moduleMemoryBytes)});
-  }
-  for (const auto& p : options_.packageDirs) {
-    argv.insert(argv.end(), {"--packages", std::filesystem::absolute(p, ec).string()});
-  }
-  for (const auto& c : options_.compositeDirs) {
-    argv.insert(argv.end(), {"--composites", std::filesystem::absolute(c, ec).string()});
-  }
-  // Each daemon reads the file itself: the command line's parameters go with it.
-  for (const auto& s : options_.overrides) argv.insert(argv.end(), {"--set", s});
-}
-
-Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& secret) {
-  const int listenFd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  if (inet_pton(AF_INET, options_.controlAddress.c_str(), &addr.sin_addr) != 1 ||
-      bind(listenFd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 ||
-      listen(listenFd, 64) != 0) {
-    close(listenFd);
-    return makeError("cannot listen for the daemons on " + options_.controlAddress + ": " +
-                     std::strerror(errno));
-  }
-  socklen_t len = sizeof addr;
-  getsockname(listenFd, reinterpret_cast<sockaddr*>(&addr), &len);
-  const std::string control = options_.controlAddress + ":" + std::to_string(ntohs(addr.sin_port));
-  const std::size_t n = application_.hosts.size();
-  bool loopback = true;
-  std::string hostList;
-  for (const auto& h : application_.hosts) {
-    loopback = loopback && h.address.rfind("127.", 0) == 0;
-    hostList += (hostList.empty() ? "" : ",") + h.address;
-  }
-  std::error_code ec;
-  std::vector<std::string> argv{"mpirun", "-np", std::to_string(n), "-x", "VRFLOW_RUN_SECRET"};
-  for (const char* name : {"VRFLOW_PACKAGE_PATH", "VRFLOW_COMPOSITE_PATH", "VRFLOW_FILTER_PATH"}) {
-    if (std::getenv(name) != nullptr) argv.insert(argv.end(), {"-x", name});
-  }
-  // Rank i runs on host i: all on this machine when every host is a loopback address.
-  argv.insert(argv.end(), {"--host", loopback ? "localhost:" + std::to_string(n) : hostList});
-  argv.insert(argv.end(), {daemonPath, std::filesystem::absolute(options_.appFile, ec).string(),
-                           "--control-connect", control});
-  appendDaemonOptions(argv);
-  int toMpirun = -1, fromMpirun = -1;
-  auto pid = spawnDaemon(argv, {"VRFLOW_RUN_SECRET=" + net::secretToHex(secret)}, toMpirun,
-                         fromMpirun, /*stdoutToStderr=*/true);
-  if (!pid) {
-    close(listenFd);
-    return makeError("mpirun: " + pid.error().message);
-  }
-  close(toMpirun);
-  close(fromMpirun);
-  for (std::size_t i = 0; i < n; ++i) {
-    HostDaemon d;
-    d.index = static_cast<int>(i);
-    d.host = application_.hosts[i].id;
-    d.bind = application_.hosts[i].address;
-    d.pid = *pid;
-    d.viaMpirun = true;
-    daemons_.push_back(std::move(d));
-  }
-  const auto begin = Clock::now();
-  std::size_t linked = 0;
-  while (linked < n && !failure_) {
-    if (secondsSince(begin) > options_.startSeconds) {
-      close(listenFd);
-      return makeError("not every daemon started by mpirun reached the launcher within " +
-                       std::to_string(static_cast<int>(options_.startSeconds)) + " s");
-    }
-    pollfd p{listenFd, POLLIN, 0};
-    if (poll(&p, 1, 50) == 1) {
-      const int fd = accept4(listenFd, nullptr, nullptr, SOCK_CLOEXEC);
-      if (fd < 0) continue;
-      const std::string nonce = net::newNonceHex();
-      const std::string hello = "nonce " + nonce + "\n";
-      [[maybe_unused]] auto w = write(fd, hello.data(), hello.size());
-      // Its answer, "hello INDEX PROOF", within 5 s.
-      std::string line;
-      const auto until = Clock::now() + std::chrono::seconds(5);
-      char c = 0;
-      while (Clock::now() < until && line.size() < 512) {
-        pollfd q{fd, POLLIN, 0};
-        if (poll(&q, 1, 100) != 1) continue;
-        if (read(fd, &c, 1) != 1 || c == '\n') break;
-        line += c;
-      }
-      std::istringstream words(line);
-      std::string word, proof;
-      int index = -1;
-      words >> word >> index >> proof;
-      if (word != "hello" || index < 0 || static_cast<std::size_t>(index) >= n ||
-          daemons_[static_cast<std::size_t>(index)].toDaemon >= 0 ||
-          proof != net::controlProof(secret, index, nonce)) {
-        std::fprintf(stderr,
-                     "vrflow: refused a control connection that did not prove the run secret\n");
-        close(fd);
-        continue;
-      }
-      HostDaemon& d = daemons_[static_cast<std::size_t>(index)];
-      d.toDaemon = fd;
-      d.fromDaemon = dup(fd);
-      fcntl(d.fromDaemon, F_SETFL, fcntl(d.fromDaemon, F_GETFL) | O_NONBLOCK);
-      ++linked;
-    }
-    pump(0);
-  }
-  close(listenFd);
-  if (failure_) return makeError(failure_->error);
-  return {};
-}
-
-Status Launcher::start() {
-  const std::string daemonPath = (executableDir() / "vrflow-daemon").string();
-  const bool ssh = options_.backend == "ssh";
-  std::vector<HostEntry> entries;
-  if (ssh && options_.hostfile.empty()) {
-    return makeError("--backend ssh needs --hosts HOSTFILE (where each host is and how to log in)");
-  }
-  if (!options_.hostfile.empty()) {
-    auto read = readHostfile(options_.hostfile, application_);
-    if (!read) return read.error();
-    entries = *read;
-  }
-  const net::Secret secret = net::newSecret();
-  if (options_.backend == "mpirun") {
-    if (auto status = startMpirun(daemonPath, secret); !status) return status;
-  }
-  for (std::size_t i = 0; i < application_.hosts.size() && options_.backend != "mpirun"; ++i) {
-    const app::Host& host = application_.hosts[i];
-    HostDaemon d;
-    d.index = static_cast<int>(i);
-    d.host = host.id;
-    // local: every host on its own loopback address, as a cluster would be.
-    d.bind = "127.0.0." + std::to_string(i + 1);
-    std::vector<std::string> environment;
-    const HostEntry* entry = nullptr;
-    for (const auto& e : entries) {
-      if (e.host != host.id) continue;
-      entry = &e;
-      if (!e.address.empty()) d.bind = e.address;
-      environment = e.environment;
-    }
-    if (ssh) {
-      if (entry == nullptr) {
-        return makeError(options_.hostfile + ": error: no line for host '" + host.id +
-                         "' (--backend ssh needs one per host)");
-      }
-      if (entry->address.empty()) d.bind = host.address;
-    }
-    std::error_code ec;
-    const std::string appFile = std::filesystem::absolute(options_.appFile, ec).string();
-    std::vector<std::string> argv{
-        entry != nullptr && !entry->daemon.empty() ? entry->daemon : daemonPath,
-        appFile,
-        "--host",
-        host.id,
-        "--control",
-        "--bind",
-        d.bind};
-    appendDaemonOptions(argv);
-    if (ssh) {
-      // ssh carries nothing of our environment: the search paths and the hostfile's env go
-      // explicitly on the remote command line (the secret does not: it goes on stdin).
-      std::string remote =
-          "cd " +
-          shellQuote(entry->directory.empty() ? std::filesystem::current_path(ec).string()
-                                              : entry->directory) +
-          " && exec env";
-      for (const char* name :
-           {"VRFLOW_PACKAGE_PATH", "VRFLOW_COMPOSITE_PATH", "VRFLOW_FILTER_PATH"}) {
-        if (const char* value = std::getenv(name))
-          remote += " " + shellQuote(std::string(name) + "=" + value);
-      }
-      for (const auto& e : environment) remote += " " + shellQuote(e);
-      for (const auto& a : argv) remote += " " + shellQuote(a);
-      std::vector<std::string> sshArgv{"ssh",           "-T", "-o",
-                                       "BatchMode=yes", "-p", std::to_string(entry->sshPort)};
-      if (!entry->identity.empty()) sshArgv.insert(sshArgv.end(), {"-i", entry->identity});
-      for (const auto& o : entry->sshOptions) sshArgv.insert(sshArgv.end(), {"-o", o});
-      sshArgv.push_back(entry->user.empty() ? d.bind : entry->user + "@" + d.bind);
-      sshArgv.push_back(remote);
-      argv = std::move(sshArgv);
-      environment.clear();
-      d.viaSsh = true;
-    }
-    auto pid = spawnDaemon(argv, environment, d.toDaemon, d.fromDaemon);
-    if (!pid) return makeError("host '" + host.id + "': " + pid.error().message);
-    d.pid = *pid;
-    // The secret travels on the daemon's stdin: never on a command line or in a file.
-    d.send("secret " + net::secretToHex(secret));
-    daemons_.push_back(std::move(d));
-  }
-  auto waitFor = [&](auto done, const char* what) -> Status {
-    const auto begin = Clock::now();
-    while (!failure_) {
-      bool all = true;
-      for (const auto& d : daemons_) all = all && done(d);
-      if (all) return {};
-      if (secondsSince(begin) > options_.startSeconds) {
-        std::string late;
-        for (const auto& d : daemons_) {
-          if (!done(d)) late += (late.empty() ? "" : ", ") + d.name();
-        }
-        char text[64];
-        std::snprintf(text, sizeof text, "%g s", options_.startSeconds);
-        return makeError(std::string("not ") + what + " within " + text + ": " + late);
-      }
-      pump(50);
-    }
-    return makeError(failure_->error);
-  };
-  if (auto s = waitFor([](const HostDaemon& d) { return d.port > 0; }, "listening"); !s) return s;
-  for (const auto& d : daemons_) {
-    for (const auto& peer : daemons_) {
-      d.send("peer " + std::to_string(peer.index) + " " + peer.bind + " " +
-             std::to_string(peer.port));
-    }
-    d.send("connect");
-  }
-  if (auto s = waitFor([](const HostDaemon& d) { return d.connected; }, "linked"); !s) return s;
-  if (!options_.tracePath.empty()) {
-    for (const auto& d : daemons_) d.send("clock " + std::to_string(steadyNs()));
-    if (auto s = waitFor([](const HostDaemon& d) { return d.clockKnown; }, "clock-aligned"); !s) {
-      return s;
-    }
-  }
-  for (const auto& d : daemons_) d.send("go");
-  return {};
 }
 
 // Rewrites this launch's monitor file (atomically: write, then rename).
@@ -587,7 +79,7 @@ void Launcher::publish() {
 void Launcher::stopAll() {
   stopping_ = true;
   for (const auto& d : daemons_) {
-    if (!d.exited) d.send("stop");
+    if (!d.exited) d.send(net::ControlCommand::bare(net::ControlCommand::Kind::Stop));
   }
   const auto begin = Clock::now();
   auto allAnswered = [&] {
@@ -640,6 +132,8 @@ run::RunOutcome Launcher::run() {
 
   if (auto status = start(); !status) {
     failWith({run::kExitRunFailed, "failed", status.error().message}, true);
+  } else if (options_.events != nullptr) {
+    options_.events->started(application_);  // every host said "go"
   }
   bool quitSent = false;
   while (!allExited()) {
@@ -662,7 +156,8 @@ run::RunOutcome Launcher::run() {
     bool allFinished = true;
     for (const auto& d : daemons_) allFinished = allFinished && d.finished;
     if (allFinished && !quitSent) {
-      for (const auto& d : daemons_) d.send("quit");
+      for (const auto& d : daemons_)
+        d.send(net::ControlCommand::bare(net::ControlCommand::Kind::Quit));
       quitSent = true;
     }
   }
@@ -708,10 +203,11 @@ run::RunOutcome Launcher::run() {
   while (sigtimedwait(&signals, nullptr, &zero) > 0) {
   }
   sigprocmask(SIG_SETMASK, &previous, nullptr);
+  if (options_.events != nullptr) options_.events->end(outcome);
   return outcome;
 }
 
-}  // namespace
+}  // namespace detail
 
 run::RunOutcome launch(const app::Application& application, const LaunchOptions& options) {
   if (options.backend != "local" && options.backend != "ssh" && options.backend != "mpirun") {
@@ -727,7 +223,7 @@ run::RunOutcome launch(const app::Application& application, const LaunchOptions&
       return {run::kExitInvalid, "failed", read.error().message};
     }
   }
-  Launcher launcher(application, options);
+  detail::Launcher launcher(application, options);
   return launcher.run();
 }
 

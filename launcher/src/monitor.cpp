@@ -36,11 +36,14 @@ const json* findById(const json& list, const char* key, const std::string& value
   return nullptr;
 }
 
-std::string render(const json& launch) {
+}  // namespace
+
+std::string renderLaunch(const json& launch) {
   std::ostringstream out;
   char line[256];
-  out << launch.value("application", "?") << "  (" << launch.value("file", "") << ", launcher pid "
-      << launch.value("launcher_pid", 0) << ")\n";
+  out << launch.value("application", "?") << "  (" << launch.value("file", "");
+  if (launch.contains("launcher_pid")) out << ", launcher pid " << launch.value("launcher_pid", 0);
+  out << ")\n";
   std::snprintf(line, sizeof line, "%-8s %-16s %10s %6s %-16s %6s %10s\n", "HOST", "MODULE", "IT/S",
                 "WAIT%", "STATE", "CPU%", "RSS MiB");
   out << line;
@@ -114,6 +117,8 @@ std::string render(const json& launch) {
   if (!links.str().empty()) out << "LINKS\n" << links.str();
   return out.str();
 }
+
+namespace {
 
 // A monitor file larger than this is not a launcher's (they hold a few KiB per host).
 constexpr off_t kMaxMonitorFileBytes = off_t{16} << 20;
@@ -257,7 +262,7 @@ int monitor(bool once, bool asJson) {
     }
     seen = true;
     std::string text;
-    for (const auto& l : *launches) text += asJson ? l.dump() + "\n" : render(l) + "\n";
+    for (const auto& l : *launches) text += asJson ? l.dump() + "\n" : renderLaunch(l) + "\n";
     if (!once && !asJson && isatty(STDOUT_FILENO)) std::fputs("\033[H\033[2J", stdout);
     std::fputs(text.c_str(), stdout);
     std::fflush(stdout);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 
 // The files of the monitor folder (monitorDirectory()): one "monitor-<launcher pid>.json" per
@@ -16,5 +17,10 @@ bool publishMonitorFile(const std::string& dir, const std::string& text);
 
 /// Removes this launcher's monitor file from `dir`.
 void removeMonitorFile(const std::string& dir);
+
+/// The table `vrflow monitor` prints for one launch: `launch` holds "application", "file",
+/// "launcher_pid" (optional) and "hosts", each with "host" and its last two statistics
+/// snapshots "now" and "before" (null when not yet known).
+std::string renderLaunch(const nlohmann::json& launch);
 
 }  // namespace vrflow::launcher

@@ -40,10 +40,16 @@ vrflow_add_library(daemon SHARED
 # modules, watches them, and writes the report.
 vrflow_add_library(run SHARED
   SOURCES
+    src/run/prepare.cpp
+    src/run/process.cpp
     src/run/spawn.cpp
     src/run/report.cpp
     src/run/trace.cpp
     src/run/runner.cpp
+    src/run/supervisor.cpp
+    src/run/stall_check.cpp
+    src/run/live_stats.cpp
+    src/run/events.cpp
   PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/run
   PUBLIC_DEPS vrflow::daemon vrflow::app vrflow::module
   PRIVATE_DEPS nlohmann_json::nlohmann_json)

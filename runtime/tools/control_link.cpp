@@ -16,6 +16,8 @@
 namespace vrflow::tools {
 namespace {
 
+using Kind = net::ControlCommand::Kind;
+
 // One line from a descriptor, byte by byte (the secret must not be read ahead into a buffer
 // shared with anything else); false at end of input.
 bool readLine(int fd, std::string& line) {
@@ -51,11 +53,14 @@ Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application&
     secret = *given;
   } else {
     std::string line;
-    if (!readLine(in, line) || line.rfind("secret ", 0) != 0) {
+    const bool read = readLine(in, line);
+    auto command = net::parseControlCommand(line);
+    std::fill(line.begin(), line.end(), '\0');
+    if (!read || !command || command->kind != net::ControlCommand::Kind::Secret) {
       return makeError("--control: the first line on stdin must be the run secret");
     }
-    secret = net::secretFromHex(line.substr(7));
-    std::fill(line.begin(), line.end(), '\0');
+    secret = net::secretFromHex(command->secretHex);
+    std::fill(command->secretHex.begin(), command->secretHex.end(), '\0');
     if (!secret) return secret.error();
   }
   link->host_ = host;
@@ -101,8 +106,8 @@ Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application&
       link->transport_->addConnection(r);
     }
   }
-  link->send("listening " + std::to_string(link->transport_->port()));
-  std::thread([fd = in, inbox = link->inbox_] { readLoop(fd, inbox); }).detach();
+  link->send(net::ControlEvent::listening(link->transport_->port()));
+  std::thread([fd = in, host, inbox = link->inbox_] { readLoop(fd, host, inbox); }).detach();
   return link;
 }
 
@@ -123,12 +128,15 @@ Result<int> ControlLink::connectBack(const std::string& address, const net::Secr
     return makeError("cannot reach the launcher at " + address + ": " + std::strerror(err));
   }
   std::string line;
-  if (!readLine(fd, line) || line.rfind("nonce ", 0) != 0) {
+  const bool read = readLine(fd, line);
+  const auto nonce = net::parseControlCommand(line);
+  if (!read || !nonce || nonce->kind != net::ControlCommand::Kind::Nonce) {
     close(fd);
     return makeError("the launcher at " + address + " did not send its nonce");
   }
-  const std::string hello = "hello " + std::to_string(hostIndex) + " " +
-                            net::controlProof(secret, hostIndex, line.substr(6)) + "\n";
+  const std::string hello = net::toLine(net::ControlEvent::hello(
+                                hostIndex, net::controlProof(secret, hostIndex, nonce->nonceHex))) +
+                            "\n";
   if (write(fd, hello.data(), hello.size()) != static_cast<ssize_t>(hello.size())) {
     close(fd);
     return makeError("the launcher at " + address + " closed the control channel");
@@ -142,43 +150,51 @@ ControlLink::~ControlLink() {
   // holds the inbox, not this object.
 }
 
-void ControlLink::readLoop(int fd, const std::shared_ptr<Inbox>& inbox) {
+void ControlLink::readLoop(int fd, const std::string& host, const std::shared_ptr<Inbox>& inbox) {
   std::string line;
   while (readLine(fd, line)) {
+    auto command = net::parseControlCommand(line);
+    if (!command) {
+      std::fprintf(stderr, "vrflow-daemon (host %s): ignored a line of the launcher: %s\n",
+                   host.c_str(), command.error().message.c_str());
+      continue;
+    }
     // Answered here, at once, whatever the main thread is doing: the launcher kills a daemon
     // that does not (a frozen one) instead of waiting for it.
-    if (line == "stop") sendOn(*inbox, "stopping");
+    if (command->kind == Kind::Stop) {
+      sendOn(*inbox, net::ControlEvent::bare(net::ControlEvent::Kind::Stopping));
+    }
     std::lock_guard lock(inbox->mutex);
-    inbox->lines.push_back(line);
+    inbox->commands.push_back(std::move(*command));
     inbox->changed.notify_all();
   }
   std::lock_guard lock(inbox->mutex);
-  inbox->lines.push_back("eof");
+  inbox->commands.push_back(net::ControlCommand::bare(Kind::End));
   inbox->changed.notify_all();
 }
 
-std::string ControlLink::next(double seconds) {
+std::optional<net::ControlCommand> ControlLink::next(double seconds) {
   Inbox& inbox = *inbox_;
   std::unique_lock lock(inbox.mutex);
   if (seconds < 0) {
-    inbox.changed.wait(lock, [&] { return !inbox.lines.empty(); });
+    inbox.changed.wait(lock, [&] { return !inbox.commands.empty(); });
   } else if (!inbox.changed.wait_for(lock, std::chrono::duration<double>(seconds),
-                                     [&] { return !inbox.lines.empty(); })) {
-    return {};
+                                     [&] { return !inbox.commands.empty(); })) {
+    return std::nullopt;
   }
-  std::string line = inbox.lines.front();
-  if (line != "eof") inbox.lines.pop_front();  // end of input stays visible
-  return line;
+  net::ControlCommand command = inbox.commands.front();
+  if (command.kind != Kind::End) inbox.commands.pop_front();  // end of input stays visible
+  return command;
 }
 
-void ControlLink::send(const std::string& line) {
-  sendOn(*inbox_, line);
+void ControlLink::send(const net::ControlEvent& event) {
+  sendOn(*inbox_, event);
 }
 
-void ControlLink::sendOn(Inbox& inbox, const std::string& line) {
+void ControlLink::sendOn(Inbox& inbox, const net::ControlEvent& event) {
   std::lock_guard lock(inbox.writeMutex);
   const int fd = inbox.out;
-  std::string text = line + "\n";
+  std::string text = net::toLine(event) + "\n";
   const char* p = text.data();
   std::size_t left = text.size();
   while (left > 0) {
@@ -200,57 +216,42 @@ void ControlLink::configure(daemon::DaemonOptions& options) {
 Status ControlLink::ready() {
   std::vector<net::PeerAddress> peers;
   while (true) {
-    const auto command = nextCommand();
-    if (!command) continue;
-    if (command->kind == net::ControlCommand::Kind::Connect) break;
-    if (command->kind == net::ControlCommand::Kind::End ||
-        command->kind == net::ControlCommand::Kind::Stop) {
-      return stoppedBeforeStart(*command);
+    const net::ControlCommand command = *next(-1);
+    if (command.kind == Kind::Connect) break;
+    if (command.kind == Kind::End || command.kind == Kind::Stop) {
+      return stoppedBeforeStart(command);
     }
-    if (command->kind == net::ControlCommand::Kind::Peer) {
-      peers.push_back({command->peerIndex, command->peerAddress, command->peerPort});
+    if (command.kind == Kind::Peer) {
+      peers.push_back({command.peerIndex, command.peerAddress, command.peerPort});
     }
   }
   if (auto status = transport_->connectPeers(peers); !status) {
     std::fprintf(stderr, "vrflow-daemon (host %s): cannot link to the other hosts: %s\n",
                  host_.c_str(), status.error().message.c_str());
-    send("error " + status.error().message);
+    send(net::ControlEvent::error(status.error().message));
     return status;
   }
-  send("connected");
+  send(net::ControlEvent::bare(net::ControlEvent::Kind::Connected));
   while (true) {
-    const auto command = nextCommand();
-    if (!command) continue;
-    if (command->kind == net::ControlCommand::Kind::Go) return {};
+    const net::ControlCommand command = *next(-1);
+    if (command.kind == Kind::Go) return {};
     // "clock T": the launcher aligns this host's clock with its own (--trace).
-    if (command->kind == net::ControlCommand::Kind::Clock) {
+    if (command.kind == Kind::Clock) {
       const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
                            std::chrono::steady_clock::now().time_since_epoch())
                            .count();
-      send("clock " + std::to_string(command->clockNs) + " " + std::to_string(now));
+      send(net::ControlEvent::clock(command.clockNs, now));
       continue;
     }
-    if (command->kind == net::ControlCommand::Kind::End ||
-        command->kind == net::ControlCommand::Kind::Stop) {
-      return stoppedBeforeStart(*command);
+    if (command.kind == Kind::End || command.kind == Kind::Stop) {
+      return stoppedBeforeStart(command);
     }
   }
-}
-
-std::optional<net::ControlCommand> ControlLink::nextCommand() {
-  const std::string line = next(-1);
-  auto command = net::parseControlCommand(line);
-  if (!command) {
-    std::fprintf(stderr, "vrflow-daemon (host %s): ignored a line of the launcher: %s\n",
-                 host_.c_str(), command.error().message.c_str());
-    return std::nullopt;
-  }
-  return *command;
 }
 
 Status ControlLink::stoppedBeforeStart(const net::ControlCommand& command) {
   stopped_ = true;
-  const std::string why = command.kind == net::ControlCommand::Kind::Stop
+  const std::string why = command.kind == Kind::Stop
                               ? "stopped by the launcher before the start"
                               : "the launcher closed the control channel before the start";
   std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", host_.c_str(), why.c_str());
@@ -261,27 +262,29 @@ std::optional<run::RunOutcome> ControlLink::poll() {
   if (auto fatal = transport_->fatalError(); !fatal.empty()) {
     return run::RunOutcome{run::kExitRunFailed, "failed", fatal};
   }
-  const std::string line = next(0);
-  if (line == "stop" || line == "eof") stopped_ = true;
-  if (line == "stop")
+  const auto command = next(0);
+  if (!command) return std::nullopt;
+  if (command->kind == Kind::Stop || command->kind == Kind::End) stopped_ = true;
+  if (command->kind == Kind::Stop)
     return run::RunOutcome{run::kExitInterrupted, "stopped", "stopped by the launcher"};
-  if (line == "eof")
+  if (command->kind == Kind::End)
     return run::RunOutcome{run::kExitInterrupted, "stopped", "the launcher went away"};
   return std::nullopt;
 }
 
 std::vector<std::string> ControlLink::drain(const run::RunOutcome& outcome) {
-  send(net::finishedLine(outcome.exitCode, outcome.status, outcome.error));
+  send(net::ControlEvent::finished(outcome.exitCode, outcome.status, outcome.error));
   std::vector<std::string> warnings;
   // Keep routing (messages for the other hosts) until the launcher says every host is done.
   while (!stopped_) {
-    const std::string line = next(0.05);
-    if (line == "quit") {
+    const auto command = next(0.05);
+    if (!command) continue;
+    if (command->kind == Kind::Quit) {
       warnings = settle();
       if (!stopped_) transport_->finish(2.0);
       break;
     }
-    if (line == "stop" || line == "eof") stopped_ = true;
+    if (command->kind == Kind::Stop || command->kind == Kind::End) stopped_ = true;
   }
   if (stopped_) transport_->finish(0.5);  // say bye, so that peers do not log a lost link
   transport_->stop();
@@ -299,8 +302,8 @@ std::vector<std::string> ControlLink::settle() {
   while (true) {
     open = transport_->settle(0.05);
     if (open.empty() || !transport_->fatalError().empty()) break;
-    const std::string line = next(0);
-    if (line == "stop" || line == "eof") {
+    const auto command = next(0);
+    if (command && (command->kind == Kind::Stop || command->kind == Kind::End)) {
       stopped_ = true;
       return {};
     }
@@ -319,7 +322,7 @@ std::vector<std::string> ControlLink::settle() {
 }
 
 void ControlLink::trace(const std::string& json) {
-  send("trace " + json);
+  send(net::ControlEvent::payload(net::ControlEvent::Kind::Trace, json));
 }
 
 void ControlLink::stats(const std::string& json) {
@@ -335,15 +338,16 @@ void ControlLink::stats(const std::string& json) {
   }
   links += "]";
   if (json.empty() || json.back() != '}') return;
-  send("stats " + json.substr(0, json.size() - 1) + ",\"links\":" + links + "}");
+  send(net::ControlEvent::payload(net::ControlEvent::Kind::Stats,
+                                  json.substr(0, json.size() - 1) + ",\"links\":" + links + "}"));
+}
+
+void ControlLink::event(const std::string& line) {
+  send(net::ControlEvent::payload(net::ControlEvent::Kind::Event, line));
 }
 
 void ControlLink::report(const std::string& json) {
-  std::string flat = json;
-  for (char& c : flat) {
-    if (c == '\n') c = ' ';  // JSON strings hold no raw newline: this keeps it one line
-  }
-  send("report " + flat);
+  send(net::ControlEvent::payload(net::ControlEvent::Kind::Report, json));
 }
 
 }  // namespace vrflow::tools

@@ -41,20 +41,19 @@ class ControlLink final : public run::HostLink {
   void report(const std::string& json) override;
   void trace(const std::string& json) override;
   void stats(const std::string& json) override;
+  /// Sends a line of this host's event stream to the launcher, which merges every host's.
+  void event(const std::string& line);
 
  private:
   ControlLink(int in, int out) : in_(in), out_(out) { inbox_->out = out; }
-  void send(const std::string& line);
-  /// The next command from the launcher ("eof" when it went away); waits up to `seconds`
-  /// (negative: forever); empty on timeout.
-  std::string next(double seconds);
+  void send(const net::ControlEvent& event);
+  /// The next command from the launcher (End when it went away, and from then on); waits up to
+  /// `seconds` (negative: forever); none on timeout.
+  std::optional<net::ControlCommand> next(double seconds);
   /// After "quit": waits until the connections crossing hosts are over (or a stop comes);
   /// returns a warning for those still open.
   std::vector<std::string> settle();
 
-  /// The next command from the launcher, waiting for it; none (and a line on stderr) for a
-  /// malformed one.
-  std::optional<net::ControlCommand> nextCommand();
   /// Stops before "go" ("stop" or the end of input): says so on stderr; the error.
   Status stoppedBeforeStart(const net::ControlCommand& command);
 
@@ -66,19 +65,21 @@ class ControlLink final : public run::HostLink {
   std::unique_ptr<net::Transport> transport_;
   std::vector<net::RemoteConnection> remote_;
   std::vector<uint32_t> localChannels_;
-  /// The launcher's lines, shared with the thread that reads them: it blocks in read() until
+  /// The launcher's commands, shared with the thread that reads them: it blocks in read() until
   /// the launcher closes the channel, which may come after this object is gone.
   struct Inbox {
     std::mutex mutex;
     std::condition_variable changed;
-    std::deque<std::string> lines;
-    int out = -1;           ///< the channel to the launcher
-    std::mutex writeMutex;  ///< one line at a time on `out`, from either thread
+    std::deque<net::ControlCommand> commands;  ///< parsed; malformed lines are dropped
+    int out = -1;                              ///< the channel to the launcher
+    std::mutex writeMutex;                     ///< one line at a time on `out`, from either thread
   };
-  /// Writes `line` and a newline on the channel to the launcher (any thread).
-  static void sendOn(Inbox& inbox, const std::string& line);
+  /// Writes `event` as one line on the channel to the launcher (any thread).
+  static void sendOn(Inbox& inbox, const net::ControlEvent& event);
   std::shared_ptr<Inbox> inbox_ = std::make_shared<Inbox>();
-  static void readLoop(int fd, const std::shared_ptr<Inbox>& inbox);
+  /// Reads and parses the launcher's lines until the end of input (`host` names the daemon in
+  /// the warning for a malformed line).
+  static void readLoop(int fd, const std::string& host, const std::shared_ptr<Inbox>& inbox);
 };
 
 }  // namespace vrflow::tools

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -13,16 +14,14 @@
 #include <set>
 
 #include "control_link.hpp"
-#include "vrflow/app/catalog.hpp"
-#include "vrflow/app/diagnostic.hpp"
-#include "vrflow/app/expand.hpp"
-#include "vrflow/app/loader.hpp"
-#include "vrflow/app/overrides.hpp"
-#include "vrflow/app/validate.hpp"
-#include "vrflow/daemon/plugin.hpp"
+#include "vrflow/run/events.hpp"
+#include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 
 int main(int argc, char** argv) {
+  // The launcher gone, writes on the control channel fail (EPIPE) instead of killing the
+  // daemon before it stops its modules (spawnProcess() gives children SIGPIPE's default).
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App cli{"vrflow-daemon: serve one host of an application"};
   std::string file, host;
   std::vector<std::string> packageDirs;
@@ -66,36 +65,17 @@ int main(int argc, char** argv) {
     return cli.exit(e) == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
-  auto catalog = vrflow::run::loadCatalog(packageDirs);
-  if (!catalog) {
-    std::fprintf(stderr, "vrflow-daemon: %s\n", catalog.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
-  std::vector<vrflow::app::Diagnostic> problems;
-  auto application = vrflow::app::loadApplicationFile(file, &problems);
-  if (!application) {
-    std::fprintf(stderr, "%s\n", application.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
-  vrflow::app::applyInstanceOverrides(*application, overrides);  // as `vrflow` does
-  application = vrflow::app::expandComposites(
-      *application, vrflow::app::defaultCompositeSources(*application, compositeDirs), &problems);
-  if (!application) {
-    std::fprintf(stderr, "%s\n", application.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
-  if (auto set = vrflow::app::applyOverrides(*application, overrides); !set) {
-    std::fprintf(stderr, "vrflow-daemon: %s\n", set.error().message.c_str());
-    return vrflow::run::kExitInvalid;
-  }
-  auto loaded = vrflow::daemon::loadApplicationPlugins(*application, *catalog);
-  problems.insert(problems.end(), loaded.begin(), loaded.end());
-  auto more = vrflow::app::validate(*application, *catalog);
-  problems.insert(problems.end(), more.begin(), more.end());
-  vrflow::app::sortAndDeduplicate(problems);
-  for (const auto& d : problems)
-    std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(d).c_str());
-  if (vrflow::app::hasErrors(problems)) return vrflow::run::kExitInvalid;
+  vrflow::run::Prepared prepared = vrflow::run::prepare({.file = file,
+                                                         .packageDirs = packageDirs,
+                                                         .compositeDirs = compositeDirs,
+                                                         .overrides = overrides,
+                                                         .validate = true,
+                                                         .files = std::nullopt,
+                                                         .program = "vrflow-daemon"});
+  vrflow::run::printProblems(prepared);
+  if (!prepared.ok()) return vrflow::run::kExitInvalid;
+  const vrflow::app::Catalog& catalog = *prepared.catalog;
+  std::optional<vrflow::app::Application> application = std::move(prepared.application);
   std::optional<vrflow::net::Secret> secret;
   if (!controlConnect.empty()) {
     const char* text = std::getenv("VRFLOW_RUN_SECRET");
@@ -137,6 +117,7 @@ int main(int argc, char** argv) {
   // Under the launcher, the control channel is this process's stdin/stdout: keep them for it,
   // and give modules (which inherit fds 0 and 1) /dev/null and stderr instead.
   std::unique_ptr<vrflow::tools::ControlLink> link;
+  std::unique_ptr<vrflow::run::EventStream> events;  // declared after `link`: destroyed before
   if (control || !controlConnect.empty()) {
     int in = -1, out = -1;
     if (control) {
@@ -170,6 +151,11 @@ int main(int argc, char** argv) {
     }
     link = std::move(*made);
     options.hostLink = link.get();
+    // This host's events go to the launcher, which writes the launch's stream; statistics
+    // travel on their own control lines (with the links' counters).
+    events = std::make_unique<vrflow::run::EventStream>(
+        [l = link.get()](const std::string& line) { l->event(line); }, /*withStats=*/false);
+    options.events = events.get();
   }
 
   // Multi-rate: the iterations of each module come from the whole network, before the split.
@@ -211,7 +197,7 @@ int main(int argc, char** argv) {
     if (from) local.connections.push_back(c);
   }
   options.wholeApplication = &*application;
-  const auto outcome = vrflow::run::runApplication(local, *catalog, options);
+  const auto outcome = vrflow::run::runApplication(local, catalog, options);
   if (link) return outcome.exitCode;  // the launcher reports
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow-daemon: %s\n", outcome.error.c_str());
   return outcome.exitCode;

@@ -15,15 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "vrflow/app/catalog.hpp"
-#include "vrflow/app/diagnostic.hpp"
-#include "vrflow/app/expand.hpp"
-#include "vrflow/app/loader.hpp"
-#include "vrflow/app/overrides.hpp"
 #include "vrflow/app/package_files.hpp"
-#include "vrflow/app/validate.hpp"
 #include "vrflow/app/writer.hpp"
-#include "vrflow/daemon/plugin.hpp"
+#include "vrflow/run/events.hpp"
+#include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 #ifdef VRFLOW_HAS_LAUNCHER
 #include "vrflow/launcher/launch.hpp"
@@ -43,6 +38,17 @@ struct SharedOptions {
     compositeDirs.insert(compositeDirs.end(), other.compositeDirs.begin(),
                          other.compositeDirs.end());
     overrides.insert(overrides.end(), other.overrides.begin(), other.overrides.end());
+  }
+
+  // What run::prepare() needs to prepare `file` with these options.
+  vrflow::run::PrepareSettings settings(const std::string& file, bool validate) const {
+    return {.file = file,
+            .packageDirs = packageDirs,
+            .compositeDirs = compositeDirs,
+            .overrides = overrides,
+            .validate = validate,
+            .files = std::nullopt,
+            .program = "vrflow"};
   }
 };
 
@@ -116,53 +122,15 @@ std::optional<std::string> outputFileProblem(const std::string& path) {
   return std::nullopt;
 }
 
-// Loads the file and expands its composites (search path: the file's folder, --composites,
-// $VRFLOW_COMPOSITE_PATH), applies the --set parameters, and validates the flat application when
-// a catalog is given; with `files`, also checks the files its modules name on this machine.
-// Prints every diagnostic; returns the flat application when there is no error.
-std::optional<vrflow::app::Application> loadFlat(
-    const std::string& file, const std::vector<std::string>& compositeDirs,
-    const std::vector<std::string>& overrides, vrflow::app::Catalog* catalog,
-    std::optional<vrflow::app::ModuleFileChecks> files = std::nullopt) {
-  std::vector<vrflow::app::Diagnostic> problems;
-  auto application = vrflow::app::loadApplicationFile(file, &problems);
-  if (!application) {
-    std::fprintf(stderr, "%s\n", application.error().message.c_str());
-    return std::nullopt;
-  }
-  // Settings of the file's own composite instances change what the expansion makes.
-  std::vector<std::string> moduleSettings = overrides;
-  vrflow::app::applyInstanceOverrides(*application, moduleSettings);
-  const auto sources = vrflow::app::defaultCompositeSources(*application, compositeDirs);
-  auto flat = vrflow::app::expandComposites(*application, sources, &problems);
-  if (!flat) {
-    std::fprintf(stderr, "%s\n", flat.error().message.c_str());
-    return std::nullopt;
-  }
-  if (auto set = vrflow::app::applyOverrides(*flat, moduleSettings); !set) {
-    std::fprintf(stderr, "vrflow: %s\n", set.error().message.c_str());
-    return std::nullopt;
-  }
-  if (catalog != nullptr) {
-    auto plugins = vrflow::daemon::loadApplicationPlugins(*flat, *catalog);
-    problems.insert(problems.end(), plugins.begin(), plugins.end());
-    auto more = vrflow::app::validate(*flat, *catalog);
-    problems.insert(problems.end(), more.begin(), more.end());
-    if (files) {
-      auto named = vrflow::app::checkModuleFiles(*flat, *catalog, *files);
-      problems.insert(problems.end(), named.begin(), named.end());
-    }
-  }
-  vrflow::app::sortAndDeduplicate(problems);
-  const std::size_t printed = std::min(problems.size(), kMaxPrintedDiagnostics);
-  for (std::size_t i = 0; i < printed; ++i) {
-    std::fprintf(stderr, "%s\n", vrflow::app::formatDiagnostic(problems[i]).c_str());
-  }
-  if (problems.size() > printed) {
-    std::fprintf(stderr, "... and %zu more problems\n", problems.size() - printed);
-  }
-  if (vrflow::app::hasErrors(problems)) return std::nullopt;
-  return std::move(*flat);
+// Prepares the file (run::prepare) and prints its problems; the flat application when there is
+// no error.
+std::optional<vrflow::app::Application> loadFlat(vrflow::run::PrepareSettings settings,
+                                                 vrflow::run::Prepared* into = nullptr) {
+  vrflow::run::Prepared prepared = vrflow::run::prepare(settings);
+  vrflow::run::printProblems(prepared, kMaxPrintedDiagnostics);
+  std::optional<vrflow::app::Application> flat = std::move(prepared.application);
+  if (into != nullptr) *into = std::move(prepared);
+  return flat;
 }
 
 }  // namespace
@@ -213,6 +181,10 @@ int main(int argc, char** argv) {
       ->transform(CLI::AsSizeValue(false));
   run->add_option("--trace", options.tracePath,
                   "Write a Chrome/Perfetto trace (modules' wait/compute spans, messages as flows)");
+  std::string eventsTarget;
+  run->add_option("--events", eventsTarget,
+                  "Write the run's events as JSON lines to FILE, or to stdout with '-' "
+                  "(docs/events.md)");
 
 #ifdef VRFLOW_HAS_LAUNCHER
   auto* launch = cli.add_subcommand(
@@ -240,6 +212,9 @@ int main(int argc, char** argv) {
                      "mpirun: this machine's address as the daemons reach it (default 127.0.0.1)");
   launch->add_option("--trace", launchOptions.tracePath,
                      "Write a Chrome/Perfetto trace of every host, clocks aligned");
+  launch->add_option("--events", eventsTarget,
+                     "Write the events of every host as JSON lines to FILE, or to stdout with '-' "
+                     "(docs/events.md)");
   launch
       ->add_option(
           "--module-memory-limit", launchOptions.moduleMemoryBytes,
@@ -254,6 +229,10 @@ int main(int argc, char** argv) {
   bool monitorOnce = false, monitorJson = false;
   monitorCommand->add_flag("--once", monitorOnce, "Print one snapshot and exit");
   monitorCommand->add_flag("--json", monitorJson, "Print the raw snapshots (JSON lines)");
+  std::string monitorSource;
+  monitorCommand->add_option("--events", monitorSource,
+                             "Show an event stream (FILE, or '-' for stdin) instead of the "
+                             "running launches (docs/events.md)");
 #endif
   try {
     cli.parse(argc, argv);
@@ -263,7 +242,11 @@ int main(int argc, char** argv) {
   }
 
 #ifdef VRFLOW_HAS_LAUNCHER
-  if (monitorCommand->parsed()) return vrflow::launcher::monitor(monitorOnce, monitorJson);
+  if (monitorCommand->parsed()) {
+    return monitorSource.empty()
+               ? vrflow::launcher::monitor(monitorOnce, monitorJson)
+               : vrflow::launcher::monitorEvents(monitorSource, monitorOnce, monitorJson);
+  }
 #endif
   SharedOptions shared = before;
   for (const SharedOptions* after : {&validateShared, &expandShared, &runShared}) {
@@ -273,42 +256,81 @@ int main(int argc, char** argv) {
   shared.append(launchShared);
 #endif
   if (expand->parsed()) {
-    const auto flat = loadFlat(expandFile, shared.compositeDirs, shared.overrides, nullptr);
+    const auto flat = loadFlat(shared.settings(expandFile, /*validate=*/false));
     if (!flat) return 1;
     std::fputs(vrflow::app::saveApplication(*flat).c_str(), stdout);
     return 0;
   }
-  // Output files are checked before anything is loaded or started: a run must not end, after
+  // Output files are checked before anything is loaded or started (the event stream's first,
+  // so that it can say why the others are refused): a run must not end, after
   // all its work, unable to write what it was asked for.
   std::vector<std::pair<const char*, std::string>> outputs;
-  if (run->parsed()) outputs = {{"report", options.reportPath}, {"trace", options.tracePath}};
+  if (run->parsed()) {
+    outputs = {{"report", options.reportPath}, {"trace", options.tracePath}};
+  }
 #ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
     outputs = {{"report", launchOptions.reportPath}, {"trace", launchOptions.tracePath}};
   }
 #endif
+  std::unique_ptr<vrflow::run::EventStream> events;
+  if (!eventsTarget.empty()) {
+    if (eventsTarget != "-") {
+      if (const auto problem = outputFileProblem(eventsTarget)) {
+        std::fprintf(stderr, "vrflow: cannot write the events to '%s': %s\n", eventsTarget.c_str(),
+                     problem->c_str());
+        return vrflow::run::kExitInvalid;
+      }
+    }
+    auto opened = vrflow::run::EventStream::open(eventsTarget);
+    if (!opened) {
+      std::fprintf(stderr, "vrflow: %s\n", opened.error().message.c_str());
+      return vrflow::run::kExitInvalid;
+    }
+    events = std::move(*opened);
+    // The stream has standard output to itself: what modules print goes to stderr instead.
+    if (eventsTarget == "-") dup2(STDERR_FILENO, STDOUT_FILENO);
+    options.events = events.get();
+#ifdef VRFLOW_HAS_LAUNCHER
+    launchOptions.events = events.get();
+#endif
+  }
   for (const auto& [what, path] : outputs) {
     if (const auto problem = outputFileProblem(path)) {
-      std::fprintf(stderr, "vrflow: cannot write the %s to '%s': %s\n", what, path.c_str(),
-                   problem->c_str());
+      const std::string text =
+          "cannot write the " + std::string(what) + " to '" + path + "': " + *problem;
+      std::fprintf(stderr, "vrflow: %s\n", text.c_str());
+      if (events) events->end({vrflow::run::kExitInvalid, "invalid", text});
       return vrflow::run::kExitInvalid;
     }
   }
-  auto catalog = vrflow::run::loadCatalog(shared.packageDirs);
-  if (!catalog) {
-    std::fprintf(stderr, "vrflow: %s\n", catalog.error().message.c_str());
+  // An application that cannot run still ends its event stream, with its first problem.
+  const auto refused = [&](const vrflow::run::Prepared& prepared) {
+    if (events) {
+      std::string first = prepared.error;
+      for (const auto& d : prepared.diagnostics) {
+        if (first.empty() && d.severity == vrflow::app::Diagnostic::Error) {
+          first = vrflow::app::formatDiagnostic(d);
+        }
+      }
+      events->end({vrflow::run::kExitInvalid, "invalid", first});
+    }
     return vrflow::run::kExitInvalid;
-  }
+  };
+  // A catalog that cannot be loaded is a mistake in what was given (exit 2), whatever the command.
+  const auto invalid = [](const vrflow::run::Prepared& prepared, int code) {
+    return prepared.catalog ? code : vrflow::run::kExitInvalid;
+  };
+  vrflow::run::Prepared prepared;
   if (validate->parsed()) {
-    return loadFlat(validateFile, shared.compositeDirs, shared.overrides, &*catalog,
-                    vrflow::app::ModuleFileChecks{})
-               ? 0
-               : 1;
+    auto settings = shared.settings(validateFile, /*validate=*/true);
+    settings.files = vrflow::app::ModuleFileChecks{};
+    return loadFlat(settings, &prepared) ? 0 : invalid(prepared, 1);
   }
 #ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
-    auto flat = loadFlat(launchOptions.appFile, shared.compositeDirs, shared.overrides, &*catalog);
-    if (!flat) return vrflow::run::kExitInvalid;
+    auto flat = loadFlat(shared.settings(launchOptions.appFile, /*validate=*/true), &prepared);
+    if (!flat) return refused(prepared);
     launchOptions.packageDirs = shared.packageDirs;
     launchOptions.compositeDirs = shared.compositeDirs;
     launchOptions.overrides = shared.overrides;
@@ -317,12 +339,14 @@ int main(int argc, char** argv) {
     return outcome.exitCode;
   }
 #endif
-  auto application = loadFlat(runFile, shared.compositeDirs, shared.overrides, &*catalog,
-                              vrflow::app::ModuleFileChecks{.executables = true});
-  if (!application) return vrflow::run::kExitInvalid;
+  auto settings = shared.settings(runFile, /*validate=*/true);
+  settings.files = vrflow::app::ModuleFileChecks{.executables = true};
+  auto application = loadFlat(settings, &prepared);
+  if (!application) return refused(prepared);
+  const vrflow::app::Catalog& catalog = *prepared.catalog;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
   options.progress = !noProgress && isatty(STDERR_FILENO) != 0;
-  const auto outcome = vrflow::run::runApplication(*application, *catalog, options);
+  const auto outcome = vrflow::run::runApplication(*application, catalog, options);
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
   return outcome.exitCode;
 }

@@ -569,7 +569,7 @@ TEST_F(EditorWindow, RunsAnApplicationAndShowsWhatTheRunReported) {
 TEST_F(EditorWindow, ShowsLiveIterationRatesWhileARunGoesOn) {
   QDir::setCurrent(dir_.path());
   // 60 iterations of a relay that waits 25 ms each: the run lasts at least 1.5 s, and the
-  // runtime prints its progress line every second.
+  // runtime writes its statistics to the event stream every second.
   dropFromPalette("module core source", {0, 0});
   dropFromPalette("module core relay", {300, 0});
   dropFromPalette("module core recorder", {600, 0});
@@ -585,6 +585,9 @@ TEST_F(EditorWindow, ShowsLiveIterationRatesWhileARunGoesOn) {
   ASSERT_GE(live.count(), 1) << window_->log()->toPlainText().toStdString();
   EXPECT_EQ(window_->liveRates().count("relay"), 1u);
   EXPECT_EQ(window_->liveRates().count("source"), 1u);
+  EXPECT_GT(window_->liveRates().at("relay"), 0.0);
+  // The rates come from the run's event stream (docs/events.md), not from its progress line.
+  EXPECT_TRUE(window_->log()->toPlainText().contains("--events -"));
   EXPECT_FALSE(window_->log()->toPlainText().contains("[vrflow "));  // not in the log
   EXPECT_EQ(window_->lastRun()->modules.at("relay").iterations, 60);
 }

@@ -30,21 +30,20 @@ void commandLine(std::string_view line) {
     case ControlCommand::Kind::Peer: {
       check(command->peerIndex >= 0 && command->peerPort != 0);
       check(!command->peerAddress.empty() && command->peerAddress.find(' ') == std::string::npos);
-      const std::string again = "peer " + std::to_string(command->peerIndex) + " " +
-                                command->peerAddress + " " + std::to_string(command->peerPort);
-      auto reparsed = vrflow::net::parseControlCommand(again);
+      auto reparsed = vrflow::net::parseControlCommand(vrflow::net::toLine(*command));
       check(reparsed.ok() && reparsed->peerIndex == command->peerIndex &&
             reparsed->peerAddress == command->peerAddress &&
             reparsed->peerPort == command->peerPort);
       break;
     }
     case ControlCommand::Kind::Clock: {
-      auto reparsed = vrflow::net::parseControlCommand("clock " + std::to_string(command->clockNs));
+      auto reparsed = vrflow::net::parseControlCommand(vrflow::net::toLine(*command));
       check(reparsed.ok() && reparsed->clockNs == command->clockNs);
       break;
     }
     case ControlCommand::Kind::Secret:
-      check(line == "secret " + command->secretHex);
+    case ControlCommand::Kind::Nonce:
+      check(line == vrflow::net::toLine(*command));
       break;
     default:
       check(line == "connect" || line == "go" || line == "stop" || line == "quit" || line == "eof");
@@ -64,8 +63,7 @@ void eventLine(std::string_view line) {
       break;
     case ControlEvent::Kind::Finished: {
       check(!event->status.empty() && event->status.find(' ') == std::string::npos);
-      auto reparsed = vrflow::net::parseControlEvent(
-          vrflow::net::finishedLine(event->exitCode, event->status, event->text));
+      auto reparsed = vrflow::net::parseControlEvent(vrflow::net::toLine(*event));
       check(reparsed.ok() && reparsed->kind == ControlEvent::Kind::Finished &&
             reparsed->exitCode == event->exitCode && reparsed->status == event->status &&
             reparsed->text == event->text);
@@ -75,6 +73,7 @@ void eventLine(std::string_view line) {
     case ControlEvent::Kind::Report:
     case ControlEvent::Kind::Stats:
     case ControlEvent::Kind::Trace:
+    case ControlEvent::Kind::Event:
       check(!event->text.empty() && line.size() > event->text.size() &&
             line.substr(line.size() - event->text.size()) == event->text);
       break;

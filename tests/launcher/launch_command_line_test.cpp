@@ -65,7 +65,7 @@ TEST_F(LaunchCommandLineTest, HelpListsEveryOptionAndItsReferenceExists) {
   EXPECT_NE(help.out.find("docs/launcher.md"), std::string::npos) << help.out;
   const std::string reference = readFile(sourceDir() + "/docs/launcher.md");
   for (const char* option :
-       {"--hosts", "--backend", "--iterations", "--report", "--trace", "--timeout",
+       {"--hosts", "--backend", "--iterations", "--report", "--trace", "--events", "--timeout",
         "--peer-timeout", "--control-address", "--packages", "--composites", "--set"}) {
     EXPECT_NE(help.out.find(option), std::string::npos) << "launch --help lacks " << option;
     EXPECT_NE(reference.find(std::string("`") + option), std::string::npos)

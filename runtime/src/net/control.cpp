@@ -72,9 +72,15 @@ Result<ControlCommand> parseControlCommand(std::string_view line) {
   if (word == "stop") return bare(ControlCommand::Kind::Stop);
   if (word == "quit") return bare(ControlCommand::Kind::Quit);
   if (word == "secret") {
-    if (args != 1 || extra) return malformed("expected 'secret HEX'", line);
+    if (args != 1 || extra || s.words[1].empty()) return malformed("expected 'secret HEX'", line);
     c.kind = ControlCommand::Kind::Secret;
     c.secretHex = std::string(s.words[1]);
+    return c;
+  }
+  if (word == "nonce") {
+    if (args != 1 || extra || s.words[1].empty()) return malformed("expected 'nonce HEX'", line);
+    c.kind = ControlCommand::Kind::Nonce;
+    c.nonceHex = std::string(s.words[1]);
     return c;
   }
   if (word == "clock") {
@@ -117,6 +123,17 @@ Result<ControlEvent> parseControlEvent(std::string_view line) {
   if (word == "report") return payload(ControlEvent::Kind::Report);
   if (word == "stats") return payload(ControlEvent::Kind::Stats);
   if (word == "trace") return payload(ControlEvent::Kind::Trace);
+  if (word == "event") return payload(ControlEvent::Kind::Event);
+  if (word == "hello") {
+    const Split s = split(line, 3);
+    if (s.words.size() != 3 || s.hasRest || !number(s.words[1], e.hostIndex) || e.hostIndex < 0 ||
+        s.words[2].empty()) {
+      return malformed("expected 'hello INDEX PROOF'", line);
+    }
+    e.kind = ControlEvent::Kind::Hello;
+    e.text = std::string(s.words[2]);
+    return e;
+  }
   if (word == "listening") {
     const Split s = split(line, 2);
     if (s.words.size() != 2 || s.hasRest || !port(s.words[1], e.port)) {
@@ -148,8 +165,139 @@ Result<ControlEvent> parseControlEvent(std::string_view line) {
   return malformed("unknown control event", line);
 }
 
-std::string finishedLine(int exitCode, const std::string& status, const std::string& error) {
-  return "finished " + std::to_string(exitCode) + " " + status + " " + error;
+ControlCommand ControlCommand::bare(Kind kind) {
+  ControlCommand c;
+  c.kind = kind;
+  return c;
+}
+
+ControlCommand ControlCommand::secret(std::string hex) {
+  ControlCommand c = bare(Kind::Secret);
+  c.secretHex = std::move(hex);
+  return c;
+}
+
+ControlCommand ControlCommand::nonce(std::string hex) {
+  ControlCommand c = bare(Kind::Nonce);
+  c.nonceHex = std::move(hex);
+  return c;
+}
+
+ControlCommand ControlCommand::peer(int index, std::string address, uint16_t port) {
+  ControlCommand c = bare(Kind::Peer);
+  c.peerIndex = index;
+  c.peerAddress = std::move(address);
+  c.peerPort = port;
+  return c;
+}
+
+ControlCommand ControlCommand::clock(int64_t ns) {
+  ControlCommand c = bare(Kind::Clock);
+  c.clockNs = ns;
+  return c;
+}
+
+std::string toLine(const ControlCommand& command) {
+  using Kind = ControlCommand::Kind;
+  switch (command.kind) {
+    case Kind::Secret:
+      return "secret " + command.secretHex;
+    case Kind::Nonce:
+      return "nonce " + command.nonceHex;
+    case Kind::Peer:
+      return "peer " + std::to_string(command.peerIndex) + " " + command.peerAddress + " " +
+             std::to_string(command.peerPort);
+    case Kind::Connect:
+      return "connect";
+    case Kind::Clock:
+      return "clock " + std::to_string(command.clockNs);
+    case Kind::Go:
+      return "go";
+    case Kind::Stop:
+      return "stop";
+    case Kind::Quit:
+      return "quit";
+    case Kind::End:
+      break;
+  }
+  return "eof";
+}
+
+ControlEvent ControlEvent::bare(Kind kind) {
+  ControlEvent e;
+  e.kind = kind;
+  return e;
+}
+
+ControlEvent ControlEvent::hello(int index, std::string proof) {
+  ControlEvent e = bare(Kind::Hello);
+  e.hostIndex = index;
+  e.text = std::move(proof);
+  return e;
+}
+
+ControlEvent ControlEvent::listening(uint16_t port) {
+  ControlEvent e = bare(Kind::Listening);
+  e.port = port;
+  return e;
+}
+
+ControlEvent ControlEvent::error(std::string text) {
+  return payload(Kind::Error, std::move(text));
+}
+
+ControlEvent ControlEvent::finished(int exitCode, std::string status, std::string error) {
+  ControlEvent e = bare(Kind::Finished);
+  e.exitCode = exitCode;
+  e.status = std::move(status);
+  e.text = std::move(error);
+  return e;
+}
+
+ControlEvent ControlEvent::payload(Kind kind, std::string json) {
+  ControlEvent e = bare(kind);
+  e.text = std::move(json);
+  return e;
+}
+
+ControlEvent ControlEvent::clock(int64_t sentNs, int64_t daemonNs) {
+  ControlEvent e = bare(Kind::Clock);
+  e.clockSentNs = sentNs;
+  e.clockDaemonNs = daemonNs;
+  return e;
+}
+
+std::string toLine(const ControlEvent& event) {
+  using Kind = ControlEvent::Kind;
+  // Free text ends the line: a newline in it would start a line of its own.
+  std::string text = event.text;
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  switch (event.kind) {
+    case Kind::Hello:
+      return "hello " + std::to_string(event.hostIndex) + " " + text;
+    case Kind::Listening:
+      return "listening " + std::to_string(event.port);
+    case Kind::Connected:
+      return "connected";
+    case Kind::Stopping:
+      return "stopping";
+    case Kind::Error:
+      return "error " + text;
+    case Kind::Finished:
+      return "finished " + std::to_string(event.exitCode) + " " + event.status + " " + text;
+    case Kind::Report:
+      return "report " + text;
+    case Kind::Stats:
+      return "stats " + text;
+    case Kind::Trace:
+      return "trace " + text;
+    case Kind::Event:
+      return "event " + text;
+    case Kind::Clock:
+      return "clock " + std::to_string(event.clockSentNs) + " " +
+             std::to_string(event.clockDaemonNs);
+  }
+  return {};
 }
 
 }  // namespace vrflow::net

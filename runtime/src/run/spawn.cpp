@@ -3,8 +3,6 @@
 #include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
-#include <sys/prctl.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,6 +13,8 @@
 #include <cstring>
 #include <filesystem>
 
+#include "vrflow/run/process.hpp"
+
 extern char** environ;
 
 namespace vrflow::run {
@@ -22,24 +22,6 @@ namespace vrflow::run {
 Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::string>& args,
                           int inheritFd, const std::vector<std::string>& extraEnvironment,
                           uint64_t memoryLimitBytes) {
-  std::string path = executable;
-  if (path.find('/') == std::string::npos) {  // a bare name: looked up on PATH
-    const char* searchPath = std::getenv("PATH");
-    std::string dirs = searchPath ? searchPath : "/usr/local/bin:/usr/bin:/bin";
-    for (std::size_t start = 0; start <= dirs.size();) {
-      const std::size_t end = std::min(dirs.find(':', start), dirs.size());
-      const std::string candidate = dirs.substr(start, end - start) + "/" + executable;
-      if (access(candidate.c_str(), X_OK) == 0) {
-        path = candidate;
-        break;
-      }
-      start = end + 1;
-    }
-  }
-  if (access(path.c_str(), X_OK) != 0) {
-    return makeError("cannot start '" + executable + "': " + std::strerror(errno));
-  }
-  // Everything the child needs is prepared before fork: after it, only async-signal-safe calls.
   std::vector<std::string> envStrings;
   for (char** e = environ; *e != nullptr; ++e) {
     if (std::strncmp(*e, "VRFLOW_SEGMENT_FD=", 18) == 0 ||
@@ -49,42 +31,13 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
     envStrings.emplace_back(*e);
   }
   for (const auto& e : extraEnvironment) envStrings.push_back(e);
-  std::vector<char*> envp;
-  for (auto& e : envStrings) envp.push_back(e.data());
-  envp.push_back(nullptr);
-  std::vector<std::string> argStrings{path};
-  argStrings.insert(argStrings.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argStrings) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const pid_t parent = getpid();
-
-  const pid_t pid = fork();
-  if (pid < 0) return makeError(std::string("fork failed: ") + std::strerror(errno));
-  if (pid == 0) {
-    setpgid(0, 0);
-    prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (getppid() != parent) _exit(127);  // the runtime died before we set the death signal
-    sigset_t none;
-    sigemptyset(&none);
-    sigprocmask(SIG_SETMASK, &none, nullptr);
-    signal(SIGPIPE, SIG_DFL);
-    if (inheritFd >= 0) fcntl(inheritFd, F_SETFD, 0);
-    if (memoryLimitBytes > 0) {
-      const rlimit limit{memoryLimitBytes, memoryLimitBytes};
-      if (setrlimit(RLIMIT_DATA, &limit) != 0) {
-        const char* text = "vrflow: cannot set the module memory limit (RLIMIT_DATA)\n";
-        (void)!write(2, text, std::strlen(text));
-        _exit(127);
-      }
-    }
-    execve(argv[0], argv.data(), envp.data());
-    const char* text = "vrflow: exec of a module failed\n";
-    (void)!write(2, text, std::strlen(text));
-    _exit(127);
-  }
-  setpgid(pid, pid);  // also from the parent, so there is no window where it is unset
-  return pid;
+  ProcessSettings settings;
+  settings.argv = {executable};
+  settings.argv.insert(settings.argv.end(), args.begin(), args.end());
+  settings.environment = std::move(envStrings);
+  settings.inheritFd = inheritFd;
+  settings.memoryLimitBytes = memoryLimitBytes;
+  return spawnProcess(settings);
 }
 
 namespace {

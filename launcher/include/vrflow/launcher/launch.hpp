@@ -45,6 +45,8 @@ struct LaunchOptions {
   std::vector<std::string> packageDirs, compositeDirs;
   std::vector<std::string> overrides;  ///< `--set ID.PARAM=VALUE`, applied by every daemon
   bool progress = false;
+  /// The launch's event stream, merged from every host's (docs/events.md); null: none.
+  run::EventStream* events = nullptr;
 };
 
 /// Merges the hosts' report shares into one report in the shape `vrflow run` writes (modules,
@@ -61,6 +63,11 @@ Result<std::string> monitorDirectory();
 /// module (iterations/s, wait vs compute, state, CPU, memory), per connection (queue, messages/s,
 /// bytes/s) and per link. Returns 0, or 1 when no launch is running.
 int monitor(bool once, bool json);
+
+/// `vrflow monitor --events FILE|-`: the same table from an event stream (docs/events.md),
+/// redrawn at each statistics event, until its "end" (a file still being written is followed;
+/// `-` reads standard input to its end). `once`: the state at the end of what is there now.
+int monitorEvents(const std::string& source, bool once, bool json);
 
 /// Runs `application` (loaded, expanded and validated) with one daemon per host. Exit codes as
 /// `vrflow run`.

@@ -25,6 +25,7 @@ enum ExitCode : int {
 };
 
 class HostLink;
+class EventStream;
 
 /// How to run an application on this machine.
 struct RunOptions {
@@ -50,6 +51,9 @@ struct RunOptions {
   const app::Application* wholeApplication = nullptr;
   bool trace = false;     ///< record modules' spans (also implied by tracePath)
   std::string tracePath;  ///< Chrome trace-event JSON; empty = none
+  /// Where the run's events go (docs/events.md): started, stats each second, warnings,
+  /// module exits, end; null: nowhere.
+  EventStream* events = nullptr;
 };
 
 /// What happened, for the report and the exit code.
@@ -80,11 +84,6 @@ class HostLink {
   /// About once a second: live counters of this host's modules and connections (JSON).
   virtual void stats(const std::string& json) = 0;
 };
-
-/// The node packages on the search path: `extraDirs` first, then $VRFLOW_PACKAGE_PATH, then
-/// <folder of this executable>/../share/vrflow/packages (the build tree and installs alike);
-/// plus the filter plugins of $VRFLOW_FILTER_PATH.
-Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs);
 
 /// How many iterations each module of the whole `application` runs in `outer` outer
 /// iterations (RunOptions::moduleIterations).
