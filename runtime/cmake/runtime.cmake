@@ -53,8 +53,3 @@ vrflow_add_library(run SHARED
   PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/run
   PUBLIC_DEPS vrflow::daemon vrflow::app vrflow::module
   PRIVATE_DEPS nlohmann_json::nlohmann_json)
-
-# The programs.
-vrflow_add_executable(vrflow SOURCES tools/vrflow_main.cpp DEPS vrflow::run CLI11::CLI11)
-vrflow_add_executable(vrflow-daemon SOURCES tools/daemon_main.cpp tools/control_link.cpp
-  DEPS vrflow::run vrflow::net CLI11::CLI11)

@@ -20,9 +20,7 @@
 #include "vrflow/run/events.hpp"
 #include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
-#ifdef VRFLOW_HAS_LAUNCHER
 #include "vrflow/launcher/launch.hpp"
-#endif
 
 namespace {
 
@@ -186,7 +184,6 @@ int main(int argc, char** argv) {
                   "Write the run's events as JSON lines to FILE, or to stdout with '-' "
                   "(docs/events.md)");
 
-#ifdef VRFLOW_HAS_LAUNCHER
   auto* launch = cli.add_subcommand(
       "launch", "Run an application with one daemon per host (TCP between them)");
   vrflow::launcher::LaunchOptions launchOptions;
@@ -233,7 +230,6 @@ int main(int argc, char** argv) {
   monitorCommand->add_option("--events", monitorSource,
                              "Show an event stream (FILE, or '-' for stdin) instead of the "
                              "running launches (docs/events.md)");
-#endif
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -241,20 +237,16 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
-#ifdef VRFLOW_HAS_LAUNCHER
   if (monitorCommand->parsed()) {
     return monitorSource.empty()
                ? vrflow::launcher::monitor(monitorOnce, monitorJson)
                : vrflow::launcher::monitorEvents(monitorSource, monitorOnce, monitorJson);
   }
-#endif
   SharedOptions shared = before;
   for (const SharedOptions* after : {&validateShared, &expandShared, &runShared}) {
     shared.append(*after);
   }
-#ifdef VRFLOW_HAS_LAUNCHER
   shared.append(launchShared);
-#endif
   if (expand->parsed()) {
     const auto flat = loadFlat(shared.settings(expandFile, /*validate=*/false));
     if (!flat) return 1;
@@ -268,11 +260,9 @@ int main(int argc, char** argv) {
   if (run->parsed()) {
     outputs = {{"report", options.reportPath}, {"trace", options.tracePath}};
   }
-#ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
     outputs = {{"report", launchOptions.reportPath}, {"trace", launchOptions.tracePath}};
   }
-#endif
   std::unique_ptr<vrflow::run::EventStream> events;
   if (!eventsTarget.empty()) {
     if (eventsTarget != "-") {
@@ -291,9 +281,7 @@ int main(int argc, char** argv) {
     // The stream has standard output to itself: what modules print goes to stderr instead.
     if (eventsTarget == "-") dup2(STDERR_FILENO, STDOUT_FILENO);
     options.events = events.get();
-#ifdef VRFLOW_HAS_LAUNCHER
     launchOptions.events = events.get();
-#endif
   }
   for (const auto& [what, path] : outputs) {
     if (const auto problem = outputFileProblem(path)) {
@@ -327,7 +315,6 @@ int main(int argc, char** argv) {
     settings.files = vrflow::app::ModuleFileChecks{};
     return loadFlat(settings, &prepared) ? 0 : invalid(prepared, 1);
   }
-#ifdef VRFLOW_HAS_LAUNCHER
   if (launch->parsed()) {
     auto flat = loadFlat(shared.settings(launchOptions.appFile, /*validate=*/true), &prepared);
     if (!flat) return refused(prepared);
@@ -338,7 +325,6 @@ int main(int argc, char** argv) {
     if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
     return outcome.exitCode;
   }
-#endif
   auto settings = shared.settings(runFile, /*validate=*/true);
   settings.files = vrflow::app::ModuleFileChecks{.executables = true};
   auto application = loadFlat(settings, &prepared);
