@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
-#include "../module/shm_sink.hpp"
 #include "filters/filters.hpp"
+#include "vrflow/ipc/shm_byte_sink.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow::daemon {
@@ -127,7 +127,7 @@ void Node::recordMerge(std::span<const msg::MessageView> views) {
 
 Result<MessageRef> Node::compose(std::size_t sizeHint,
                                  const std::function<void(msg::MessageBuilder&)>& fill) {
-  detail::ShmSink sink(*graph_->segment, std::max<std::size_t>(sizeHint, 128));
+  ipc::ShmByteSink sink(*graph_->segment, std::max<std::size_t>(sizeHint, 128));
   msg::MessageBuilder builder(sink);
   builder.setSource(id_);
   builder.setSendTimeNs(wallNs());

@@ -12,6 +12,7 @@
 #include "vrflow/daemon/filter.hpp"
 #include "vrflow/ipc/control.hpp"
 #include "vrflow/ipc/ring.hpp"
+#include "vrflow/ipc/sink.hpp"
 
 namespace vrflow::daemon {
 
@@ -29,17 +30,9 @@ struct Queue {
   bool isConnection = false;  ///< false for the internal ring -> output-filter hop
 };
 
-/// Where an output's messages go: a filter's queue here, a module's input ring here, or (later)
-/// a peer daemon over the network.
-class Sink {
- public:
-  virtual ~Sink() = default;
-  virtual bool hasSpace() const = 0;
-  virtual void push(MessageRef message) = 0;
-  virtual void close() = 0;
-  /// True when the destination is a module that has ended (what is pushed is dropped).
-  virtual bool ended() const { return false; }
-};
+/// Where an output's messages go: a filter's queue here, a module's input ring here, or a peer
+/// daemon over the network (net::Transport::makeSink).
+using Sink = ipc::Sink;
 
 /// A sink that appends to a queue, honouring its capacity and policy.
 class QueueSink final : public Sink {

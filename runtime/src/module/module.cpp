@@ -16,10 +16,10 @@
 #include <new>
 #include <vector>
 
-#include "shm_sink.hpp"
 #include "vrflow/base/assert.hpp"
 #include "vrflow/ipc/control.hpp"
 #include "vrflow/ipc/ring.hpp"
+#include "vrflow/ipc/shm_byte_sink.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow {
@@ -108,7 +108,7 @@ void markOutOfMemory() {
 
 struct OutgoingMessage::Impl {
   Impl(ipc::Segment& segment, std::size_t hint) : sink(segment, hint), builder(sink) {}
-  detail::ShmSink sink;
+  ipc::ShmByteSink sink;
   msg::MessageBuilder builder;
 };
 
@@ -224,7 +224,7 @@ struct Module::Impl {
   // The endIt signal of the iteration in progress, when the port is connected.
   void sendEndIt() {
     if (endItSlot >= 0 && slot->ports[endItSlot].connected) {
-      detail::ShmSink sink(segment, 64);
+      ipc::ShmByteSink sink(segment, 64);
       msg::MessageBuilder builder(sink);
       builder.setSource(id);
       builder.setIteration(iteration);

@@ -24,9 +24,10 @@
 #include <set>
 #include <thread>
 
-#include "daemon/graph.hpp"
 #include "handshake.hpp"
+#include "vrflow/ipc/block_ref.hpp"
 #include "vrflow/ipc/segment.hpp"
+#include "vrflow/ipc/sink.hpp"
 #include "vrflow/message/reader.hpp"
 
 namespace vrflow::net {
@@ -107,7 +108,7 @@ namespace {
 struct OutItem {
   std::array<std::byte, kFrameHeaderBytes + 64> head{};
   std::size_t headBytes = 0;
-  daemon::MessageRef message;
+  ipc::BlockRef message;
   std::size_t total() const { return headBytes + (message.valid() ? message.size() : 0); }
 };
 
@@ -130,7 +131,7 @@ struct Link {
 
 struct Channel {
   RemoteConnection remote;
-  std::deque<daemon::MessageRef> inbox;  ///< incoming: received, not yet routed
+  std::deque<ipc::BlockRef> inbox;  ///< incoming: received, not yet routed
   bool closedByPeer = false;
   uint32_t creditsToSend = 0;       ///< incoming: messages routed since the last Credit
   std::atomic<int64_t> credits{0};  ///< outgoing: messages the peer can still take
@@ -313,7 +314,7 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
     }
     case FrameType::Message: {
       const uint64_t handle = std::exchange(link.pendingHandle, 0);
-      daemon::MessageRef message(segment, handle);
+      ipc::BlockRef message(segment, handle);
       segment->block(handle).used = header.length;
       auto it = channels.find(header.channel);
       if (it == channels.end() || it->second->remote.outgoing ||
@@ -695,13 +696,13 @@ void Transport::addConnection(const RemoteConnection& connection) {
 
 namespace {
 
-class RemoteSink final : public daemon::Sink {
+class RemoteSink final : public ipc::Sink {
  public:
   RemoteSink(Transport::Impl& transport, Channel& channel) : t_(&transport), c_(&channel) {}
   bool hasSpace() const override {
     return c_->remote.connection.policy != app::QueuePolicy::Block || c_->credits.load() > 0;
   }
-  void push(daemon::MessageRef message) override {
+  void push(ipc::BlockRef message) override {
     if (t_->stopped.load()) return;
     c_->credits.fetch_sub(1);
     {
@@ -747,7 +748,7 @@ class RemoteSink final : public daemon::Sink {
 
 }  // namespace
 
-std::unique_ptr<daemon::Sink> Transport::makeSink(uint32_t channel) {
+std::unique_ptr<ipc::Sink> Transport::makeSink(uint32_t channel) {
   return std::make_unique<RemoteSink>(*impl_, *impl_->channels.at(channel));
 }
 
@@ -810,11 +811,11 @@ Status Transport::connectPeers(const std::vector<PeerAddress>& peers) {
   return makeError("no authenticated link to host(s) " + missing + " within " + text);
 }
 
-std::size_t Transport::receive(uint32_t channel, daemon::Sink& sink, bool& closed) {
+std::size_t Transport::receive(uint32_t channel, ipc::Sink& sink, bool& closed) {
   Impl& t = *impl_;
   if (t.stopped.load()) return 0;
   std::size_t moved = 0;
-  std::deque<daemon::MessageRef> taken;
+  std::deque<ipc::BlockRef> taken;
   {
     std::lock_guard lock(t.mutex);
     if (t.stopped.load()) return 0;
