@@ -5,6 +5,7 @@ vrflow_add_library(runtime
   SOURCES
     src/ipc/doorbell.cpp
     src/ipc/segment.cpp
+    src/ipc/join_contract.cpp
     src/module/message.cpp
     src/module/module.cpp
     src/daemon/filter.cpp

@@ -18,6 +18,7 @@
 
 #include "vrflow/base/assert.hpp"
 #include "vrflow/ipc/control.hpp"
+#include "vrflow/ipc/join_contract.hpp"
 #include "vrflow/ipc/ring.hpp"
 #include "vrflow/ipc/shm_byte_sink.hpp"
 #include "vrflow/message/ids.hpp"
@@ -38,62 +39,6 @@ uint64_t wallNs() {
 }
 
 constexpr int64_t kPollNs = 200'000'000;  // re-check the stop flag at least this often
-
-// The slot index of this module in the run's control table. A module started alone gets it in
-// VRFLOW_MODULE_INDEX; the modules of one MPI job share one mpirun and get the indices of all
-// of them in rank order (VRFLOW_MODULE_INDICES), this process's rank choosing its own.
-Result<long> moduleIndexFromEnvironment() {
-  const char* indices = std::getenv("VRFLOW_MODULE_INDICES");
-  if (indices == nullptr) {
-    const char* index = std::getenv("VRFLOW_MODULE_INDEX");
-    if (index == nullptr) {
-      return makeError(
-          "this program is a vrflow module: start it through an application "
-          "(`vrflow run APP.xml`), not by hand");
-    }
-    return std::atol(index);
-  }
-  const char* rankText = nullptr;
-  const char* rankName = nullptr;
-  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK"}) {
-    if ((rankText = std::getenv(name)) != nullptr) {
-      rankName = name;
-      break;
-    }
-  }
-  const std::string job = std::getenv("VRFLOW_MPI_JOB") != nullptr
-                              ? " '" + std::string(std::getenv("VRFLOW_MPI_JOB")) + "'"
-                              : std::string();
-  if (rankText == nullptr) {
-    return makeError("cannot join the run: this process is a module of MPI job" + job +
-                     " (VRFLOW_MODULE_INDICES=" + indices +
-                     ") but has no MPI rank (neither OMPI_COMM_WORLD_RANK nor PMIX_RANK is set): "
-                     "its ranks are started by the runtime's mpirun");
-  }
-  std::vector<long> list;
-  for (const char* p = indices; *p != '\0';) {
-    char* end = nullptr;
-    errno = 0;
-    const long value = std::strtol(p, &end, 10);
-    if (end == p || errno != 0 || value < 0 || (*end != ',' && *end != '\0')) {
-      return makeError(std::string("cannot join the run: malformed VRFLOW_MODULE_INDICES '") +
-                       indices + "' (expected slot indices separated by ',')");
-    }
-    list.push_back(value);
-    p = *end == ',' ? end + 1 : end;
-  }
-  char* end = nullptr;
-  errno = 0;
-  const long rank = std::strtol(rankText, &end, 10);
-  if (end == rankText || *end != '\0' || errno != 0 || rank < 0 ||
-      rank >= static_cast<long>(list.size())) {
-    return makeError("cannot join the run: MPI rank " + std::string(rankText) + " (" + rankName +
-                     ") is not a rank of MPI job" + job + ", which has " +
-                     std::to_string(list.size()) + " module(s) (VRFLOW_MODULE_INDICES=" + indices +
-                     "): start the job with as many ranks as modules");
-  }
-  return list[static_cast<std::size_t>(rank)];
-}
 
 // The slot of this process's module, marked when operator new finds no memory (the runtime
 // then names its memory limit as the cause of the module's end).
@@ -290,25 +235,20 @@ OutputPort& Module::addOutput(std::string name) {
 
 Status Module::init() {
   Impl& m = *impl_;
-  const char* fdText = std::getenv("VRFLOW_SEGMENT_FD");
-  // A module started through mpirun (which closes inherited descriptors) opens the runtime's
-  // descriptor by its /proc path instead.
-  const char* pathText = std::getenv("VRFLOW_SEGMENT_PATH");
-  if (fdText == nullptr && pathText == nullptr) {
-    return makeError(
-        "this program is a vrflow module: start it through an application "
-        "(`vrflow run APP.xml`), not by hand");
-  }
-  const Result<long> found = moduleIndexFromEnvironment();
+  // The supervisor's contract: which segment, and which slot of it is this module's. A module
+  // of an MPI job takes the slot of its rank.
+  const auto contract = ipc::JoinContract::decodeEnvironment();
+  if (!contract) return contract.error();
+  const auto found = contract->slotIndex([](const char* name) { return std::getenv(name); });
   if (!found) return found.error();
   const long index = *found;
-  int fd = -1;
-  if (fdText != nullptr) {
-    fd = std::atoi(fdText);
-  } else {
-    fd = open(pathText, O_RDWR | O_CLOEXEC);
+  int fd = contract->segmentFd;
+  if (fd < 0) {
+    // A module started through mpirun (which closes inherited descriptors) opens the runtime's
+    // descriptor by its /proc path instead.
+    fd = open(contract->segmentPath.c_str(), O_RDWR | O_CLOEXEC);
     if (fd < 0) {
-      return makeError(std::string("cannot join the run: cannot open ") + pathText + ": " +
+      return makeError("cannot join the run: cannot open " + contract->segmentPath + ": " +
                        std::strerror(errno));
     }
   }

@@ -144,8 +144,7 @@ class Supervisor {
   };
   std::string jobLabel(const app::MpiJob& job, pid_t mpirun) const;
   std::optional<std::string> refusedWithoutMpirun() const;
-  bool startJob(std::size_t jobIndex, int segmentFd, std::vector<std::string> environment,
-                RunOutcome& outcome);
+  bool startJob(std::size_t jobIndex, ipc::JoinContract contract, RunOutcome& outcome);
   void reap(RunOutcome& outcome, bool stopping);
   void stopAll();
   std::size_t liveCount() const;
@@ -307,20 +306,18 @@ std::optional<std::string> Supervisor::refusedWithoutMpirun() const {
 
 // Starts every module of jobs_[jobIndex] as one mpirun; false (and `outcome` says why) when it
 // cannot start.
-bool Supervisor::startJob(std::size_t jobIndex, int segmentFd, std::vector<std::string> environment,
-                          RunOutcome& outcome) {
+bool Supervisor::startJob(std::size_t jobIndex, ipc::JoinContract contract, RunOutcome& outcome) {
   const app::MpiJob& job = jobs_[jobIndex];
   std::vector<int> slots;
   for (const std::size_t m : job.modules) slots.push_back(daemon_.modules()[m].slotIndex);
-  environment.push_back("VRFLOW_MPI_JOB=" + job.name);
+  contract.mpiJob = job.name;
   const auto& first = daemon_.modules()[job.modules.front()];
   auto backing = mpiFolder_.path();
   if (!backing) {
     outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + backing.error().message};
     return false;
   }
-  auto pid = spawnMpiJob(first.executable, slots, segmentFd, environment, *backing,
-                         options_.moduleMemoryBytes);
+  auto pid = spawnMpiJob(first.executable, slots, contract, *backing, options_.moduleMemoryBytes);
   if (!pid) {
     outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + pid.error().message};
     return false;
@@ -649,12 +646,13 @@ RunOutcome Supervisor::run() {
   for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
     if (children_[i].alive) continue;  // started with its MPI job
     const auto& module = daemon_.modules()[i];
-    std::vector<std::string> environment{"VRFLOW_SEGMENT_FD=" + std::to_string(fd),
-                                         "VRFLOW_MODULE_INDEX=" + std::to_string(module.slotIndex),
-                                         "VRFLOW_MODULE_ID=" + module.id,
-                                         "VRFLOW_HOST=" + module.host};
+    ipc::JoinContract contract;
+    contract.segmentFd = fd;
+    contract.moduleIndex = module.slotIndex;
+    contract.moduleId = module.id;
+    contract.host = module.host;
     if (jobOf_[i] >= 0) {
-      if (!startJob(static_cast<std::size_t>(jobOf_[i]), fd, environment, outcome)) break;
+      if (!startJob(static_cast<std::size_t>(jobOf_[i]), contract, outcome)) break;
       continue;
     }
     const bool viaMpirun = module.mpiRanks > 1;  // VRFLOW_MPIRUN=none: refused above
@@ -664,10 +662,10 @@ RunOutcome Supervisor::run() {
                  "module '" + module.id + "': " + backing.error().message};
       break;
     }
-    auto pid =
-        viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, fd, environment, *backing,
-                                   options_.moduleMemoryBytes)
-                  : spawnModule(module.executable, {}, fd, environment, options_.moduleMemoryBytes);
+    auto pid = viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, contract, *backing,
+                                          options_.moduleMemoryBytes)
+                         : spawnModule(module.executable, {}, fd, contract.encode(),
+                                       options_.moduleMemoryBytes);
     if (!pid) {
       outcome = {kExitRunFailed, "failed", "module '" + module.id + "': " + pid.error().message};
       break;
