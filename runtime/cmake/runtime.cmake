@@ -6,6 +6,7 @@ vrflow_add_library(runtime
     src/ipc/doorbell.cpp
     src/ipc/segment.cpp
     src/ipc/join_contract.cpp
+    src/ipc/module_slot.cpp
     src/module/message.cpp
     src/module/module.cpp
     src/daemon/filter.cpp

@@ -31,11 +31,6 @@ uint64_t nowNs() {
                                    .count());
 }
 
-void copyName(char (&dst)[ipc::kNameBytes], const std::string& src) {
-  std::strncpy(dst, src.c_str(), ipc::kNameBytes - 1);
-  dst[ipc::kNameBytes - 1] = '\0';
-}
-
 std::map<std::string, std::string> toMap(const std::vector<app::Param>& params) {
   std::map<std::string, std::string> map;
   for (const auto& p : params) map[p.name] = p.value;
@@ -49,7 +44,8 @@ struct Daemon::Impl {
   ipc::Segment segment;
   std::unique_ptr<Graph> graph;
   std::vector<ModuleProcess> modules;
-  ipc::ModuleSlot* slots = nullptr;
+  ipc::ControlTableDaemon table;
+  std::vector<ipc::ModuleSlotDaemon> slots;  ///< per module
   std::vector<std::atomic<bool>> ended;
   std::vector<std::vector<ipc::RingRef>>
       rings;  ///< per module and port, kept out of modules' reach
@@ -138,18 +134,11 @@ Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& ty
 
 Status Daemon::Impl::build(const app::Application& application, const app::Catalog& catalog) {
   // The control table and one slot per module.
-  const uint64_t tableOffset = segment.reserve(sizeof(ipc::ControlTable));
-  const uint64_t slotsOffset =
-      segment.reserve(sizeof(ipc::ModuleSlot) * application.modules.size());
-  if (tableOffset == 0 || (slotsOffset == 0 && !application.modules.empty())) {
-    return makeError("shared-memory segment too small for the control table");
-  }
-  auto* table = new (segment.at<void>(tableOffset)) ipc::ControlTable();
-  table->moduleCount = static_cast<uint32_t>(application.modules.size());
-  segment.header().idCounter.store(
-      (std::min<uint32_t>(table->moduleCount, ipc::kIdBlockModules) + 1) << ipc::kIdBlockBits);
-  table->modulesOffset = slotsOffset;
-  slots = segment.at<ipc::ModuleSlot>(slotsOffset);
+  const auto moduleCount = static_cast<uint32_t>(application.modules.size());
+  auto created = ipc::ControlTableDaemon::create(segment, moduleCount);
+  if (!created) return created.error();
+  table = *created;
+  for (uint32_t m = 0; m < moduleCount; ++m) slots.push_back(table.slot(static_cast<int>(m)));
   ended = std::vector<std::atomic<bool>>(application.modules.size());
   moduleOutputs.resize(application.modules.size());
   hasDataInputs.resize(application.modules.size());
@@ -176,24 +165,19 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     if (type == nullptr) {
       return makeError("unknown module type '" + module.package + "/" + module.type + "'");
     }
-    auto* slot = new (&slots[m]) ipc::ModuleSlot();
+    ipc::ModuleSlotDaemon& slot = slots[m];
     rings.emplace_back();
     outputNames.emplace_back();
-    for (auto& bucket : slot->histogram) bucket.store(0);
-    copyName(slot->id, module.id);
     const std::string host = app::effectiveHost(application, module.host);
-    copyName(slot->host, host);
-    slot->iterationLimit = options.iterationLimit;
+    uint64_t iterationLimit = options.iterationLimit;
     if (const auto limit = options.moduleIterationLimits.find(module.id);
         limit != options.moduleIterationLimits.end()) {
-      slot->iterationLimit = limit->second;
+      iterationLimit = limit->second;
     }
+    slot.describe(module.id, host, iterationLimit, module.endIt == app::EndItTiming::AfterWait);
     if (options.trace) {
-      slot->traceOffset = segment.reserve(sizeof(ipc::TraceRing));
-      if (slot->traceOffset == 0) return makeError("shared-memory segment too small for tracing");
-      new (segment.at<void>(slot->traceOffset)) ipc::TraceRing();
+      if (auto status = slot.addTraceRing(); !status) return status.error();
     }
-    slot->endItAfterWait = module.endIt == app::EndItTiming::AfterWait ? 1 : 0;
     modules.push_back({module.id, host, type->executable, static_cast<int>(m)});
 
     // Parameters: manifest defaults, overridden by the file.
@@ -221,24 +205,16 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     }
     std::string text;
     for (const auto& [name, value] : values) text += name + "=" + value + "\n";
-    slot->paramsOffset = segment.reserve(text.size() + 1, 8);
-    if (slot->paramsOffset == 0) return makeError("shared-memory segment too small");
-    std::memcpy(segment.at<char>(slot->paramsOffset), text.c_str(), text.size() + 1);
-    slot->paramsBytes = static_cast<uint32_t>(text.size());
+    if (auto status = slot.setParams(text); !status) return status.error();
 
     const auto ports = catalog.portsOf(module);
     if (ports.size() > ipc::kMaxPortsPerModule) {
       return makeError("module '" + module.id + "' has more than " +
                        std::to_string(ipc::kMaxPortsPerModule) + " ports");
     }
-    slot->portCount = static_cast<uint32_t>(ports.size());
     for (std::size_t p = 0; p < ports.size(); ++p) {
       const app::PortSpec& spec = ports[p];
-      ipc::PortSlot& port = slot->ports[p];
-      copyName(port.name, spec.name);
       outputNames[m].push_back(spec.name);
-      port.isInput = spec.isInput ? 1 : 0;
-      port.stampsOnly = spec.stampsOnly ? 1 : 0;
       const auto key = std::make_pair(module.id, spec.name);
       const int fan = spec.isInput ? fanIn[key] : fanOut[key];
       const app::InputConfig* config =
@@ -249,15 +225,13 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
                          "': initial-messages must be 0 to " + std::to_string(kMaxInitialMessages));
       }
       // An input with only initial messages and no connection is still served: it gets them.
-      port.connected = (fan > 0 || initial > 0) ? 1 : 0;
+      const bool connected = fan > 0 || initial > 0;
       uint32_t capacity = spec.isInput ? kInputRingCapacity : kOutputRingCapacity;
       capacity = std::bit_ceil(std::max<uint32_t>(capacity, static_cast<uint32_t>(initial) + 1));
-      port.ringOffset = segment.reserve(ipc::Ring::bytesFor(capacity));
-      if (port.ringOffset == 0) return makeError("shared-memory segment too small for rings");
-      auto* ring = new (segment.at<void>(port.ringOffset)) ipc::Ring();
-      ring->init(capacity);
-      rings[m].emplace_back(ring);
-      if (!port.connected) continue;
+      auto ring = slot.addPort(spec.name, spec.isInput, spec.stampsOnly, connected, capacity);
+      if (!ring) return ring.error();
+      rings[m].push_back(*ring);
+      if (!connected) continue;
 
       const std::string nodeId = module.id + "." + spec.name;
       if (spec.isInput) {
@@ -266,8 +240,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         params["mode"] = latest ? "latest" : "fifo";
         auto node = addNode(nodeId, "port-input", std::move(params), {}, {"out"});
         if (!node) return node.error();
-        (*node)->outputs[0].push_back(
-            std::make_unique<RingSink>(rings[m][p], *slot, static_cast<int>(p), latest, ended[m]));
+        (*node)->outputs[0].push_back(std::make_unique<RingSink>(
+            rings[m][p], slot, static_cast<int>(m), static_cast<int>(p), latest, ended[m]));
         if (!spec.stampsOnly) hasDataInputs[m] = true;
         portNodes[{static_cast<int>(m), spec.name}] = *node;
       } else {
@@ -408,7 +382,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
       queueOwners[input] = node.get();
     }
   }
-  segment.header().controlOffset = tableOffset;
+  table.publish();
   built = true;
   return {};
 }
@@ -419,8 +393,8 @@ ipc::Segment& Daemon::segment() {
 const std::vector<ModuleProcess>& Daemon::modules() const {
   return impl_->modules;
 }
-ipc::ModuleSlot& Daemon::slot(int index) {
-  return impl_->slots[index];
+ipc::ModuleSlotDaemon Daemon::slot(int index) const {
+  return impl_->slots[static_cast<std::size_t>(index)];
 }
 
 Status Daemon::start() {
@@ -441,7 +415,7 @@ void Daemon::moduleEnded(int index) {
 void Daemon::requestStop() {
   Impl& d = *impl_;
   d.segment.header().stopRequested.store(1, std::memory_order_release);
-  for (const auto& module : d.modules) d.slots[module.slotIndex].bell.ring();
+  for (const auto& module : d.modules) d.slots[static_cast<std::size_t>(module.slotIndex)].wake();
   d.segment.header().daemonBell.ring();
 }
 
@@ -508,7 +482,7 @@ bool Daemon::Impl::pass() {
   std::size_t buffered = 0;
   for (auto& source : graph->sources) {
     if (source.closed) continue;
-    ipc::ModuleSlot& slot = slots[source.module];
+    const ipc::ModuleSlotDaemon& slot = slots[static_cast<std::size_t>(source.module)];
     const ipc::RingRef& ring = source.ring;
     bool popped = false;
     uint64_t handle = 0;
@@ -544,11 +518,10 @@ bool Daemon::Impl::pass() {
       popped = true;
       ++graph->operations;
     }
-    if (popped) slot.bell.ring();  // room on the module's output ring
+    if (popped) slot.wake();  // room on the module's output ring
     const bool moduleDone =
         ended[static_cast<std::size_t>(source.module)].load(std::memory_order_acquire) ||
-        slot.state.load(std::memory_order_acquire) ==
-            static_cast<uint32_t>(ipc::ModuleState::Finished);
+        slot.finished();
     if (moduleDone && ring.empty()) {
       source.closed = true;
       source.queue->closed = true;
@@ -676,9 +649,7 @@ void Daemon::Impl::markUnneededModules() {
   std::function<Reach(const Node*)> reachOfNode;
   // What a module's data outputs reach, seen from a producer of it.
   const auto reachOfModule = [&](std::size_t m) -> Reach {
-    if (ended[m].load(std::memory_order_acquire) ||
-        slots[m].state.load(std::memory_order_acquire) ==
-            static_cast<uint32_t>(ipc::ModuleState::Finished)) {
+    if (ended[m].load(std::memory_order_acquire) || slots[m].finished()) {
       return OnlyEnded;
     }
     if (const auto found = moduleMemo.find(m); found != moduleMemo.end()) return found->second;
@@ -699,7 +670,7 @@ void Daemon::Impl::markUnneededModules() {
         for (const auto& sink : sinks) {
           Reach one = Running;
           if (const auto* ring = dynamic_cast<const RingSink*>(sink.get())) {
-            one = reachOfModule(static_cast<std::size_t>(&ring->slot() - slots));
+            one = reachOfModule(static_cast<std::size_t>(ring->module()));
           } else if (const auto* queue = dynamic_cast<const QueueSink*>(sink.get())) {
             const auto owner = queueOwners.find(&queue->queue());
             one = owner == queueOwners.end() ? Running : reachOfNode(owner->second);
@@ -712,16 +683,13 @@ void Daemon::Impl::markUnneededModules() {
     return reach;
   };
   for (std::size_t m = 0; m < moduleOutputs.size(); ++m) {
-    ipc::ModuleSlot& slot = slots[m];
-    if (moduleOutputs[m].empty() || hasDataInputs[m] ||
-        slot.unneeded.load(std::memory_order_relaxed) != 0 || reachOfModule(m) != OnlyEnded ||
-        ended[m].load(std::memory_order_acquire) ||
-        slot.state.load(std::memory_order_acquire) ==
-            static_cast<uint32_t>(ipc::ModuleState::Finished)) {
+    const ipc::ModuleSlotDaemon& slot = slots[m];
+    if (moduleOutputs[m].empty() || hasDataInputs[m] || slot.unneeded() ||
+        reachOfModule(m) != OnlyEnded || ended[m].load(std::memory_order_acquire) ||
+        slot.finished()) {
       continue;
     }
-    slot.unneeded.store(1, std::memory_order_release);
-    slot.bell.ring();
+    slot.markUnneeded();
   }
 }
 

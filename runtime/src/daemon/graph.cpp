@@ -42,13 +42,8 @@ void RingSink::push(MessageRef message) {
   const bool pushed = ring_.push(message.handle());
   if (pushed) {
     message.release();  // the ring holds the reference now
-    slot_->bell.ring();
+    slot_.wake();
   }
-}
-
-void RingSink::close() {
-  slot_->ports[port_].closed.store(1, std::memory_order_release);
-  slot_->bell.ring();
 }
 
 std::string Node::param(const std::string& key, const std::string& fallback) const {

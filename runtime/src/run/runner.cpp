@@ -37,8 +37,8 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-const char* stateName(uint32_t state) {
-  switch (static_cast<ipc::ModuleState>(state)) {
+const char* stateName(ipc::ModuleState state) {
+  switch (state) {
     case ipc::ModuleState::Starting:
       return "starting";
     case ipc::ModuleState::Waiting:
@@ -51,11 +51,6 @@ const char* stateName(uint32_t state) {
       return "finished";
   }
   return "?";
-}
-
-// A port's name as the module's memory holds it (bounded: that memory is the module's to write).
-std::string portName(const ipc::PortSlot& port) {
-  return std::string(port.name, strnlen(port.name, sizeof port.name));
 }
 
 // Who feeds an input port, for deadlock reports: `whole` is the whole application, `local`
@@ -163,14 +158,13 @@ class Supervisor {
   /// Moves what the modules traced into trace_ (no-op when the run is not traced).
   void drainTraces() {
     for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
-      const auto& slot = daemon_.slot(daemon_.modules()[i].slotIndex);
-      if (slot.traceOffset == 0) continue;
+      ipc::TraceRing* ring = daemon_.slot(daemon_.modules()[i].slotIndex).traceRing();
+      if (ring == nullptr) continue;
       if (trace_.modules.size() != daemon_.modules().size()) {
         trace_.modules.clear();
         for (const auto& m : daemon_.modules()) trace_.modules.push_back(m.id);
       }
-      auto& ring = *daemon_.segment().at<ipc::TraceRing>(slot.traceOffset);
-      drainTraceRing(ring, static_cast<uint32_t>(i), trace_);
+      drainTraceRing(*ring, static_cast<uint32_t>(i), trace_);
     }
     for (const auto& merge : daemon_.takeTraceMerges()) {
       if (trace_.merges.size() >= kMaxTraceEventsPerHost) break;
@@ -189,13 +183,13 @@ class Supervisor {
     const long page = sysconf(_SC_PAGESIZE);
     for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
       const auto& module = daemon_.modules()[i];
-      const auto& slot = daemon_.slot(module.slotIndex);
+      const auto slot = daemon_.slot(module.slotIndex);
       nlohmann::json m;
       m["id"] = module.id;
-      m["iterations"] = slot.iterations.load();
-      m["state"] = children_[i].alive ? stateName(slot.state.load()) : "ended";
-      m["compute_ns"] = slot.computeNs.load();
-      m["wait_ns"] = slot.waitNs.load();
+      m["iterations"] = slot.iterations();
+      m["state"] = children_[i].alive ? stateName(slot.state()) : "ended";
+      m["compute_ns"] = slot.computeNs();
+      m["wait_ns"] = slot.waitNs();
       uint64_t cpuNs = 0, rss = 0;
       // A module of an MPI job is its rank's process (it wrote its pid when it joined), not
       // the mpirun it shares with the job's other modules.
@@ -354,11 +348,11 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
                                          : "signal " + std::to_string(WTERMSIG(status));
       daemon_.moduleEnded(static_cast<int>(i));
       const auto& module = daemon_.modules()[i];
-      if (notJoined.empty() && daemon_.slot(module.slotIndex).state.load() ==
-                                   static_cast<uint32_t>(ipc::ModuleState::Starting)) {
+      if (notJoined.empty() &&
+          daemon_.slot(module.slotIndex).state() == ipc::ModuleState::Starting) {
         notJoined = module.id;
       }
-      if (daemon_.slot(module.slotIndex).outOfMemory.load() != 0) {
+      if (daemon_.slot(module.slotIndex).outOfMemory()) {
         child.end.cause = memoryCause();
         if (outOfMemory.empty()) outOfMemory = module.id;
       }
@@ -415,8 +409,7 @@ bool Supervisor::lingering(std::string& detail) {
   for (std::size_t i = 0; i < children_.size() && all; ++i) {
     if (!children_[i].alive) continue;
     const auto& module = daemon_.modules()[i];
-    all = daemon_.slot(module.slotIndex).state.load() ==
-          static_cast<uint32_t>(ipc::ModuleState::Finished);
+    all = daemon_.slot(module.slotIndex).finished();
     names += (names.empty() ? "'" : ", '") + module.id + "'";
   }
   if (!all) {
@@ -434,8 +427,8 @@ bool Supervisor::notJoined(std::string& detail) {
   if (secondsSince(start_) < options_.joinSeconds) return false;
   for (std::size_t i = 0; i < children_.size(); ++i) {
     const auto& module = daemon_.modules()[i];
-    if (children_[i].alive && daemon_.slot(module.slotIndex).state.load() ==
-                                  static_cast<uint32_t>(ipc::ModuleState::Starting)) {
+    if (children_[i].alive &&
+        daemon_.slot(module.slotIndex).state() == ipc::ModuleState::Starting) {
       char text[64];
       std::snprintf(text, sizeof text, "%g s", options_.joinSeconds);
       const int job = children_[i].job;
@@ -454,31 +447,29 @@ bool Supervisor::notJoined(std::string& detail) {
 // The process of module `module`: its own (it wrote its pid when it joined) when it is a rank
 // of an MPI job or of an mpirun of its own, else the one started for it.
 pid_t Supervisor::processOf(std::size_t module) const {
-  const int32_t own = daemon_.slot(daemon_.modules()[module].slotIndex).pid.load();
+  const int32_t own = daemon_.slot(daemon_.modules()[module].slotIndex).pid();
   const Child& child = children_[module];
   return (child.job >= 0 || child.mpiRanks > 1) && own > 0 ? own : child.pid;
 }
 
 // "waits on input 'in' (from src.out) at iteration 3", as the module's slot tells.
 std::string Supervisor::waitDetail(std::size_t module, bool& remote) const {
-  const auto& slot = daemon_.slot(daemon_.modules()[module].slotIndex);
-  int port = slot.waitingPort.load();
-  if (port >= static_cast<int>(std::min<uint32_t>(slot.portCount, ipc::kMaxPortsPerModule)))
-    port = -1;
-  const auto state = static_cast<ipc::ModuleState>(slot.state.load());
+  const auto slot = daemon_.slot(daemon_.modules()[module].slotIndex);
+  const int port = slot.waitingPort();
+  const auto state = slot.state();
   std::string detail;
   if (port >= 0 && state == ipc::ModuleState::Waiting) {
-    const std::string name = portName(slot.ports[port]);
+    const std::string name = slot.portName(port);
     const app::Application& whole =
         options_.wholeApplication != nullptr ? *options_.wholeApplication : application_;
     detail = "waits on input '" + name + "' (" +
              sourcesOf(whole, application_, daemon_.modules()[module].id, name, remote) + ")";
   } else if (port >= 0) {
-    detail = "is blocked sending on '" + portName(slot.ports[port]) + "'";
+    detail = "is blocked sending on '" + slot.portName(port) + "'";
   } else {
-    detail = stateName(slot.state.load());
+    detail = stateName(state);
   }
-  return detail + " at iteration " + std::to_string(slot.iterations.load());
+  return detail + " at iteration " + std::to_string(slot.iterations());
 }
 
 // No module has finished an iteration for options_.deadlockSeconds: a deadlock (every live
@@ -488,7 +479,7 @@ std::string Supervisor::waitDetail(std::size_t module, bool& remote) const {
 std::optional<RunOutcome> Supervisor::noProgress() {
   uint64_t sum = 0;
   for (std::size_t i = 0; i < children_.size(); ++i) {
-    sum += daemon_.slot(daemon_.modules()[i].slotIndex).iterations.load();
+    sum += daemon_.slot(daemon_.modules()[i].slotIndex).iterations();
   }
   const auto now = Clock::now();
   if (sum != lastIterationSum_ || liveCount() == 0) {
@@ -515,7 +506,7 @@ std::optional<RunOutcome> Supervisor::noProgress() {
   for (std::size_t i = 0; i < children_.size(); ++i) {
     if (!children_[i].alive) continue;
     const auto& module = daemon_.modules()[i];
-    const auto state = static_cast<ipc::ModuleState>(daemon_.slot(module.slotIndex).state.load());
+    const auto state = daemon_.slot(module.slotIndex).state();
     const bool inWait = state == ipc::ModuleState::Waiting || state == ipc::ModuleState::Putting;
     const pid_t pid = processOf(i);
     const ProcessSample process = sampleProcess(pid);
@@ -581,7 +572,7 @@ void Supervisor::showProgress(bool final) {
   lastDisplayIterations_.resize(children_.size(), 0);
   for (std::size_t i = 0; i < children_.size(); ++i) {
     const auto& module = daemon_.modules()[i];
-    const uint64_t it = daemon_.slot(module.slotIndex).iterations.load();
+    const uint64_t it = daemon_.slot(module.slotIndex).iterations();
     const double rate = dt > 0 ? static_cast<double>(it - lastDisplayIterations_[i]) / dt : 0.0;
     lastDisplayIterations_[i] = it;
     char text[128];
@@ -799,10 +790,9 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   }
   supervisor.drainTraces();
   for (std::size_t i = 0; i < (*daemon)->modules().size(); ++i) {
-    const auto& slot = (*daemon)->slot((*daemon)->modules()[i].slotIndex);
-    if (slot.traceOffset != 0) {
-      supervisor.trace_.dropped +=
-          (*daemon)->segment().at<ipc::TraceRing>(slot.traceOffset)->dropped.load();
+    if (const ipc::TraceRing* ring =
+            (*daemon)->slot((*daemon)->modules()[i].slotIndex).traceRing()) {
+      supervisor.trace_.dropped += ring->dropped.load();
     }
   }
   if (daemonOptions.trace) {
