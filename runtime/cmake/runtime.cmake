@@ -25,10 +25,15 @@ vrflow_add_library(runtime
     src/daemon/plugin_loader.cpp
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
+    src/daemon/daemon_build.cpp
+    src/daemon/daemon_stats.cpp
+    src/daemon/daemon_reach.cpp
     src/net/control.cpp
     src/net/frame.cpp
     src/net/secret.cpp
     src/net/transport.cpp
+    src/net/transport_links.cpp
+    src/net/transport_io.cpp
     src/run/spawn.cpp
     src/run/report.cpp
     src/run/trace.cpp
