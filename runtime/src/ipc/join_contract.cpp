@@ -41,6 +41,15 @@ Error malformed(const char* name, std::string_view text, const char* expected) {
                "' (expected " + expected + ")"};
 }
 
+// Reads the count `name` when the environment sets it (`text` not null) into `out`.
+Status readCount(const char* name, const char* text, const char* expected, int minimum, int& out) {
+  if (text == nullptr) return {};
+  const auto value = parseCount(text);
+  if (!value || *value < minimum) return malformed(name, text, expected);
+  out = *value;
+  return {};
+}
+
 }  // namespace
 
 std::vector<std::string> JoinContract::encode() const {
@@ -68,10 +77,9 @@ Result<JoinContract> JoinContract::decode(const EnvironmentLookup& lookup) {
   const char* fd = lookup(kSegmentFd);
   const char* path = lookup(kSegmentPath);
   if (fd == nullptr && path == nullptr) return makeError(kStartedByHand);
-  if (fd != nullptr) {
-    const auto value = parseCount(fd);
-    if (!value) return malformed(kSegmentFd, fd, "a descriptor number");
-    contract.segmentFd = *value;
+  if (auto status = readCount(kSegmentFd, fd, "a descriptor number", 0, contract.segmentFd);
+      !status) {
+    return status.error();
   }
   if (path != nullptr) {
     if (*path == '\0') return malformed(kSegmentPath, path, "a path");
@@ -80,10 +88,9 @@ Result<JoinContract> JoinContract::decode(const EnvironmentLookup& lookup) {
   const char* index = lookup(kModuleIndex);
   const char* indices = lookup(kModuleIndices);
   if (index == nullptr && indices == nullptr) return makeError(kStartedByHand);
-  if (index != nullptr) {
-    const auto value = parseCount(index);
-    if (!value) return malformed(kModuleIndex, index, "a slot index");
-    contract.moduleIndex = *value;
+  if (auto status = readCount(kModuleIndex, index, "a slot index", 0, contract.moduleIndex);
+      !status) {
+    return status.error();
   }
   if (indices != nullptr) {
     const std::string_view text(indices);
@@ -100,10 +107,10 @@ Result<JoinContract> JoinContract::decode(const EnvironmentLookup& lookup) {
   if (const char* id = lookup(kModuleId)) contract.moduleId = id;
   if (const char* host = lookup(kHost)) contract.host = host;
   if (const char* job = lookup(kMpiJob)) contract.mpiJob = job;
-  if (const char* ranks = lookup(kMpiRanks)) {
-    const auto value = parseCount(ranks);
-    if (!value || *value == 0) return malformed(kMpiRanks, ranks, "a number of ranks above 0");
-    contract.mpiRanks = *value;
+  if (auto status = readCount(kMpiRanks, lookup(kMpiRanks), "a number of ranks above 0", 1,
+                              contract.mpiRanks);
+      !status) {
+    return status.error();
   }
   return contract;
 }
