@@ -15,16 +15,35 @@ if(VRFLOW_HEAVY_VALIDATION)
   target_compile_definitions(vrflow_warnings INTERFACE VRFLOW_HEAVY_VALIDATION=1)
 endif()
 
-# vrflow_add_library(NAME SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...] [INCLUDE dir])
+# vrflow_add_library(NAME [SHARED] SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...] [INCLUDE dir]
+#                    [PRIVATE_INCLUDE dir]): SHARED makes one of vrflow's layers (docs/architecture.md),
+# a shared library with a version and an soname (libvrflow_NAME.so.0); without it a static
+# library, for what only one program or module links (a node package's solver).
 function(vrflow_add_library name)
-  cmake_parse_arguments(ARG "" "INCLUDE" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
-  add_library(vrflow_${name} STATIC ${ARG_SOURCES})
+  cmake_parse_arguments(ARG "SHARED" "INCLUDE" "PRIVATE_INCLUDE;SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  if(ARG_SHARED)
+    add_library(vrflow_${name} SHARED ${ARG_SOURCES})
+    set_target_properties(vrflow_${name} PROPERTIES VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR})
+    # Calls inside a layer stay direct (no PLT indirection on the message path).
+    target_compile_options(vrflow_${name} PRIVATE -fno-semantic-interposition)
+    # A layer resolves every symbol against itself and the layers below it: an upward call
+    # fails the link instead of waiting for the program that loads it (sanitizer builds leave
+    # their runtime's symbols to the program).
+    if(NOT CMAKE_BUILD_TYPE MATCHES "^(ASAN|TSAN)$")
+      target_link_options(vrflow_${name} PRIVATE -Wl,--no-undefined)
+    endif()
+  else()
+    add_library(vrflow_${name} STATIC ${ARG_SOURCES})
+  endif()
   add_library(vrflow::${name} ALIAS vrflow_${name})
   set_target_properties(vrflow_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON OUTPUT_NAME vrflow_${name})
   if(NOT ARG_INCLUDE)
     set(ARG_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/include)
   endif()
-  target_include_directories(vrflow_${name} PUBLIC ${ARG_INCLUDE} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  if(NOT ARG_PRIVATE_INCLUDE)
+    set(ARG_PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  endif()
+  target_include_directories(vrflow_${name} PUBLIC ${ARG_INCLUDE} PRIVATE ${ARG_PRIVATE_INCLUDE})
   target_link_libraries(vrflow_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE vrflow_warnings ${ARG_PRIVATE_DEPS})
 endfunction()
 
@@ -35,32 +54,13 @@ function(vrflow_add_executable name)
   target_link_libraries(${name} PRIVATE vrflow_warnings ${ARG_DEPS})
 endfunction()
 
-# The vrflow libraries a filter plugin may call, in link order.
-set(VRFLOW_PLUGIN_API_LIBRARIES vrflow_runtime vrflow_app vrflow_message vrflow_base)
-
-# vrflow_add_plugin_host(NAME SOURCES ... [DEPS ...]): a program that loads filter plugins. It
-# links the vrflow libraries whole and exports their symbols (-rdynamic), so that a plugin, which
-# links none of them, finds every public function of the runtime in the process, and there is
-# one copy of each (one FilterRegistry, one object type registry).
-function(vrflow_add_plugin_host name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
-  vrflow_add_executable(${name} SOURCES ${ARG_SOURCES} DEPS ${ARG_DEPS})
-  set_target_properties(${name} PROPERTIES ENABLE_EXPORTS ON)
-  foreach(library IN LISTS VRFLOW_PLUGIN_API_LIBRARIES)
-    target_link_libraries(${name} PRIVATE "$<LINK_LIBRARY:WHOLE_ARCHIVE,${library}>")
-    set_property(TARGET ${name} PROPERTY LINK_LIBRARY_OVERRIDE_${library} WHOLE_ARCHIVE)
-  endforeach()
-endfunction()
-
 # vrflow_add_filter_plugin(NAME SOURCES ... [OUTPUT_DIRECTORY dir]): a filter plugin, a shared
-# library loaded by `vrflow` at run time. It sees the vrflow headers and links no vrflow library
-# (see vrflow_add_plugin_host).
+# library that `vrflow` and `vrflow-daemon` load at run time. It links the filter SDK
+# (libvrflow_daemon.so), which the loading program links too: one copy of each registry.
 function(vrflow_add_filter_plugin name)
   cmake_parse_arguments(ARG "" "OUTPUT_DIRECTORY" "SOURCES" ${ARGN})
   add_library(${name} MODULE ${ARG_SOURCES})
-  target_include_directories(${name} PRIVATE
-    $<TARGET_PROPERTY:vrflow_runtime,INTERFACE_INCLUDE_DIRECTORIES>)
-  target_link_libraries(${name} PRIVATE vrflow_warnings)
+  target_link_libraries(${name} PRIVATE vrflow_warnings vrflow::daemon)
   set_target_properties(${name} PROPERTIES PREFIX "lib")
   if(ARG_OUTPUT_DIRECTORY)
     set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY})

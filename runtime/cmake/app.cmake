@@ -1,6 +1,8 @@
-# vrflow::app — the application model: load, validate and save application files, read node
-# package manifests. Used by the runtime, the launcher and the editor.
-vrflow_add_library(app
+# vrflow::app (libvrflow_app.so) — the application model: load, validate and save application
+# files, read node package manifests. Used by the daemon, the supervisor, the launcher and the
+# editor; never by a module.
+vrflow_add_library(app SHARED
+  PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/app
   SOURCES
     src/app/application_reader.cpp
     src/app/application_writer.cpp
@@ -34,5 +36,5 @@ vrflow_add_library(app
     src/app/validate_cycles.cpp
     src/app/validate_mpi_jobs.cpp
     src/app/xml_out.cpp
-  PUBLIC_DEPS vrflow::base
+  PUBLIC_DEPS vrflow::module
   PRIVATE_DEPS pugixml::pugixml)

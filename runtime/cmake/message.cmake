@@ -1,10 +1,9 @@
-# vrflow::message: the binary message layout (docs/message-layout.md): builder, checked
-# zero-copy reader, object types, ids and digests. Eigen (header-only) does the shape geometry;
-# it stays private: the node packages that include vrflow/message/eigen.hpp (Eigen views of the
-# wire's arrays) link Eigen3::Eigen themselves, and nothing else sees it.
+# The binary message layout (docs/message-layout.md): builder, checked zero-copy reader, object
+# types, ids and digests; part of vrflow::module (cmake/module.cmake). Eigen (header-only) does the
+# shape geometry; it stays private: the node packages that include vrflow/message/eigen.hpp (Eigen
+# views of the wire's arrays) link Eigen3::Eigen themselves, and nothing else sees it.
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
-vrflow_add_library(message
-  SOURCES
+set(vrflow_message_sources
     src/message/builder.cpp
     src/message/builtin_types.cpp
     src/message/shape.cpp
@@ -17,6 +16,4 @@ vrflow_add_library(message
     src/message/object_writer.cpp
     src/message/parse.cpp
     src/message/stamps.cpp
-    src/message/view.cpp
-  PUBLIC_DEPS vrflow::base
-  PRIVATE_DEPS PkgConfig::XXHASH Eigen3::Eigen)
+    src/message/view.cpp)

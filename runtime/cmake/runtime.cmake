@@ -1,14 +1,23 @@
 pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)
 
-# The runtime proper: shared memory, module API, daemon and filters, the run supervisor.
-vrflow_add_library(runtime
+# vrflow::net (libvrflow_net.so): authenticated TCP links between host daemons, their frames, and
+# the launcher <-> daemon control channel.
+vrflow_add_library(net SHARED
   SOURCES
-    src/ipc/doorbell.cpp
-    src/ipc/segment.cpp
-    src/ipc/join_contract.cpp
-    src/ipc/module_slot.cpp
-    src/module/message.cpp
-    src/module/module.cpp
+    src/net/control.cpp
+    src/net/frame.cpp
+    src/net/secret.cpp
+    src/net/transport.cpp
+    src/net/transport_links.cpp
+    src/net/transport_io.cpp
+  PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/net
+  PUBLIC_DEPS vrflow::app vrflow::module
+  PRIVATE_DEPS PkgConfig::SODIUM)
+
+# vrflow::daemon (libvrflow_daemon.so): one host's filter network, the built-in filters and the
+# filter SDK that plugins link (docs/filters.md).
+vrflow_add_library(daemon SHARED
+  SOURCES
     src/daemon/filter.cpp
     src/daemon/builtin_filters.cpp
     src/daemon/filters/common.cpp
@@ -28,20 +37,23 @@ vrflow_add_library(runtime
     src/daemon/daemon_build.cpp
     src/daemon/daemon_stats.cpp
     src/daemon/daemon_reach.cpp
-    src/net/control.cpp
-    src/net/frame.cpp
-    src/net/secret.cpp
-    src/net/transport.cpp
-    src/net/transport_links.cpp
-    src/net/transport_io.cpp
+  PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/daemon
+  PUBLIC_DEPS vrflow::net vrflow::app vrflow::module
+  PRIVATE_DEPS ${CMAKE_DL_LIBS})
+
+# vrflow::run (libvrflow_run.so): the supervisor of one host's share of a run: it starts the
+# modules, watches them, and writes the report.
+vrflow_add_library(run SHARED
+  SOURCES
     src/run/spawn.cpp
     src/run/report.cpp
     src/run/trace.cpp
     src/run/runner.cpp
-  PUBLIC_DEPS vrflow::message vrflow::app vrflow::base Threads::Threads
-  PRIVATE_DEPS nlohmann_json::nlohmann_json PkgConfig::SODIUM ${CMAKE_DL_LIBS})
+  PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/run
+  PUBLIC_DEPS vrflow::daemon vrflow::app vrflow::module
+  PRIVATE_DEPS nlohmann_json::nlohmann_json)
 
-# The programs that load filter plugins export the whole runtime (docs/filters.md, "Plugins").
-vrflow_add_plugin_host(vrflow SOURCES tools/vrflow_main.cpp DEPS CLI11::CLI11)
-vrflow_add_plugin_host(vrflow-daemon SOURCES tools/daemon_main.cpp tools/control_link.cpp
-  DEPS CLI11::CLI11)
+# The programs.
+vrflow_add_executable(vrflow SOURCES tools/vrflow_main.cpp DEPS vrflow::run CLI11::CLI11)
+vrflow_add_executable(vrflow-daemon SOURCES tools/daemon_main.cpp tools/control_link.cpp
+  DEPS vrflow::run vrflow::net CLI11::CLI11)
