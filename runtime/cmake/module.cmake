@@ -8,6 +8,8 @@ vrflow_add_library(module SHARED
     ${vrflow_message_sources}
     src/ipc/doorbell.cpp
     src/ipc/segment.cpp
+    src/ipc/join_contract.cpp
+    src/ipc/module_slot.cpp
     src/module/message.cpp
     src/module/module.cpp
   PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/module

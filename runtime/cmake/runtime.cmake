@@ -8,7 +8,9 @@ vrflow_add_library(net SHARED
     src/net/frame.cpp
     src/net/secret.cpp
     src/net/transport.cpp
-  PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/net ${CMAKE_CURRENT_SOURCE_DIR}/src  # TEMP until item 4
+    src/net/transport_links.cpp
+    src/net/transport_io.cpp
+  PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/net
   PUBLIC_DEPS vrflow::app vrflow::module
   PRIVATE_DEPS PkgConfig::SODIUM)
 
@@ -32,6 +34,9 @@ vrflow_add_library(daemon SHARED
     src/daemon/plugin_loader.cpp
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
+    src/daemon/daemon_build.cpp
+    src/daemon/daemon_stats.cpp
+    src/daemon/daemon_reach.cpp
   PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/daemon
   PUBLIC_DEPS vrflow::net vrflow::app vrflow::module
   PRIVATE_DEPS ${CMAKE_DL_LIBS})

@@ -18,8 +18,8 @@
 #include <optional>
 #include <thread>
 
-#include "daemon/graph.hpp"
 #include "vrflow/ipc/segment.hpp"
+#include "vrflow/ipc/sink.hpp"
 #include "vrflow/message/builder.hpp"
 #include "vrflow/message/byte_sink.hpp"
 #include "vrflow/message/empty_message.hpp"
@@ -72,12 +72,12 @@ int rawConnect(uint16_t port) {
   return fd;
 }
 
-class Collect final : public daemon::Sink {
+class Collect final : public ipc::Sink {
  public:
   bool hasSpace() const override { return true; }
-  void push(daemon::MessageRef message) override { messages.push_back(std::move(message)); }
+  void push(ipc::BlockRef message) override { messages.push_back(std::move(message)); }
   void close() override {}
-  std::vector<daemon::MessageRef> messages;
+  std::vector<ipc::BlockRef> messages;
 };
 
 // Transports a (127.0.0.1) and b (127.0.0.2), each with a segment of `segmentBytes`, sharing
@@ -143,7 +143,7 @@ TEST(Transport, AuthenticatedPeersCarryAMessageIntoTheReceiversSharedMemory) {
   const uint64_t handle = emptyMessageIn(*segA, stamps);
   auto sink = a->makeSink(0);
   ASSERT_TRUE(sink->hasSpace());
-  sink->push(daemon::MessageRef(&*segA, handle));
+  sink->push(ipc::BlockRef(&*segA, handle));
   sink->close();
 
   Collect received;
@@ -172,7 +172,7 @@ TEST(Transport, SettleWaitsUntilWhatCameBeforeThePeersCloseIsRouted) {
 
   const uint64_t handle = emptyMessageIn(*segA, msg::Stamps{});
   auto sink = a->makeSink(0);
-  sink->push(daemon::MessageRef(&*segA, handle));
+  sink->push(ipc::BlockRef(&*segA, handle));
   sink->close();
   EXPECT_TRUE(a->settle(0).empty()) << "the sender closed its side";
   // The message and the close arrive, but nothing routed the message yet: not over (stopping
@@ -218,7 +218,7 @@ TEST(Transport, LargeMessagesArriveIntactAndInOrderUnderCreditFlowControl) {
       ASSERT_NE(handle, 0u);
       std::memcpy(segA->payload(handle), bytes.buffer().data(), used);
       segA->block(handle).used = used;
-      sink->push(daemon::MessageRef(&*segA, handle));
+      sink->push(ipc::BlockRef(&*segA, handle));
       if (++sent == kCount) sink->close();
     }
     b->receive(0, received, closed);
@@ -320,7 +320,7 @@ int serveUnderAttack(int command, int report) {
     bool closed = false;
     auto pump = [&] {
       if (sink->hasSpace()) {
-        sink->push(daemon::MessageRef(&*pair.segA, emptyMessageIn(*pair.segA, msg::Stamps{})));
+        sink->push(ipc::BlockRef(&*pair.segA, emptyMessageIn(*pair.segA, msg::Stamps{})));
       }
       pair.b->receive(0, received, closed);
       total += received.messages.size();

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
-#include "../module/shm_sink.hpp"
 #include "filters/filters.hpp"
+#include "vrflow/ipc/shm_byte_sink.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow::daemon {
@@ -42,13 +42,8 @@ void RingSink::push(MessageRef message) {
   const bool pushed = ring_.push(message.handle());
   if (pushed) {
     message.release();  // the ring holds the reference now
-    slot_->bell.ring();
+    slot_.wake();
   }
-}
-
-void RingSink::close() {
-  slot_->ports[port_].closed.store(1, std::memory_order_release);
-  slot_->bell.ring();
 }
 
 std::string Node::param(const std::string& key, const std::string& fallback) const {
@@ -127,7 +122,7 @@ void Node::recordMerge(std::span<const msg::MessageView> views) {
 
 Result<MessageRef> Node::compose(std::size_t sizeHint,
                                  const std::function<void(msg::MessageBuilder&)>& fill) {
-  detail::ShmSink sink(*graph_->segment, std::max<std::size_t>(sizeHint, 128));
+  ipc::ShmByteSink sink(*graph_->segment, std::max<std::size_t>(sizeHint, 128));
   msg::MessageBuilder builder(sink);
   builder.setSource(id_);
   builder.setSendTimeNs(wallNs());

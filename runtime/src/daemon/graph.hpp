@@ -11,7 +11,9 @@
 #include "vrflow/app/model.hpp"
 #include "vrflow/daemon/filter.hpp"
 #include "vrflow/ipc/control.hpp"
+#include "vrflow/ipc/module_slot_daemon.hpp"
 #include "vrflow/ipc/ring.hpp"
+#include "vrflow/ipc/sink.hpp"
 
 namespace vrflow::daemon {
 
@@ -29,17 +31,9 @@ struct Queue {
   bool isConnection = false;  ///< false for the internal ring -> output-filter hop
 };
 
-/// Where an output's messages go: a filter's queue here, a module's input ring here, or (later)
-/// a peer daemon over the network.
-class Sink {
- public:
-  virtual ~Sink() = default;
-  virtual bool hasSpace() const = 0;
-  virtual void push(MessageRef message) = 0;
-  virtual void close() = 0;
-  /// True when the destination is a module that has ended (what is pushed is dropped).
-  virtual bool ended() const { return false; }
-};
+/// Where an output's messages go: a filter's queue here, a module's input ring here, or a peer
+/// daemon over the network (net::Transport::makeSink).
+using Sink = ipc::Sink;
 
 /// A sink that appends to a queue, honouring its capacity and policy.
 class QueueSink final : public Sink {
@@ -60,10 +54,11 @@ class QueueSink final : public Sink {
 /// A sink that hands messages to a module's input ring and wakes the module.
 class RingSink final : public Sink {
  public:
-  RingSink(ipc::RingRef ring, ipc::ModuleSlot& slot, int port, bool onlyWhenEmpty,
+  RingSink(ipc::RingRef ring, ipc::ModuleSlotDaemon slot, int module, int port, bool onlyWhenEmpty,
            const std::atomic<bool>& moduleEnded)
       : ring_(ring),
-        slot_(&slot),
+        slot_(slot),
+        module_(module),
         port_(port),
         onlyWhenEmpty_(onlyWhenEmpty),
         moduleEnded_(&moduleEnded) {}
@@ -74,25 +69,23 @@ class RingSink final : public Sink {
     if (!space) {
       // Ask the module to ring the daemon when it takes a message; re-check, since it may
       // have taken one before it could see the request.
-      slot_->ports[port_].wantsSpace.store(1, std::memory_order_seq_cst);
-      std::atomic_thread_fence(std::memory_order_seq_cst);
+      slot_.requestSpace(port_);
       return onlyWhenEmpty_ ? ring_.empty() : !ring_.full();
     }
     return true;
   }
   void push(MessageRef message) override;
-  void close() override;
+  void close() override { slot_.closeInput(port_); }
   bool ended() const override {
-    return moduleEnded_->load(std::memory_order_acquire) ||
-           slot_->state.load(std::memory_order_acquire) ==
-               static_cast<uint32_t>(ipc::ModuleState::Finished);
+    return moduleEnded_->load(std::memory_order_acquire) || slot_.finished();
   }
-  /// The module slot it feeds.
-  const ipc::ModuleSlot& slot() const { return *slot_; }
+  /// The index of the module it feeds.
+  int module() const { return module_; }
 
  private:
   ipc::RingRef ring_;
-  ipc::ModuleSlot* slot_;
+  ipc::ModuleSlotDaemon slot_;
+  int module_;
   int port_;
   bool onlyWhenEmpty_;
   const std::atomic<bool>* moduleEnded_;

@@ -16,10 +16,12 @@
 #include <new>
 #include <vector>
 
-#include "shm_sink.hpp"
 #include "vrflow/base/assert.hpp"
 #include "vrflow/ipc/control.hpp"
+#include "vrflow/ipc/join_contract.hpp"
+#include "vrflow/ipc/module_slot_user.hpp"
 #include "vrflow/ipc/ring.hpp"
+#include "vrflow/ipc/shm_byte_sink.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow {
@@ -39,68 +41,12 @@ uint64_t wallNs() {
 
 constexpr int64_t kPollNs = 200'000'000;  // re-check the stop flag at least this often
 
-// The slot index of this module in the run's control table. A module started alone gets it in
-// VRFLOW_MODULE_INDEX; the modules of one MPI job share one mpirun and get the indices of all
-// of them in rank order (VRFLOW_MODULE_INDICES), this process's rank choosing its own.
-Result<long> moduleIndexFromEnvironment() {
-  const char* indices = std::getenv("VRFLOW_MODULE_INDICES");
-  if (indices == nullptr) {
-    const char* index = std::getenv("VRFLOW_MODULE_INDEX");
-    if (index == nullptr) {
-      return makeError(
-          "this program is a vrflow module: start it through an application "
-          "(`vrflow run APP.xml`), not by hand");
-    }
-    return std::atol(index);
-  }
-  const char* rankText = nullptr;
-  const char* rankName = nullptr;
-  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK"}) {
-    if ((rankText = std::getenv(name)) != nullptr) {
-      rankName = name;
-      break;
-    }
-  }
-  const std::string job = std::getenv("VRFLOW_MPI_JOB") != nullptr
-                              ? " '" + std::string(std::getenv("VRFLOW_MPI_JOB")) + "'"
-                              : std::string();
-  if (rankText == nullptr) {
-    return makeError("cannot join the run: this process is a module of MPI job" + job +
-                     " (VRFLOW_MODULE_INDICES=" + indices +
-                     ") but has no MPI rank (neither OMPI_COMM_WORLD_RANK nor PMIX_RANK is set): "
-                     "its ranks are started by the runtime's mpirun");
-  }
-  std::vector<long> list;
-  for (const char* p = indices; *p != '\0';) {
-    char* end = nullptr;
-    errno = 0;
-    const long value = std::strtol(p, &end, 10);
-    if (end == p || errno != 0 || value < 0 || (*end != ',' && *end != '\0')) {
-      return makeError(std::string("cannot join the run: malformed VRFLOW_MODULE_INDICES '") +
-                       indices + "' (expected slot indices separated by ',')");
-    }
-    list.push_back(value);
-    p = *end == ',' ? end + 1 : end;
-  }
-  char* end = nullptr;
-  errno = 0;
-  const long rank = std::strtol(rankText, &end, 10);
-  if (end == rankText || *end != '\0' || errno != 0 || rank < 0 ||
-      rank >= static_cast<long>(list.size())) {
-    return makeError("cannot join the run: MPI rank " + std::string(rankText) + " (" + rankName +
-                     ") is not a rank of MPI job" + job + ", which has " +
-                     std::to_string(list.size()) + " module(s) (VRFLOW_MODULE_INDICES=" + indices +
-                     "): start the job with as many ranks as modules");
-  }
-  return list[static_cast<std::size_t>(rank)];
-}
-
 // The slot of this process's module, marked when operator new finds no memory (the runtime
 // then names its memory limit as the cause of the module's end).
-std::atomic<ipc::ModuleSlot*> slotToMarkOutOfMemory{nullptr};
+std::atomic<ipc::ModuleSlotUser*> slotToMarkOutOfMemory{nullptr};
 
 void markOutOfMemory() {
-  if (auto* slot = slotToMarkOutOfMemory.load()) slot->outOfMemory.store(1);
+  if (auto* slot = slotToMarkOutOfMemory.load()) slot->markOutOfMemory();
   std::set_new_handler(nullptr);  // operator new now throws std::bad_alloc
 }
 
@@ -108,7 +54,7 @@ void markOutOfMemory() {
 
 struct OutgoingMessage::Impl {
   Impl(ipc::Segment& segment, std::size_t hint) : sink(segment, hint), builder(sink) {}
-  detail::ShmSink sink;
+  ipc::ShmByteSink sink;
   msg::MessageBuilder builder;
 };
 
@@ -122,7 +68,7 @@ msg::MessageBuilder& OutgoingMessage::builder() {
 
 struct Module::Impl {
   ipc::Segment segment;
-  ipc::ModuleSlot* slot = nullptr;
+  ipc::ModuleSlotUser slot;
   std::atomic<uint32_t> idNext{0};  // this module's own block of ids (ipc::kIdBlockBits)
   uint32_t idEnd = 0;
   std::string id;
@@ -163,48 +109,19 @@ struct Module::Impl {
   double timeStep = 0.0;
   std::map<std::string, std::string, std::less<>> params;
 
-  ipc::Ring& ring(int portSlot) { return *segment.at<ipc::Ring>(slot->ports[portSlot].ringOffset); }
-  bool stopRequested() const {
-    return segment.header().stopRequested.load(std::memory_order_acquire) != 0;
-  }
-  // The daemon found that every module this one's outputs reach has ended.
-  bool unneeded() const { return slot->unneeded.load(std::memory_order_acquire) != 0; }
-  int findPort(std::string_view name, bool input) const {
-    for (uint32_t i = 0; i < slot->portCount; ++i) {
-      const auto& port = slot->ports[i];
-      if ((port.isInput != 0) == input && name == port.name) return static_cast<int>(i);
-    }
-    return -1;
-  }
-  void setState(ipc::ModuleState state, int port = -1) {
-    slot->waitingPort.store(port, std::memory_order_relaxed);
-    slot->state.store(static_cast<uint32_t>(state), std::memory_order_release);
-  }
+  bool stopRequested() const { return slot.stopRequested(); }
+  void setState(ipc::ModuleState state, int port = -1) { slot.setState(state, port); }
   // Pushes a handle on an output ring, sleeping while it is full. False if the run stops.
   bool push(int portSlot, uint64_t handle) {
-    auto& port = slot->ports[portSlot];
-    if (!port.connected) {
+    if (!slot.portConnected(portSlot)) {
       segment.release(handle);  // nothing listens: dropped here, as the output filter would
       return true;
     }
-    ipc::Ring& out = ring(portSlot);
-    // Read before the push: from then on the daemon holds the block and may free it.
-    const uint64_t bytes = segment.block(handle).used;
     // Traced: the send time is taken before the push (a receiver may wake at once), with the
     // stamps that name the message, which differ from this module's when it forwards one.
     TraceEvent sent{};
     if (trace != nullptr) sent = sentEvent(handle);
-    segment.handOver(handle);
-    setState(ipc::ModuleState::Putting, portSlot);
-    while (!out.push(handle)) {
-      const uint32_t seen = slot->bell.prepare();
-      if (stopRequested()) return false;
-      if (out.push(handle)) break;
-      slot->bell.sleep(seen, kPollNs);
-    }
-    port.messages.fetch_add(1, std::memory_order_relaxed);
-    port.bytes.fetch_add(bytes, std::memory_order_relaxed);
-    segment.header().daemonBell.ring();
+    if (!slot.put(portSlot, handle, kPollNs)) return false;
     if (trace != nullptr) trace->record(sent);
     setState(ipc::ModuleState::Computing);
     return true;
@@ -213,18 +130,17 @@ struct Module::Impl {
   void endIteration() {
     const uint64_t now = nowNs();
     const uint64_t took = now - iterationStartNs;
-    slot->computeNs.fetch_add(took, std::memory_order_relaxed);
-    slot->histogram[ipc::histogramBucket(took)].fetch_add(1, std::memory_order_relaxed);
+    slot.addCompute(took);
     traceEvent(ipc::TraceKind::Compute, iterationStartNs, now);
-    if (slot->endItAfterWait == 0) sendEndIt();
+    if (!slot.endItAfterWait()) sendEndIt();
     inIteration = false;
     ++iteration;
-    slot->iterations.store(iteration, std::memory_order_release);
+    slot.setIterations(iteration);
   }
   // The endIt signal of the iteration in progress, when the port is connected.
   void sendEndIt() {
-    if (endItSlot >= 0 && slot->ports[endItSlot].connected) {
-      detail::ShmSink sink(segment, 64);
+    if (endItSlot >= 0 && slot.portConnected(endItSlot)) {
+      ipc::ShmByteSink sink(segment, 64);
       msg::MessageBuilder builder(sink);
       builder.setSource(id);
       builder.setIteration(iteration);
@@ -249,24 +165,22 @@ struct Module::Impl {
   void finish(ipc::EndCause cause) {
     if (finished) return;
     finished = true;
-    slot->endCause.store(static_cast<uint32_t>(cause), std::memory_order_release);
     current.clear();
-    setState(ipc::ModuleState::Finished);
-    segment.header().daemonBell.ring();
+    slot.finish(cause);
   }
 };
 
 bool InputPort::connected() const {
-  return module_->impl_->slot && slot_ >= 0 && module_->impl_->slot->ports[slot_].connected;
+  return module_->impl_->slot.joined() && slot_ >= 0 && module_->impl_->slot.portConnected(slot_);
 }
 bool OutputPort::connected() const {
-  return module_->impl_->slot && slot_ >= 0 && module_->impl_->slot->ports[slot_].connected;
+  return module_->impl_->slot.joined() && slot_ >= 0 && module_->impl_->slot.portConnected(slot_);
 }
 
 Module::Module() : impl_(std::make_unique<Impl>()) {}
 
 Module::~Module() {
-  if (impl_->slot == nullptr) return;
+  if (!impl_->slot.joined()) return;
   // Leaving the loop ends the iteration in progress: it counts (docs/module-api.md).
   if (impl_->inIteration) impl_->endIteration();
   impl_->finish(ipc::EndCause::LeftLoop);
@@ -290,25 +204,20 @@ OutputPort& Module::addOutput(std::string name) {
 
 Status Module::init() {
   Impl& m = *impl_;
-  const char* fdText = std::getenv("VRFLOW_SEGMENT_FD");
-  // A module started through mpirun (which closes inherited descriptors) opens the runtime's
-  // descriptor by its /proc path instead.
-  const char* pathText = std::getenv("VRFLOW_SEGMENT_PATH");
-  if (fdText == nullptr && pathText == nullptr) {
-    return makeError(
-        "this program is a vrflow module: start it through an application "
-        "(`vrflow run APP.xml`), not by hand");
-  }
-  const Result<long> found = moduleIndexFromEnvironment();
+  // The supervisor's contract: which segment, and which slot of it is this module's. A module
+  // of an MPI job takes the slot of its rank.
+  const auto contract = ipc::JoinContract::decodeEnvironment();
+  if (!contract) return contract.error();
+  const auto found = contract->slotIndex([](const char* name) { return std::getenv(name); });
   if (!found) return found.error();
   const long index = *found;
-  int fd = -1;
-  if (fdText != nullptr) {
-    fd = std::atoi(fdText);
-  } else {
-    fd = open(pathText, O_RDWR | O_CLOEXEC);
+  int fd = contract->segmentFd;
+  if (fd < 0) {
+    // A module started through mpirun (which closes inherited descriptors) opens the runtime's
+    // descriptor by its /proc path instead.
+    fd = open(contract->segmentPath.c_str(), O_RDWR | O_CLOEXEC);
     if (fd < 0) {
-      return makeError(std::string("cannot join the run: cannot open ") + pathText + ": " +
+      return makeError("cannot join the run: cannot open " + contract->segmentPath + ": " +
                        std::strerror(errno));
     }
   }
@@ -319,31 +228,23 @@ Status Module::init() {
   prctl(PR_SET_PDEATHSIG, SIGKILL);
   fcntl(fd, F_SETFD, FD_CLOEXEC);
   m.segment = std::move(*segment);
-  const auto offset = m.segment.header().controlOffset;
-  if (offset == 0 || !m.segment.contains(offset, sizeof(ipc::ControlTable))) {
-    return makeError("cannot join the run: the segment has no control table");
-  }
-  const auto& table = *m.segment.at<ipc::ControlTable>(offset);
-  if (index < 0 || index >= static_cast<long>(table.moduleCount)) {
-    return makeError("cannot join the run: module index out of range");
-  }
-  m.slot = m.segment.at<ipc::ModuleSlot>(table.modulesOffset) + index;
+  auto slot = ipc::ModuleSlotUser::join(m.segment, index);
+  if (!slot) return slot.error();
+  m.slot = *slot;
   if (index < static_cast<long>(ipc::kIdBlockModules)) {
     const auto block = static_cast<uint32_t>(index + 1);
     m.idNext.store(block << ipc::kIdBlockBits);
     m.idEnd = (block + 1) << ipc::kIdBlockBits;
   }
-  m.id = m.slot->id;
-  m.slot->pid.store(static_cast<int32_t>(getpid()));
-  slotToMarkOutOfMemory.store(m.slot);
+  m.id = m.slot.id();
+  m.slot.setPid(static_cast<int32_t>(getpid()));
+  slotToMarkOutOfMemory.store(&m.slot);
   if (std::get_new_handler() == nullptr) std::set_new_handler(&markOutOfMemory);
-  m.current.resize(m.slot->portCount);
-  if (m.slot->traceOffset != 0 && m.segment.contains(m.slot->traceOffset, sizeof(ipc::TraceRing))) {
-    m.trace = m.segment.at<ipc::TraceRing>(m.slot->traceOffset);
-  }
+  m.current.resize(static_cast<std::size_t>(m.slot.portCount()));
+  m.trace = m.slot.traceRing();
 
   // Parameters: "name=value" lines.
-  std::string_view text(m.segment.at<char>(m.slot->paramsOffset), m.slot->paramsBytes);
+  std::string_view text = m.slot.paramsText();
   while (!text.empty()) {
     const auto eol = text.find('\n');
     const auto line = text.substr(0, eol);
@@ -354,9 +255,9 @@ Status Module::init() {
   }
 
   // Match declared ports with the run's.
-  std::vector<bool> declared(m.slot->portCount, false);
+  std::vector<bool> declared(static_cast<std::size_t>(m.slot.portCount()), false);
   for (auto& port : m.inputs) {
-    port.slot_ = m.findPort(port.name_, true);
+    port.slot_ = m.slot.findPort(port.name_, true);
     if (port.slot_ < 0) {
       return makeError("module '" + m.id + "' declares input port '" + port.name_ +
                        "' that its package manifest does not list");
@@ -364,23 +265,24 @@ Status Module::init() {
     declared[static_cast<std::size_t>(port.slot_)] = true;
   }
   for (auto& port : m.outputs) {
-    port.slot_ = m.findPort(port.name_, false);
+    port.slot_ = m.slot.findPort(port.name_, false);
     if (port.slot_ < 0) {
       return makeError("module '" + m.id + "' declares output port '" + port.name_ +
                        "' that its package manifest does not list");
     }
     declared[static_cast<std::size_t>(port.slot_)] = true;
   }
-  for (uint32_t i = 0; i < m.slot->portCount; ++i) {
-    const auto& port = m.slot->ports[i];
-    const std::string_view name = port.name;
+  for (int i = 0; i < m.slot.portCount(); ++i) {
+    const std::string_view name = m.slot.portName(i);
+    const bool isInput = m.slot.portIsInput(i);
+    const bool connected = m.slot.portConnected(i);
     const bool implicit = name == "beginIt" || name == "endIt";
-    if (name == "endIt" && !port.isInput) m.endItSlot = static_cast<int>(i);
-    if (!declared[i] && !implicit && port.connected) {
+    if (name == "endIt" && !isInput) m.endItSlot = i;
+    if (!declared[static_cast<std::size_t>(i)] && !implicit && connected) {
       return makeError("module '" + m.id + "' does not declare port '" + std::string(name) +
                        "' that the application connects");
     }
-    if (port.isInput && port.connected) m.waitOrder.push_back(static_cast<int>(i));
+    if (isInput && connected) m.waitOrder.push_back(i);
   }
   m.initialized = true;
   m.setState(ipc::ModuleState::Computing);
@@ -392,50 +294,43 @@ bool Module::wait() {
   VRFLOW_ASSERT(m.initialized, "call init() before wait()");
   if (m.finished) return false;
   if (m.inIteration) m.endIteration();
-  if (m.slot->iterationLimit != 0 && m.iteration >= m.slot->iterationLimit) {
+  if (m.slot.iterationLimit() != 0 && m.iteration >= m.slot.iterationLimit()) {
     m.finish(ipc::EndCause::IterationLimit);
     return false;
   }
   // Waiting on an input sees a stop request; a module without connected inputs sees it here
   // (or it would run until killed).
-  if (m.waitOrder.empty() && (m.stopRequested() || m.unneeded())) {
+  if (m.waitOrder.empty() && (m.stopRequested() || m.slot.unneeded())) {
     m.finish(m.stopRequested() ? ipc::EndCause::RunStopped : ipc::EndCause::Unneeded);
     return false;
   }
   const uint64_t waitStart = nowNs();
   for (const int portSlot : m.waitOrder) {
-    auto& port = m.slot->ports[portSlot];
-    ipc::Ring& in = m.ring(portSlot);
-    m.setState(ipc::ModuleState::Waiting, portSlot);
     uint64_t handle = 0;
-    for (;;) {
-      const uint32_t seen = m.slot->bell.prepare();
-      if (m.stopRequested() || m.unneeded()) {
-        m.finish(m.stopRequested() ? ipc::EndCause::RunStopped : ipc::EndCause::Unneeded);
+    switch (m.slot.take(portSlot, handle, kPollNs)) {
+      case ipc::ModuleSlotUser::Take::Message:
+        break;
+      case ipc::ModuleSlotUser::Take::RunStopped:
+        m.finish(ipc::EndCause::RunStopped);
         return false;
-      }
-      if (in.pop(handle)) break;
-      if (port.closed.load(std::memory_order_acquire) != 0 && in.empty()) {
+      case ipc::ModuleSlotUser::Take::Unneeded:
+        m.finish(ipc::EndCause::Unneeded);
+        return false;
+      case ipc::ModuleSlotUser::Take::EndOfInput:
         m.finish(ipc::EndCause::EndOfInput);  // every upstream module has ended
         return false;
-      }
-      m.slot->bell.sleep(seen, kPollNs);
-    }
-    // Room freed on this ring: wake the daemon only if it is waiting for it.
-    std::atomic_thread_fence(std::memory_order_seq_cst);
-    if (port.wantsSpace.load(std::memory_order_seq_cst) != 0 && port.wantsSpace.exchange(0) != 0) {
-      m.segment.header().daemonBell.ring();
     }
     auto message = Message::adopt(m.segment, handle);
     if (!message) {
       std::fprintf(stderr, "vrflow: module '%s': malformed message on input '%s': %s\n",
-                   m.id.c_str(), port.name, message.error().message.c_str());
+                   m.id.c_str(), std::string(m.slot.portName(portSlot)).c_str(),
+                   message.error().message.c_str());
       std::_Exit(3);
     }
     m.current[static_cast<std::size_t>(portSlot)] = std::move(*message);
   }
   const uint64_t now = nowNs();
-  m.slot->waitNs.fetch_add(now - waitStart, std::memory_order_relaxed);
+  m.slot.addWait(now - waitStart);
   if (m.trace != nullptr) {
     m.traceEvent(ipc::TraceKind::Wait, waitStart, now);
     for (const int portSlot : m.waitOrder) {
@@ -453,7 +348,7 @@ bool Module::wait() {
   m.inIteration = true;
   // FlowVR's timing: the signal leaves as the iteration begins, so that a producer paced by it
   // computes its next iteration while this one runs.
-  if (m.slot->endItAfterWait != 0) m.sendEndIt();
+  if (m.slot.endItAfterWait()) m.sendEndIt();
   m.setState(ipc::ModuleState::Computing);
   return true;
 }

@@ -13,14 +13,13 @@ namespace vrflow::run::detail {
 
 void Supervisor::drainTraces() {
   for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
-    const auto& slot = daemon_.slot(daemon_.modules()[i].slotIndex);
-    if (slot.traceOffset == 0) continue;
+    ipc::TraceRing* ring = daemon_.slot(daemon_.modules()[i].slotIndex).traceRing();
+    if (ring == nullptr) continue;
     if (trace_.modules.size() != daemon_.modules().size()) {
       trace_.modules.clear();
       for (const auto& m : daemon_.modules()) trace_.modules.push_back(m.id);
     }
-    auto& ring = *daemon_.segment().at<ipc::TraceRing>(slot.traceOffset);
-    drainTraceRing(ring, static_cast<uint32_t>(i), trace_);
+    drainTraceRing(*ring, static_cast<uint32_t>(i), trace_);
   }
   for (const auto& merge : daemon_.takeTraceMerges()) {
     if (trace_.merges.size() >= kMaxTraceEventsPerHost) break;
@@ -36,13 +35,13 @@ nlohmann::json Supervisor::statsSnapshot() {
   const long page = sysconf(_SC_PAGESIZE);
   for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
     const auto& module = daemon_.modules()[i];
-    const auto& slot = daemon_.slot(module.slotIndex);
+    const auto slot = daemon_.slot(module.slotIndex);
     nlohmann::json m;
     m["id"] = module.id;
-    m["iterations"] = slot.iterations.load();
-    m["state"] = children_[i].alive ? stateName(slot.state.load()) : "ended";
-    m["compute_ns"] = slot.computeNs.load();
-    m["wait_ns"] = slot.waitNs.load();
+    m["iterations"] = slot.iterations();
+    m["state"] = children_[i].alive ? stateName(slot.state()) : "ended";
+    m["compute_ns"] = slot.computeNs();
+    m["wait_ns"] = slot.waitNs();
     uint64_t cpuNs = 0, rss = 0;
     // A module of an MPI job is its rank's process (it wrote its pid when it joined), not
     // the mpirun it shares with the job's other modules.

@@ -7,14 +7,14 @@
 namespace vrflow::run {
 namespace {
 
-double percentileMs(const ipc::ModuleSlot& slot, double fraction) {
+double percentileMs(const ipc::ModuleSlotDaemon& slot, double fraction) {
   uint64_t total = 0;
-  for (const auto& bucket : slot.histogram) total += bucket.load();
+  for (int b = 0; b < ipc::kHistogramBuckets; ++b) total += slot.histogramCount(b);
   if (total == 0) return 0.0;
   const auto target = static_cast<uint64_t>(fraction * static_cast<double>(total) + 0.999999);
   uint64_t seen = 0;
   for (int b = 0; b < ipc::kHistogramBuckets; ++b) {
-    seen += slot.histogram[b].load();
+    seen += slot.histogramCount(b);
     if (seen >= target) return static_cast<double>(ipc::histogramUpperNs(b)) / 1e6;
   }
   return 0.0;
@@ -80,13 +80,13 @@ nlohmann::ordered_json filterStatsJson(const std::vector<daemon::FilterStats>& f
 std::string shortModules(daemon::Daemon& daemon) {
   std::string text;
   for (const auto& module : daemon.modules()) {
-    const ipc::ModuleSlot& slot = daemon.slot(module.slotIndex);
-    const uint64_t done = slot.iterations.load();
-    const uint32_t cause = slot.endCause.load();
+    const ipc::ModuleSlotDaemon slot = daemon.slot(module.slotIndex);
+    const uint64_t done = slot.iterations();
+    const auto cause = static_cast<uint32_t>(slot.endCause());
     // Stopped by the run (an error or Ctrl-C, reported as such) or unneeded: not short.
     const bool counts = cause == static_cast<uint32_t>(ipc::EndCause::EndOfInput) ||
                         cause == static_cast<uint32_t>(ipc::EndCause::LeftLoop);
-    if (slot.iterationLimit == 0 || done >= slot.iterationLimit || !counts) continue;
+    if (slot.iterationLimit() == 0 || done >= slot.iterationLimit() || !counts) continue;
     // A filter or connection that dropped messages on the way explains a short input (a gate,
     // decimate; the report's "filters" and "connections" count them).
     if (cause == static_cast<uint32_t>(ipc::EndCause::EndOfInput) &&
@@ -94,8 +94,8 @@ std::string shortModules(daemon::Daemon& daemon) {
       continue;
     }
     text += (text.empty() ? "" : "; ") + std::string("module '") + module.id + "' did " +
-            std::to_string(done) + " of " + std::to_string(slot.iterationLimit) + " iterations (" +
-            endCauseName(cause) + ")";
+            std::to_string(done) + " of " + std::to_string(slot.iterationLimit()) +
+            " iterations (" + endCauseName(cause) + ")";
   }
   return text;
 }
@@ -116,8 +116,8 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
   ordered_json modules = ordered_json::array();
   for (std::size_t i = 0; i < daemon.modules().size(); ++i) {
     const auto& module = daemon.modules()[i];
-    const ipc::ModuleSlot& slot = daemon.slot(module.slotIndex);
-    const uint64_t iterations = slot.iterations.load();
+    const ipc::ModuleSlotDaemon slot = daemon.slot(module.slotIndex);
+    const uint64_t iterations = slot.iterations();
     ordered_json m;
     m["id"] = module.id;
     m["host"] = module.host;
@@ -128,14 +128,14 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
       m["exit"] = ends[i].exit;
       if (!ends[i].cause.empty()) m["cause"] = ends[i].cause;
     }
-    m["end"] = endCauseName(slot.endCause.load());
+    m["end"] = endCauseName(static_cast<uint32_t>(slot.endCause()));
     ordered_json timing;
-    const double computeS = static_cast<double>(slot.computeNs.load()) / 1e9;
+    const double computeS = static_cast<double>(slot.computeNs()) / 1e9;
     timing["iteration_ms_mean"] =
         iterations ? computeS * 1e3 / static_cast<double>(iterations) : 0.0;
     timing["iteration_ms_p99"] = percentileMs(slot, 0.99);
     timing["compute_s"] = computeS;
-    timing["wait_s"] = static_cast<double>(slot.waitNs.load()) / 1e9;
+    timing["wait_s"] = static_cast<double>(slot.waitNs()) / 1e9;
     m["timing"] = timing;
     modules.push_back(m);
   }

@@ -94,10 +94,9 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
   }
   supervisor.drainTraces();
   for (std::size_t i = 0; i < (*daemon)->modules().size(); ++i) {
-    const auto& slot = (*daemon)->slot((*daemon)->modules()[i].slotIndex);
-    if (slot.traceOffset != 0) {
-      supervisor.trace_.dropped +=
-          (*daemon)->segment().at<ipc::TraceRing>(slot.traceOffset)->dropped.load();
+    if (const ipc::TraceRing* ring =
+            (*daemon)->slot((*daemon)->modules()[i].slotIndex).traceRing()) {
+      supervisor.trace_.dropped += ring->dropped.load();
     }
   }
   if (daemonOptions.trace) {

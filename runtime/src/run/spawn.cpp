@@ -24,9 +24,8 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
                           uint64_t memoryLimitBytes) {
   std::vector<std::string> envStrings;
   for (char** e = environ; *e != nullptr; ++e) {
-    if (std::strncmp(*e, "VRFLOW_SEGMENT_FD=", 18) == 0 ||
-        std::strncmp(*e, "VRFLOW_MODULE_", 14) == 0 || std::strncmp(*e, "VRFLOW_HOST=", 12) == 0) {
-      continue;  // ours are set below; inherited ones would shadow them
+    if (ipc::JoinContract::isContractEntry(*e)) {
+      continue;  // ours are set below; inherited ones would shadow them or join a wrong run
     }
     envStrings.emplace_back(*e);
   }
@@ -43,19 +42,16 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
 namespace {
 
 // Starts `executable` as `ranks` ranks of one job through mpirun (VRFLOW_MPIRUN names another
-// launcher), with `extraEnvironment` exported to every rank (VRFLOW_SEGMENT_FD replaced by
-// VRFLOW_SEGMENT_PATH: mpirun closes inherited descriptors).
-Result<pid_t> spawnMpirun(const std::string& executable, int ranks, int segmentFd,
-                          const std::vector<std::string>& extraEnvironment,
+// launcher), with `contract` exported to every rank (the segment by its /proc path instead of
+// its descriptor: mpirun closes inherited descriptors).
+Result<pid_t> spawnMpirun(const std::string& executable, int ranks, ipc::JoinContract contract,
                           const std::string& backingDir, uint64_t memoryLimitBytes) {
   const char* launcher = std::getenv("VRFLOW_MPIRUN");
   const std::string mpirun = launcher != nullptr && *launcher != '\0' ? launcher : "mpirun";
-  std::vector<std::string> environment;
-  for (const auto& e : extraEnvironment) {
-    if (e.rfind("VRFLOW_SEGMENT_FD=", 0) != 0) environment.push_back(e);
-  }
-  environment.push_back("VRFLOW_SEGMENT_PATH=/proc/" + std::to_string(getpid()) + "/fd/" +
-                        std::to_string(segmentFd));
+  contract.segmentPath =
+      "/proc/" + std::to_string(getpid()) + "/fd/" + std::to_string(contract.segmentFd);
+  contract.segmentFd = -1;
+  std::vector<std::string> environment = contract.encode();
   // More ranks than cores is allowed; ranks that wait yield the core. Root (containers, CI)
   // must be allowed explicitly.
   // CMA single copies need ptrace rights that containers often withhold: copy through the
@@ -78,7 +74,7 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, int segmentF
     environment.push_back("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1");
   }
   for (const auto& e : environment) {
-    if (e.rfind("VRFLOW_", 0) == 0) {
+    if (ipc::JoinContract::isContractEntry(e)) {
       args.push_back("-x");
       args.push_back(e.substr(0, e.find('=')));
     }
@@ -90,12 +86,12 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, int segmentF
 
 }  // namespace
 
-Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segmentFd,
-                             const std::vector<std::string>& extraEnvironment,
-                             const std::string& backingDir, uint64_t memoryLimitBytes) {
-  std::vector<std::string> environment = extraEnvironment;
-  environment.push_back("VRFLOW_MPI_RANKS=" + std::to_string(ranks));
-  auto pid = spawnMpirun(executable, ranks, segmentFd, environment, backingDir, memoryLimitBytes);
+Result<pid_t> spawnMpiModule(const std::string& executable, int ranks,
+                             const ipc::JoinContract& contract, const std::string& backingDir,
+                             uint64_t memoryLimitBytes) {
+  ipc::JoinContract ranksContract = contract;
+  ranksContract.mpiRanks = ranks;
+  auto pid = spawnMpirun(executable, ranks, ranksContract, backingDir, memoryLimitBytes);
   if (!pid) {
     return makeError(pid.error().message + " (a module of " + std::to_string(ranks) +
                      " MPI ranks is started through mpirun: install Open MPI, or set "
@@ -105,22 +101,15 @@ Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segme
 }
 
 Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>& slotIndices,
-                          int segmentFd, const std::vector<std::string>& extraEnvironment,
-                          const std::string& backingDir, uint64_t memoryLimitBytes) {
-  std::string indices;
-  for (const int index : slotIndices) {
-    indices += (indices.empty() ? "" : ",") + std::to_string(index);
-  }
-  std::vector<std::string> environment;
-  for (const auto& e : extraEnvironment) {
-    // One process per module: the modules' own index and id would name rank 0's to every rank.
-    if (e.rfind("VRFLOW_MODULE_INDEX=", 0) != 0 && e.rfind("VRFLOW_MODULE_ID=", 0) != 0) {
-      environment.push_back(e);
-    }
-  }
-  environment.push_back("VRFLOW_MODULE_INDICES=" + indices);
+                          const ipc::JoinContract& contract, const std::string& backingDir,
+                          uint64_t memoryLimitBytes) {
+  ipc::JoinContract jobContract = contract;
+  // One process per module: the modules' own index and id would name rank 0's to every rank.
+  jobContract.moduleIndex = -1;
+  jobContract.moduleId.clear();
+  jobContract.moduleIndices = slotIndices;
   const int ranks = static_cast<int>(slotIndices.size());
-  auto pid = spawnMpirun(executable, ranks, segmentFd, environment, backingDir, memoryLimitBytes);
+  auto pid = spawnMpirun(executable, ranks, jobContract, backingDir, memoryLimitBytes);
   if (!pid) {
     return makeError(pid.error().message + " (an MPI job of " + std::to_string(ranks) +
                      " modules is started through mpirun: install Open MPI, or set "

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+#include "vrflow/ipc/join_contract.hpp"
 
 namespace vrflow::run {
 
@@ -22,24 +23,24 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
 /// environment variable VRFLOW_MPIRUN names another launcher; found on PATH otherwise), as
 /// spawnModule does for one process: the returned pid is mpirun's, in its own process group,
 /// killed if the runtime dies. mpirun closes inherited descriptors, so the ranks get the
-/// segment as VRFLOW_SEGMENT_PATH=/proc/<runtime pid>/fd/<fd> instead (rank 0 opens it and
-/// joins as the module; the others are its workers), and VRFLOW_MPI_RANKS=ranks. Every
-/// VRFLOW_* variable of `extraEnvironment` is exported to the ranks (`-x`).
+/// segment of `contract` by its path (JoinContract::segmentPath = /proc/<runtime pid>/fd/<fd>)
+/// instead (rank 0 opens it and joins as the module; the others are its workers), and
+/// JoinContract::mpiRanks = ranks. The whole contract is exported to the ranks (`-x`).
 /// `backingDir` (see MpiBackingFolder; empty: Open MPI's default, /dev/shm) receives the
 /// shared-memory files of Open MPI's vader transport.
-Result<pid_t> spawnMpiModule(const std::string& executable, int ranks, int segmentFd,
-                             const std::vector<std::string>& extraEnvironment,
-                             const std::string& backingDir, uint64_t memoryLimitBytes = 0);
+Result<pid_t> spawnMpiModule(const std::string& executable, int ranks,
+                             const ipc::JoinContract& contract, const std::string& backingDir,
+                             uint64_t memoryLimitBytes = 0);
 
 /// Starts the modules of one MPI job (app::MpiJob), one per rank, as one `mpirun -np N` of
 /// `executable` with N = slotIndices.size(), the options, launcher and segment path of
 /// spawnMpiModule(). Rank r joins the run as the module of slot slotIndices[r]: the ranks get
-/// VRFLOW_MODULE_INDICES="i0,i1,..." (Module::init() takes the entry of its rank, from
-/// OMPI_COMM_WORLD_RANK or PMIX_RANK) instead of VRFLOW_MODULE_INDEX and VRFLOW_MODULE_ID, and
-/// no VRFLOW_MPI_RANKS (every rank is a module, none a worker).
+/// JoinContract::moduleIndices = slotIndices (Module::init() takes the entry of its rank, from
+/// OMPI_COMM_WORLD_RANK or PMIX_RANK) instead of the contract's moduleIndex and moduleId, and
+/// no mpiRanks (every rank is a module, none a worker).
 Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>& slotIndices,
-                          int segmentFd, const std::vector<std::string>& extraEnvironment,
-                          const std::string& backingDir, uint64_t memoryLimitBytes = 0);
+                          const ipc::JoinContract& contract, const std::string& backingDir,
+                          uint64_t memoryLimitBytes = 0);
 
 /// The folder of a runtime's MPI jobs' shared-memory files (Open MPI's vader segments, which
 /// its ranks cannot unlink when they die with the runtime): /dev/shm/ompi-job.<runtime pid>.XXXXXX,

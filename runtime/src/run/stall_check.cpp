@@ -10,11 +10,6 @@
 namespace vrflow::run::detail {
 namespace {
 
-// A port's name as the module's memory holds it (bounded: that memory is the module's to write).
-std::string portName(const ipc::PortSlot& port) {
-  return std::string(port.name, strnlen(port.name, sizeof port.name));
-}
-
 // Who feeds an input port, for deadlock reports: `whole` is the whole application, `local`
 // this host's share of it (the same under `vrflow run`). Sets `remote` if a feeder is elsewhere.
 std::string sourcesOf(const app::Application& whole, const app::Application& local,
@@ -56,8 +51,8 @@ std::string notRunningReason(char state) {
 
 }  // namespace
 
-const char* stateName(uint32_t state) {
-  switch (static_cast<ipc::ModuleState>(state)) {
+const char* stateName(ipc::ModuleState state) {
+  switch (state) {
     case ipc::ModuleState::Starting:
       return "starting";
     case ipc::ModuleState::Waiting:
@@ -100,8 +95,7 @@ bool Supervisor::lingering(std::string& detail) {
   for (std::size_t i = 0; i < children_.size() && all; ++i) {
     if (!children_[i].alive) continue;
     const auto& module = daemon_.modules()[i];
-    all = daemon_.slot(module.slotIndex).state.load() ==
-          static_cast<uint32_t>(ipc::ModuleState::Finished);
+    all = daemon_.slot(module.slotIndex).finished();
     names += (names.empty() ? "'" : ", '") + module.id + "'";
   }
   if (!all) {
@@ -119,8 +113,8 @@ bool Supervisor::notJoined(std::string& detail) {
   if (secondsSince(start_) < options_.joinSeconds) return false;
   for (std::size_t i = 0; i < children_.size(); ++i) {
     const auto& module = daemon_.modules()[i];
-    if (children_[i].alive && daemon_.slot(module.slotIndex).state.load() ==
-                                  static_cast<uint32_t>(ipc::ModuleState::Starting)) {
+    if (children_[i].alive &&
+        daemon_.slot(module.slotIndex).state() == ipc::ModuleState::Starting) {
       char text[64];
       std::snprintf(text, sizeof text, "%g s", options_.joinSeconds);
       const int job = children_[i].job;
@@ -139,31 +133,29 @@ bool Supervisor::notJoined(std::string& detail) {
 // The process of module `module`: its own (it wrote its pid when it joined) when it is a rank
 // of an MPI job or of an mpirun of its own, else the one started for it.
 pid_t Supervisor::processOf(std::size_t module) const {
-  const int32_t own = daemon_.slot(daemon_.modules()[module].slotIndex).pid.load();
+  const int32_t own = daemon_.slot(daemon_.modules()[module].slotIndex).pid();
   const Child& child = children_[module];
   return (child.job >= 0 || child.mpiRanks > 1) && own > 0 ? own : child.pid;
 }
 
 // "waits on input 'in' (from src.out) at iteration 3", as the module's slot tells.
 std::string Supervisor::waitDetail(std::size_t module, bool& remote) const {
-  const auto& slot = daemon_.slot(daemon_.modules()[module].slotIndex);
-  int port = slot.waitingPort.load();
-  if (port >= static_cast<int>(std::min<uint32_t>(slot.portCount, ipc::kMaxPortsPerModule)))
-    port = -1;
-  const auto state = static_cast<ipc::ModuleState>(slot.state.load());
+  const auto slot = daemon_.slot(daemon_.modules()[module].slotIndex);
+  const int port = slot.waitingPort();
+  const auto state = slot.state();
   std::string detail;
   if (port >= 0 && state == ipc::ModuleState::Waiting) {
-    const std::string name = portName(slot.ports[port]);
+    const std::string name = slot.portName(port);
     const app::Application& whole =
         options_.wholeApplication != nullptr ? *options_.wholeApplication : application_;
     detail = "waits on input '" + name + "' (" +
              sourcesOf(whole, application_, daemon_.modules()[module].id, name, remote) + ")";
   } else if (port >= 0) {
-    detail = "is blocked sending on '" + portName(slot.ports[port]) + "'";
+    detail = "is blocked sending on '" + slot.portName(port) + "'";
   } else {
-    detail = stateName(slot.state.load());
+    detail = stateName(state);
   }
-  return detail + " at iteration " + std::to_string(slot.iterations.load());
+  return detail + " at iteration " + std::to_string(slot.iterations());
 }
 
 // No module has finished an iteration for options_.deadlockSeconds: a deadlock (every live
@@ -173,7 +165,7 @@ std::string Supervisor::waitDetail(std::size_t module, bool& remote) const {
 std::optional<RunOutcome> Supervisor::noProgress() {
   uint64_t sum = 0;
   for (std::size_t i = 0; i < children_.size(); ++i) {
-    sum += daemon_.slot(daemon_.modules()[i].slotIndex).iterations.load();
+    sum += daemon_.slot(daemon_.modules()[i].slotIndex).iterations();
   }
   const auto now = Clock::now();
   if (sum != lastIterationSum_ || liveCount() == 0) {
@@ -200,7 +192,7 @@ std::optional<RunOutcome> Supervisor::noProgress() {
   for (std::size_t i = 0; i < children_.size(); ++i) {
     if (!children_[i].alive) continue;
     const auto& module = daemon_.modules()[i];
-    const auto state = static_cast<ipc::ModuleState>(daemon_.slot(module.slotIndex).state.load());
+    const auto state = daemon_.slot(module.slotIndex).state();
     const bool inWait = state == ipc::ModuleState::Waiting || state == ipc::ModuleState::Putting;
     const pid_t pid = processOf(i);
     const ProcessSample process = sampleProcess(pid);

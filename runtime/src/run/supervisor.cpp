@@ -64,20 +64,18 @@ std::optional<std::string> Supervisor::refusedWithoutMpirun() const {
 
 // Starts every module of jobs_[jobIndex] as one mpirun; false (and `outcome` says why) when it
 // cannot start.
-bool Supervisor::startJob(std::size_t jobIndex, int segmentFd, std::vector<std::string> environment,
-                          RunOutcome& outcome) {
+bool Supervisor::startJob(std::size_t jobIndex, ipc::JoinContract contract, RunOutcome& outcome) {
   const app::MpiJob& job = jobs_[jobIndex];
   std::vector<int> slots;
   for (const std::size_t m : job.modules) slots.push_back(daemon_.modules()[m].slotIndex);
-  environment.push_back("VRFLOW_MPI_JOB=" + job.name);
+  contract.mpiJob = job.name;
   const auto& first = daemon_.modules()[job.modules.front()];
   auto backing = mpiFolder_.path();
   if (!backing) {
     outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + backing.error().message};
     return false;
   }
-  auto pid = spawnMpiJob(first.executable, slots, segmentFd, environment, *backing,
-                         options_.moduleMemoryBytes);
+  auto pid = spawnMpiJob(first.executable, slots, contract, *backing, options_.moduleMemoryBytes);
   if (!pid) {
     outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + pid.error().message};
     return false;
@@ -114,11 +112,11 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
                                          : "signal " + std::to_string(WTERMSIG(status));
       daemon_.moduleEnded(static_cast<int>(i));
       const auto& module = daemon_.modules()[i];
-      if (notJoined.empty() && daemon_.slot(module.slotIndex).state.load() ==
-                                   static_cast<uint32_t>(ipc::ModuleState::Starting)) {
+      if (notJoined.empty() &&
+          daemon_.slot(module.slotIndex).state() == ipc::ModuleState::Starting) {
         notJoined = module.id;
       }
-      if (daemon_.slot(module.slotIndex).outOfMemory.load() != 0) {
+      if (daemon_.slot(module.slotIndex).outOfMemory()) {
         child.end.cause = memoryCause();
         if (outOfMemory.empty()) outOfMemory = module.id;
       }
@@ -218,12 +216,13 @@ RunOutcome Supervisor::run() {
   for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
     if (children_[i].alive) continue;  // started with its MPI job
     const auto& module = daemon_.modules()[i];
-    std::vector<std::string> environment{"VRFLOW_SEGMENT_FD=" + std::to_string(fd),
-                                         "VRFLOW_MODULE_INDEX=" + std::to_string(module.slotIndex),
-                                         "VRFLOW_MODULE_ID=" + module.id,
-                                         "VRFLOW_HOST=" + module.host};
+    ipc::JoinContract contract;
+    contract.segmentFd = fd;
+    contract.moduleIndex = module.slotIndex;
+    contract.moduleId = module.id;
+    contract.host = module.host;
     if (jobOf_[i] >= 0) {
-      if (!startJob(static_cast<std::size_t>(jobOf_[i]), fd, environment, outcome)) break;
+      if (!startJob(static_cast<std::size_t>(jobOf_[i]), contract, outcome)) break;
       continue;
     }
     const bool viaMpirun = module.mpiRanks > 1;  // VRFLOW_MPIRUN=none: refused above
@@ -233,10 +232,10 @@ RunOutcome Supervisor::run() {
                  "module '" + module.id + "': " + backing.error().message};
       break;
     }
-    auto pid =
-        viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, fd, environment, *backing,
-                                   options_.moduleMemoryBytes)
-                  : spawnModule(module.executable, {}, fd, environment, options_.moduleMemoryBytes);
+    auto pid = viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, contract, *backing,
+                                          options_.moduleMemoryBytes)
+                         : spawnModule(module.executable, {}, fd, contract.encode(),
+                                       options_.moduleMemoryBytes);
     if (!pid) {
       outcome = {kExitRunFailed, "failed", "module '" + module.id + "': " + pid.error().message};
       break;

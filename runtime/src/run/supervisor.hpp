@@ -32,7 +32,7 @@ inline double secondsSince(Clock::time_point start) {
 }
 
 /// A module's state in words ("waiting", "blocked sending", ...), from its slot.
-const char* stateName(uint32_t state);
+const char* stateName(ipc::ModuleState state);
 
 /// What /proc/PID/stat says of a process: its state letter (R, S, D, T, t, Z...) and CPU time.
 struct ProcessSample {
@@ -64,8 +64,7 @@ class Supervisor {
   };
   std::string jobLabel(const app::MpiJob& job, pid_t mpirun) const;
   std::optional<std::string> refusedWithoutMpirun() const;
-  bool startJob(std::size_t jobIndex, int segmentFd, std::vector<std::string> environment,
-                RunOutcome& outcome);
+  bool startJob(std::size_t jobIndex, ipc::JoinContract contract, RunOutcome& outcome);
   void reap(RunOutcome& outcome, bool stopping);
   void stopAll();
   std::size_t liveCount() const;

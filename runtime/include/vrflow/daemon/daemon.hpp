@@ -10,6 +10,7 @@
 #include "vrflow/app/model.hpp"
 #include "vrflow/base/result.hpp"
 #include "vrflow/ipc/control.hpp"
+#include "vrflow/ipc/module_slot_daemon.hpp"
 #include "vrflow/ipc/segment.hpp"
 #include "vrflow/net/transport.hpp"
 
@@ -102,7 +103,8 @@ class Daemon {
 
   ipc::Segment& segment();
   const std::vector<ModuleProcess>& modules() const;
-  ipc::ModuleSlot& slot(int index);
+  /// The host side of module slot `index` (ModuleProcess::slotIndex).
+  ipc::ModuleSlotDaemon slot(int index) const;
 
   /// Starts the routing thread (filters' start() run first).
   Status start();

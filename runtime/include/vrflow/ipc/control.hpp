@@ -14,7 +14,7 @@ inline constexpr int kHistogramBuckets = 256;
 /// What a module is doing, as seen by the daemon (for deadlock reports and monitoring).
 enum class ModuleState : uint32_t { Starting = 0, Waiting, Computing, Putting, Finished };
 
-/// Why a module left the run (ModuleSlot::endCause), for the run report.
+/// Why a module left the run (ModuleSlotDaemon::endCause), for the run report.
 enum class EndCause : uint32_t {
   Running = 0,     ///< not ended, or ended without a word (killed, crashed)
   IterationLimit,  ///< wait() returned false at the module's iteration count (--iterations)
@@ -22,45 +22,6 @@ enum class EndCause : uint32_t {
   LeftLoop,        ///< the module left its loop by itself (its Module was destroyed)
   RunStopped,      ///< wait() returned false: the run stopped (Ctrl-C, --timeout, an error)
   Unneeded,        ///< wait() returned false: every module its outputs reach has ended
-};
-
-/// One port of a module, shared between the module and the daemon.
-struct PortSlot {
-  char name[kNameBytes] = {};
-  uint8_t isInput = 0;
-  uint8_t connected = 0;
-  uint8_t stampsOnly = 0;
-  uint8_t pad = 0;
-  std::atomic<uint32_t> closed{0};      ///< input: no message will ever come again
-  std::atomic<uint32_t> wantsSpace{0};  ///< input: the daemon waits for room on this ring
-  uint64_t ringOffset = 0;              ///< input: daemon -> module; output: module -> daemon
-  std::atomic<uint64_t> messages{0};
-  std::atomic<uint64_t> bytes{0};
-};
-
-/// One module process, shared between the module and the daemon.
-struct ModuleSlot {
-  char id[kNameBytes] = {};
-  char host[kNameBytes] = {};
-  uint32_t portCount = 0;
-  uint32_t pad = 0;
-  PortSlot ports[kMaxPortsPerModule];
-  Doorbell bell;                         ///< the daemon rings it when this module may go on
-  std::atomic<uint32_t> state{0};        ///< a ModuleState
-  std::atomic<int32_t> waitingPort{-1};  ///< port index while Waiting/Putting
-  std::atomic<uint64_t> iterations{0};
-  uint64_t iterationLimit = 0;  ///< 0: no limit
-  std::atomic<int32_t> pid{0};
-  uint64_t paramsOffset = 0;  ///< "name=value\n" text
-  uint32_t paramsBytes = 0;
-  std::atomic<uint64_t> computeNs{0};  ///< total time between wait() returning and the next wait()
-  std::atomic<uint64_t> waitNs{0};     ///< total time spent in wait()
-  std::atomic<uint64_t> histogram[kHistogramBuckets];  ///< iteration durations, log-linear buckets
-  uint64_t traceOffset = 0;              ///< a TraceRing when the run is traced; 0: not traced
-  std::atomic<uint32_t> outOfMemory{0};  ///< set by the module when an allocation failed
-  uint32_t endItAfterWait = 0;           ///< 1: endIt leaves as wait() returns (FlowVR)
-  std::atomic<uint32_t> unneeded{0};     ///< 1: the daemon asks it to end (EndCause::Unneeded)
-  std::atomic<uint32_t> endCause{0};     ///< an EndCause, written once as the module ends
 };
 
 /// What a module records when the run is traced (`--trace`), in steady-clock ns.
@@ -109,13 +70,6 @@ struct TraceRing {
     events[h % kTraceCapacity] = event;
     head.store(h + 1, std::memory_order_release);
   }
-};
-
-/// The run's table of modules, at SegmentHeader::controlOffset.
-struct ControlTable {
-  uint32_t moduleCount = 0;
-  uint32_t pad = 0;
-  uint64_t modulesOffset = 0;  ///< ModuleSlot[moduleCount]
 };
 
 /// Bucket of a duration in the log-linear histogram (4 sub-buckets per power of two).

@@ -9,14 +9,9 @@
 
 #include "vrflow/app/model.hpp"
 #include "vrflow/base/result.hpp"
+#include "vrflow/ipc/segment.hpp"
+#include "vrflow/ipc/sink.hpp"
 #include "vrflow/net/frame.hpp"
-
-namespace vrflow::ipc {
-class Segment;
-}
-namespace vrflow::daemon {
-class Sink;
-}
 
 // TCP between host daemons: one authenticated, persistent link per pair of hosts that share a
 // connection; messages of every connection between the two hosts travel on it as frames.
@@ -93,13 +88,13 @@ class Transport {
   void addConnection(const RemoteConnection& connection);
   /// A sink that sends an outgoing connection's messages to its peer (flow-controlled by
   /// credits for the block policy). The Transport must outlive it or be stopped first.
-  std::unique_ptr<daemon::Sink> makeSink(uint32_t channel);
+  std::unique_ptr<ipc::Sink> makeSink(uint32_t channel);
   /// Connects to the peers of higher index and waits until every peer that shares a
   /// connection with this host is linked and authenticated (both directions).
   Status connectPeers(const std::vector<PeerAddress>& peers);
   /// Moves messages received on an incoming connection into `sink` while it has space; sets
   /// `closed` once the peer closed the connection and nothing is left. Returns messages moved.
-  std::size_t receive(uint32_t channel, daemon::Sink& sink, bool& closed);
+  std::size_t receive(uint32_t channel, ipc::Sink& sink, bool& closed);
   /// The first failure of an established link (peer lost, malformed frame), or empty.
   std::string fatalError() const;
   /// Waits up to `seconds` until every connection crossing this host's boundary is over: each

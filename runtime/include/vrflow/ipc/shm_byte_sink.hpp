@@ -1,19 +1,21 @@
 #pragma once
 
 #include <cstring>
+#include <utility>
 
 #include "vrflow/ipc/segment.hpp"
 #include "vrflow/message/builder.hpp"
 
-namespace vrflow::detail {
+namespace vrflow::ipc {
 
-/// A builder's byte sink backed by a shared-memory block; growing moves to a larger block.
-class ShmSink final : public msg::ByteSink {
+/// A message builder's byte sink backed by a shared-memory block; growing moves to a larger
+/// block. Modules and daemon filters write their messages through it.
+class ShmByteSink final : public msg::ByteSink {
  public:
-  ShmSink(ipc::Segment& segment, std::size_t initial) : segment_(&segment) { grow(initial); }
-  ShmSink(const ShmSink&) = delete;
-  ShmSink& operator=(const ShmSink&) = delete;
-  ~ShmSink() override {
+  ShmByteSink(ipc::Segment& segment, std::size_t initial) : segment_(&segment) { grow(initial); }
+  ShmByteSink(const ShmByteSink&) = delete;
+  ShmByteSink& operator=(const ShmByteSink&) = delete;
+  ~ShmByteSink() override {
     if (handle_ != 0) segment_->release(handle_);
   }
 
@@ -39,8 +41,8 @@ class ShmSink final : public msg::ByteSink {
   }
 
  private:
-  ipc::Segment* segment_;
+  Segment* segment_;
   uint64_t handle_ = 0;
 };
 
-}  // namespace vrflow::detail
+}  // namespace vrflow::ipc
