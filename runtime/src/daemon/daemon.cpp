@@ -36,10 +36,9 @@ void copyName(char (&dst)[ipc::kNameBytes], const std::string& src) {
   dst[ipc::kNameBytes - 1] = '\0';
 }
 
-std::map<std::string, std::string> toMap(const std::vector<app::Param>& params) {
-  std::map<std::string, std::string> map;
-  for (const auto& p : params) map[p.name] = p.value;
-  return map;
+// Who a filter node's parameters belong to, as their errors name it.
+std::string filterOwner(const std::string& id, const std::string& type) {
+  return "filter '" + id + "' (" + type + ")";
 }
 
 }  // namespace
@@ -82,9 +81,8 @@ struct Daemon::Impl {
   void markUnneededModules();
 
   Status build(const app::Application& application, const app::Catalog& catalog);
-  Result<Node*> addNode(const std::string& id, const std::string& type,
-                        std::map<std::string, std::string> params, std::vector<std::string> inputs,
-                        std::vector<std::string> outputs);
+  Result<Node*> addNode(const std::string& id, const std::string& type, Parameters params,
+                        std::vector<std::string> inputs, std::vector<std::string> outputs);
   void loop();
   bool pass();
   void checkFullQueues(uint64_t now);
@@ -118,8 +116,7 @@ Result<std::unique_ptr<Daemon>> Daemon::create(const app::Application& applicati
 }
 
 Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& type,
-                                    std::map<std::string, std::string> params,
-                                    std::vector<std::string> inputs,
+                                    Parameters params, std::vector<std::string> inputs,
                                     std::vector<std::string> outputs) {
   const FilterFactory* factory = FilterRegistry::instance().find(type);
   if (factory == nullptr) return makeError("unknown filter type '" + type + "' for '" + id + "'");
@@ -131,6 +128,7 @@ Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& ty
   node->outputs.resize(node->outputNames.size());
   auto filter = (*factory)(*node);
   if (!filter) return filter.error();
+  if (const auto& misread = node->params().firstError()) return *misread;
   node->filter = std::move(*filter);
   graph->nodes.push_back(std::move(node));
   return graph->nodes.back().get();
@@ -196,35 +194,35 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     slot->endItAfterWait = module.endIt == app::EndItTiming::AfterWait ? 1 : 0;
     modules.push_back({module.id, host, type->executable, static_cast<int>(m)});
 
-    // Parameters: manifest defaults, overridden by the file.
-    std::map<std::string, std::string> values;
-    for (const auto& spec : type->params) values[spec.name] = spec.defaultValue;
-    for (const auto& p : module.params) values[p.name] = p.value;
+    // Parameters: typed once, the file's values over the manifest's defaults.
+    auto moduleParams =
+        app::parameterSet(type->params, module.params,
+                          "module '" + module.id + "' (" + type->package + "/" + type->type + ")");
+    if (!moduleParams) return moduleParams.error();
     // A relative path in a file parameter names a file beside the application when one exists
     // there (input data shipped with it); otherwise it stays relative to the working directory
     // (outputs). The same rule as a manifest's executable.
     if (!application.file.empty()) {
       const auto base = std::filesystem::path(application.file).parent_path();
-      for (const auto& spec : type->params) {
-        auto found = values.find(spec.name);
-        if (spec.type != app::ParamType::File || found == values.end() || found->second.empty())
-          continue;
-        const std::filesystem::path path(found->second);
+      for (const auto& [name, entry] : std::map(moduleParams->entries())) {
+        if (entry.type != app::ParamType::File || !entry.value) continue;
+        const std::filesystem::path path(std::get<std::string>(*entry.value));
         std::error_code error;
-        if (path.is_relative() && std::filesystem::is_regular_file(base / path, error)) {
-          found->second = (base / path).lexically_normal().string();
+        if (!path.empty() && path.is_relative() &&
+            std::filesystem::is_regular_file(base / path, error)) {
+          moduleParams->declare(name, entry.type, (base / path).lexically_normal().string());
         }
       }
     }
     if (!type->mpiRanksParam.empty()) {  // validated as an int parameter in range
-      modules.back().mpiRanks = std::max(1, std::atoi(values[type->mpiRanksParam].c_str()));
+      modules.back().mpiRanks = static_cast<int>(
+          std::clamp<int64_t>(moduleParams->getInt(type->mpiRanksParam), 1, 1 << 20));
     }
-    std::string text;
-    for (const auto& [name, value] : values) text += name + "=" + value + "\n";
-    slot->paramsOffset = segment.reserve(text.size() + 1, 8);
+    const std::string bytes = encodeParameters(*moduleParams);
+    slot->paramsOffset = segment.reserve(bytes.size() + 1, 8);
     if (slot->paramsOffset == 0) return makeError("shared-memory segment too small");
-    std::memcpy(segment.at<char>(slot->paramsOffset), text.c_str(), text.size() + 1);
-    slot->paramsBytes = static_cast<uint32_t>(text.size());
+    std::memcpy(segment.at<char>(slot->paramsOffset), bytes.data(), bytes.size());
+    slot->paramsBytes = static_cast<uint32_t>(bytes.size());
 
     const auto ports = catalog.portsOf(module);
     if (ports.size() > ipc::kMaxPortsPerModule) {
@@ -261,9 +259,10 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
 
       const std::string nodeId = module.id + "." + spec.name;
       if (spec.isInput) {
-        std::map<std::string, std::string> params{{"initial", std::to_string(initial)}};
+        Parameters params(filterOwner(nodeId, "port-input"));
+        params.declare("initial", app::ParamType::Int, int64_t{initial});
         const bool latest = config != nullptr && config->mode == app::InputMode::Latest;
-        params["mode"] = latest ? "latest" : "fifo";
+        params.declare("mode", app::ParamType::Enum, std::string(latest ? "latest" : "fifo"));
         auto node = addNode(nodeId, "port-input", std::move(params), {}, {"out"});
         if (!node) return node.error();
         (*node)->outputs[0].push_back(
@@ -271,7 +270,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         if (!spec.stampsOnly) hasDataInputs[m] = true;
         portNodes[{static_cast<int>(m), spec.name}] = *node;
       } else {
-        auto node = addNode(nodeId, "port-output", {}, {"in"}, {"out"});
+        auto node = addNode(nodeId, "port-output", Parameters(filterOwner(nodeId, "port-output")),
+                            {"in"}, {"out"});
         if (!node) return node.error();
         Queue& queue = graph->newQueue();
         queue.capacity = 4;
@@ -292,13 +292,12 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     for (const auto& spec : catalog.portsOf(filter)) {
       (spec.isInput ? inputs : outputs).push_back(spec.name);
     }
-    // Parameters: the catalog's defaults, overridden by the file.
-    std::map<std::string, std::string> params;
-    if (const app::FilterType* type = catalog.findFilter(filter.type)) {
-      for (const auto& spec : type->params) params[spec.name] = spec.defaultValue;
-    }
-    for (auto& [name, value] : toMap(filter.params)) params[name] = value;
-    auto node = addNode(filter.id, filter.type, std::move(params), inputs, outputs);
+    // Parameters: typed once, the file's values over the filter spec's defaults.
+    const app::FilterType* type = catalog.findFilter(filter.type);
+    auto params = app::parameterSet(type != nullptr ? type->params : std::vector<app::ParamSpec>{},
+                                    filter.params, filterOwner(filter.id, filter.type));
+    if (!params) return params.error();
+    auto node = addNode(filter.id, filter.type, std::move(*params), inputs, outputs);
     if (!node) return node.error();
     filterNodes[filter.id] = *node;
   }
@@ -427,6 +426,7 @@ Status Daemon::start() {
   Impl& d = *impl_;
   for (auto& node : d.graph->nodes) {
     if (auto status = node->filter->start(*node); !status) return status;
+    if (const auto& misread = node->params().firstError()) return *misread;
   }
   d.running.store(true);
   d.thread = std::thread([&d] { d.loop(); });

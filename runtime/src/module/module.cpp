@@ -37,6 +37,14 @@ uint64_t wallNs() {
                                    .count());
 }
 
+// A module that reads a parameter its manifest does not declare (or as another type) has a bug
+// the run cannot work around: say so and leave with a non-zero status.
+void exitOnParameterError(const Error& error) {
+  std::fprintf(stderr, "%s\n", error.message.c_str());
+  std::fflush(nullptr);
+  std::_Exit(1);
+}
+
 constexpr int64_t kPollNs = 200'000'000;  // re-check the stop flag at least this often
 
 // The slot index of this module in the run's control table. A module started alone gets it in
@@ -161,7 +169,7 @@ struct Module::Impl {
   }
   double simTime = 0.0;
   double timeStep = 0.0;
-  std::map<std::string, std::string, std::less<>> params;
+  Parameters params{"module (not joined to a run yet)"};
 
   ipc::Ring& ring(int portSlot) { return *segment.at<ipc::Ring>(slot->ports[portSlot].ringOffset); }
   bool stopRequested() const {
@@ -342,16 +350,15 @@ Status Module::init() {
     m.trace = m.segment.at<ipc::TraceRing>(m.slot->traceOffset);
   }
 
-  // Parameters: "name=value" lines.
-  std::string_view text(m.segment.at<char>(m.slot->paramsOffset), m.slot->paramsBytes);
-  while (!text.empty()) {
-    const auto eol = text.find('\n');
-    const auto line = text.substr(0, eol);
-    const auto eq = line.find('=');
-    if (eq != std::string_view::npos) m.params.emplace(line.substr(0, eq), line.substr(eq + 1));
-    if (eol == std::string_view::npos) break;
-    text.remove_prefix(eol + 1);
+  // Parameters: the typed set the daemon encoded (vrflow/base/parameters.hpp).
+  if (!m.segment.contains(m.slot->paramsOffset, m.slot->paramsBytes)) {
+    return makeError("cannot join the run: the parameter block lies outside the segment");
   }
+  auto params = decodeParameters(
+      std::string_view(m.segment.at<char>(m.slot->paramsOffset), m.slot->paramsBytes));
+  if (!params) return makeError("cannot join the run: " + params.error().message);
+  m.params = std::move(*params);
+  m.params.setFailureHandler(&exitOnParameterError);
 
   // Match declared ports with the run's.
   std::vector<bool> declared(m.slot->portCount, false);
@@ -530,25 +537,8 @@ bool Module::stopRequested() const {
   return impl_->stopRequested();
 }
 
-std::string Module::param(std::string_view name, std::string_view fallback) const {
-  const auto it = impl_->params.find(name);
-  return it == impl_->params.end() ? std::string(fallback) : it->second;
-}
-
-double Module::paramDouble(std::string_view name, double fallback) const {
-  const auto it = impl_->params.find(name);
-  if (it == impl_->params.end()) return fallback;
-  char* end = nullptr;
-  const double value = std::strtod(it->second.c_str(), &end);
-  return end != it->second.c_str() ? value : fallback;
-}
-
-int64_t Module::paramInt(std::string_view name, int64_t fallback) const {
-  const auto it = impl_->params.find(name);
-  if (it == impl_->params.end()) return fallback;
-  char* end = nullptr;
-  const long long value = std::strtoll(it->second.c_str(), &end, 10);
-  return end != it->second.c_str() ? value : fallback;
+const Parameters& Module::params() const {
+  return impl_->params;
 }
 
 uint64_t Module::newId() {
