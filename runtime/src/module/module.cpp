@@ -271,7 +271,9 @@ bool OutputPort::connected() const {
   return module_->impl_->slot && slot_ >= 0 && module_->impl_->slot->ports[slot_].connected;
 }
 
-Module::Module() : impl_(std::make_unique<Impl>()) {}
+Module::Module() : impl_(std::make_unique<Impl>()) {
+  impl_->params.setFailureHandler(&exitOnParameterError);  // also before init(): a bug to report
+}
 
 Module::~Module() {
   if (impl_->slot == nullptr) return;
