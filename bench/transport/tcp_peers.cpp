@@ -163,9 +163,11 @@ void writeManifest(const fs::path& dir) {
       << "/vrflow-bench-peer\" kind=\"other\">\n"
       << "    <doc>Transport benchmark peer.</doc>\n"
       << "    <input name=\"in\" data=\"any\"/>\n    <output name=\"out\" data=\"any\"/>\n";
-  for (const char* p : {"role", "size", "warmup", "results", "count"}) {
-    out << "    <param name=\"" << p << "\" type=\"string\" default=\"\" doc=\"-\"/>\n";
-  }
+  out << "    <param name=\"role\" type=\"string\" default=\"pong\" doc=\"-\"/>\n"
+      << "    <param name=\"size\" type=\"int\" default=\"64\" min=\"0\" doc=\"-\"/>\n"
+      << "    <param name=\"warmup\" type=\"int\" default=\"0\" min=\"0\" doc=\"-\"/>\n"
+      << "    <param name=\"results\" type=\"file\" default=\"\" doc=\"-\"/>\n"
+      << "    <param name=\"count\" type=\"int\" default=\"0\" min=\"0\" doc=\"-\"/>\n";
   out << "  </module>\n</package>\n";
 }
 

@@ -30,11 +30,11 @@ int main() {
     std::fprintf(stderr, "vrflow-bench-peer: %s\n", status.error().message.c_str());
     return 2;
   }
-  const std::string role = module.param("role", "pong");
-  const auto size = static_cast<std::size_t>(module.paramInt("size", 64));
-  const auto warmup = static_cast<uint64_t>(module.paramInt("warmup", 0));
-  const std::string results = module.param("results", "");
-  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));  // 0: until input ends
+  const std::string role = module.params().getString("role");
+  const auto size = static_cast<std::size_t>(module.params().getInt("size"));
+  const auto warmup = static_cast<uint64_t>(module.params().getInt("warmup"));
+  const std::string results = module.params().getString("results");
+  const auto count = static_cast<uint64_t>(module.params().getInt("count"));  // 0: until input ends
 
   // The payload, built once in shared memory.
   auto build = [&]() -> vrflow::Result<vrflow::Message> {

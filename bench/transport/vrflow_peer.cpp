@@ -50,10 +50,21 @@ Result<app::Catalog> benchCatalog() {
   out.name = "out";
   out.isInput = false;
   type.ports = {in, out};
-  for (const char* name : {"role", "size", "warmup", "results", "count"}) {
+  // The same declarations as the manifest tcp_peers.cpp writes for `vrflow launch`.
+  struct Declared {
+    const char* name;
+    app::ParamType type;
+    const char* defaultValue;
+  };
+  for (const Declared& declared :
+       {Declared{"role", app::ParamType::String, "pong"},
+        Declared{"size", app::ParamType::Int, "64"}, Declared{"warmup", app::ParamType::Int, "0"},
+        Declared{"results", app::ParamType::File, ""},
+        Declared{"count", app::ParamType::Int, "0"}}) {
     app::ParamSpec spec;
-    spec.name = name;
-    spec.type = app::ParamType::String;
+    spec.name = declared.name;
+    spec.type = declared.type;
+    spec.defaultValue = declared.defaultValue;
     type.params.push_back(spec);
   }
   app::Catalog catalog;

@@ -23,15 +23,15 @@ int main() {
     std::fprintf(stderr, "routing-movers: %s\n", status.error().message.c_str());
     return 2;
   }
-  const auto count = static_cast<std::size_t>(module.paramInt("count", 64));
-  const auto meshCount = static_cast<std::size_t>(module.paramInt("meshes", 4));
-  const auto iterations = static_cast<uint64_t>(module.paramInt("iterations", 0));
-  const double width = module.paramDouble("width", 40);
-  const double dt = module.paramDouble("dt", 0.1);
-  const auto triangles = static_cast<std::size_t>(module.paramInt("mesh-triangles", 200));
-  const auto meshesAt = static_cast<uint64_t>(module.paramInt("meshes-at", 0));
-  const auto deleteAt = static_cast<uint64_t>(module.paramInt("delete-at", 0));
-  const bool dynamicMeshes = module.param("dynamic-meshes", "false") == "true";
+  const auto count = static_cast<std::size_t>(module.params().getInt("count"));
+  const auto meshCount = static_cast<std::size_t>(module.params().getInt("meshes"));
+  const auto iterations = static_cast<uint64_t>(module.params().getInt("iterations"));
+  const double width = module.params().getFloat("width");
+  const double dt = module.params().getFloat("dt");
+  const auto triangles = static_cast<std::size_t>(module.params().getInt("mesh-triangles"));
+  const auto meshesAt = static_cast<uint64_t>(module.params().getInt("meshes-at"));
+  const auto deleteAt = static_cast<uint64_t>(module.params().getInt("delete-at"));
+  const bool dynamicMeshes = module.params().getBool("dynamic-meshes");
 
   std::vector<uint64_t> meshIds, bodyIds;
   for (std::size_t m = 0; m < meshCount; ++m) meshIds.push_back(module.newId());

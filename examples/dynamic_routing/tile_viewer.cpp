@@ -21,11 +21,11 @@ int main() {
     std::fprintf(stderr, "routing-tile-viewer: %s\n", status.error().message.c_str());
     return 2;
   }
-  const std::string box = module.param("box", "all");
-  const std::string box2 = module.param("box2", "");
-  const auto moveAt = static_cast<uint64_t>(module.paramInt("move-at", 0));
+  const std::string box = module.params().getString("box");
+  const std::string box2 = module.params().getString("box2");
+  const auto moveAt = static_cast<uint64_t>(module.params().getInt("move-at"));
   std::ofstream log;
-  if (const auto path = module.param("file"); !path.empty()) {
+  if (const auto path = module.params().getString("file"); !path.empty()) {
     log.open(path);
     log << "iteration,kind,id,op,mask,x,ref\n";
     log.precision(17);

@@ -66,7 +66,7 @@ extern "C" void vrflowRegisterFilters(vrflow::daemon::FilterRegistry& registry,
   registry.add("every-nth",
                [](const FilterContext& context) -> vrflow::Result<std::unique_ptr<Filter>> {
                  // The catalog has checked n already; the factory still refuses what it cannot run.
-                 const long n = context.paramInt("n", 2);
+                 const long n = context.params().getInt("n");
                  if (n < 1)
                    return vrflow::makeError("filter '" + context.name() + "': n must be >= 1");
                  return std::unique_ptr<Filter>(std::make_unique<EveryNthFilter>(n));

@@ -11,7 +11,7 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const double k = module.paramDouble("stiffness", 10);
+  const double k = module.params().getFloat("stiffness");
   while (module.wait()) {            // false when the run stops
     auto out = module.newMessage();  // written straight into shared memory
     for (const auto chunk : module.get(objects).view()) {

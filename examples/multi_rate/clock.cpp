@@ -14,8 +14,8 @@ int main() {
     std::fprintf(stderr, "multirate-clock: %s\n", status.error().message.c_str());
     return 2;
   }
-  const double dt = module.paramDouble("dt", 0.2);
-  const auto count = static_cast<uint64_t>(module.paramInt("count", 10));
+  const double dt = module.params().getFloat("dt");
+  const auto count = static_cast<uint64_t>(module.params().getInt("count"));
   // wait() only for an iteration it will do: leaving the loop counts the one in progress.
   for (uint64_t done = 0; (count == 0 || done < count) && module.wait(); ++done) {
     const uint64_t i = module.iteration();

@@ -17,10 +17,10 @@ int main() {
     std::fprintf(stderr, "multirate-oscillator: %s\n", status.error().message.c_str());
     return 2;
   }
-  const double k = module.paramDouble("stiffness", 225);
-  const double m = module.paramDouble("mass", 1);
-  const double fallback = module.paramDouble("dt", 0.02);
-  double x = module.paramDouble("x0", 1);
+  const double k = module.params().getFloat("stiffness");
+  const double m = module.params().getFloat("mass");
+  const double fallback = module.params().getFloat("dt");
+  double x = module.params().getFloat("x0");
   double v = 0;
   const uint64_t id = module.newId();
   while (module.wait()) {

@@ -16,7 +16,7 @@ int main() {
     std::fprintf(stderr, "broadcast-checker: %s\n", status.error().message.c_str());
     return 2;
   }
-  std::ofstream csv(module.param("file", "received.csv"));
+  std::ofstream csv(module.params().getString("file"));
   csv << "counter,size,latency_ns\n";
   while (module.wait()) {
     const auto now = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(

@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "vrflow/message/builtin_types.hpp"
@@ -23,14 +22,12 @@ int main() {
     std::fprintf(stderr, "vrflow-fluidtest-box: %s\n", status.error().message.c_str());
     return 2;
   }
-  const double half = module.paramDouble("half", 0.15);
-  const double density = module.paramDouble("density", 500);
-  const double dt = module.paramDouble("dt", 0.01);
-  const auto brokenAt = static_cast<std::uint64_t>(module.paramInt("broken-at", 0));
-  msg::Vec3 position{};
-  std::istringstream(module.param("start", "0.4 0.5 0.4")) >> position[0] >> position[1] >>
-      position[2];
-  std::ofstream trajectory(module.param("trajectory", "box.csv"), std::ios::trunc);
+  const double half = module.params().getFloat("half");
+  const double density = module.params().getFloat("density");
+  const double dt = module.params().getFloat("dt");
+  const auto brokenAt = static_cast<std::uint64_t>(module.params().getInt("broken-at"));
+  msg::Vec3 position = module.params().getVec3("start");
+  std::ofstream trajectory(module.params().getString("trajectory"), std::ios::trunc);
   const double mass = density * 8 * half * half * half;
   const auto shape = msg::Shape::box({half, half, half});
   const auto shapeBytes = msg::encodeShape(shape);

@@ -13,9 +13,9 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const auto at = static_cast<uint64_t>(module.paramInt("at", 3));
-  const int status = static_cast<int>(module.paramInt("status", 7));
-  const int sig = static_cast<int>(module.paramInt("signal", 0));
+  const auto at = static_cast<uint64_t>(module.params().getInt("at"));
+  const int status = static_cast<int>(module.params().getInt("status"));
+  const int sig = static_cast<int>(module.params().getInt("signal"));
   while (module.wait()) {
     if (module.iteration() == at) {
       if (sig != 0) std::raise(sig);

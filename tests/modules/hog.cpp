@@ -15,8 +15,8 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const auto step = static_cast<std::size_t>(module.paramInt("step-mib", 16)) << 20;
-  const auto max = static_cast<std::size_t>(module.paramInt("max-mib", 0)) << 20;
+  const auto step = static_cast<std::size_t>(module.params().getInt("step-mib")) << 20;
+  const auto max = static_cast<std::size_t>(module.params().getInt("max-mib")) << 20;
   std::vector<std::unique_ptr<char[]>> held;
   while (module.wait()) {
     if (max == 0 || held.size() * step < max) {

@@ -22,15 +22,15 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
-  std::vector<uint64_t> points(static_cast<std::size_t>(module.paramInt("points", 3)));
-  std::vector<uint64_t> rigids(static_cast<std::size_t>(module.paramInt("rigids", 2)));
+  const auto count = static_cast<uint64_t>(module.params().getInt("count"));
+  std::vector<uint64_t> points(static_cast<std::size_t>(module.params().getInt("points")));
+  std::vector<uint64_t> rigids(static_cast<std::size_t>(module.params().getInt("rigids")));
   for (auto& id : points) id = module.newId();
   for (auto& id : rigids) id = module.newId();
-  const double extent = module.paramDouble("extent", 0.0);
-  const auto deleteAt = static_cast<uint64_t>(module.paramInt("delete-at", 0));
+  const double extent = module.params().getFloat("extent");
+  const auto deleteAt = static_cast<uint64_t>(module.params().getInt("delete-at"));
   const auto payload =
-      static_cast<std::size_t>(std::max<int64_t>(8, module.paramInt("payload", 8)));
+      static_cast<std::size_t>(std::max<int64_t>(8, module.params().getInt("payload")));
   const uint64_t resource = module.newId();
   // wait() only for an iteration it will do: leaving the loop counts the one in progress.
   for (uint64_t done = 0; (count == 0 || done < count) && module.wait(); ++done) {

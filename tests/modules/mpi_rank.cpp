@@ -39,7 +39,7 @@ int run(int argc, char** argv) {
                  status.error().message.c_str());
     return 2;  // without MPI_Finalize: mpirun ends the job's other ranks
   }
-  const auto crashAt = static_cast<uint64_t>(module.paramInt("crash-at", 0));
+  const auto crashAt = static_cast<uint64_t>(module.params().getInt("crash-at"));
   const uint64_t point = module.newId();
   const auto& type = msg::pointType();
   for (;;) {

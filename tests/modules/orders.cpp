@@ -12,9 +12,9 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const int64_t step = module.paramInt("step", 1);
-  const int64_t offset = module.paramInt("offset", 0);
-  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
+  const int64_t step = module.params().getInt("step");
+  const int64_t offset = module.params().getInt("offset");
+  const auto count = static_cast<uint64_t>(module.params().getInt("count"));
   // wait() only for an iteration it will do: leaving the loop counts the one in progress.
   for (uint64_t done = 0; (count == 0 || done < count) && module.wait(); ++done) {
     const uint64_t it = module.iteration();

@@ -19,9 +19,9 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const auto delay = std::chrono::milliseconds(module.paramInt("delay-ms", 0));
-  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
-  std::ofstream log(module.param("log", "phases.log"), std::ios::app);
+  const auto delay = std::chrono::milliseconds(module.params().getInt("delay-ms"));
+  const auto count = static_cast<uint64_t>(module.params().getInt("count"));
+  std::ofstream log(module.params().getString("log"), std::ios::app);
   const auto note = [&](const char* what) {
     log << module.id() << " " << what << " " << module.iteration() << std::endl;
   };

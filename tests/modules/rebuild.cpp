@@ -27,7 +27,7 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  std::ofstream csv(module.param("file", "rebuild.csv"));
+  std::ofstream csv(module.params().getString("file"));
   if (!csv) return 2;
   csv << "iteration,parts,total,ok\n";
   while (module.wait()) {

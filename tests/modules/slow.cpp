@@ -16,8 +16,8 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const auto delay = std::chrono::milliseconds(module.paramInt("delay-ms", 1));
-  const bool copy = module.param("copy", "false") == "true";
+  const auto delay = std::chrono::milliseconds(module.params().getInt("delay-ms"));
+  const bool copy = module.params().getBool("copy");
   while (module.wait()) {
     std::this_thread::sleep_for(delay);
     const Message& received = module.get(in);

@@ -18,11 +18,11 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const int64_t value = module.paramInt("value", 0);
-  const double weight = module.paramDouble("weight", 0.0);
-  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
+  const int64_t value = module.params().getInt("value");
+  const double weight = module.params().getFloat("weight");
+  const auto count = static_cast<uint64_t>(module.params().getInt("count"));
   std::ofstream log;
-  if (in.connected()) log.open(module.param("log", "stamps.log"), std::ios::app);
+  if (in.connected()) log.open(module.params().getString("log"), std::ios::app);
   for (uint64_t i = 0; count == 0 || i < count; ++i) {
     if (!module.wait()) break;
     if (in.connected()) {

@@ -15,8 +15,8 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const std::string pattern = module.param("pattern", "10");
-  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
+  const std::string pattern = module.params().getString("pattern");
+  const auto count = static_cast<uint64_t>(module.params().getInt("count"));
   const uint64_t resource = module.newId();
   // wait() only for an iteration it will do: leaving the loop counts the one in progress.
   for (uint64_t done = 0; ((count == 0 || done < count) && !pattern.empty()) && module.wait();

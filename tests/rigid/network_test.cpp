@@ -9,11 +9,32 @@
 #include <sstream>
 
 #include "process_helpers.hpp"
+#include "vrflow/app/catalog.hpp"
 #include "vrflow/rigid/scene.hpp"
 #include "vrflow/rigid/world.hpp"
 
 namespace vrflow::testing {
 namespace {
+
+// One place for each default: ContactParams' defaults are generated from the interactor's
+// manifest, so a library user and the module start from the same values.
+TEST(RigidInteractorDefaults, ContactParamsDefaultsAreTheManifests) {
+  app::Catalog catalog;
+  ASSERT_TRUE(catalog.addPackageFile(sourceDir() + "/nodes/rigid/vrflow-package.xml").ok());
+  const app::ModuleType* type = catalog.findModule("rigid", "interactor");
+  ASSERT_NE(type, nullptr);
+  const auto manifest = app::parameterSet(type->params, {}, "rigid/interactor");
+  ASSERT_TRUE(manifest.ok()) << manifest.error().message;
+  const rigid::ContactParams defaults;
+  EXPECT_EQ(defaults.gravity, manifest->getVec3("gravity"));
+  EXPECT_EQ(defaults.restitution, manifest->getFloat("restitution"));
+  EXPECT_EQ(defaults.friction, manifest->getFloat("friction"));
+  EXPECT_EQ(defaults.restitutionThreshold, manifest->getFloat("restitution-threshold"));
+  EXPECT_EQ(defaults.iterations, manifest->getInt("iterations"));
+  EXPECT_EQ(defaults.baumgarte, manifest->getFloat("baumgarte"));
+  EXPECT_EQ(defaults.slop, manifest->getFloat("slop"));
+  EXPECT_FALSE(manifest->firstError().has_value());
+}
 
 std::string app(const std::string& scene, const std::string& stateFile) {
   return R"(<?xml version="1.0" encoding="UTF-8"?>

@@ -96,5 +96,23 @@ TEST_F(FilterPlugins, PluginRedefiningABuiltinFilterIsRefused) {
   EXPECT_NE(named.err.find("filter type 'merge' exists already"), std::string::npos) << named.err;
 }
 
+// A filter reads typed parameters (FilterContext::params()): reading one that its declaration
+// does not have stops the run's start with a message naming the filter and the parameter (it
+// once got the fallback silently).
+TEST_F(FilterPlugins, FilterReadingAnUndeclaredParameterStopsTheRunNamingIt) {
+  const auto file = dir.write(
+      "app.xml",
+      appXml(moduleXml("src", "core/source", paramXml("count", "10")) +
+                 moduleXml("rec", "core/recorder", paramXml("file", dir.file("out.csv"))),
+             filterXml("d", "misread", "", "plugin=\"" + testPlugin("misreading_plugin") + "\""),
+             connectXml("src.out", "d.in") + connectXml("d.out", "rec.in")));
+  const auto result = runVrflow({"run", file});
+  EXPECT_NE(result.exitCode, 0) << result.err;
+  EXPECT_NE(result.err.find("filter 'd' (misread): reads parameter 'm', which is not declared "
+                            "(declared: n)"),
+            std::string::npos)
+      << result.err;
+}
+
 }  // namespace
 }  // namespace vrflow::testing

@@ -55,7 +55,7 @@ TEST(ModuleSlot, AModuleFindsWhatTheDaemonSetUp) {
   EXPECT_EQ(user->findPort("out", false), 1);
   EXPECT_EQ(user->findPort("in", false), -1);
   EXPECT_TRUE(user->portConnected(1));
-  EXPECT_EQ(user->paramsText(), "gain=2\n");
+  EXPECT_EQ(user->paramsBlock(), "gain=2\n");
   EXPECT_EQ(user->traceRing(), nullptr);
 }
 

@@ -301,6 +301,35 @@ TEST_F(RunTest, ModuleThatExitsWithAnErrorStopsTheRunAndIsNamed) {
   EXPECT_EQ(json["status"], "failed");
 }
 
+// Module::params() is typed: reading a parameter the manifest does not declare, or as another
+// type, is a bug the module cannot go on with (it once got the fallback silently).
+TEST_F(RunTest, ModuleReadingAnUndeclaredParameterExitsNamingTheModuleAndTheParameter) {
+  const auto file =
+      dir.write("app.xml", app(module("src", "core/source") + module("bad", "testing/misread"),
+                               connect("src.out", "bad.in")));
+  const auto result = runVrflow({"run", file, "-n", "5"});
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("module 'bad' (testing/misread): reads parameter 'not-declared', "
+                            "which is not declared (declared: what)"),
+            std::string::npos)
+      << result.err;
+  EXPECT_NE(result.err.find("exited with status 1"), std::string::npos) << result.err;
+  EXPECT_EQ(result.out.find("without an error"), std::string::npos) << result.out;
+}
+
+TEST_F(RunTest, ModuleReadingAParameterAsAnotherTypeExitsNamingIt) {
+  const auto file =
+      dir.write("app.xml", app(module("src", "core/source") +
+                                   module("bad", "testing/misread", param("what", "wrong-type")),
+                               connect("src.out", "bad.in")));
+  const auto result = runVrflow({"run", file, "-n", "5"});
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("module 'bad' (testing/misread): reads parameter 'what' as a float, "
+                            "but it is declared enum"),
+            std::string::npos)
+      << result.err;
+}
+
 TEST_F(RunTest, ModuleKilledBySignalIsReportedWithTheSignal) {
   const auto file = dir.write(
       "app.xml", app(module("src", "core/source") +

@@ -20,9 +20,9 @@ int main() {
     std::fprintf(stderr, "%s\n", status.error().message.c_str());
     return 2;
   }
-  const auto count = static_cast<std::uint64_t>(module.paramInt("count", 5));
-  const auto deleteAt = module.paramInt("delete-at", -1);
-  const bool forged = module.param("forged", "false") == "true";
+  const auto count = static_cast<std::uint64_t>(module.params().getInt("count"));
+  const auto deleteAt = module.params().getInt("delete-at");
+  const bool forged = module.params().getBool("forged");
   const std::uint64_t boxShape = module.newId(), sphereShape = module.newId();
   const std::uint64_t forgedShape = module.newId();
   const std::uint64_t box = module.newId(), sphere = module.newId(), net = module.newId();

@@ -26,14 +26,6 @@ namespace {
 
 using namespace vrflow;
 
-bool parseVec3(const std::string& text, msg::Vec3& out) {
-  std::istringstream in(text);
-  msg::Vec3 v{};
-  if (!(in >> v[0] >> v[1] >> v[2])) return false;
-  out = v;
-  return true;
-}
-
 bool parseCounts(const std::string& text, std::array<int, 3>& out) {
   std::istringstream in(text);
   std::array<int, 3> v{};
@@ -115,29 +107,25 @@ int main(int argc, char** argv) {
     return 2;
   }
   fluid::FluidSettings s;
-  s.nx = static_cast<int>(module.paramInt("nx", s.nx));
-  s.ny = static_cast<int>(module.paramInt("ny", s.ny));
-  s.nz = static_cast<int>(module.paramInt("nz", s.nz));
-  s.cellSize = module.paramDouble("cell-size", s.cellSize);
-  s.density = module.paramDouble("density", s.density);
-  s.flipRatio = module.paramDouble("flip-ratio", s.flipRatio);
-  s.particlesPerCell = static_cast<int>(module.paramInt("particles-per-cell", s.particlesPerCell));
-  s.maxParticles = static_cast<int>(module.paramInt("max-particles", s.maxParticles));
-  s.cgTolerance = module.paramDouble("cg-tolerance", s.cgTolerance);
-  s.cgMaxIterations = static_cast<int>(module.paramInt("cg-max-iterations", s.cgMaxIterations));
-  s.volumeCorrection = module.paramDouble("volume-correction", s.volumeCorrection);
-  msg::Aabb fill{{0, 0, 0}, {1, 0.5, 1}};
-  if (!parseVec3(module.param("origin", "0 0 0"), s.origin) ||
-      !parseVec3(module.param("gravity", "0 -9.81 0"), s.gravity) ||
-      !parseVec3(module.param("fill-min", "0 0 0"), fill.min) ||
-      !parseVec3(module.param("fill-max", "1 0.5 1"), fill.max)) {
-    return fail("origin, gravity, fill-min and fill-max must be three numbers each");
-  }
-  const double dt = module.paramDouble("dt", 0.01);
-  const auto particlesEvery = module.paramInt("particles-every", 1);
-  const double nodeRadius = module.paramDouble("node-radius", 0.0);
+  s.nx = static_cast<int>(module.params().getInt("nx"));
+  s.ny = static_cast<int>(module.params().getInt("ny"));
+  s.nz = static_cast<int>(module.params().getInt("nz"));
+  s.cellSize = module.params().getFloat("cell-size");
+  s.density = module.params().getFloat("density");
+  s.flipRatio = module.params().getFloat("flip-ratio");
+  s.particlesPerCell = static_cast<int>(module.params().getInt("particles-per-cell"));
+  s.maxParticles = static_cast<int>(module.params().getInt("max-particles"));
+  s.cgTolerance = module.params().getFloat("cg-tolerance");
+  s.cgMaxIterations = static_cast<int>(module.params().getInt("cg-max-iterations"));
+  s.volumeCorrection = module.params().getFloat("volume-correction");
+  s.origin = module.params().getVec3("origin");
+  s.gravity = module.params().getVec3("gravity");
+  const msg::Aabb fill{module.params().getVec3("fill-min"), module.params().getVec3("fill-max")};
+  const double dt = module.params().getFloat("dt");
+  const auto particlesEvery = module.params().getInt("particles-every");
+  const double nodeRadius = module.params().getFloat("node-radius");
   Regions regions;
-  if (!parseCounts(module.param("particle-regions", "1 1 1"), regions.counts)) {
+  if (!parseCounts(module.params().getString("particle-regions"), regions.counts)) {
     return fail("particle-regions must be three whole numbers (boxes along x, y and z)");
   }
   for (std::size_t a = 0; a < 3; ++a) {
@@ -149,8 +137,8 @@ int main(int argc, char** argv) {
     }
   }
 
-  const auto blocks = module.paramInt("blocks", 1);
-  const std::string job = module.param("job", "");
+  const auto blocks = module.params().getInt("blocks");
+  const std::string job = module.params().getString("job");
   if (!job.empty() && blocks > 1) {
     return fail("blocks = " + std::to_string(blocks) + " with job = '" + job +
                 "': a module of an MPI job is one block of it (leave blocks at 1)");
@@ -183,8 +171,8 @@ int main(int argc, char** argv) {
   };
   // The blocks of a job make the collective queries together: block 0's file parameters decide.
   const bool first = !jobBlock || jobBlock->rank() == 0;
-  const std::string statsPath = module.param("stats");
-  const std::string statePath = module.param("state-file");
+  const std::string statsPath = module.params().getString("stats");
+  const std::string statePath = module.params().getString("state-file");
   const bool withStats = jobBlock ? jobBlock->fromFirst(!statsPath.empty()) : !statsPath.empty();
   const bool withState = jobBlock ? jobBlock->fromFirst(!statePath.empty()) : !statePath.empty();
 

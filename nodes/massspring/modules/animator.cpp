@@ -2,7 +2,6 @@
 // it with internal sub-steps from the forces it receives (see vrflow/massspring/solver.hpp).
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "common.hpp"
 #include "vrflow/massspring/objects.hpp"
@@ -21,13 +20,12 @@ int main() {
     return 2;
   }
   modules::Params params(module, program);
-  const double inf = std::numeric_limits<double>::max();
   StepOptions options;
-  options.dt = params.number("dt", 0.01, 1e-9, 10);
-  options.substeps = params.integer("substeps", 10, 1, 100000);
-  options.internalSprings = params.flag("internal-springs", true);
-  options.constraintIterations = params.integer("constraint-iterations", 50, 0, 1000000);
-  const auto g = params.vector("gravity", "0 0 0", 3);
+  options.dt = params.number("dt");
+  options.substeps = params.integer("substeps");
+  options.internalSprings = params.flag("internal-springs");
+  options.constraintIterations = params.integer("constraint-iterations");
+  const msg::Vec3 g = params.vec3("gravity");
   options.gravity = {g[0], g[1], g[2]};
 
   Net net;
@@ -40,19 +38,19 @@ int main() {
       net = std::move(*loaded);
   } else {
     GridParams grid;
-    grid.n = params.integer("n", 20, 2, 4096);
-    grid.m = params.integer("m", 20, 2, 4096);
-    grid.spacing = params.number("spacing", 0.1, 1e-9, inf);
-    grid.mass = params.number("mass", 1.0, 1e-12, inf);
-    grid.stiffness = params.number("stiffness", 500, 0, inf);
-    grid.shearFactor = params.number("shear", 0.5, 0, inf);
-    grid.bendFactor = params.number("bend", 0.1, 0, inf);
-    grid.damping = params.number("damping", 0.05, 0, inf);
-    grid.maxStretch = params.number("max-stretch", 1.1, 0, inf);
-    grid.pinCorners = params.flag("pin-corners", true);
-    const auto origin = params.vector("origin", "0 0 0", 3);
+    grid.n = params.integer("n");
+    grid.m = params.integer("m");
+    grid.spacing = params.number("spacing");
+    grid.mass = params.number("mass");
+    grid.stiffness = params.number("stiffness");
+    grid.shearFactor = params.number("shear");
+    grid.bendFactor = params.number("bend");
+    grid.damping = params.number("damping");
+    grid.maxStretch = params.number("max-stretch");
+    grid.pinCorners = params.flag("pin-corners");
+    const msg::Vec3 origin = params.vec3("origin");
     grid.origin = {origin[0], origin[1], origin[2]};
-    const auto q = params.vector("orientation", "0 0 0 1", 4);
+    const auto q = params.numbersIn("orientation", 4);
     grid.orientation = {q[0], q[1], q[2], q[3]};
     if (!params.report()) {
       auto generated = generateGrid(grid);

@@ -19,10 +19,10 @@ int main() {
   }
   modules::Params params(module, program);
   ContactParams contact;
-  contact.thickness = params.number("thickness", 0.05, 1e-9, 1e6);
-  contact.beta = params.number("beta", 0.2, 0, 1);
-  const double fallbackDt = params.number("dt", 0.01, 1e-9, 10);
-  contact.springMassWeight = params.number("spring-mass-weight", 0.01, 0, 1e6);
+  contact.thickness = params.number("thickness");
+  contact.beta = params.number("beta");
+  const double fallbackDt = params.number("dt");
+  contact.springMassWeight = params.number("spring-mass-weight");
   if (params.report()) return 2;
   SceneCopy scene;
   ContactMemory memory;

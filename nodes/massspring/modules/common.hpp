@@ -31,51 +31,29 @@ inline std::optional<std::vector<double>> numbers(const std::string& text, std::
   return values;
 }
 
-/// A parameter read by a module, with the first error kept for the module to report.
+/// The module's typed parameters (Module::params()), with the first problem in their values
+/// kept for the module to report.
 class Params {
  public:
   Params(const Module& module, std::string program)
-      : module_(module), program_(std::move(program)) {}
+      : values_(module.params()), program_(std::move(program)) {}
 
-  double number(const char* name, double fallback, double min, double max) {
-    const auto text = module_.param(name);
-    if (text.empty()) return fallback;
-    const auto v = numbers(text, 1);
-    if (!v || (*v)[0] < min || (*v)[0] > max) {
-      fail(std::string("parameter '") + name + "' = '" + text + "' must be a number in [" +
-           format(min) + ", " + format(max) + "]");
-      return fallback;
-    }
-    return (*v)[0];
-  }
-  int integer(const char* name, int fallback, int min, int max) {
-    const double v = number(name, fallback, min, max);
-    if (v != std::floor(v)) {
-      fail(std::string("parameter '") + name + "' must be an integer");
-      return fallback;
-    }
-    return static_cast<int>(v);
-  }
-  bool flag(const char* name, bool fallback) {
-    const auto text = module_.param(name);
-    if (text.empty()) return fallback;
-    if (text == "true" || text == "1" || text == "yes" || text == "on") return true;
-    if (text == "false" || text == "0" || text == "no" || text == "off") return false;
-    fail(std::string("parameter '") + name + "' = '" + text + "' must be true or false");
-    return fallback;
-  }
-  std::vector<double> vector(const char* name, const std::string& fallback, std::size_t count) {
-    auto text = module_.param(name);
-    if (text.empty()) text = fallback;
-    const auto v = numbers(text, count);
+  double number(const char* name) const { return values_.getFloat(name); }
+  int integer(const char* name) const { return static_cast<int>(values_.getInt(name)); }
+  bool flag(const char* name) const { return values_.getBool(name); }
+  msg::Vec3 vec3(const char* name) const { return values_.getVec3(name); }
+  std::string text(const char* name) const { return values_.getString(name); }
+  /// A string parameter holding `count` numbers (an orientation's quaternion).
+  std::vector<double> numbersIn(const char* name, std::size_t count) {
+    const std::string value = text(name);
+    const auto v = numbers(value, count);
     if (!v) {
-      fail(std::string("parameter '") + name + "' = '" + text + "' must be " +
+      fail(std::string("parameter '") + name + "' = '" + value + "' must be " +
            std::to_string(count) + " finite numbers");
       return std::vector<double>(count, 0.0);
     }
     return *v;
   }
-  std::string text(const char* name) const { return module_.param(name); }
 
   void fail(std::string message) {
     if (error_.empty()) error_ = std::move(message);
@@ -88,12 +66,7 @@ class Params {
   }
 
  private:
-  static std::string format(double v) {
-    std::ostringstream out;
-    out << v;
-    return out.str();
-  }
-  const Module& module_;
+  const Parameters& values_;
   std::string program_;
   std::string error_;
 };

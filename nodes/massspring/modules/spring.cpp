@@ -23,7 +23,7 @@ int main() {
     return 2;
   }
   modules::Params params(module, program);
-  const double scale = params.number("scale", 1.0, 0, 1e12);
+  const double scale = params.number("scale");
   if (params.report()) return 2;
   SceneCopy scene;
   modules::Warnings warnings(program);

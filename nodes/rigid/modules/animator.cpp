@@ -20,14 +20,14 @@ int main() {
     std::fprintf(stderr, "vrflow-rigid-animator: %s\n", status.error().message.c_str());
     return 2;
   }
-  const double dt = module.paramDouble("dt", 0.01);
+  const double dt = module.params().getFloat("dt");
   if (!(dt > 0)) {
     std::fprintf(stderr, "vrflow-rigid-animator: dt must be positive\n");
     return 2;
   }
   std::vector<rigid::Body> bodies;
-  const std::string scenePath = module.param("scene");
-  const std::string generator = module.param("generate");
+  const std::string scenePath = module.params().getString("scene");
+  const std::string generator = module.params().getString("generate");
   if (scenePath.empty() && generator.empty()) {
     std::fprintf(stderr, "vrflow-rigid-animator: set the 'scene' or the 'generate' parameter\n");
     return 2;
@@ -45,14 +45,7 @@ int main() {
   }
   rigid::RigidAnimatorState state;
   rigid::SleepParams sleep;
-  const std::string sleepText = module.param("sleep", "true");
-  if (sleepText != "true" && sleepText != "false" && sleepText != "1" && sleepText != "0") {
-    std::fprintf(stderr,
-                 "vrflow-rigid-animator: parameter 'sleep' must be true or false, not '%s'\n",
-                 sleepText.c_str());
-    return 2;
-  }
-  sleep.enabled = sleepText == "true" || sleepText == "1";
+  sleep.enabled = module.params().getBool("sleep");
   state.setSleep(sleep);
   std::map<std::uint64_t, std::uint64_t> shapeIds;
   for (auto& body : bodies) {
@@ -91,7 +84,7 @@ int main() {
     }
     if (!module.put(objects, std::move(out))) break;
   }
-  if (const auto path = module.param("state-file"); !path.empty()) {
+  if (const auto path = module.params().getString("state-file"); !path.empty()) {
     std::FILE* file = std::fopen(path.c_str(), "w");
     if (!file) {
       std::fprintf(stderr, "vrflow-rigid-animator: cannot write the state file %s\n", path.c_str());

@@ -19,14 +19,14 @@ int main() {
     std::fprintf(stderr, "vrflow-rigid-forcefield: %s\n", status.error().message.c_str());
     return 2;
   }
-  auto field = rigid::ForceField::parse(module.param("field", "gravity 0 -9.81 0"));
+  auto field = rigid::ForceField::parse(module.params().getString("field"));
   if (!field) {
     std::fprintf(stderr, "vrflow-rigid-forcefield: parameter 'field': %s\n",
                  field.error().message.c_str());
     return 2;
   }
   bool rigidBodies = false, points = false;
-  std::istringstream types(module.param("types", "rigid"));
+  std::istringstream types(module.params().getString("types"));
   for (std::string type; types >> type;) {
     if (type == "rigid")
       rigidBodies = true;
@@ -39,7 +39,7 @@ int main() {
       return 2;
     }
   }
-  const double fallbackDt = module.paramDouble("dt", 0.01);
+  const double fallbackDt = module.params().getFloat("dt");
   std::map<std::uint64_t, rigid::FieldTarget> targets;  // by id, for a fixed order
   while (module.wait()) {
     const Message& received = module.get(objects);

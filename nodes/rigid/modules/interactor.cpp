@@ -2,7 +2,6 @@
 // Bullet and answers with the contact impulses of our sequential impulse solver, as force events
 // over the step (the animator applies them).
 #include <cstdio>
-#include <sstream>
 
 #include "vrflow/module/module.hpp"
 #include "vrflow/rigid/contact_solver.hpp"
@@ -18,19 +17,14 @@ int main() {
     return 2;
   }
   rigid::ContactParams params;
-  std::istringstream g(module.param("gravity", "0 -9.81 0"));
-  if (!(g >> params.gravity[0] >> params.gravity[1] >> params.gravity[2])) {
-    std::fprintf(stderr, "vrflow-rigid-interactor: gravity must be three numbers\n");
-    return 2;
-  }
-  params.restitution = module.paramDouble("restitution", params.restitution);
-  params.friction = module.paramDouble("friction", params.friction);
-  params.iterations = static_cast<int>(module.paramInt("iterations", params.iterations));
-  params.baumgarte = module.paramDouble("baumgarte", params.baumgarte);
-  params.slop = module.paramDouble("slop", params.slop);
-  params.restitutionThreshold =
-      module.paramDouble("restitution-threshold", params.restitutionThreshold);
-  const double fallbackDt = module.paramDouble("dt", 0.01);
+  params.gravity = module.params().getVec3("gravity");
+  params.restitution = module.params().getFloat("restitution");
+  params.friction = module.params().getFloat("friction");
+  params.iterations = static_cast<int>(module.params().getInt("iterations"));
+  params.baumgarte = module.params().getFloat("baumgarte");
+  params.slop = module.params().getFloat("slop");
+  params.restitutionThreshold = module.params().getFloat("restitution-threshold");
+  const double fallbackDt = module.params().getFloat("dt");
   rigid::RigidContactSolver solver(params);
   rigid::RigidObjectCopy copy;
   while (module.wait()) {

@@ -25,56 +25,14 @@ struct ParamError {
   std::string message;
 };
 
-class Params {
+// The first problem found in the parameters' values (their types and ranges were checked by
+// the validator against the manifest; these are the viewer's own rules).
+class ParamProblems {
  public:
-  explicit Params(const Module& module) : module_(module) {}
+  explicit ParamProblems(const Module& module) : module_(module) {}
 
   std::optional<ParamError> error;
 
-  double number(const char* name, double fallback, double min, double max) {
-    const std::string text = module_.param(name, "");
-    if (text.empty()) return fallback;
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || *end != '\0' || !(value >= min && value <= max)) {
-      fail(name, "expects a number in [" + num(min) + ", " + num(max) + "], got '" + text + "'");
-      return fallback;
-    }
-    return value;
-  }
-  int integer(const char* name, int fallback, int min, int max) {
-    const double value = number(name, fallback, min, max);
-    if (value != static_cast<double>(static_cast<int>(value))) {
-      fail(name, "expects an integer, got '" + module_.param(name, "") + "'");
-      return fallback;
-    }
-    return static_cast<int>(value);
-  }
-  bool boolean(const char* name, bool fallback) {
-    const std::string text = module_.param(name, "");
-    if (text.empty()) return fallback;
-    if (text == "true" || text == "1") return true;
-    if (text == "false" || text == "0") return false;
-    fail(name, "expects true, false, 1 or 0, got '" + text + "'");
-    return fallback;
-  }
-  msg::Vec3 vec3(const char* name, const msg::Vec3& fallback) {
-    std::string text = module_.param(name, "");
-    if (text.empty()) return fallback;
-    for (char& c : text) {
-      if (c == ',') c = ' ';
-    }
-    std::istringstream in(text);
-    msg::Vec3 v{};
-    std::string extra;
-    if (!(in >> v[0] >> v[1] >> v[2]) || (in >> extra) || !std::isfinite(v[0]) ||
-        !std::isfinite(v[1]) || !std::isfinite(v[2])) {
-      fail(name, "expects three finite numbers, got '" + module_.param(name, "") + "'");
-      return fallback;
-    }
-    return v;
-  }
-  std::string text(const char* name, const char* fallback) { return module_.param(name, fallback); }
   void fail(const char* name, const std::string& what) {
     if (!error) {
       error = ParamError{"module '" + module_.id() + "' (viewer/viewer): parameter '" + name +
@@ -83,11 +41,6 @@ class Params {
   }
 
  private:
-  static std::string num(double v) {
-    std::ostringstream out;
-    out << v;
-    return out.str();
-  }
   const Module& module_;
 };
 
@@ -106,50 +59,51 @@ int main() {
     std::fprintf(stderr, "vrflow-viewer: %s\n", status.error().message.c_str());
     return 2;
   }
-  Params params(module);
+  ParamProblems params(module);
+  const Parameters& values = module.params();
   viewer::RenderSettings render;
-  render.width = params.integer("width", 960, 16, 8192);
-  render.height = params.integer("height", 540, 16, 8192);
-  render.ground = params.boolean("ground", true);
-  render.groundHeight = params.number("ground-height", 0.0, -1e6, 1e6);
-  render.groundHalfSize = params.number("ground-size", 20.0, 0.01, 1e4);
-  render.groundTile = params.number("ground-tile", 1.0, 0.001, 1e4);
-  render.shadows = params.boolean("shadows", true);
-  render.netLines = params.boolean("net-lines", true);
-  render.supersample = params.integer("supersample", 2, 1, 4);
-  render.pointRadius = params.number("point-radius", 0.08, 1e-6, 1e6);
-  render.particleSize = static_cast<float>(params.number("particle-size", 3.0, 1.0, 64.0));
-  if (auto tile = viewer::parseTile(params.text("tile", "0 0 1 1")); tile) {
+  render.width = static_cast<int>(values.getInt("width"));
+  render.height = static_cast<int>(values.getInt("height"));
+  render.ground = values.getBool("ground");
+  render.groundHeight = values.getFloat("ground-height");
+  render.groundHalfSize = values.getFloat("ground-size");
+  render.groundTile = values.getFloat("ground-tile");
+  render.shadows = values.getBool("shadows");
+  render.netLines = values.getBool("net-lines");
+  render.supersample = static_cast<int>(values.getInt("supersample"));
+  render.pointRadius = values.getFloat("point-radius");
+  render.particleSize = static_cast<float>(values.getFloat("particle-size"));
+  if (auto tile = viewer::parseTile(values.getString("tile")); tile) {
     render.tile = *tile;
   } else {
     params.fail("tile", tile.error().message);
   }
-  const double viewDepth = params.number("view-depth", 20.0, 1e-3, 1e6);
+  const double viewDepth = values.getFloat("view-depth");
   std::optional<msg::Aabb> interestBox;
-  if (const auto text = params.text("interest-box", ""); !text.empty()) {
+  if (const auto text = values.getString("interest-box"); !text.empty()) {
     if (auto box = viewer::parseBox(text); box) {
       interestBox = *box;
     } else {
       params.fail("interest-box", box.error().message);
     }
   }
-  const int segments = params.integer("segments", 24, 4, 256);
-  const int every = params.integer("every", 1, 1, 1000000);
+  const int segments = static_cast<int>(values.getInt("segments"));
+  const int every = static_cast<int>(values.getInt("every"));
   viewer::Camera camera;
-  camera.eye = params.vec3("eye", camera.eye);
-  camera.target = params.vec3("target", camera.target);
-  camera.up = params.vec3("up", camera.up);
-  camera.fovYDegrees = params.number("fov", 45.0, 1.0, 170.0);
+  camera.eye = values.getVec3("eye");
+  camera.target = values.getVec3("target");
+  camera.up = values.getVec3("up");
+  camera.fovYDegrees = values.getFloat("fov");
   viewer::FrameWriterSettings output;
-  output.directory = params.text("output-dir", "frames");
-  output.prefix = params.text("prefix", "frame");
+  output.directory = values.getString("output-dir");
+  output.prefix = values.getString("prefix");
   output.width = render.width;
   output.height = render.height;
-  output.fps = params.number("fps", 30.0, 0.1, 1000.0);
-  if (auto format = viewer::parseFrameFormat(params.text("format", "auto")); format) {
+  output.fps = values.getFloat("fps");
+  if (auto format = viewer::parseFrameFormat(values.getString("format")); format) {
     output.format = *format;
   } else {
-    params.fail("format", "expects png, mp4 or auto, got '" + params.text("format", "") + "'");
+    params.fail("format", "expects png, mp4 or auto, got '" + values.getString("format") + "'");
   }
   if (camera.eye == camera.target) params.fail("eye", "must differ from 'target'");
   if (viewDepth <= camera.nearPlane) {
@@ -157,7 +111,7 @@ int main() {
                                   " m), got " + std::to_string(viewDepth));
   }
   std::optional<viewer::CameraPath> path;
-  if (const auto file = params.text("camera-path", ""); !file.empty()) {
+  if (const auto file = values.getString("camera-path"); !file.empty()) {
     auto loaded = viewer::CameraPath::load(file, camera);
     if (!loaded) {
       params.fail("camera-path", loaded.error().message);

@@ -1,6 +1,5 @@
 // core/gravity: a uniform force field, the weight m g of every point.
 #include <cstdio>
-#include <sstream>
 
 #include "interactor_common.hpp"
 #include "vrflow/module/module.hpp"
@@ -14,9 +13,7 @@ int main() {
     std::fprintf(stderr, "vrflow-core-gravity: %s\n", status.error().message.c_str());
     return 2;
   }
-  msg::Vec3 g{0, -9.81, 0};
-  std::istringstream text(module.param("g", "0 -9.81 0"));
-  text >> g[0] >> g[1] >> g[2];
+  const msg::Vec3 g = module.params().getVec3("g");
   std::map<uint64_t, core::PointState> points;
   while (module.wait()) {
     core::applyObjectChunks(module.get(objects), points);

@@ -26,12 +26,13 @@ int main() {
     std::fprintf(stderr, "vrflow-core-points: %s\n", status.error().message.c_str());
     return 2;
   }
-  const auto count = module.paramInt("count", 4);
-  const double mass = module.paramDouble("mass", 1.0);
-  const double dt = module.paramDouble("dt", 0.01);
-  const double spacing = module.paramDouble("spacing", 1.0);
+  const auto count = module.params().getInt("count");
+  const double mass = module.params().getFloat("mass");
+  const double dt = module.params().getFloat("dt");
+  const double spacing = module.params().getFloat("spacing");
   std::ofstream log;
-  if (const auto path = module.param("log"); !path.empty()) log.open(path, std::ios::app);
+  if (const auto path = module.params().getString("log"); !path.empty())
+    log.open(path, std::ios::app);
 
   std::vector<Point> points;
   std::unordered_map<uint64_t, std::size_t> index;

@@ -17,7 +17,7 @@ int main() {
     std::fprintf(stderr, "vrflow-core-recorder: %s\n", status.error().message.c_str());
     return 2;
   }
-  const std::string path = module.param("file", "recording.csv");
+  const std::string path = module.params().getString("file");
   // A missing folder is created only inside the run's working folder.
   if (auto folder = prepareOutputPath(path); !folder) {
     std::fprintf(stderr, "vrflow-core-recorder: module %s: cannot write %s: %s\n",

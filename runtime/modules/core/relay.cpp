@@ -15,7 +15,7 @@ int main() {
     std::fprintf(stderr, "vrflow-core-relay: %s\n", status.error().message.c_str());
     return 2;
   }
-  const auto delay = std::chrono::milliseconds(module.paramInt("delay-ms", 0));
+  const auto delay = std::chrono::milliseconds(module.params().getInt("delay-ms"));
   while (module.wait()) {
     if (delay.count() > 0) std::this_thread::sleep_for(delay);
     if (!module.put(out, module.get(in))) break;

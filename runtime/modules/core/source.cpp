@@ -15,8 +15,8 @@ int main() {
     std::fprintf(stderr, "vrflow-core-source: %s\n", status.error().message.c_str());
     return 2;
   }
-  const auto size = static_cast<std::size_t>(module.paramInt("size", 64));
-  const auto count = static_cast<uint64_t>(module.paramInt("count", 0));
+  const auto size = static_cast<std::size_t>(module.params().getInt("size"));
+  const auto count = static_cast<uint64_t>(module.params().getInt("count"));
   std::vector<std::byte> payload(size < 8 ? 8 : size);
   const uint64_t resource = module.newId();
   // wait() only for an iteration it will do: leaving the loop counts the one in progress.

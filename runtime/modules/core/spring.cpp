@@ -16,11 +16,12 @@ int main() {
     std::fprintf(stderr, "vrflow-core-spring: %s\n", status.error().message.c_str());
     return 2;
   }
-  const double k = module.paramDouble("stiffness", 50);
-  const double c = module.paramDouble("damping", 0.5);
-  const double rest = module.paramDouble("rest", 1);
+  const double k = module.params().getFloat("stiffness");
+  const double c = module.params().getFloat("damping");
+  const double rest = module.params().getFloat("rest");
   std::ofstream log;
-  if (const auto path = module.param("log"); !path.empty()) log.open(path, std::ios::app);
+  if (const auto path = module.params().getString("log"); !path.empty())
+    log.open(path, std::ios::app);
 
   std::map<uint64_t, core::PointState> points;
   bool anchored = false;

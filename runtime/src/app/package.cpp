@@ -18,24 +18,6 @@ std::optional<std::string> checkRange(const ParamSpec& spec, double value, std::
   return std::nullopt;
 }
 
-// Three numbers separated by spaces and/or commas.
-std::optional<std::vector<std::string_view>> splitVec3(std::string_view text) {
-  std::vector<std::string_view> parts;
-  std::size_t p = 0;
-  const auto isSeparator = [](char c) {
-    return c == ',' || std::isspace(static_cast<unsigned char>(c)) != 0;
-  };
-  while (p < text.size()) {
-    while (p < text.size() && isSeparator(text[p])) ++p;
-    const std::size_t start = p;
-    while (p < text.size() && !isSeparator(text[p])) ++p;
-    if (p > start) parts.push_back(text.substr(start, p - start));
-    if (parts.size() > 3) return std::nullopt;
-  }
-  if (parts.size() != 3) return std::nullopt;
-  return parts;
-}
-
 }  // namespace
 
 const PortSpec* findPort(const std::vector<PortSpec>& ports, std::string_view name) {
@@ -66,34 +48,6 @@ const ParamSpec* FilterType::findParam(std::string_view paramName) const {
   const auto it = std::find_if(params.begin(), params.end(),
                                [&](const ParamSpec& param) { return param.name == paramName; });
   return it == params.end() ? nullptr : &*it;
-}
-
-std::string toString(ParamType type) {
-  switch (type) {
-    case ParamType::Int:
-      return "int";
-    case ParamType::Float:
-      return "float";
-    case ParamType::Bool:
-      return "bool";
-    case ParamType::String:
-      return "string";
-    case ParamType::Enum:
-      return "enum";
-    case ParamType::Vec3:
-      return "vec3";
-    case ParamType::File:
-      return "file";
-  }
-  return "string";
-}
-
-std::optional<ParamType> parseParamType(std::string_view text) {
-  for (const ParamType type : {ParamType::Int, ParamType::Float, ParamType::Bool, ParamType::String,
-                               ParamType::Enum, ParamType::Vec3, ParamType::File}) {
-    if (toString(type) == text) return type;
-  }
-  return std::nullopt;
 }
 
 std::string toString(FileAccess access) {
@@ -139,45 +93,64 @@ std::optional<ModuleKind> parseModuleKind(std::string_view text) {
   return std::nullopt;
 }
 
-std::optional<std::string> checkParamValue(const ParamSpec& spec, std::string_view value) {
-  const std::string got = ", got '" + std::string(value) + "'";
-  switch (spec.type) {
-    case ParamType::Int: {
-      const std::optional<long long> parsed = detail::parseInteger(value);
-      if (!parsed) return "expects an int" + got;
-      return checkRange(spec, static_cast<double>(*parsed), value);
-    }
-    case ParamType::Float: {
-      const std::optional<double> parsed = detail::parseFloat(value);
-      if (!parsed) return "expects a finite float" + got;
-      return checkRange(spec, *parsed, value);
-    }
-    case ParamType::Bool:
-      if (!detail::parseBool(value)) return "expects a bool (true or false)" + got;
-      return std::nullopt;
-    case ParamType::Enum:
-      if (std::find(spec.choices.begin(), spec.choices.end(), value) == spec.choices.end()) {
-        return "expects one of " + detail::joinNames(spec.choices) + got +
-               detail::didYouMean(value, spec.choices);
-      }
-      return std::nullopt;
-    case ParamType::Vec3: {
-      const auto parts = splitVec3(value);
-      if (!parts) return "expects 3 numbers 'x y z'" + got;
-      for (const std::string_view part : *parts) {
-        const std::optional<double> parsed = detail::parseFloat(part);
-        if (!parsed) return "expects 3 finite numbers 'x y z'" + got;
-        if (auto outOfRange = checkRange(spec, *parsed, part)) {
-          return "component " + *outOfRange;
-        }
-      }
-      return std::nullopt;
-    }
-    case ParamType::String:
-    case ParamType::File:
-      return std::nullopt;
+Result<ParamValue> parseParamValue(const ParamSpec& spec, std::string_view text) {
+  if (spec.type == ParamType::Enum &&
+      std::find(spec.choices.begin(), spec.choices.end(), text) == spec.choices.end()) {
+    return makeError("expects one of " + detail::joinNames(spec.choices) + ", got '" +
+                     std::string(text) + "'" + detail::didYouMean(text, spec.choices));
   }
+  Result<ParamValue> value = vrflow::parseParamValue(spec.type, text);
+  if (!value) return value;
+  std::optional<std::string> outOfRange;
+  if (const auto* number = std::get_if<int64_t>(&*value)) {
+    outOfRange = checkRange(spec, static_cast<double>(*number), text);
+  } else if (const auto* real = std::get_if<double>(&*value)) {
+    outOfRange = checkRange(spec, *real, text);
+  } else if (const auto* vector = std::get_if<ParamVec3>(&*value)) {
+    for (const double component : *vector) {
+      outOfRange = checkRange(spec, component, detail::formatNumber(component));
+      if (outOfRange) {
+        outOfRange = "component " + *outOfRange;
+        break;
+      }
+    }
+  }
+  if (outOfRange) return makeError(*outOfRange);
+  return value;
+}
+
+std::optional<std::string> checkParamValue(const ParamSpec& spec, std::string_view value) {
+  const Result<ParamValue> parsed = parseParamValue(spec, value);
+  if (!parsed) return parsed.error().message;
   return std::nullopt;
+}
+
+Result<Parameters> parameterSet(const std::vector<ParamSpec>& specs,
+                                const std::vector<Param>& values, std::string owner) {
+  Parameters parameters(std::move(owner));
+  for (const Param& value : values) {
+    if (std::none_of(specs.begin(), specs.end(),
+                     [&](const ParamSpec& spec) { return spec.name == value.name; })) {
+      return makeError(parameters.owner() + " has no parameter '" + value.name + "'");
+    }
+  }
+  for (const ParamSpec& spec : specs) {
+    const Param* set = findParam(values, spec.name);
+    const std::string& text = set != nullptr ? set->value : spec.defaultValue;
+    const bool needsText = spec.type == ParamType::Int || spec.type == ParamType::Float ||
+                           spec.type == ParamType::Bool || spec.type == ParamType::Vec3;
+    if (set == nullptr && needsText && text.empty()) {
+      parameters.declare(spec.name, spec.type, std::nullopt);
+      continue;
+    }
+    Result<ParamValue> value = parseParamValue(spec, text);
+    if (!value) {
+      return makeError(parameters.owner() + ": parameter '" + spec.name + "' " +
+                       value.error().message);
+    }
+    parameters.declare(spec.name, spec.type, std::move(*value));
+  }
+  return parameters;
 }
 
 }  // namespace vrflow::app

@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cmath>
-#include <system_error>
 
 #include "vrflow/base/echo.hpp"
+#include "vrflow/base/parameters.hpp"
 
 namespace vrflow::app::detail {
 namespace {
@@ -74,27 +73,21 @@ std::string formatNumber(double value) {
 }
 
 std::optional<long long> parseInteger(std::string_view text) {
-  long long value = 0;
-  const char* end = text.data() + text.size();
-  const auto result = std::from_chars(text.data(), end, value);
-  if (text.empty() || result.ec != std::errc() || result.ptr != end) return std::nullopt;
-  return value;
+  const Result<ParamValue> value = vrflow::parseParamValue(ParamType::Int, text);
+  if (!value) return std::nullopt;
+  return std::get<int64_t>(*value);
 }
 
 std::optional<double> parseFloat(std::string_view text) {
-  double value = 0;
-  const char* end = text.data() + text.size();
-  const auto result = std::from_chars(text.data(), end, value, std::chars_format::general);
-  if (text.empty() || result.ec != std::errc() || result.ptr != end || !std::isfinite(value)) {
-    return std::nullopt;
-  }
-  return value;
+  const Result<ParamValue> value = vrflow::parseParamValue(ParamType::Float, text);
+  if (!value) return std::nullopt;
+  return std::get<double>(*value);
 }
 
 std::optional<bool> parseBool(std::string_view text) {
-  if (text == "true" || text == "1") return true;
-  if (text == "false" || text == "0") return false;
-  return std::nullopt;
+  const Result<ParamValue> value = vrflow::parseParamValue(ParamType::Bool, text);
+  if (!value) return std::nullopt;
+  return std::get<bool>(*value);
 }
 
 std::optional<char> firstControlCharacter(std::string_view text) {

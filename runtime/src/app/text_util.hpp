@@ -21,7 +21,7 @@ std::string didYouMean(std::string_view word, const std::vector<std::string>& ca
 /// The shortest text that reads back as `value` ("10", "0.5", "1e+20").
 std::string formatNumber(double value);
 
-/// Parses a whole string as a decimal integer (optional '-'), or nullopt.
+/// Parses a whole string as a decimal integer (optional '-'), or nullopt (parseParamValue).
 std::optional<long long> parseInteger(std::string_view text);
 /// Parses a whole string as a finite decimal float, or nullopt.
 std::optional<double> parseFloat(std::string_view text);

@@ -25,7 +25,7 @@ class PassthroughFilter final : public Filter {
 class InitialFilter final : public Filter {
  public:
   Status start(FilterContext& context) override {
-    pending_ = context.paramInt("count", 1);
+    pending_ = context.params().getInt("count");
     if (pending_ < 0) return makeError("filter '" + context.name() + "': count must be >= 0");
     return {};
   }
@@ -96,7 +96,7 @@ class MergeFilter final : public Filter {
 
 Result<std::unique_ptr<Filter>> makeMerge(const FilterContext& context) {
   std::string problem;
-  auto rules = app::parseStampRules(context.param("stamps", ""), problem);
+  auto rules = app::parseStampRules(context.params().getString("stamps"), problem);
   if (!rules) return makeError("filter '" + context.name() + "': " + problem);
   return std::unique_ptr<Filter>(std::make_unique<MergeFilter>(std::move(*rules)));
 }
@@ -110,8 +110,8 @@ Result<std::unique_ptr<Filter>> makeMerge(const FilterContext& context) {
 class PortInputFilter final : public Filter {
  public:
   Status start(FilterContext& context) override {
-    initial_ = context.paramInt("initial", 0);
-    latest_ = context.param("mode", "fifo") == "latest";
+    initial_ = context.params().getInt("initial");
+    latest_ = context.params().getString("mode") == "latest";
     if (latest_) merge_.keepLast();
     return {};
   }

@@ -61,6 +61,7 @@ Status Daemon::start() {
   Impl& d = *impl_;
   for (auto& node : d.graph->nodes) {
     if (auto status = node->filter->start(*node); !status) return status;
+    if (const auto& misread = node->params().firstError()) return *misread;
   }
   d.running.store(true);
   d.thread = std::thread([&d] { d.loop(); });

@@ -15,17 +15,15 @@ constexpr uint32_t kOutputRingCapacity = 16;
 constexpr uint32_t kInputRingCapacity = 16;
 constexpr int kMaxInitialMessages = 1'000'000;
 
-std::map<std::string, std::string> toMap(const std::vector<app::Param>& params) {
-  std::map<std::string, std::string> map;
-  for (const auto& p : params) map[p.name] = p.value;
-  return map;
+// Who a filter node's parameters belong to, as their errors name it.
+std::string filterOwner(const std::string& id, const std::string& type) {
+  return "filter '" + id + "' (" + type + ")";
 }
 
 }  // namespace
 
 Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& type,
-                                    std::map<std::string, std::string> params,
-                                    std::vector<std::string> inputs,
+                                    Parameters params, std::vector<std::string> inputs,
                                     std::vector<std::string> outputs) {
   const FilterFactory* factory = FilterRegistry::instance().find(type);
   if (factory == nullptr) return makeError("unknown filter type '" + type + "' for '" + id + "'");
@@ -37,6 +35,7 @@ Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& ty
   node->outputs.resize(node->outputNames.size());
   auto filter = (*factory)(*node);
   if (!filter) return filter.error();
+  if (const auto& misread = node->params().firstError()) return *misread;
   node->filter = std::move(*filter);
   graph->nodes.push_back(std::move(node));
   return graph->nodes.back().get();
@@ -90,32 +89,33 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     }
     modules.push_back({module.id, host, type->executable, static_cast<int>(m)});
 
-    // Parameters: manifest defaults, overridden by the file.
-    std::map<std::string, std::string> values;
-    for (const auto& spec : type->params) values[spec.name] = spec.defaultValue;
-    for (const auto& p : module.params) values[p.name] = p.value;
+    // Parameters: typed once, the file's values over the manifest's defaults.
+    auto moduleParams =
+        app::parameterSet(type->params, module.params,
+                          "module '" + module.id + "' (" + type->package + "/" + type->type + ")");
+    if (!moduleParams) return moduleParams.error();
     // A relative path in a file parameter names a file beside the application when one exists
     // there (input data shipped with it); otherwise it stays relative to the working directory
     // (outputs). The same rule as a manifest's executable.
     if (!application.file.empty()) {
       const auto base = std::filesystem::path(application.file).parent_path();
-      for (const auto& spec : type->params) {
-        auto found = values.find(spec.name);
-        if (spec.type != app::ParamType::File || found == values.end() || found->second.empty())
-          continue;
-        const std::filesystem::path path(found->second);
+      for (const auto& [name, entry] : std::map(moduleParams->entries())) {
+        if (entry.type != app::ParamType::File || !entry.value) continue;
+        const std::filesystem::path path(std::get<std::string>(*entry.value));
         std::error_code error;
-        if (path.is_relative() && std::filesystem::is_regular_file(base / path, error)) {
-          found->second = (base / path).lexically_normal().string();
+        if (!path.empty() && path.is_relative() &&
+            std::filesystem::is_regular_file(base / path, error)) {
+          moduleParams->declare(name, entry.type, (base / path).lexically_normal().string());
         }
       }
     }
     if (!type->mpiRanksParam.empty()) {  // validated as an int parameter in range
-      modules.back().mpiRanks = std::max(1, std::atoi(values[type->mpiRanksParam].c_str()));
+      modules.back().mpiRanks = static_cast<int>(
+          std::clamp<int64_t>(moduleParams->getInt(type->mpiRanksParam), 1, 1 << 20));
     }
-    std::string text;
-    for (const auto& [name, value] : values) text += name + "=" + value + "\n";
-    if (auto status = slot.setParams(text); !status) return status.error();
+    if (auto status = slot.setParams(encodeParameters(*moduleParams)); !status) {
+      return status.error();
+    }
 
     const auto ports = catalog.portsOf(module);
     if (ports.size() > ipc::kMaxPortsPerModule) {
@@ -145,9 +145,10 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
 
       const std::string nodeId = module.id + "." + spec.name;
       if (spec.isInput) {
-        std::map<std::string, std::string> params{{"initial", std::to_string(initial)}};
+        Parameters params(filterOwner(nodeId, "port-input"));
+        params.declare("initial", app::ParamType::Int, int64_t{initial});
         const bool latest = config != nullptr && config->mode == app::InputMode::Latest;
-        params["mode"] = latest ? "latest" : "fifo";
+        params.declare("mode", app::ParamType::Enum, std::string(latest ? "latest" : "fifo"));
         auto node = addNode(nodeId, "port-input", std::move(params), {}, {"out"});
         if (!node) return node.error();
         (*node)->outputs[0].push_back(std::make_unique<RingSink>(
@@ -155,7 +156,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         if (!spec.stampsOnly) hasDataInputs[m] = true;
         portNodes[{static_cast<int>(m), spec.name}] = *node;
       } else {
-        auto node = addNode(nodeId, "port-output", {}, {"in"}, {"out"});
+        auto node = addNode(nodeId, "port-output", Parameters(filterOwner(nodeId, "port-output")),
+                            {"in"}, {"out"});
         if (!node) return node.error();
         Queue& queue = graph->newQueue();
         queue.capacity = 4;
@@ -176,13 +178,12 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     for (const auto& spec : catalog.portsOf(filter)) {
       (spec.isInput ? inputs : outputs).push_back(spec.name);
     }
-    // Parameters: the catalog's defaults, overridden by the file.
-    std::map<std::string, std::string> params;
-    if (const app::FilterType* type = catalog.findFilter(filter.type)) {
-      for (const auto& spec : type->params) params[spec.name] = spec.defaultValue;
-    }
-    for (auto& [name, value] : toMap(filter.params)) params[name] = value;
-    auto node = addNode(filter.id, filter.type, std::move(params), inputs, outputs);
+    // Parameters: typed once, the file's values over the filter spec's defaults.
+    const app::FilterType* type = catalog.findFilter(filter.type);
+    auto params = app::parameterSet(type != nullptr ? type->params : std::vector<app::ParamSpec>{},
+                                    filter.params, filterOwner(filter.id, filter.type));
+    if (!params) return params.error();
+    auto node = addNode(filter.id, filter.type, std::move(*params), inputs, outputs);
     if (!node) return node.error();
     filterNodes[filter.id] = *node;
   }

@@ -61,9 +61,8 @@ struct Daemon::Impl {
   void markUnneededModules();
 
   Status build(const app::Application& application, const app::Catalog& catalog);
-  Result<Node*> addNode(const std::string& id, const std::string& type,
-                        std::map<std::string, std::string> params, std::vector<std::string> inputs,
-                        std::vector<std::string> outputs);
+  Result<Node*> addNode(const std::string& id, const std::string& type, Parameters params,
+                        std::vector<std::string> inputs, std::vector<std::string> outputs);
   void loop();
   bool pass();
   void checkFullQueues(uint64_t now);

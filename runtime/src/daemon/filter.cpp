@@ -1,34 +1,8 @@
 #include "vrflow/daemon/filter.hpp"
 
-#include <cmath>
-#include <cstdlib>
-
 #include "builtin_filters.hpp"
 
 namespace vrflow::daemon {
-
-long FilterContext::paramInt(const std::string& key, long fallback) const {
-  const std::string text = param(key, "");
-  if (text.empty()) return fallback;
-  char* end = nullptr;
-  const long value = std::strtol(text.c_str(), &end, 10);
-  return (end != nullptr && *end == '\0') ? value : fallback;
-}
-
-double FilterContext::paramFloat(const std::string& key, double fallback) const {
-  const std::string text = param(key, "");
-  if (text.empty()) return fallback;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  return (end != nullptr && *end == '\0' && std::isfinite(value)) ? value : fallback;
-}
-
-bool FilterContext::paramBool(const std::string& key, bool fallback) const {
-  const std::string text = param(key, "");
-  if (text == "true" || text == "1") return true;
-  if (text == "false" || text == "0") return false;
-  return fallback;
-}
 
 bool Filter::exhausted(FilterContext& context) const {
   for (std::size_t i = 0; i < context.inputCount(); ++i) {

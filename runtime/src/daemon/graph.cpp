@@ -46,11 +46,6 @@ void RingSink::push(MessageRef message) {
   }
 }
 
-std::string Node::param(const std::string& key, const std::string& fallback) const {
-  const auto it = params_.find(key);
-  return it == params_.end() ? fallback : it->second;
-}
-
 void Node::countDropped(std::size_t i, uint64_t count, std::string_view reason) {
   if (count == 0) return;
   if (dropped.size() < inputs.size()) dropped.resize(inputs.size());

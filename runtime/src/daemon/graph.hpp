@@ -96,12 +96,11 @@ class Graph;
 /// A filter with its inputs (queues) and outputs (sinks); also its FilterContext.
 class Node final : public FilterContext {
  public:
-  Node(Graph& graph, std::string id, std::string typeName,
-       std::map<std::string, std::string> params)
+  Node(Graph& graph, std::string id, std::string typeName, Parameters params)
       : type(std::move(typeName)), graph_(&graph), id_(std::move(id)), params_(std::move(params)) {}
 
   const std::string& name() const override { return id_; }
-  std::string param(const std::string& key, const std::string& fallback) const override;
+  const Parameters& params() const override { return params_; }
   std::size_t inputCount() const override { return inputs.size(); }
   std::deque<MessageRef>& input(std::size_t i) override { return inputs[i]->items; }
   bool inputClosed(std::size_t i) const override { return inputs[i]->closed; }
@@ -135,7 +134,7 @@ class Node final : public FilterContext {
  private:
   Graph* graph_;
   std::string id_;
-  std::map<std::string, std::string> params_;
+  Parameters params_;
 };
 
 /// A module output ring feeding the queue of its port's output filter.

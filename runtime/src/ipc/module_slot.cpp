@@ -37,7 +37,10 @@ int ModuleSlotUser::findPort(std::string_view name, bool input) const {
   return -1;
 }
 
-std::string_view ModuleSlotUser::paramsText() const {
+std::string_view ModuleSlotUser::paramsBlock() const {
+  // The daemon wrote the block; a slot pointing outside the segment reads as no bytes, which
+  // the parameter codec refuses.
+  if (!segment_->contains(slot_->paramsOffset, slot_->paramsBytes)) return {};
   return {segment_->at<char>(slot_->paramsOffset), slot_->paramsBytes};
 }
 

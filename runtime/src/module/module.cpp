@@ -39,6 +39,14 @@ uint64_t wallNs() {
                                    .count());
 }
 
+// A module that reads a parameter its manifest does not declare (or as another type) has a bug
+// the run cannot work around: say so and leave with a non-zero status.
+void exitOnParameterError(const Error& error) {
+  std::fprintf(stderr, "%s\n", error.message.c_str());
+  std::fflush(nullptr);
+  std::_Exit(1);
+}
+
 constexpr int64_t kPollNs = 200'000'000;  // re-check the stop flag at least this often
 
 // The slot of this process's module, marked when operator new finds no memory (the runtime
@@ -107,7 +115,7 @@ struct Module::Impl {
   }
   double simTime = 0.0;
   double timeStep = 0.0;
-  std::map<std::string, std::string, std::less<>> params;
+  Parameters params{"module (not joined to a run yet)"};
 
   bool stopRequested() const { return slot.stopRequested(); }
   void setState(ipc::ModuleState state, int port = -1) { slot.setState(state, port); }
@@ -177,7 +185,9 @@ bool OutputPort::connected() const {
   return module_->impl_->slot.joined() && slot_ >= 0 && module_->impl_->slot.portConnected(slot_);
 }
 
-Module::Module() : impl_(std::make_unique<Impl>()) {}
+Module::Module() : impl_(std::make_unique<Impl>()) {
+  impl_->params.setFailureHandler(&exitOnParameterError);  // also before init(): a bug to report
+}
 
 Module::~Module() {
   if (!impl_->slot.joined()) return;
@@ -243,16 +253,11 @@ Status Module::init() {
   m.current.resize(static_cast<std::size_t>(m.slot.portCount()));
   m.trace = m.slot.traceRing();
 
-  // Parameters: "name=value" lines.
-  std::string_view text = m.slot.paramsText();
-  while (!text.empty()) {
-    const auto eol = text.find('\n');
-    const auto line = text.substr(0, eol);
-    const auto eq = line.find('=');
-    if (eq != std::string_view::npos) m.params.emplace(line.substr(0, eq), line.substr(eq + 1));
-    if (eol == std::string_view::npos) break;
-    text.remove_prefix(eol + 1);
-  }
+  // Parameters: the typed set the daemon encoded (vrflow/base/parameters.hpp).
+  auto params = decodeParameters(m.slot.paramsBlock());
+  if (!params) return makeError("cannot join the run: " + params.error().message);
+  m.params = std::move(*params);
+  m.params.setFailureHandler(&exitOnParameterError);
 
   // Match declared ports with the run's.
   std::vector<bool> declared(static_cast<std::size_t>(m.slot.portCount()), false);
@@ -425,25 +430,8 @@ bool Module::stopRequested() const {
   return impl_->stopRequested();
 }
 
-std::string Module::param(std::string_view name, std::string_view fallback) const {
-  const auto it = impl_->params.find(name);
-  return it == impl_->params.end() ? std::string(fallback) : it->second;
-}
-
-double Module::paramDouble(std::string_view name, double fallback) const {
-  const auto it = impl_->params.find(name);
-  if (it == impl_->params.end()) return fallback;
-  char* end = nullptr;
-  const double value = std::strtod(it->second.c_str(), &end);
-  return end != it->second.c_str() ? value : fallback;
-}
-
-int64_t Module::paramInt(std::string_view name, int64_t fallback) const {
-  const auto it = impl_->params.find(name);
-  if (it == impl_->params.end()) return fallback;
-  char* end = nullptr;
-  const long long value = std::strtoll(it->second.c_str(), &end, 10);
-  return end != it->second.c_str() ? value : fallback;
+const Parameters& Module::params() const {
+  return impl_->params;
 }
 
 uint64_t Module::newId() {

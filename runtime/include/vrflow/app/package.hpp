@@ -8,6 +8,7 @@
 
 #include "vrflow/app/model.hpp"
 #include "vrflow/app/source_location.hpp"
+#include "vrflow/base/parameters.hpp"
 
 namespace vrflow::app {
 
@@ -31,8 +32,10 @@ struct PortSpec {
   std::string doc;
 };
 
-/// The value types of parameters.
-enum class ParamType { Int, Float, Bool, String, Enum, Vec3, File };
+/// The value types of parameters (vrflow/base/parameters.hpp).
+using vrflow::ParamType;
+using vrflow::parseParamType;
+using vrflow::toString;
 
 /// What a module does with the path a file parameter names (manifest attribute `access`).
 enum class FileAccess {
@@ -108,10 +111,6 @@ struct FilterType {
   const ParamSpec* findParam(std::string_view paramName) const;
 };
 
-/// "int", "float", "bool", "string", "enum", "vec3" or "file".
-std::string toString(ParamType type);
-/// The type written `text`, or nullopt.
-std::optional<ParamType> parseParamType(std::string_view text);
 /// "input", "output" or "" (unstated).
 std::string toString(FileAccess access);
 /// The access written `text` ("input" or "output"), or nullopt.
@@ -122,8 +121,19 @@ std::string toString(ModuleKind kind);
 std::optional<ModuleKind> parseModuleKind(std::string_view text);
 
 /// Why `value` is not a valid value of parameter `spec` ("expects an int, got 'x'", "is above
-/// its maximum 10", ...), or nullopt when it is valid.
+/// its maximum 10", ...), or nullopt when it is valid: the type's parser (parseParamValue), then
+/// the declaration's range or choices.
 std::optional<std::string> checkParamValue(const ParamSpec& spec, std::string_view value);
+
+/// The typed value of `text` for `spec`, or why it is not valid (checkParamValue's message).
+Result<ParamValue> parseParamValue(const ParamSpec& spec, std::string_view text);
+
+/// The typed parameter set of one module or filter owned by `owner`: each of `specs` with its
+/// value in `values` (already validated) or else its default; a parameter with neither (an
+/// empty default of an int, float, bool or vec3) is declared without a value. Fails on a value
+/// that is not valid or a name that is not declared (the validator refuses both first).
+Result<Parameters> parameterSet(const std::vector<ParamSpec>& specs,
+                                const std::vector<Param>& values, std::string owner);
 
 /// The port with this name in `ports`, or nullptr.
 const PortSpec* findPort(const std::vector<PortSpec>& ports, std::string_view name);

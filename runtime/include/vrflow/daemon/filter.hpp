@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "vrflow/base/parameters.hpp"
 #include "vrflow/base/result.hpp"
 #include "vrflow/daemon/message_ref.hpp"
 #include "vrflow/message/builder.hpp"
@@ -24,13 +25,10 @@ class FilterContext {
 
   /// The filter's id (for messages) and its parameters from the application file.
   virtual const std::string& name() const = 0;
-  /// Parameters hold the file's values over the catalog's defaults for the filter type.
-  virtual std::string param(const std::string& key, const std::string& fallback) const = 0;
-  /// The parameter read as an integer / finite number / bool (true, false, 1, 0); `fallback`
-  /// when it is absent or unreadable.
-  long paramInt(const std::string& key, long fallback) const;
-  double paramFloat(const std::string& key, double fallback) const;
-  bool paramBool(const std::string& key, bool fallback) const;
+  /// The typed parameters: the file's values over the filter spec's defaults. Reading one the
+  /// spec does not declare, or as another type, is an error the daemon reports (naming the
+  /// filter and the parameter) once the factory or start() returns: the run does not start.
+  virtual const Parameters& params() const = 0;
 
   virtual std::size_t inputCount() const = 0;
   /// Messages buffered on input `i`, oldest first. Pop what you consume.

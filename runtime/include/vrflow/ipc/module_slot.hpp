@@ -51,7 +51,7 @@ class ModuleSlot {
   std::atomic<uint64_t> iterations{0};
   uint64_t iterationLimit = 0;  ///< 0: no limit
   std::atomic<int32_t> pid{0};
-  uint64_t paramsOffset = 0;  ///< "name=value\n" text
+  uint64_t paramsOffset = 0;  ///< the typed parameter set (encodeParameters)
   uint32_t paramsBytes = 0;
   std::atomic<uint64_t> computeNs{0};  ///< total time between wait() returning and the next wait()
   std::atomic<uint64_t> waitNs{0};     ///< total time spent in wait()

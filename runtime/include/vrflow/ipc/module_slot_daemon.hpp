@@ -26,7 +26,7 @@ class ModuleSlotDaemon {
   /// Set-up: gives the module a trace ring (`--trace`).
   Status addTraceRing();
   /// Set-up: the module's "name=value\n" parameter text.
-  Status setParams(std::string_view text);
+  Status setParams(std::string_view bytes);  ///< the encoded parameter set
   /// Set-up: appends a port with a ring of `ringCapacity` (a power of two) handles, and returns
   /// the daemon's view of that ring. At most kMaxPortsPerModule ports.
   Result<RingRef> addPort(std::string_view name, bool isInput, bool stampsOnly, bool connected,

@@ -41,7 +41,7 @@ class ModuleSlotUser {
   /// True when endIt leaves as wait() returns (FlowVR's timing) rather than at the next wait().
   bool endItAfterWait() const { return slot_->endItAfterWait != 0; }
   /// The "name=value\n" text of the module's parameters.
-  std::string_view paramsText() const;
+  std::string_view paramsBlock() const;
   /// The module's trace ring when the run is traced; null otherwise.
   TraceRing* traceRing() const;
 

@@ -5,6 +5,7 @@
 #include <string>
 #include <string_view>
 
+#include "vrflow/base/parameters.hpp"
 #include "vrflow/base/result.hpp"
 #include "vrflow/message/builder.hpp"
 #include "vrflow/module/message.hpp"
@@ -104,10 +105,11 @@ class Module {
   /// end because nothing needs its outputs: wait() returns false then).
   bool stopRequested() const;
 
-  /// Parameters from the application file (defaults from the manifest filled in).
-  std::string param(std::string_view name, std::string_view fallback = {}) const;
-  double paramDouble(std::string_view name, double fallback) const;
-  int64_t paramInt(std::string_view name, int64_t fallback) const;
+  /// The typed parameters: the application file's values over the manifest's defaults, each of
+  /// its declared type (params().getFloat("dt"), getInt, getBool, getString, getVec3). Reading
+  /// one the manifest does not declare, or as another type, prints an error naming the module
+  /// and the parameter and exits with status 1 (docs/module-api.md).
+  const Parameters& params() const;
 
   /// A new object or resource id, unique on this host across processes.
   uint64_t newId();

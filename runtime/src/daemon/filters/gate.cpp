@@ -52,7 +52,7 @@ class GateFilter final : public Filter {
 void registerGate(FilterRegistry& registry) {
   registry.add("gate", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
     return std::unique_ptr<Filter>(
-        std::make_unique<GateFilter>(context.param("initially", "closed") == "open"));
+        std::make_unique<GateFilter>(context.params().getString("initially") == "open"));
   });
 }
 

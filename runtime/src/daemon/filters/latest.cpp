@@ -14,7 +14,7 @@ class LatestFilter final : public Filter {
   explicit LatestFilter(bool repeat) : repeat_(repeat) {}
 
   Status start(FilterContext& context) override {
-    const long initial = context.paramInt("initial-sync", 1);
+    const long initial = context.params().getInt("initial-sync");
     if (initial < 0) return makeError("filter '" + context.name() + "': initial-sync must be >= 0");
     triggers_ = static_cast<uint64_t>(initial);
     return {};
@@ -71,7 +71,7 @@ class LatestFilter final : public Filter {
 void registerLatest(FilterRegistry& registry) {
   registry.add("latest", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
     return std::unique_ptr<Filter>(
-        std::make_unique<LatestFilter>(context.paramBool("repeat", false)));
+        std::make_unique<LatestFilter>(context.params().getBool("repeat")));
   });
 }
 

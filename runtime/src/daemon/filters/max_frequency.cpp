@@ -43,13 +43,13 @@ class MaxFrequencyFilter final : public Filter {
 
 void registerMaxFrequency(FilterRegistry& registry) {
   registry.add("maxfrequency", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const double frequency = context.paramFloat("frequency", 30.0);
+    const double frequency = context.params().getFloat("frequency");
     if (!(frequency > 0.0) || !std::isfinite(frequency)) {
       return makeError("filter '" + context.name() + "': frequency must be a positive number");
     }
     const auto periodNs = static_cast<uint64_t>(std::llround(1e9 / frequency));
-    return std::unique_ptr<Filter>(
-        std::make_unique<MaxFrequencyFilter>(periodNs, context.param("mode", "wait") == "latest"));
+    return std::unique_ptr<Filter>(std::make_unique<MaxFrequencyFilter>(
+        periodNs, context.params().getString("mode") == "latest"));
   });
 }
 

@@ -286,16 +286,16 @@ class DecimateFilter final : public Filter {
 
 void registerMultiRate(FilterRegistry& registry) {
   registry.add("repeat", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const long count = context.paramInt("count", 10);
+    const long count = context.params().getInt("count");
     if (count < 1) return makeError("filter '" + context.name() + "': count must be >= 1");
     return std::unique_ptr<Filter>(std::make_unique<RepeatFilter>(static_cast<uint64_t>(count)));
   });
   registry.add("decimate", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const long count = context.paramInt("count", 10);
+    const long count = context.params().getInt("count");
     if (count < 1) return makeError("filter '" + context.name() + "': count must be >= 1");
     return std::unique_ptr<Filter>(std::make_unique<DecimateFilter>(
-        static_cast<uint64_t>(count), context.paramBool("restamp", true),
-        context.paramBool("merge", true)));
+        static_cast<uint64_t>(count), context.params().getBool("restamp"),
+        context.params().getBool("merge")));
   });
 }
 

@@ -56,7 +56,7 @@ class MultiplexFilter final : public Filter {
 void registerMultiplex(FilterRegistry& registry) {
   registry.add("multiplex", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
     return std::unique_ptr<Filter>(
-        std::make_unique<MultiplexFilter>(context.paramBool("renumber", true)));
+        std::make_unique<MultiplexFilter>(context.params().getBool("renumber")));
   });
 }
 

@@ -89,7 +89,7 @@ void registerRotate(FilterRegistry& registry) {
   registry.add("rotate", factoryOf<RotateFilter>());
   registry.add("unrotate", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
     return std::unique_ptr<Filter>(std::make_unique<UnrotateFilter>(
-        context.inputCount(), context.param("order", "iteration") != "round-robin"));
+        context.inputCount(), context.params().getString("order") != "round-robin"));
   });
 }
 

@@ -409,8 +409,8 @@ class RouteFilter final : public Filter {
 
 void registerRoute(FilterRegistry& registry) {
   registry.add("route", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const std::string initially = context.param("initially", "none");
-    const std::string unbounded = context.param("unbounded", "all");
+    const std::string initially = context.params().getString("initially");
+    const std::string unbounded = context.params().getString("unbounded");
     if (initially != "none" && initially != "all") {
       return makeError("filter '" + context.name() + "': initially must be none or all");
     }
@@ -418,7 +418,7 @@ void registerRoute(FilterRegistry& registry) {
       return makeError("filter '" + context.name() + "': unbounded must be all or drop");
     }
     return std::unique_ptr<Filter>(std::make_unique<RouteFilter>(
-        context.param("stamp", "interest"), initially == "all", unbounded == "all"));
+        context.params().getString("stamp"), initially == "all", unbounded == "all"));
   });
 }
 

@@ -253,23 +253,23 @@ class ScatterFilter final : public Filter {
 
 void registerScatter(FilterRegistry& registry) {
   registry.add("scatter", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const std::string by = context.param("by", "chunk");
+    const std::string by = context.params().getString("by");
     const SplitBy split = by == "id"       ? SplitBy::Id
                           : by == "type"   ? SplitBy::Type
                           : by == "bounds" ? SplitBy::Bounds
                           : by == "size"   ? SplitBy::Size
                                            : SplitBy::Chunk;
     std::vector<uint32_t> typeIds;
-    for (const auto& name : app::splitList(context.param("types", ""))) {
+    for (const auto& name : app::splitList(context.params().getString("types"))) {
       typeIds.push_back(msg::fnv1a32(name));
     }
     if (split == SplitBy::Type && typeIds.size() != context.outputCount()) {
       return makeError("filter '" + context.name() + "': by=type needs one type name per output");
     }
-    const std::string axisName = context.param("axis", "x");
+    const std::string axisName = context.params().getString("axis");
     const int axis = axisName == "y" ? 1 : axisName == "z" ? 2 : 0;
     std::vector<double> cuts;
-    for (const auto& text : app::splitList(context.param("cuts", ""))) {
+    for (const auto& text : app::splitList(context.params().getString("cuts"))) {
       char* end = nullptr;
       const double v = std::strtod(text.c_str(), &end);
       if (end == text.c_str() || *end != '\0' || !std::isfinite(v) ||
@@ -282,9 +282,8 @@ void registerScatter(FilterRegistry& registry) {
       return makeError("filter '" + context.name() + "': by=bounds needs N-1 cuts for N outputs");
     }
     return std::unique_ptr<Filter>(std::make_unique<ScatterFilter>(
-        split, std::move(typeIds), context.param("others", "all") != "drop", axis, std::move(cuts),
-        static_cast<uint64_t>(
-            std::strtoull(context.param("element-size", "1").c_str(), nullptr, 10))));
+        split, std::move(typeIds), context.params().getString("others") != "drop", axis,
+        std::move(cuts), static_cast<uint64_t>(context.params().getInt("element-size"))));
   });
 }
 

@@ -84,7 +84,7 @@ class StampFilter final : public Filter {
 void registerStampFilter(FilterRegistry& registry) {
   registry.add("stampfilter", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
     return std::unique_ptr<Filter>(
-        std::make_unique<StampFilter>(context.param("stamp", "iteration")));
+        std::make_unique<StampFilter>(context.params().getString("stamp")));
   });
 }
 

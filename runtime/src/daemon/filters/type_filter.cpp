@@ -63,11 +63,11 @@ class TypeFilter final : public Filter {
 void registerTypeFilter(FilterRegistry& registry) {
   registry.add("typefilter", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
     std::vector<uint32_t> typeIds;
-    for (const auto& name : app::splitList(context.param("types", ""))) {
+    for (const auto& name : app::splitList(context.params().getString("types"))) {
       typeIds.push_back(msg::fnv1a32(name));
     }
     return std::unique_ptr<Filter>(
-        std::make_unique<TypeFilter>(std::move(typeIds), context.paramBool("drop-others", false)));
+        std::make_unique<TypeFilter>(std::move(typeIds), context.params().getBool("drop-others")));
   });
 }
 

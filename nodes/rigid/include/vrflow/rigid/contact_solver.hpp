@@ -10,6 +10,7 @@
 #include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/message/values.hpp"
 #include "vrflow/rigid/body.hpp"
+#include "vrflow/rigid/contact_defaults.hpp"
 
 // The rigid interactor's solver: Bullet finds the contacts (btCollisionWorld with a
 // btDbvtBroadphase and btCollisionDispatcher; persistent manifolds), then our own sequential
@@ -21,17 +22,23 @@
 
 namespace vrflow::rigid {
 
+/// The solver's settings. The defaults of the fields that the interactor's manifest declares
+/// (gravity to slop) are the manifest's, generated into contact_defaults.hpp.
 struct ContactParams {
   /// External acceleration every dynamic body receives during the step (the force field's
   /// gravity): the solver predicts v + g dt before solving, so resting contact holds.
-  Vec3 gravity{0, -9.81, 0};
-  double restitution = 0.3;           ///< coefficient of restitution (one value for every pair)
-  double friction = 0.6;              ///< Coulomb friction coefficient
-  double restitutionThreshold = 0.5;  ///< closing speeds (m/s) below this do not bounce
-  int iterations = 20;                ///< sequential impulse iterations
-  double baumgarte = 0.2;             ///< fraction of the penetration removed per step
-  double slop = 0.005;                ///< penetration (m) left alone, keeps contacts alive
-  double margin = 0.005;              ///< Bullet collision margin of hull shapes (m)
+  Vec3 gravity{manifest_defaults::kGravityX, manifest_defaults::kGravityY,
+               manifest_defaults::kGravityZ};
+  /// coefficient of restitution (one value for every pair)
+  double restitution = manifest_defaults::kRestitution;
+  double friction = manifest_defaults::kFriction;  ///< Coulomb friction coefficient
+  /// closing speeds (m/s) below this do not bounce
+  double restitutionThreshold = manifest_defaults::kRestitutionThreshold;
+  int iterations = manifest_defaults::kIterations;  ///< sequential impulse iterations
+  double baumgarte =
+      manifest_defaults::kBaumgarte;       ///< fraction of the penetration removed per step
+  double slop = manifest_defaults::kSlop;  ///< penetration (m) left alone, keeps contacts alive
+  double margin = 0.005;                   ///< Bullet collision margin of hull shapes (m)
   /// Rolling and spinning resistance (m): a contact where a sphere or a capsule takes part resists
   /// relative rotation with a torque of at most this times the normal force, so that they come to
   /// rest (flat-faced shapes need none: their face contacts stop rolling).
