@@ -8,8 +8,13 @@ vrflow_add_library(runtime
     src/module/message.cpp
     src/module/module.cpp
     src/daemon/filter.cpp
+    src/daemon/filter_spec.cpp
+    src/daemon/filter_registry.cpp
+    src/daemon/compose.cpp
     src/daemon/builtin_filters.cpp
     src/daemon/filters/common.cpp
+    src/daemon/filters/forward.cpp
+    src/daemon/filters/merge.cpp
     src/daemon/filters/gate.cpp
     src/daemon/filters/latest.cpp
     src/daemon/filters/max_frequency.cpp
@@ -21,6 +26,7 @@ vrflow_add_library(runtime
     src/daemon/filters/stamp_filter.cpp
     src/daemon/filters/type_filter.cpp
     src/daemon/plugin_loader.cpp
+    src/daemon/testing/filter_harness.cpp
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
     src/net/control.cpp

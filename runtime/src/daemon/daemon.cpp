@@ -23,7 +23,6 @@ namespace {
 constexpr uint32_t kOutputRingCapacity = 16;
 constexpr uint32_t kInputRingCapacity = 16;
 constexpr int64_t kIdleSleepNs = 100'000'000;
-constexpr int kMaxInitialMessages = 1'000'000;
 
 uint64_t nowNs() {
   return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -121,15 +120,15 @@ Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& ty
                                     std::map<std::string, std::string> params,
                                     std::vector<std::string> inputs,
                                     std::vector<std::string> outputs) {
-  const FilterFactory* factory = FilterRegistry::instance().find(type);
-  if (factory == nullptr) return makeError("unknown filter type '" + type + "' for '" + id + "'");
+  const FilterSpec* spec = FilterRegistry::instance().find(type);
+  if (spec == nullptr) return makeError("unknown filter type '" + type + "' for '" + id + "'");
   auto node = std::make_unique<Node>(*graph, id, type, std::move(params));
   node->inputNames = std::move(inputs);
   node->outputNames = std::move(outputs);
   // Named inputs get their queues when connected; a factory already sees how many there are.
   node->inputs.assign(node->inputNames.size(), nullptr);
   node->outputs.resize(node->outputNames.size());
-  auto filter = (*factory)(*node);
+  auto filter = spec->factory(*node);
   if (!filter) return filter.error();
   node->filter = std::move(*filter);
   graph->nodes.push_back(std::move(node));

@@ -16,12 +16,14 @@ namespace vrflow::app {
 inline constexpr std::string_view kManifestFileName = "vrflow-package.xml";
 
 /// Every module type and filter type an application may use: the node packages' manifests
-/// plus the built-in filters (passthrough, merge, initial, broadcast). Pointers it hands out
-/// stay valid while the catalog lives (entries are never moved or removed).
+/// plus the filter types. The filter types are declared in the daemon layer beside their code:
+/// programs and tests start from daemon::makeCatalog() (vrflow/daemon/filter_registry.hpp),
+/// which fills them in. Pointers it hands out stay valid while the catalog lives (entries are
+/// never moved or removed).
 class Catalog {
  public:
-  /// A catalog with the built-in filter types only.
-  Catalog();
+  /// An empty catalog: no package, no filter type.
+  Catalog() = default;
 
   /// Reads one vrflow-package.xml. Fails with "FILE:LINE:COL: error: ..." lines for a bad
   /// manifest, or when its package name is already in the catalog from another file (adding

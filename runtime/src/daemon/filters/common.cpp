@@ -3,8 +3,14 @@
 
 #include "../graph.hpp"
 #include "filters.hpp"
+#include "vrflow/base/assert.hpp"
 
 namespace vrflow::daemon::filters {
+
+void addBuiltin(FilterRegistry& registry, FilterSpec spec) {
+  const Status added = registry.add(std::move(spec));
+  VRFLOW_ASSERT(added.ok(), "built-in filter types have distinct names and factories");
+}
 
 bool allInputsDone(FilterContext& context) {
   for (std::size_t i = 0; i < context.inputCount(); ++i) {

@@ -7,12 +7,28 @@
 #include <vector>
 
 #include "vrflow/app/model.hpp"
-#include "vrflow/daemon/filter.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/message/reader.hpp"
 
-// The standard filter library (docs/filters.md): one register function per file.
+// The standard filter library (docs/filters.md): one register function per file, adding the
+// FilterSpec of each type the file implements (its declaration beside its code).
 
 namespace vrflow::daemon::filters {
+
+using app::FilterType;
+using app::Param;
+using app::paramString;
+using app::PortSpec;
+using app::splitList;
+
+/// kMaxFilterPorts as the bound of a parameter.
+inline constexpr double kMaxPorts = static_cast<double>(kMaxFilterPorts);
+
+/// Adds a built-in filter type to `registry` (a bug when its name is taken).
+void addBuiltin(FilterRegistry& registry, FilterSpec spec);
+
+void registerForward(FilterRegistry& registry);  ///< passthrough, broadcast and initial
+void registerMerge(FilterRegistry& registry);    ///< merge and gather
 
 void registerMultiplex(FilterRegistry& registry);
 void registerGate(FilterRegistry& registry);

@@ -51,13 +51,33 @@ class MultiplexFilter final : public Filter {
   uint64_t sent_ = 0;
 };
 
+app::FilterType multiplexType() {
+  FilterType type;
+  type.name = "multiplex";
+  type.doc =
+      "Forwards each message of in0..in{N-1} to out as it comes (one input after the other "
+      "when several wait), renumbered: the iteration stamp counts the messages sent.";
+  type.params.push_back(intParam("inputs", "2", 1, kMaxPorts, "number of inputs N"));
+  type.params.push_back(
+      boolParam("renumber", "true",
+                "stamp each message's iteration with the count of messages sent (a "
+                "copy); false forwards them untouched, by reference"));
+  type.ports = [](const std::vector<Param>& params) {
+    auto ports = numberedPorts("in", portCount(params, "inputs", 2), true, "messages to forward");
+    ports.push_back(filterPort("out", false, "every message, in arrival order"));
+    return ports;
+  };
+  return type;
+}
+
 }  // namespace
 
 void registerMultiplex(FilterRegistry& registry) {
-  registry.add("multiplex", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    return std::unique_ptr<Filter>(
-        std::make_unique<MultiplexFilter>(context.paramBool("renumber", true)));
-  });
+  addBuiltin(registry,
+             {multiplexType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+                return std::unique_ptr<Filter>(
+                    std::make_unique<MultiplexFilter>(context.paramBool("renumber", true)));
+              }});
 }
 
 }  // namespace vrflow::daemon::filters
