@@ -29,6 +29,8 @@ Status joinFailures(const std::vector<std::string>& failures) {
 
 }  // namespace
 
+Catalog::Catalog() = default;
+
 Status Catalog::addPackageFile(const std::string& path) {
   return addPackageFileImpl(path, /*firstWins=*/false);
 }

@@ -23,16 +23,7 @@ class PortInputFilter final : public Filter {
     return {};
   }
   void process(FilterContext& context) override {
-    while (initial_ > 0 && context.canEmit(0)) {
-      auto message = context.makeEmpty(static_cast<uint64_t>(emittedInitial_++), false);
-      if (!message) {
-        context.warn(message.error().message);
-        return;
-      }
-      context.emit(0, std::move(*message));
-      --initial_;
-    }
-    if (initial_ > 0) return;
+    if (!filters::emitInitialMessages(context, initial_, emittedInitial_) || initial_ > 0) return;
     if (!latest_) {
       merge_.process(context);
       return;

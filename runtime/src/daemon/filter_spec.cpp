@@ -7,6 +7,16 @@
 
 namespace vrflow::daemon {
 
+app::FilterType filterType(
+    std::string name, std::string doc,
+    std::function<std::vector<app::PortSpec>(const std::vector<app::Param>&)> ports) {
+  app::FilterType type;
+  type.name = std::move(name);
+  type.doc = std::move(doc);
+  type.ports = std::move(ports);
+  return type;
+}
+
 app::PortSpec filterPort(std::string name, bool isInput, std::string doc) {
   app::PortSpec port;
   port.name = std::move(name);
@@ -23,10 +33,6 @@ std::vector<app::PortSpec> numberedPorts(const std::string& prefix, long long co
     ports.push_back(filterPort(prefix + std::to_string(i), isInput, doc));
   }
   return ports;
-}
-
-long long portCount(const std::vector<app::Param>& params, const char* name, long long fallback) {
-  return std::clamp(app::paramInt(params, name, fallback), 1LL, kMaxFilterPorts);
 }
 
 std::vector<app::PortSpec> inToOut(const std::vector<app::Param>& /*params*/) {

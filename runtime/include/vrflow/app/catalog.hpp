@@ -15,15 +15,13 @@ namespace vrflow::app {
 /// The name of a node package's manifest file.
 inline constexpr std::string_view kManifestFileName = "vrflow-package.xml";
 
-/// Every module type and filter type an application may use: the node packages' manifests
-/// plus the filter types. The filter types are declared in the daemon layer beside their code:
-/// programs and tests start from daemon::makeCatalog() (vrflow/daemon/filter_registry.hpp),
-/// which fills them in. Pointers it hands out stay valid while the catalog lives (entries are
-/// never moved or removed).
+/// Every module type and filter type an application may use: the node packages' manifests plus
+/// the filter types that daemon::makeCatalog() fills in (declared beside their code). Pointers it
+/// hands out stay valid while the catalog lives (entries are never moved or removed).
 class Catalog {
  public:
-  /// An empty catalog: no package, no filter type.
-  Catalog() = default;
+  /// An empty catalog (daemon::makeCatalog() gives one with every filter type).
+  Catalog();
 
   /// Reads one vrflow-package.xml. Fails with "FILE:LINE:COL: error: ..." lines for a bad
   /// manifest, or when its package name is already in the catalog from another file (adding

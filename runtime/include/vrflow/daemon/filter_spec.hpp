@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,6 +27,11 @@ struct FilterSpec {
   const std::string& name() const { return declaration.name; }
 };
 
+/// A declaration with a name, its documentation and its ports (add parameters after).
+app::FilterType filterType(
+    std::string name, std::string doc,
+    std::function<std::vector<app::PortSpec>(const std::vector<app::Param>&)> ports);
+
 /// Most inputs or outputs a filter with a numbered port family may have.
 inline constexpr long long kMaxFilterPorts = 256;
 /// Most initial messages one filter or module input may emit at start-up.
@@ -36,8 +42,6 @@ app::PortSpec filterPort(std::string name, bool isInput, std::string doc);
 /// `prefix`0 .. `prefix`{count-1}.
 std::vector<app::PortSpec> numberedPorts(const std::string& prefix, long long count, bool isInput,
                                          const std::string& doc);
-/// The value of an int parameter clamped to [1, kMaxFilterPorts] (bad values: `fallback`).
-long long portCount(const std::vector<app::Param>& params, const char* name, long long fallback);
 /// Ports `in` -> `out`.
 std::vector<app::PortSpec> inToOut(const std::vector<app::Param>& params);
 

@@ -49,6 +49,11 @@ FilterFactory factoryOf() {
   };
 }
 
+/// Emits the empty initial messages still `pending` on output 0 while it can take them,
+/// numbering them from `emitted` (both counted down / up). False when one could not be made
+/// (warned): try again on the next pass.
+bool emitInitialMessages(FilterContext& context, long& pending, long& emitted);
+
 /// True when every input is closed and drained (for filters that go on while any input may
 /// still bring something).
 bool allInputsDone(FilterContext& context);

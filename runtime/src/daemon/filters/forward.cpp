@@ -28,16 +28,7 @@ class InitialFilter final : public Filter {
     return {};
   }
   void process(FilterContext& context) override {
-    while (pending_ > 0 && context.canEmit(0)) {
-      auto message = context.makeEmpty(static_cast<uint64_t>(emitted_++), false);
-      if (!message) {
-        context.warn(message.error().message);
-        return;
-      }
-      context.emit(0, std::move(*message));
-      --pending_;
-    }
-    if (pending_ == 0) forwardAll(context);
+    if (emitInitialMessages(context, pending_, emitted_) && pending_ == 0) forwardAll(context);
   }
   bool exhausted(FilterContext& context) const override {
     return pending_ == 0 && Filter::exhausted(context);
@@ -48,34 +39,14 @@ class InitialFilter final : public Filter {
   long emitted_ = 0;
 };
 
-FilterType passthroughType() {
-  FilterType type;
-  type.name = "passthrough";
-  type.doc = "Forwards every message from in to out unchanged.";
-  type.ports = inToOut;
-  return type;
-}
-
-FilterType broadcastType() {
-  FilterType type;
-  type.name = "broadcast";
-  type.doc =
-      "Forwards every message from in to each connection of out; chain them as a tree to "
-      "reach N receivers in O(log N) steps.";
-  type.ports = inToOut;
-  return type;
-}
-
 FilterType initialType() {
-  FilterType type;
-  type.name = "initial";
-  type.doc =
-      "Emits `count` empty messages on out at start-up, then forwards in to out; starts a "
-      "cycle of the network.";
+  FilterType type = filterType("initial",
+                               "Emits `count` empty messages on out at start-up, then forwards in "
+                               "to out; starts a cycle of the network.",
+                               inToOut);
   const app::ParamSpec count = intParam("count", "1", 0, static_cast<double>(kMaxInitialMessages),
                                         "messages emitted at start-up");
   type.params.push_back(count);
-  type.ports = inToOut;
   type.initialMessages = [count](const std::vector<Param>& params) {
     return static_cast<int>(clampedInt(count, params));
   };
@@ -85,8 +56,15 @@ FilterType initialType() {
 }  // namespace
 
 void registerForward(FilterRegistry& registry) {
-  addBuiltin(registry, {passthroughType(), factoryOf<PassthroughFilter>()});
-  addBuiltin(registry, {broadcastType(), factoryOf<PassthroughFilter>()});
+  addBuiltin(registry, {filterType("passthrough",
+                                   "Forwards every message from in to out unchanged.", inToOut),
+                        factoryOf<PassthroughFilter>()});
+  addBuiltin(registry,
+             {filterType("broadcast",
+                         "Forwards every message from in to each connection of out; chain them "
+                         "as a tree to reach N receivers in O(log N) steps.",
+                         inToOut),
+              factoryOf<PassthroughFilter>()});
   addBuiltin(registry, {initialType(), factoryOf<InitialFilter>()});
 }
 

@@ -46,11 +46,12 @@ FilterType mergeType() {
   FilterType type;
   type.name = "merge";
   type.doc = "Waits for one message on each of in0..in{N-1} and emits their concatenation on out.";
-  type.params.push_back(intParam("inputs", "2", 1, kMaxPorts, "number of inputs N"));
+  const app::ParamSpec inputCount = intParam("inputs", "2", 1, kMaxPorts, "number of inputs N");
+  type.params.push_back(inputCount);
   type.params.push_back(stampsParam());
-  type.ports = [](const std::vector<Param>& params) {
+  type.ports = [inputCount](const std::vector<Param>& params) {
     auto ports =
-        numberedPorts("in", portCount(params, "inputs", 2), true, "one of the merged inputs");
+        numberedPorts("in", clampedInt(inputCount, params), true, "one of the merged inputs");
     ports.push_back(filterPort("out", false, "the merged messages"));
     return ports;
   };
@@ -64,10 +65,11 @@ FilterType gatherType() {
   type.doc =
       "Joins the parts made by a scatter: one message from each of in0..in{N-1}, chunks "
       "concatenated in input order (the semantics of merge).";
-  type.params.push_back(intParam("inputs", "2", 1, kMaxPorts, "number of inputs N"));
+  const app::ParamSpec inputCount = intParam("inputs", "2", 1, kMaxPorts, "number of inputs N");
+  type.params.push_back(inputCount);
   type.params.push_back(stampsParam());
-  type.ports = [](const std::vector<Param>& params) {
-    auto ports = numberedPorts("in", portCount(params, "inputs", 2), true, "one part");
+  type.ports = [inputCount](const std::vector<Param>& params) {
+    auto ports = numberedPorts("in", clampedInt(inputCount, params), true, "one part");
     ports.push_back(filterPort("out", false, "the joined messages"));
     return ports;
   };

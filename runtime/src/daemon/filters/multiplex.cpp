@@ -57,13 +57,14 @@ app::FilterType multiplexType() {
   type.doc =
       "Forwards each message of in0..in{N-1} to out as it comes (one input after the other "
       "when several wait), renumbered: the iteration stamp counts the messages sent.";
-  type.params.push_back(intParam("inputs", "2", 1, kMaxPorts, "number of inputs N"));
+  const app::ParamSpec inputCount = intParam("inputs", "2", 1, kMaxPorts, "number of inputs N");
+  type.params.push_back(inputCount);
   type.params.push_back(
       boolParam("renumber", "true",
                 "stamp each message's iteration with the count of messages sent (a "
                 "copy); false forwards them untouched, by reference"));
-  type.ports = [](const std::vector<Param>& params) {
-    auto ports = numberedPorts("in", portCount(params, "inputs", 2), true, "messages to forward");
+  type.ports = [inputCount](const std::vector<Param>& params) {
+    auto ports = numberedPorts("in", clampedInt(inputCount, params), true, "messages to forward");
     ports.push_back(filterPort("out", false, "every message, in arrival order"));
     return ports;
   };

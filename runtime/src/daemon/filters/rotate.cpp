@@ -89,10 +89,12 @@ app::FilterType rotateType() {
   type.doc =
       "Dispatches the messages of in round-robin to out0..out{N-1}: message k goes to "
       "out{k mod N} (waiting for that output when it is full), by reference.";
-  type.params.push_back(intParam("outputs", "2", 1, kMaxPorts, "number of outputs N (workers)"));
-  type.ports = [](const std::vector<Param>& params) {
+  const app::ParamSpec outputCount =
+      intParam("outputs", "2", 1, kMaxPorts, "number of outputs N (workers)");
+  type.params.push_back(outputCount);
+  type.ports = [outputCount](const std::vector<Param>& params) {
     std::vector<PortSpec> ports{filterPort("in", true, "messages to dispatch")};
-    for (auto& port : numberedPorts("out", portCount(params, "outputs", 2), false,
+    for (auto& port : numberedPorts("out", clampedInt(outputCount, params), false,
                                     "every N-th message, to one worker")) {
       ports.push_back(std::move(port));
     }
@@ -109,11 +111,13 @@ app::FilterType unrotateType() {
       "`iteration`: the pending message with the smallest iteration stamp goes first (ties: "
       "lower input first), once every open input has one; `round-robin`: in0, in1, ... in "
       "turn.";
-  type.params.push_back(intParam("inputs", "2", 1, kMaxPorts, "number of inputs N (workers)"));
+  const app::ParamSpec inputCount =
+      intParam("inputs", "2", 1, kMaxPorts, "number of inputs N (workers)");
+  type.params.push_back(inputCount);
   type.params.push_back(
       enumParam("order", {"iteration", "round-robin"}, "how the original order is found back"));
-  type.ports = [](const std::vector<Param>& params) {
-    auto ports = numberedPorts("in", portCount(params, "inputs", 2), true, "one worker's results");
+  type.ports = [inputCount](const std::vector<Param>& params) {
+    auto ports = numberedPorts("in", clampedInt(inputCount, params), true, "one worker's results");
     ports.push_back(filterPort("out", false, "every result, in the original order"));
     return ports;
   };

@@ -413,8 +413,9 @@ app::FilterType routeType() {
       "interest{k} (string user stamp `stamp`: \"minx miny minz maxx maxy maxz\", \"all\" or "
       "\"none\"); out{k} gets the chunks of objects whose bounds meet it, the full state of "
       "an object when it enters, and the resources those objects refer to, once.";
-  type.params.push_back(
-      intParam("outputs", "1", 1, static_cast<double>(kMaxFilterPorts), "number of receivers N"));
+  const app::ParamSpec outputCount =
+      intParam("outputs", "1", 1, static_cast<double>(kMaxFilterPorts), "number of receivers N");
+  type.params.push_back(outputCount);
   type.params.push_back(
       stringParam("stamp", "interest", "name of the string user stamp holding the volume"));
   type.params.push_back(enumParam("initially", {"none", "all"},
@@ -422,8 +423,8 @@ app::FilterType routeType() {
   type.params.push_back(enumParam("unbounded", {"all", "drop"},
                                   "objects whose bounds are unknown: to every receiver that has "
                                   "a volume, or to none"));
-  type.ports = [](const std::vector<Param>& params) {
-    const long long n = portCount(params, "outputs", 1);
+  type.ports = [outputCount](const std::vector<Param>& params) {
+    const long long n = clampedInt(outputCount, params);
     std::vector<PortSpec> ports{filterPort("in", true, "the sender's messages")};
     for (auto& port : numberedPorts("interest", n, true, "a receiver's volume of interest")) {
       port.gating = false;  // out{k} leaves without it: a receiver -> interest cycle is fine

@@ -261,7 +261,8 @@ app::FilterType scatterType() {
       "without bounds in a message where its latest bounds sent it, other chunks by `others`; "
       "`size`: every raw resource cut into N parts of whole `element-size` elements, each a "
       "raw resource of the same id prefixed by its u64 offset and u64 total size.";
-  type.params.push_back(intParam("outputs", "2", 1, kMaxPorts, "number of outputs N"));
+  const app::ParamSpec outputCount = intParam("outputs", "2", 1, kMaxPorts, "number of outputs N");
+  type.params.push_back(outputCount);
   type.params.push_back(
       enumParam("by", {"chunk", "id", "type", "bounds", "size"}, "how chunks are split"));
   type.params.push_back(intParam("element-size", "1", 1, 1 << 30,
@@ -277,22 +278,22 @@ app::FilterType scatterType() {
   type.params.push_back(enumParam("others", {"all", "drop"},
                                   "chunks not split by type, bounds or size (by=type, bounds, "
                                   "size) go to every output (all) or nowhere (drop)"));
-  type.ports = [](const std::vector<Param>& params) {
+  type.ports = [outputCount](const std::vector<Param>& params) {
     std::vector<PortSpec> ports{filterPort("in", true, "messages to split")};
-    for (auto& port : numberedPorts("out", portCount(params, "outputs", 2), false,
+    for (auto& port : numberedPorts("out", clampedInt(outputCount, params), false,
                                     "one part of every message")) {
       ports.push_back(std::move(port));
     }
     return ports;
   };
-  type.check = [](const std::vector<Param>& params) -> std::optional<std::string> {
+  type.check = [outputCount](const std::vector<Param>& params) -> std::optional<std::string> {
     const std::string by = paramString(params, "by", "chunk");
     const bool byType = by == "type";
     const auto names = splitList(paramString(params, "types", ""));
     const auto cuts = splitList(paramString(params, "cuts", ""));
     if (by != "bounds" && !cuts.empty()) return "parameter 'cuts' applies only with by=\"bounds\"";
     if (by == "bounds") {
-      const long long outputs = portCount(params, "outputs", 2);
+      const long long outputs = clampedInt(outputCount, params);
       if (static_cast<long long>(cuts.size()) + 1 != outputs) {
         return "by=\"bounds\" needs N-1 numbers in 'cuts' for N outputs: " +
                std::to_string(outputs) + " outputs, " + std::to_string(cuts.size()) + " cuts";
@@ -312,7 +313,7 @@ app::FilterType scatterType() {
       if (!names.empty()) return "parameter 'types' applies only with by=\"type\"";
       return std::nullopt;
     }
-    const long long outputs = portCount(params, "outputs", 2);
+    const long long outputs = clampedInt(outputCount, params);
     if (static_cast<long long>(names.size()) != outputs) {
       return "by=\"type\" needs one type name in 'types' per output: " + std::to_string(outputs) +
              " outputs, " + std::to_string(names.size()) + " names";
