@@ -17,6 +17,18 @@ app::FilterType filterType(
   return type;
 }
 
+void declareNumberedInputs(app::FilterType& type, const std::string& inputDoc,
+                           const std::string& outputDoc) {
+  const app::ParamSpec inputCount =
+      intParam("inputs", "2", 1, static_cast<double>(kMaxFilterPorts), "number of inputs N");
+  type.params.push_back(inputCount);
+  type.ports = [inputCount, inputDoc, outputDoc](const std::vector<app::Param>& params) {
+    auto ports = numberedPorts("in", clampedInt(inputCount, params), true, inputDoc);
+    ports.push_back(filterPort("out", false, outputDoc));
+    return ports;
+  };
+}
+
 app::PortSpec filterPort(std::string name, bool isInput, std::string doc) {
   app::PortSpec port;
   port.name = std::move(name);

@@ -32,6 +32,11 @@ app::FilterType filterType(
     std::string name, std::string doc,
     std::function<std::vector<app::PortSpec>(const std::vector<app::Param>&)> ports);
 
+/// Gives `type` an int parameter `inputs` (N, default 2) and the ports in0..in{N-1}, each
+/// documented `inputDoc`, then `out`, documented `outputDoc`: a filter joining N inputs.
+void declareNumberedInputs(app::FilterType& type, const std::string& inputDoc,
+                           const std::string& outputDoc);
+
 /// Most inputs or outputs a filter with a numbered port family may have.
 inline constexpr long long kMaxFilterPorts = 256;
 /// Most initial messages one filter or module input may emit at start-up.

@@ -46,15 +46,8 @@ FilterType mergeType() {
   FilterType type;
   type.name = "merge";
   type.doc = "Waits for one message on each of in0..in{N-1} and emits their concatenation on out.";
-  const app::ParamSpec inputCount = intParam("inputs", "2", 1, kMaxPorts, "number of inputs N");
-  type.params.push_back(inputCount);
+  declareNumberedInputs(type, "one of the merged inputs", "the merged messages");
   type.params.push_back(stampsParam());
-  type.ports = [inputCount](const std::vector<Param>& params) {
-    auto ports =
-        numberedPorts("in", clampedInt(inputCount, params), true, "one of the merged inputs");
-    ports.push_back(filterPort("out", false, "the merged messages"));
-    return ports;
-  };
   type.check = checkStamps;
   return type;
 }
@@ -65,14 +58,8 @@ FilterType gatherType() {
   type.doc =
       "Joins the parts made by a scatter: one message from each of in0..in{N-1}, chunks "
       "concatenated in input order (the semantics of merge).";
-  const app::ParamSpec inputCount = intParam("inputs", "2", 1, kMaxPorts, "number of inputs N");
-  type.params.push_back(inputCount);
+  declareNumberedInputs(type, "one part", "the joined messages");
   type.params.push_back(stampsParam());
-  type.ports = [inputCount](const std::vector<Param>& params) {
-    auto ports = numberedPorts("in", clampedInt(inputCount, params), true, "one part");
-    ports.push_back(filterPort("out", false, "the joined messages"));
-    return ports;
-  };
   type.check = checkStamps;
   return type;
 }

@@ -57,17 +57,11 @@ app::FilterType multiplexType() {
   type.doc =
       "Forwards each message of in0..in{N-1} to out as it comes (one input after the other "
       "when several wait), renumbered: the iteration stamp counts the messages sent.";
-  const app::ParamSpec inputCount = intParam("inputs", "2", 1, kMaxPorts, "number of inputs N");
-  type.params.push_back(inputCount);
+  declareNumberedInputs(type, "messages to forward", "every message, in arrival order");
   type.params.push_back(
       boolParam("renumber", "true",
                 "stamp each message's iteration with the count of messages sent (a "
                 "copy); false forwards them untouched, by reference"));
-  type.ports = [inputCount](const std::vector<Param>& params) {
-    auto ports = numberedPorts("in", clampedInt(inputCount, params), true, "messages to forward");
-    ports.push_back(filterPort("out", false, "every message, in arrival order"));
-    return ports;
-  };
   return type;
 }
 
