@@ -26,6 +26,7 @@
 
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/writer.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/daemon/plugin.hpp"
 #include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
@@ -94,7 +95,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   if (catalog) {
     catalog_ = std::make_unique<app::Catalog>(std::move(*catalog));
   } else {
-    catalog_ = std::make_unique<app::Catalog>();
+    catalog_ = std::make_unique<app::Catalog>(daemon::makeCatalog());
     catalogProblems_ = q(catalog.error().message);
   }
 

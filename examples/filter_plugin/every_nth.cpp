@@ -31,45 +31,30 @@ class EveryNthFilter final : public Filter {
   long seen_ = 0;
 };
 
-vrflow::app::FilterType declaration() {
-  vrflow::app::FilterType type;
-  type.name = "every-nth";
-  type.doc = "Forwards the 1st, (n+1)-th, (2n+1)-th ... message of in to out; drops the others.";
-  vrflow::app::ParamSpec n;
-  n.name = "n";
-  n.type = vrflow::app::ParamType::Int;
-  n.defaultValue = "2";
-  n.min = 1;
-  n.max = 1000000;
-  n.doc = "keep one message in n";
-  type.params.push_back(n);
-  type.ports = [](const std::vector<vrflow::app::Param>&) {
-    vrflow::app::PortSpec in;
-    in.name = "in";
-    in.required = true;
-    in.doc = "messages to decimate";
-    vrflow::app::PortSpec out;
-    out.name = "out";
-    out.isInput = false;
-    out.doc = "one message in n";
-    return std::vector<vrflow::app::PortSpec>{in, out};
+// The filter type, declared once: what `vrflow validate` and the editor see, and the factory
+// the daemon builds it with.
+vrflow::daemon::FilterSpec everyNth() {
+  using namespace vrflow::daemon;
+  FilterSpec spec;
+  spec.declaration.name = "every-nth";
+  spec.declaration.doc =
+      "Forwards the 1st, (n+1)-th, (2n+1)-th ... message of in to out; drops the others.";
+  spec.declaration.params.push_back(intParam("n", "2", 1, 1000000, "keep one message in n"));
+  spec.declaration.ports = [](const std::vector<vrflow::app::Param>&) {
+    return std::vector<vrflow::app::PortSpec>{filterPort("in", true, "messages to decimate"),
+                                              filterPort("out", false, "one message in n")};
   };
-  return type;
+  spec.factory = [](const FilterContext& context) -> vrflow::Result<std::unique_ptr<Filter>> {
+    // The catalog has checked n already; the factory still refuses what it cannot run.
+    const long n = context.params().getInt("n");
+    if (n < 1) return vrflow::makeError("filter '" + context.name() + "': n must be >= 1");
+    return std::unique_ptr<Filter>(std::make_unique<EveryNthFilter>(n));
+  };
+  return spec;
 }
 
 }  // namespace
 
-VRFLOW_FILTER_PLUGIN()
-
-extern "C" void vrflowRegisterFilters(vrflow::daemon::FilterRegistry& registry,
-                                      vrflow::app::Catalog& catalog) {
-  registry.add("every-nth",
-               [](const FilterContext& context) -> vrflow::Result<std::unique_ptr<Filter>> {
-                 // The catalog has checked n already; the factory still refuses what it cannot run.
-                 const long n = context.params().getInt("n");
-                 if (n < 1)
-                   return vrflow::makeError("filter '" + context.name() + "': n must be >= 1");
-                 return std::unique_ptr<Filter>(std::make_unique<EveryNthFilter>(n));
-               });
-  (void)catalog.addFilterType(declaration());
+VRFLOW_FILTER_PLUGIN(specs) {
+  specs.push_back(everyNth());
 }

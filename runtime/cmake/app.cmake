@@ -6,7 +6,6 @@ vrflow_add_library(app SHARED
   SOURCES
     src/app/application_reader.cpp
     src/app/application_writer.cpp
-    src/app/builtin_filters.cpp
     src/app/catalog.cpp
     src/app/composite.cpp
     src/app/composite_reader.cpp
@@ -16,9 +15,6 @@ vrflow_add_library(app SHARED
     src/app/expand.cpp
     src/app/expand_body.cpp
     src/app/file_io.cpp
-    src/app/filter_types_routing.cpp
-    src/app/filter_types_patterns.cpp
-    src/app/filter_types_sampling.cpp
     src/app/graph.cpp
     src/app/rates.cpp
     src/app/manifest_reader.cpp

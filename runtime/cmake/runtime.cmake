@@ -19,8 +19,13 @@ vrflow_add_library(net SHARED
 vrflow_add_library(daemon SHARED
   SOURCES
     src/daemon/filter.cpp
+    src/daemon/filter_spec.cpp
+    src/daemon/filter_registry.cpp
+    src/daemon/compose.cpp
     src/daemon/builtin_filters.cpp
     src/daemon/filters/common.cpp
+    src/daemon/filters/forward.cpp
+    src/daemon/filters/merge.cpp
     src/daemon/filters/gate.cpp
     src/daemon/filters/latest.cpp
     src/daemon/filters/max_frequency.cpp
@@ -32,6 +37,7 @@ vrflow_add_library(daemon SHARED
     src/daemon/filters/stamp_filter.cpp
     src/daemon/filters/type_filter.cpp
     src/daemon/plugin_loader.cpp
+    src/daemon/testing/filter_harness.cpp
     src/daemon/graph.cpp
     src/daemon/daemon.cpp
     src/daemon/daemon_build.cpp

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "test_support.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 
 namespace vrflow::app {
 namespace {
@@ -84,7 +85,7 @@ TEST(Catalog, ExecutableNextToTheManifestBecomesAnAbsolutePath) {
 }
 
 TEST(Catalog, RegistersTheBuiltinFilters) {
-  const Catalog catalog;
+  const Catalog catalog = daemon::makeCatalog();
   std::vector<std::string> names;
   for (const FilterType* type : catalog.filterTypes()) names.push_back(type->name);
   EXPECT_EQ(names, (std::vector<std::string>{"broadcast", "decimate", "gate", "gather", "initial",
@@ -105,7 +106,7 @@ TEST(Catalog, RegistersTheBuiltinFilters) {
 }
 
 TEST(Catalog, StandardFiltersDeclareTheirPortsFromTheirParameters) {
-  const Catalog catalog;
+  const Catalog catalog = daemon::makeCatalog();
   const auto portsOf = [&](const char* type, std::vector<Param> params) {
     return namesOf(catalog.findFilter(type)->portsFor(params));
   };
@@ -153,7 +154,7 @@ TEST(Catalog, PortsOfAnInstanceFollowItsType) {
 }
 
 TEST(Catalog, BadManifestGivesFileLineAndColumn) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   const Status status = catalog.addPackageString(R"(<package name="p">
   <module type="m" executable="x">
     <input name="in" date="objects"/>
@@ -174,14 +175,14 @@ TEST(Catalog, BadManifestGivesFileLineAndColumn) {
 }
 
 TEST(Catalog, MalformedManifestGivesFileLineAndColumn) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   const Status status = catalog.addPackageString("<package name=\"p\">\n  <module\n", "pkg.xml");
   ASSERT_FALSE(status.ok());
   EXPECT_EQ(status.error().message, "pkg.xml:2:10: error: Error parsing start element tag");
 }
 
 TEST(Catalog, ReservedAndRepeatedPortNamesAreRejected) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   const Status status = catalog.addPackageString(R"(<package name="p">
   <module type="m" executable="x">
     <input name="beginIt"/>
@@ -200,7 +201,7 @@ TEST(Catalog, ReservedAndRepeatedPortNamesAreRejected) {
 }
 
 TEST(Catalog, EnumParameterNeedsChoices) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   const Status status = catalog.addPackageString(
       "<package name=\"p\">\n  <module type=\"m\" executable=\"x\">\n"
       "    <param name=\"e\" type=\"enum\"/>\n  </module>\n</package>\n",
@@ -213,7 +214,7 @@ TEST(Catalog, EnumParameterNeedsChoices) {
 // mpi-ranks names the int parameter that gives a module's MPI ranks (vrflow then starts it
 // through mpirun); naming anything else is an error at the attribute.
 TEST(Catalog, MpiRanksNamesAnIntParameter) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   ASSERT_TRUE(
       catalog
           .addPackageString("<package name=\"p\">\n  <module type=\"m\" executable=\"x\" "
@@ -225,7 +226,7 @@ TEST(Catalog, MpiRanksNamesAnIntParameter) {
   ASSERT_NE(type, nullptr);
   EXPECT_EQ(type->mpiRanksParam, "blocks");
   for (const char* param : {"<param name=\"blocks\" type=\"float\"/>", ""}) {
-    Catalog bad;
+    Catalog bad = daemon::makeCatalog();
     const Status status = bad.addPackageString(
         std::string("<package name=\"q\">\n  <module type=\"m\" executable=\"x\" "
                     "mpi-ranks=\"blocks\">\n    ") +
@@ -243,7 +244,7 @@ TEST(Catalog, MpiRanksNamesAnIntParameter) {
 // mpi-job names the string parameter whose value groups modules into one MPI job; naming
 // anything else is an error at the attribute.
 TEST(Catalog, MpiJobNamesAStringParameter) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   ASSERT_TRUE(catalog
                   .addPackageString("<package name=\"p\">\n  <module type=\"m\" executable=\"x\" "
                                     "mpi-job=\"job\">\n    <param name=\"job\" "
@@ -255,7 +256,7 @@ TEST(Catalog, MpiJobNamesAStringParameter) {
   EXPECT_EQ(type->mpiJobParam, "job");
   EXPECT_EQ(type->mpiRanksParam, "");
   for (const char* param : {"<param name=\"job\" type=\"int\"/>", ""}) {
-    Catalog bad;
+    Catalog bad = daemon::makeCatalog();
     const Status status = bad.addPackageString(
         std::string("<package name=\"q\">\n  <module type=\"m\" executable=\"x\" "
                     "mpi-job=\"job\">\n    ") +
@@ -271,7 +272,7 @@ TEST(Catalog, MpiJobNamesAStringParameter) {
 }
 
 TEST(Catalog, SamePackageFromAnotherFileIsAnError) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   ASSERT_TRUE(catalog.addPackageFile(packagesDir() + "/core/vrflow-package.xml").ok());
   EXPECT_TRUE(catalog.addPackageFile(packagesDir() + "/core/../core/vrflow-package.xml").ok());
   const Status again = catalog.addPackageString(
@@ -282,7 +283,7 @@ TEST(Catalog, SamePackageFromAnotherFileIsAnError) {
 }
 
 TEST(Catalog, SearchPathLetsTheFirstFolderWinAndSkipsMissingFolders) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   const Status status = catalog.loadSearchPath(
       {"/nonexistent/vrflow/packages", packagesDir() + "/core", packagesDir()});
   ASSERT_TRUE(status.ok()) << status.error().message;
@@ -291,7 +292,7 @@ TEST(Catalog, SearchPathLetsTheFirstFolderWinAndSkipsMissingFolders) {
 }
 
 TEST(Catalog, MissingPackageFileFailsWithItsPath) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   const Status status = catalog.addPackageFile("/nonexistent/vrflow-package.xml");
   ASSERT_FALSE(status.ok());
   EXPECT_EQ(status.error().message,
@@ -300,7 +301,7 @@ TEST(Catalog, MissingPackageFileFailsWithItsPath) {
 }
 
 TEST(Catalog, ModuleTypesCanBeRegisteredInCode) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   ModuleType type;
   type.package = "code";
   type.type = "gen";

@@ -17,6 +17,7 @@
 #include "test_support.hpp"
 #include "vrflow/app/app.hpp"
 #include "vrflow/base/echo.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 
 namespace vrflow::app {
 namespace {
@@ -77,7 +78,7 @@ TEST(FileReading, ApplicationManifestAndCompositeFromAFifoAreRefusedWithoutBlock
   EXPECT_EQ(loadWithHangGuard(fifo, [&] { return errorOf(loadApplicationFile(fifo)); }), expected);
   EXPECT_EQ(loadWithHangGuard(fifo,
                               [&] {
-                                Catalog catalog;
+                                Catalog catalog = daemon::makeCatalog();
                                 return errorOf(catalog.addPackageFile(fifo));
                               }),
             expected);
@@ -106,7 +107,7 @@ TEST(FileReading, SparseFileAboveTheCapIsRefusedBeforeItIsRead) {
                                ": error: cannot read file (it is 1073741824 bytes, above the "
                                "limit of 16777216 bytes (16 MiB))";
   EXPECT_EQ(errorOf(loadApplicationFile(big)), expected);
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   EXPECT_EQ(errorOf(catalog.addPackageFile(big)), expected);
   EXPECT_EQ(errorOf(loadCompositeFile(big)), expected);
 }
@@ -135,7 +136,7 @@ constexpr std::string_view kFilesManifest = R"(<package name="files">
 
 const Catalog& filesCatalog() {
   static const Catalog catalog = [] {
-    Catalog c;
+    Catalog c = daemon::makeCatalog();
     EXPECT_TRUE(c.addPackageString(kFilesManifest, "/pkg/files/vrflow-package.xml").ok());
     return c;
   }();
@@ -165,7 +166,7 @@ TEST(FileParameters, ManifestStatesInputAndOutput) {
 }
 
 TEST(FileParameters, AccessIsOnlyForFileParametersAndOnlyInputOrOutput) {
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   const Status status = catalog.addPackageString(R"(<package name="p">
   <module type="m" executable="x">
     <param name="a" type="string" access="input"/>
@@ -238,7 +239,7 @@ TEST(Executables, RelativePathIsResolvedFromTheManifestFolderEvenWhenMissing) {
   <module type="m" executable="../../bin/x"/>
 </package>
 )";
-  Catalog catalog;
+  Catalog catalog = daemon::makeCatalog();
   ASSERT_TRUE(catalog.addPackageFile(manifest).ok());
   const ModuleType* type = catalog.findModule("pkg", "m");
   ASSERT_NE(type, nullptr);

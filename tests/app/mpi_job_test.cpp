@@ -7,6 +7,7 @@
 #include "test_support.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/validate.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 
 namespace vrflow::app {
 namespace {
@@ -15,7 +16,7 @@ namespace {
 // (`ranks`); `other` forms jobs too, `plain` does not.
 const Catalog& jobCatalog() {
   static const Catalog catalog = [] {
-    Catalog made;
+    Catalog made = daemon::makeCatalog();
     const Status status = made.addPackageString(R"(<package name="par">
   <module type="block" executable="x" mpi-job="job" mpi-ranks="ranks">
     <output name="out"/>

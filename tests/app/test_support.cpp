@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "vrflow/app/validate.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 
 namespace vrflow::app::testing {
 
@@ -21,7 +22,7 @@ std::string dataDir() {
 
 const Catalog& testCatalog() {
   static const Catalog catalog = [] {
-    Catalog loaded;
+    Catalog loaded = daemon::makeCatalog();
     const Status status = loaded.addPackageDir(dataDir() + "/packages");
     if (!status) throw std::runtime_error(status.error().message);
     return loaded;

@@ -7,6 +7,7 @@
 
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/writer.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/editor/analysis.hpp"
 #include "vrflow/editor/edit.hpp"
 
@@ -16,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 app::Catalog coreCatalog() {
-  app::Catalog catalog;
+  app::Catalog catalog = daemon::makeCatalog();
   const auto status = catalog.addPackageFile(std::string(VRFLOW_TEST_SOURCE_DIR) +
                                              "/runtime/modules/core/vrflow-package.xml");
   EXPECT_TRUE(status.ok()) << status.error().message;

@@ -11,16 +11,12 @@ class NothingFilter final : public vrflow::daemon::Filter {
 
 }  // namespace
 
-VRFLOW_FILTER_PLUGIN()
-
-extern "C" void vrflowRegisterFilters(vrflow::daemon::FilterRegistry& registry,
-                                      vrflow::app::Catalog& catalog) {
-  registry.add("merge",
-               [](const vrflow::daemon::FilterContext&)
-                   -> vrflow::Result<std::unique_ptr<vrflow::daemon::Filter>> {
-                 return std::unique_ptr<vrflow::daemon::Filter>(std::make_unique<NothingFilter>());
-               });
-  vrflow::app::FilterType type;
-  type.name = "merge";
-  (void)catalog.addFilterType(std::move(type));
+VRFLOW_FILTER_PLUGIN(specs) {
+  vrflow::daemon::FilterSpec spec;
+  spec.declaration.name = "merge";
+  spec.factory = [](const vrflow::daemon::FilterContext&)
+      -> vrflow::Result<std::unique_ptr<vrflow::daemon::Filter>> {
+    return std::unique_ptr<vrflow::daemon::Filter>(std::make_unique<NothingFilter>());
+  };
+  specs.push_back(std::move(spec));
 }

@@ -18,37 +18,25 @@ class ForwardFilter final : public Filter {
   }
 };
 
-vrflow::app::FilterType declaration() {
-  vrflow::app::FilterType type;
-  type.name = "misread";
-  type.doc = "Forwards in to out; its factory reads the undeclared parameter 'm'.";
-  vrflow::app::ParamSpec n;
-  n.name = "n";
-  n.type = vrflow::app::ParamType::Int;
-  n.defaultValue = "2";
-  type.params.push_back(n);
-  type.ports = [](const std::vector<vrflow::app::Param>&) {
-    vrflow::app::PortSpec in;
-    in.name = "in";
-    in.required = true;
-    vrflow::app::PortSpec out;
-    out.name = "out";
-    out.isInput = false;
-    return std::vector<vrflow::app::PortSpec>{in, out};
+vrflow::daemon::FilterSpec misread() {
+  using namespace vrflow::daemon;
+  FilterSpec spec;
+  spec.declaration.name = "misread";
+  spec.declaration.doc = "Forwards in to out; its factory reads the undeclared parameter 'm'.";
+  spec.declaration.params.push_back(intParam("n", "2", 0, 100, "declared, never read"));
+  spec.declaration.ports = [](const std::vector<vrflow::app::Param>&) {
+    return std::vector<vrflow::app::PortSpec>{filterPort("in", true, "messages"),
+                                              filterPort("out", false, "the same messages")};
   };
-  return type;
+  spec.factory = [](const FilterContext& context) -> vrflow::Result<std::unique_ptr<Filter>> {
+    if (context.params().getInt("m") > 0) return vrflow::makeError("unreachable");
+    return std::unique_ptr<Filter>(std::make_unique<ForwardFilter>());
+  };
+  return spec;
 }
 
 }  // namespace
 
-VRFLOW_FILTER_PLUGIN()
-
-extern "C" void vrflowRegisterFilters(vrflow::daemon::FilterRegistry& registry,
-                                      vrflow::app::Catalog& catalog) {
-  registry.add("misread",
-               [](const FilterContext& context) -> vrflow::Result<std::unique_ptr<Filter>> {
-                 if (context.params().getInt("m") > 0) return vrflow::makeError("unreachable");
-                 return std::unique_ptr<Filter>(std::make_unique<ForwardFilter>());
-               });
-  (void)catalog.addFilterType(declaration());
+VRFLOW_FILTER_PLUGIN(specs) {
+  specs.push_back(misread());
 }

@@ -3,8 +3,11 @@
 // a message, never a crash.
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include "app_text.hpp"
 #include "process_helpers.hpp"
+#include "vrflow/daemon/plugin.hpp"
 
 namespace vrflow::testing {
 namespace {
@@ -82,6 +85,25 @@ TEST_F(FilterPlugins, LibraryThatIsNoPluginIsRefused) {
       runVrflow({"run", decimating("plugin=\"" + testPlugin("not_a_plugin") + "\"")});
   EXPECT_EQ(result.exitCode, 2);
   EXPECT_NE(result.err.find("not a vrflow filter plugin"), std::string::npos) << result.err;
+}
+
+TEST_F(FilterPlugins, PluginBuiltForAnotherAbiIsRefusedNamingTheFileAndBothVersions) {
+  const std::string current = std::to_string(daemon::kFilterPluginAbi);
+  // ABI 1 (vrflowFilterPluginAbi + vrflowRegisterFilters), and a later one's entry point.
+  for (const auto& [name, abi] : {std::pair{"old_abi_plugin", "1"}, {"other_abi_plugin", "999"}}) {
+    const std::string file = testPlugin(name);
+    const auto result = runVrflow({"validate", decimating("plugin=\"" + file + "\"")});
+    EXPECT_EQ(result.exitCode, 1) << name;
+    EXPECT_NE(result.err.find("filter plugin '" + file + "': built for filter plugin ABI " +
+                              std::string(abi) + ", this vrflow has ABI " + current +
+                              " (it must export vrflowFilterPluginV" + current + ")"),
+              std::string::npos)
+        << result.err;
+    const auto onPath = vrflowWithFilterPath(file, {"validate", decimating("")});
+    EXPECT_EQ(onPath.exitCode, 2) << name;
+    EXPECT_NE(onPath.err.find("built for filter plugin ABI " + std::string(abi)), std::string::npos)
+        << onPath.err;
+  }
 }
 
 TEST_F(FilterPlugins, PluginRedefiningABuiltinFilterIsRefused) {

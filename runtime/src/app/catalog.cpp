@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <tuple>
 
-#include "builtin_filters.hpp"
 #include "file_io.hpp"
 #include "manifest_reader.hpp"
 
@@ -30,9 +29,7 @@ Status joinFailures(const std::vector<std::string>& failures) {
 
 }  // namespace
 
-Catalog::Catalog() {
-  for (FilterType& type : detail::builtinFilterTypes()) filters_.push_back(std::move(type));
-}
+Catalog::Catalog() = default;
 
 Status Catalog::addPackageFile(const std::string& path) {
   return addPackageFileImpl(path, /*firstWins=*/false);

@@ -3,103 +3,10 @@
 #include <vector>
 
 #include "filters/filters.hpp"
+#include "filters/merge.hpp"
 
 namespace vrflow::daemon {
 namespace {
-
-// Forwards each message of its single input as it comes.
-void forwardAll(FilterContext& context) {
-  auto& in = context.input(0);
-  while (!in.empty() && context.canEmit(0)) {
-    context.emit(0, std::move(in.front()));
-    in.pop_front();
-  }
-}
-
-class PassthroughFilter final : public Filter {
- public:
-  void process(FilterContext& context) override { forwardAll(context); }
-};
-
-// Emits `count` empty messages at start so that a cycle can begin, then forwards.
-class InitialFilter final : public Filter {
- public:
-  Status start(FilterContext& context) override {
-    pending_ = context.params().getInt("count");
-    if (pending_ < 0) return makeError("filter '" + context.name() + "': count must be >= 0");
-    return {};
-  }
-  void process(FilterContext& context) override {
-    while (pending_ > 0 && context.canEmit(0)) {
-      auto message = context.makeEmpty(static_cast<uint64_t>(emitted_++), false);
-      if (!message) {
-        context.warn(message.error().message);
-        return;
-      }
-      context.emit(0, std::move(*message));
-      --pending_;
-    }
-    if (pending_ == 0) forwardAll(context);
-  }
-  bool exhausted(FilterContext& context) const override {
-    return pending_ == 0 && Filter::exhausted(context);
-  }
-
- private:
-  long pending_ = 0;
-  long emitted_ = 0;
-};
-
-// One message from every input, concatenated in input order; user stamps of the first, or
-// combined by the `stamps` rules.
-class MergeFilter final : public Filter {
- public:
-  explicit MergeFilter(std::vector<app::StampRule> rules = {}) : rules_(std::move(rules)) {}
-  /// Keeps a reference to the last message emitted (lastEmitted()).
-  void keepLast() { keepLast_ = true; }
-  const MessageRef* lastEmitted() const { return last_.valid() ? &last_ : nullptr; }
-
-  void process(FilterContext& context) override {
-    const std::size_t n = context.inputCount();
-    if (n == 0) return;  // nothing will ever arrive
-    for (;;) {
-      for (std::size_t i = 0; i < n; ++i) {
-        if (context.input(i).empty()) return;
-      }
-      if (!context.canEmit(0)) return;
-      parts_.clear();
-      for (std::size_t i = 0; i < n; ++i) {
-        parts_.push_back(std::move(context.input(i).front()));
-        context.input(i).pop_front();
-      }
-      if (n == 1) {
-        if (keepLast_) last_ = parts_.front();
-        context.emit(0, std::move(parts_.front()));
-        continue;
-      }
-      auto merged = filters::join(context, parts_, rules_);
-      if (!merged) {
-        context.warn(merged.error().message);
-        continue;
-      }
-      if (keepLast_) last_ = *merged;
-      context.emit(0, std::move(*merged));
-    }
-  }
-
- private:
-  std::vector<MessageRef> parts_;
-  std::vector<app::StampRule> rules_;
-  bool keepLast_ = false;
-  MessageRef last_;
-};
-
-Result<std::unique_ptr<Filter>> makeMerge(const FilterContext& context) {
-  std::string problem;
-  auto rules = app::parseStampRules(context.params().getString("stamps"), problem);
-  if (!rules) return makeError("filter '" + context.name() + "': " + problem);
-  return std::unique_ptr<Filter>(std::make_unique<MergeFilter>(std::move(*rules)));
-}
 
 // The default filter of a module's input port: initial messages first, then one message per
 // incoming connection merged into one. `fifo` takes the oldest pending message of each
@@ -116,16 +23,7 @@ class PortInputFilter final : public Filter {
     return {};
   }
   void process(FilterContext& context) override {
-    while (initial_ > 0 && context.canEmit(0)) {
-      auto message = context.makeEmpty(static_cast<uint64_t>(emittedInitial_++), false);
-      if (!message) {
-        context.warn(message.error().message);
-        return;
-      }
-      context.emit(0, std::move(*message));
-      --initial_;
-    }
-    if (initial_ > 0) return;
+    if (!filters::emitInitialMessages(context, initial_, emittedInitial_) || initial_ > 0) return;
     if (!latest_) {
       merge_.process(context);
       return;
@@ -176,8 +74,18 @@ class PortInputFilter final : public Filter {
   bool latest_ = false;
   MessageRef last_;
   std::vector<MessageRef> newestIn_;  ///< latest mode: the newest message taken from each input
-  MergeFilter merge_;
+  filters::MergeFilter merge_;
 };
+
+// The daemon's per-port filters: built for the module ports it connects, never named by an
+// application, so not in the catalog.
+FilterSpec portFilterSpec(std::string name, FilterFactory factory) {
+  FilterSpec spec;
+  spec.declaration.name = std::move(name);
+  spec.factory = std::move(factory);
+  spec.inCatalog = false;
+  return spec;
+}
 
 }  // namespace
 
@@ -192,14 +100,12 @@ void PortOutputFilter::process(FilterContext& context) {
 }
 
 void registerBuiltinFilters(FilterRegistry& registry) {
+  using filters::addBuiltin;
   using filters::factoryOf;
-  registry.add("passthrough", factoryOf<PassthroughFilter>());
-  registry.add("broadcast", factoryOf<PassthroughFilter>());
-  registry.add("initial", factoryOf<InitialFilter>());
-  registry.add("merge", makeMerge);
-  registry.add("gather", makeMerge);
-  registry.add("port-input", factoryOf<PortInputFilter>());
-  registry.add("port-output", factoryOf<PortOutputFilter>());
+  filters::registerForward(registry);
+  filters::registerMerge(registry);
+  addBuiltin(registry, portFilterSpec("port-input", factoryOf<PortInputFilter>()));
+  addBuiltin(registry, portFilterSpec("port-output", factoryOf<PortOutputFilter>()));
   filters::registerMultiplex(registry);
   filters::registerGate(registry);
   filters::registerRotate(registry);

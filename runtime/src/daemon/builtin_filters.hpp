@@ -1,6 +1,6 @@
 #pragma once
 
-#include "vrflow/daemon/filter.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 
 namespace vrflow::daemon {
 
@@ -17,7 +17,7 @@ class PortOutputFilter final : public Filter {
   uint64_t forwarded_ = 0;
 };
 
-/// Registers the built-in filter types; called once by FilterRegistry.
+/// Registers the built-in filter types; called once by FilterRegistry::instance().
 void registerBuiltinFilters(FilterRegistry& registry);
 
 }  // namespace vrflow::daemon

@@ -5,6 +5,8 @@
 #include <map>
 
 #include "daemon_impl.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
+#include "vrflow/daemon/filter_spec.hpp"
 
 // Builds a daemon's routing network from the application: module slots and rings, a filter
 // node per module port and per filter, a queue per connection, sinks to other hosts.
@@ -13,7 +15,6 @@ namespace {
 
 constexpr uint32_t kOutputRingCapacity = 16;
 constexpr uint32_t kInputRingCapacity = 16;
-constexpr int kMaxInitialMessages = 1'000'000;
 
 // Who a filter node's parameters belong to, as their errors name it.
 std::string filterOwner(const std::string& id, const std::string& type) {
@@ -25,15 +26,15 @@ std::string filterOwner(const std::string& id, const std::string& type) {
 Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& type,
                                     Parameters params, std::vector<std::string> inputs,
                                     std::vector<std::string> outputs) {
-  const FilterFactory* factory = FilterRegistry::instance().find(type);
-  if (factory == nullptr) return makeError("unknown filter type '" + type + "' for '" + id + "'");
+  const FilterSpec* spec = FilterRegistry::instance().find(type);
+  if (spec == nullptr) return makeError("unknown filter type '" + type + "' for '" + id + "'");
   auto node = std::make_unique<Node>(*graph, id, type, std::move(params));
   node->inputNames = std::move(inputs);
   node->outputNames = std::move(outputs);
   // Named inputs get their queues when connected; a factory already sees how many there are.
   node->inputs.assign(node->inputNames.size(), nullptr);
   node->outputs.resize(node->outputNames.size());
-  auto filter = (*factory)(*node);
+  auto filter = spec->factory(*node);
   if (!filter) return filter.error();
   if (const auto& misread = node->params().firstError()) return *misread;
   node->filter = std::move(*filter);

@@ -1,38 +1,28 @@
 #include "vrflow/daemon/filter.hpp"
 
-#include "builtin_filters.hpp"
+#include <cmath>
+#include <cstdlib>
+
+#include "filters/filters.hpp"
 
 namespace vrflow::daemon {
+
+Result<MessageRef> FilterContext::makeEmpty(uint64_t iteration, bool stampsOnly) {
+  return compose(128, [&](msg::MessageBuilder& builder) {
+    builder.setIteration(iteration);
+    builder.setStampsOnly(stampsOnly);
+  });
+}
+
+Result<MessageRef> FilterContext::concatenate(std::span<const MessageRef> parts) {
+  return filters::join(*this, parts, {});
+}
 
 bool Filter::exhausted(FilterContext& context) const {
   for (std::size_t i = 0; i < context.inputCount(); ++i) {
     if (context.inputClosed(i) && context.input(i).empty()) return true;
   }
   return context.inputCount() == 0;
-}
-
-FilterRegistry& FilterRegistry::instance() {
-  static FilterRegistry registry = [] {
-    FilterRegistry builtins;
-    registerBuiltinFilters(builtins);
-    return builtins;
-  }();
-  return registry;
-}
-
-void FilterRegistry::add(std::string type, FilterFactory factory) {
-  factories_[std::move(type)] = std::move(factory);
-}
-
-std::vector<std::string> FilterRegistry::types() const {
-  std::vector<std::string> names;
-  for (const auto& entry : factories_) names.push_back(entry.first);
-  return names;
-}
-
-const FilterFactory* FilterRegistry::find(const std::string& type) const {
-  const auto it = factories_.find(type);
-  return it == factories_.end() ? nullptr : &it->second;
 }
 
 }  // namespace vrflow::daemon

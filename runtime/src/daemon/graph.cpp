@@ -3,21 +3,10 @@
 #include <algorithm>
 #include <chrono>
 
-#include "filters/filters.hpp"
-#include "vrflow/ipc/shm_byte_sink.hpp"
+#include "compose.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow::daemon {
-namespace {
-
-uint64_t wallNs() {
-  return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                   std::chrono::system_clock::now().time_since_epoch())
-                                   .count());
-}
-
-}  // namespace
-
 void QueueSink::push(MessageRef message) {
   Queue& q = *queue_;
   const std::size_t size = message.size();
@@ -90,17 +79,6 @@ void Node::emit(std::size_t o, MessageRef message) {
   sinks.back()->push(std::move(message));
 }
 
-Result<MessageRef> Node::makeEmpty(uint64_t iteration, bool stampsOnly) {
-  return compose(128, [&](msg::MessageBuilder& builder) {
-    builder.setIteration(iteration);
-    builder.setStampsOnly(stampsOnly);
-  });
-}
-
-Result<MessageRef> Node::concatenate(std::span<const MessageRef> parts) {
-  return filters::join(*this, parts, {});
-}
-
 void Node::recordMerge(std::span<const msg::MessageView> views) {
   if (!graph_->traceMerges || views.size() < 2) return;
   // The merged message is stamped with the first part's source and the largest iteration.
@@ -117,16 +95,7 @@ void Node::recordMerge(std::span<const msg::MessageView> views) {
 
 Result<MessageRef> Node::compose(std::size_t sizeHint,
                                  const std::function<void(msg::MessageBuilder&)>& fill) {
-  ipc::ShmByteSink sink(*graph_->segment, std::max<std::size_t>(sizeHint, 128));
-  msg::MessageBuilder builder(sink);
-  builder.setSource(id_);
-  builder.setSendTimeNs(wallNs());
-  fill(builder);
-  const std::size_t used = builder.finish();
-  if (used == 0 || sink.data() == nullptr) {
-    return makeError("filter '" + id_ + "': shared memory exhausted");
-  }
-  return MessageRef(graph_->segment, sink.take(used));
+  return composeMessage(*graph_->segment, id_, sizeHint, fill);
 }
 
 uint64_t Node::nowNs() const {

@@ -110,8 +110,6 @@ class Node final : public FilterContext {
   void emit(std::size_t o, MessageRef message) override;
   bool outputEnded(std::size_t o) const override;
   bool runCountsIterations() const override;
-  Result<MessageRef> makeEmpty(uint64_t iteration, bool stampsOnly) override;
-  Result<MessageRef> concatenate(std::span<const MessageRef> parts) override;
   /// When the run is traced, records which parts a joined message was made of (trace arrows).
   void recordMerge(std::span<const msg::MessageView> views);
   Result<MessageRef> compose(std::size_t sizeHint,

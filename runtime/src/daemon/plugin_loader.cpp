@@ -5,9 +5,12 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 
+#include "vrflow/base/assert.hpp"
 #include "vrflow/base/executable_dir.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/daemon/plugin.hpp"
 
 namespace vrflow::daemon {
@@ -15,11 +18,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using AbiFunction = std::uint32_t (*)();
-
-// A plugin loaded in this process: what it defines, kept to add to other catalogs.
+// A plugin loaded in this process: the names of the filter types it defines, kept to add them
+// to other catalogs.
 struct LoadedPlugin {
-  std::vector<app::FilterType> types;
+  std::vector<std::string> types;
 };
 
 std::mutex pluginsMutex;
@@ -47,54 +49,47 @@ std::string joined(const std::vector<std::string>& names) {
   return text;
 }
 
-// Runs a plugin's register function into a scratch registry and catalog, so that what it
-// defines is checked before the process's registry sees any of it; then adds its factories to
-// the process's registry. The scratch objects hold code of the plugin: they are gone when this
-// returns, so that a refused plugin can be unloaded.
-Result<LoadedPlugin> registerChecked(RegisterFiltersFunction registerFilters) {
-  FilterRegistry registry;
-  app::Catalog catalog;
-  const app::Catalog builtins;
-  registerFilters(registry, catalog);
-
-  std::set<std::string> declared;
-  LoadedPlugin plugin;
-  for (const app::FilterType* type : catalog.filterTypes()) {
-    if (builtins.findFilter(type->name) != nullptr) continue;
-    declared.insert(type->name);
-    plugin.types.push_back(*type);
+// The ABI version of the entry point a library exports, when it is not this vrflow's: an
+// entry point of another version, or the interface function of ABI 1 (before the version was
+// in the entry point's name).
+std::optional<std::uint32_t> otherAbiOf(void* library) {
+  using LegacyAbiFunction = std::uint32_t (*)();
+  if (auto legacy = reinterpret_cast<LegacyAbiFunction>(dlsym(library, "vrflowFilterPluginAbi"))) {
+    return legacy();
   }
-  const std::vector<std::string> registered = registry.types();
-  std::vector<std::string> problems;
-  for (const auto& name : registered) {
-    if (FilterRegistry::instance().find(name) != nullptr) {
-      problems.push_back("filter type '" + name +
-                         "' exists already (built in or from another plugin)");
-    } else if (declared.count(name) == 0) {
-      problems.push_back("filter type '" + name +
-                         "' is registered but not declared (call catalog.addFilterType)");
-    }
+  constexpr std::uint32_t kNewerVersionsProbed = 1000;
+  for (std::uint32_t abi = 1; abi <= kFilterPluginAbi + kNewerVersionsProbed; ++abi) {
+    const std::string entry = kFilterPluginEntryPrefix + std::to_string(abi);
+    if (abi != kFilterPluginAbi && dlsym(library, entry.c_str()) != nullptr) return abi;
   }
-  for (const auto& name : declared) {
-    if (!std::binary_search(registered.begin(), registered.end(), name)) {
-      problems.push_back("filter type '" + name +
-                         "' is declared but has no factory (call registry.add)");
-    }
-  }
-  if (registered.empty()) problems.push_back("it defines no filter type");
-  if (!problems.empty()) {
-    std::string message;
-    for (const auto& problem : problems) message += (message.empty() ? "" : "; ") + problem;
-    return makeError(message);
-  }
-  for (const auto& name : registered) {
-    FilterRegistry::instance().add(name, *registry.find(name));
-  }
-  return plugin;
+  return std::nullopt;
 }
 
-// Opens the library, checks its exports and registers what it defines. A refused library is
-// unloaded; an accepted one stays loaded for good (its factories and declarations live in it).
+// What is wrong with the specs a plugin filled in (nothing: an empty string).
+std::string problemsOf(const std::vector<FilterSpec>& specs) {
+  std::vector<std::string> problems;
+  std::set<std::string> seen;
+  for (const FilterSpec& spec : specs) {
+    if (spec.name().empty()) {
+      problems.push_back("a filter type has an empty name");
+    } else if (!seen.insert(spec.name()).second) {
+      problems.push_back("filter type '" + spec.name() + "' is defined twice");
+    } else if (FilterRegistry::instance().find(spec.name()) != nullptr) {
+      problems.push_back("filter type '" + spec.name() +
+                         "' exists already (built in or from another plugin)");
+    } else if (!spec.factory) {
+      problems.push_back("filter type '" + spec.name() + "' has no factory");
+    }
+  }
+  if (specs.empty()) problems.push_back("it defines no filter type");
+  std::string message;
+  for (const auto& problem : problems) message += (message.empty() ? "" : "; ") + problem;
+  return message;
+}
+
+// Opens the library, checks its entry point and what it defines, and adds its specs to the
+// process's registry. A refused library is unloaded (its specs, which hold its code, are gone
+// by then); an accepted one stays loaded for good.
 Result<LoadedPlugin> openPlugin(const std::string& path, const std::string& label) {
   void* library = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (library == nullptr) {
@@ -105,20 +100,31 @@ Result<LoadedPlugin> openPlugin(const std::string& path, const std::string& labe
     dlclose(library);
     return makeError(label + ": " + message);
   };
-  auto abi = reinterpret_cast<AbiFunction>(dlsym(library, "vrflowFilterPluginAbi"));
-  auto registerFilters =
-      reinterpret_cast<RegisterFiltersFunction>(dlsym(library, "vrflowRegisterFilters"));
-  if (abi == nullptr || registerFilters == nullptr) {
-    return fail(
-        "not a vrflow filter plugin: it must export vrflowFilterPluginAbi (write "
-        "VRFLOW_FILTER_PLUGIN() once in its source) and extern \"C\" vrflowRegisterFilters");
+  auto entry = reinterpret_cast<FilterPluginEntry>(dlsym(library, kFilterPluginEntry));
+  if (entry == nullptr) {
+    if (const auto abi = otherAbiOf(library)) {
+      return fail("built for filter plugin ABI " + std::to_string(*abi) + ", this vrflow has ABI " +
+                  std::to_string(kFilterPluginAbi) + " (it must export " + kFilterPluginEntry +
+                  "); rebuild it against this vrflow's filter SDK");
+    }
+    return fail(std::string("not a vrflow filter plugin: it exports no ") + kFilterPluginEntry +
+                " (write VRFLOW_FILTER_PLUGIN(specs) { ... } once in its source)");
   }
-  if (abi() != kFilterPluginAbi) {
-    return fail("built for filter plugin interface " + std::to_string(abi()) +
-                ", this vrflow has " + std::to_string(kFilterPluginAbi) + "; rebuild it");
+  std::string problems;
+  LoadedPlugin plugin;
+  {
+    std::vector<FilterSpec> specs;
+    entry(specs);
+    problems = problemsOf(specs);
+    if (problems.empty()) {
+      for (FilterSpec& spec : specs) {
+        plugin.types.push_back(spec.name());
+        const Status added = FilterRegistry::instance().add(std::move(spec));
+        VRFLOW_ASSERT(added.ok(), "a checked plugin spec joins the registry");
+      }
+    }
   }
-  auto plugin = registerChecked(registerFilters);
-  if (!plugin) return fail(plugin.error().message);
+  if (!problems.empty()) return fail(problems);
   return plugin;
 }
 
@@ -139,9 +145,10 @@ Status loadFilterPlugin(const std::string& path, app::Catalog& catalog) {
     if (!plugin) return plugin.error();
     it = plugins.emplace(canonical.string(), std::move(*plugin)).first;
   }
-  for (const app::FilterType& type : it->second.types) {
-    if (catalog.findFilter(type.name) != nullptr) continue;  // this plugin's, added before
-    if (auto status = catalog.addFilterType(type); !status) {
+  for (const std::string& type : it->second.types) {
+    if (catalog.findFilter(type) != nullptr) continue;  // this plugin's, added before
+    const FilterSpec* spec = FilterRegistry::instance().find(type);
+    if (auto status = catalog.addFilterType(spec->declaration); !status) {
       return makeError(label + ": " + status.error().message);
     }
   }

@@ -8,6 +8,7 @@
 #include "vrflow/app/overrides.hpp"
 #include "vrflow/app/validate.hpp"
 #include "vrflow/base/executable_dir.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/daemon/plugin.hpp"
 
 namespace vrflow::run {
@@ -18,7 +19,7 @@ Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs) {
   if (const auto bin = executableDir(); !bin.empty()) {
     dirs.push_back((bin.parent_path() / "share/vrflow/packages").string());
   }
-  app::Catalog catalog;
+  app::Catalog catalog = daemon::makeCatalog();
   if (auto status = catalog.loadSearchPath(dirs); !status) return status.error();
   const auto plugins = daemon::filterPluginsFromEnvironment();
   if (auto status = daemon::loadFilterPlugins(plugins, catalog); !status) return status.error();

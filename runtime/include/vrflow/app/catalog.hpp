@@ -15,12 +15,12 @@ namespace vrflow::app {
 /// The name of a node package's manifest file.
 inline constexpr std::string_view kManifestFileName = "vrflow-package.xml";
 
-/// Every module type and filter type an application may use: the node packages' manifests
-/// plus the built-in filters (passthrough, merge, initial, broadcast). Pointers it hands out
-/// stay valid while the catalog lives (entries are never moved or removed).
+/// Every module type and filter type an application may use: the node packages' manifests plus
+/// the filter types that daemon::makeCatalog() fills in (declared beside their code). Pointers it
+/// hands out stay valid while the catalog lives (entries are never moved or removed).
 class Catalog {
  public:
-  /// A catalog with the built-in filter types only.
+  /// An empty catalog (daemon::makeCatalog() gives one with every filter type).
   Catalog();
 
   /// Reads one vrflow-package.xml. Fails with "FILE:LINE:COL: error: ..." lines for a bad

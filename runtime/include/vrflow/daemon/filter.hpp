@@ -3,12 +3,10 @@
 #include <cstddef>
 #include <deque>
 #include <functional>
-#include <map>
 #include <memory>
 #include <span>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include "vrflow/base/parameters.hpp"
 #include "vrflow/base/result.hpp"
@@ -53,11 +51,11 @@ class FilterContext {
   /// reaches its count (docs/filters.md).
   virtual bool runCountsIterations() const = 0;
 
-  /// A new message with no chunk (for initial messages and signals).
-  virtual Result<MessageRef> makeEmpty(uint64_t iteration, bool stampsOnly) = 0;
+  /// A new message with no chunk (for initial messages and signals), made with compose().
+  Result<MessageRef> makeEmpty(uint64_t iteration, bool stampsOnly);
   /// A new message holding the chunks of `parts` in order; stamps from the first, the
   /// iteration and simulation time the largest among them.
-  virtual Result<MessageRef> concatenate(std::span<const MessageRef> parts) = 0;
+  Result<MessageRef> concatenate(std::span<const MessageRef> parts);
   /// A new message written by `fill` straight into shared memory (`sizeHint` bytes reserved up
   /// front; the block grows as needed). The builder starts with this filter as the source;
   /// `fill` may replace every stamp (setStamps) and copy chunks (appendChunk, appendChunks).
@@ -76,8 +74,9 @@ class FilterContext {
 };
 
 /// A filter: runs inside the daemon, sees every message buffered on its inputs, emits any
-/// messages. Write one by deriving from this class and registering a factory (see
-/// FilterRegistry); the daemon calls process() whenever something may have changed.
+/// messages. Write one by deriving from this class and declaring its type with a FilterSpec
+/// (vrflow/daemon/filter_spec.hpp); the daemon calls process() whenever something may have
+/// changed.
 class Filter {
  public:
   virtual ~Filter() = default;
@@ -93,24 +92,5 @@ class Filter {
 /// Makes a filter for one node of the network. It may read the node's name, parameters and
 /// port counts (not its queues); an error (a parameter it cannot use) stops the run's start.
 using FilterFactory = std::function<Result<std::unique_ptr<Filter>>(const FilterContext&)>;
-
-/// Filter types by name: the standard library (docs/filters.md), the default per-port filters
-/// `port-input` and `port-output`, and what plugins add (vrflow/daemon/plugin.hpp).
-class FilterRegistry {
- public:
-  /// The process's registry, holding the built-in filters; the daemon builds from it.
-  static FilterRegistry& instance();
-  /// An empty registry (plugins register into one first, so that they are checked).
-  FilterRegistry() = default;
-  /// Adds or replaces the factory of `type`.
-  void add(std::string type, FilterFactory factory);
-  /// The factory of `type`, or nullptr.
-  const FilterFactory* find(const std::string& type) const;
-  /// Every registered type name, sorted.
-  std::vector<std::string> types() const;
-
- private:
-  std::map<std::string, FilterFactory> factories_;
-};
 
 }  // namespace vrflow::daemon

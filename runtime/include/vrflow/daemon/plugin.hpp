@@ -8,39 +8,54 @@
 #include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/model.hpp"
 #include "vrflow/base/result.hpp"
-#include "vrflow/daemon/filter.hpp"
+#include "vrflow/daemon/filter_spec.hpp"
 
 // Filter plugins: shared libraries that add filter types without rebuilding the runtime
-// (docs/filters.md, "Plugins"). A plugin exports two C functions:
+// (docs/filters.md, "Plugins"). A plugin exports one function, whose name carries the ABI
+// version it was built for, and fills in one FilterSpec per filter type it defines:
 //
-//   VRFLOW_FILTER_PLUGIN()   // exports vrflowFilterPluginAbi()
-//   extern "C" void vrflowRegisterFilters(vrflow::daemon::FilterRegistry& registry,
-//                                         vrflow::app::Catalog& catalog) {
-//     registry.add("every-nth", factory);       // what the daemon runs
-//     (void)catalog.addFilterType(declaration);  // what `vrflow validate` and the editor see
+//   VRFLOW_FILTER_PLUGIN(specs) {  // exports vrflowFilterPluginV<ABI>
+//     specs.push_back({declaration(), factory});
 //   }
 //
-// It links no vrflow library: its references to vrflow resolve against the program that loads
-// it (`vrflow` and `vrflow-daemon` export the whole runtime), so there is one copy of every
-// vrflow symbol in the process. A loaded plugin is never unloaded.
+// The function passes the SDK's own C++ types: the plugin and the program that loads it use
+// one copy of the filter SDK in the process, so both sides agree on them as long as they were
+// built for the same ABI. A loaded plugin is never unloaded.
+
+/// The filter plugin ABI: the version of what a plugin sees of vrflow (Filter, FilterContext,
+/// FilterSpec, app::FilterType and the types they use). Bumped on any change to them; the name
+/// of the entry point carries it, so that a plugin built for another version is refused.
+#define VRFLOW_FILTER_PLUGIN_ABI 2
+
+#define VRFLOW_DETAIL_PLUGIN_CAT(a, b) a##b
+#define VRFLOW_DETAIL_PLUGIN_ENTRY(abi) VRFLOW_DETAIL_PLUGIN_CAT(vrflowFilterPluginV, abi)
+#define VRFLOW_DETAIL_PLUGIN_TEXT(x) #x
+#define VRFLOW_DETAIL_PLUGIN_STRING(x) VRFLOW_DETAIL_PLUGIN_TEXT(x)
+
+/// The name of the entry point a plugin exports for this ABI (vrflowFilterPluginV2).
+#define VRFLOW_FILTER_PLUGIN_ENTRY VRFLOW_DETAIL_PLUGIN_ENTRY(VRFLOW_FILTER_PLUGIN_ABI)
 
 namespace vrflow::daemon {
 
-/// Version of what a plugin sees of vrflow (Filter, FilterContext, FilterRegistry,
-/// app::Catalog); a plugin built against another version is refused. Bumped on any change.
-inline constexpr std::uint32_t kFilterPluginAbi = 1;
+/// VRFLOW_FILTER_PLUGIN_ABI as a number.
+inline constexpr std::uint32_t kFilterPluginAbi = VRFLOW_FILTER_PLUGIN_ABI;
+/// The prefix of every ABI's entry point; the version follows it.
+inline constexpr const char* kFilterPluginEntryPrefix = "vrflowFilterPluginV";
+/// The symbol a plugin for this ABI exports.
+inline constexpr const char* kFilterPluginEntry =
+    VRFLOW_DETAIL_PLUGIN_STRING(VRFLOW_FILTER_PLUGIN_ENTRY);
 
-/// The function a plugin exports as `vrflowRegisterFilters`.
-using RegisterFiltersFunction = void (*)(FilterRegistry& registry, app::Catalog& catalog);
+/// The function a plugin exports: appends one spec per filter type it defines.
+using FilterPluginEntry = void (*)(std::vector<FilterSpec>& specs);
 
 /// Environment variable listing plugins to load at start-up.
 inline constexpr const char* kFilterPathVariable = "VRFLOW_FILTER_PATH";
 
-/// Loads one plugin (once per process; later calls only add its types to `catalog`). Refused,
-/// with a message naming the file: a file that cannot be loaded (missing, unresolved symbol),
-/// one without the two exported functions or built for another kFilterPluginAbi, one whose
-/// registered factories and catalog declarations differ, or one defining a type that exists
-/// already (built in or from another plugin).
+/// Loads one plugin (once per process: its specs join FilterRegistry::instance()) and adds its
+/// filter types to `catalog`. Refused, with a message naming the file: a file that cannot be
+/// loaded (missing, unresolved symbol), one without an entry point, one built for another ABI
+/// (the message names both versions), one defining no filter type, a type twice, or a type that
+/// exists already (built in or from another plugin).
 Status loadFilterPlugin(const std::string& path, app::Catalog& catalog);
 
 /// The plugin files `variable` lists: ':'-separated files or folders (a folder stands for its
@@ -59,9 +74,8 @@ std::vector<app::Diagnostic> loadApplicationPlugins(const app::Application& appl
 
 }  // namespace vrflow::daemon
 
-/// Put once in a plugin's source, at global scope: exports the plugin interface version it was
-/// built with, which the loader checks.
-#define VRFLOW_FILTER_PLUGIN()                                                              \
-  extern "C" __attribute__((visibility("default"))) std::uint32_t vrflowFilterPluginAbi() { \
-    return ::vrflow::daemon::kFilterPluginAbi;                                              \
-  }
+/// Put once in a plugin's source, at global scope, followed by the body of the entry point:
+/// `specs` names its parameter, a std::vector<vrflow::daemon::FilterSpec>& to append to.
+#define VRFLOW_FILTER_PLUGIN(specs)                                                  \
+  extern "C" __attribute__((visibility("default"))) void VRFLOW_FILTER_PLUGIN_ENTRY( \
+      std::vector<::vrflow::daemon::FilterSpec>& specs)

@@ -18,7 +18,8 @@ namespace vrflow::run {
 
 /// The node packages on the search path: `extraDirs` first, then $VRFLOW_PACKAGE_PATH, then
 /// <folder of this executable>/../share/vrflow/packages (the build tree and installs alike);
-/// plus the filter plugins of $VRFLOW_FILTER_PATH.
+/// plus every filter type: daemon::makeCatalog()'s and the filter plugins' of
+/// $VRFLOW_FILTER_PATH.
 Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs);
 
 /// What prepare() does, and with what.

@@ -3,8 +3,27 @@
 
 #include "../graph.hpp"
 #include "filters.hpp"
+#include "vrflow/base/assert.hpp"
 
 namespace vrflow::daemon::filters {
+
+void addBuiltin(FilterRegistry& registry, FilterSpec spec) {
+  const Status added = registry.add(std::move(spec));
+  VRFLOW_ASSERT(added.ok(), "built-in filter types have distinct names and factories");
+}
+
+bool emitInitialMessages(FilterContext& context, long& pending, long& emitted) {
+  while (pending > 0 && context.canEmit(0)) {
+    auto message = context.makeEmpty(static_cast<uint64_t>(emitted++), false);
+    if (!message) {
+      context.warn(message.error().message);
+      return false;
+    }
+    context.emit(0, std::move(*message));
+    --pending;
+  }
+  return true;
+}
 
 bool allInputsDone(FilterContext& context) {
   for (std::size_t i = 0; i < context.inputCount(); ++i) {

@@ -7,12 +7,28 @@
 #include <vector>
 
 #include "vrflow/app/model.hpp"
-#include "vrflow/daemon/filter.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/message/reader.hpp"
 
-// The standard filter library (docs/filters.md): one register function per file.
+// The standard filter library (docs/filters.md): one register function per file, adding the
+// FilterSpec of each type the file implements (its declaration beside its code).
 
 namespace vrflow::daemon::filters {
+
+using app::FilterType;
+using app::Param;
+using app::paramString;
+using app::PortSpec;
+using app::splitList;
+
+/// kMaxFilterPorts as the bound of a parameter.
+inline constexpr double kMaxPorts = static_cast<double>(kMaxFilterPorts);
+
+/// Adds a built-in filter type to `registry` (a bug when its name is taken).
+void addBuiltin(FilterRegistry& registry, FilterSpec spec);
+
+void registerForward(FilterRegistry& registry);  ///< passthrough, broadcast and initial
+void registerMerge(FilterRegistry& registry);    ///< merge and gather
 
 void registerMultiplex(FilterRegistry& registry);
 void registerGate(FilterRegistry& registry);
@@ -32,6 +48,11 @@ FilterFactory factoryOf() {
     return std::unique_ptr<Filter>(std::make_unique<T>());
   };
 }
+
+/// Emits the empty initial messages still `pending` on output 0 while it can take them,
+/// numbering them from `emitted` (both counted down / up). False when one could not be made
+/// (warned): try again on the next pass.
+bool emitInitialMessages(FilterContext& context, long& pending, long& emitted);
 
 /// True when every input is closed and drained (for filters that go on while any input may
 /// still bring something).

@@ -47,13 +47,31 @@ class GateFilter final : public Filter {
   bool open_;
 };
 
+app::FilterType gateType() {
+  FilterType type;
+  type.name = "gate";
+  type.doc =
+      "Forwards in to out while open, drops in's messages while closed. Each message on open "
+      "sets the state: an integer or float user stamp `open` opens when non-zero; without "
+      "it, a message with at least one chunk opens and an empty one closes.";
+  type.params.push_back(
+      enumParam("initially", {"closed", "open"}, "the state before the first control message"));
+  type.ports = [](const std::vector<Param>&) {
+    return std::vector<PortSpec>{filterPort("in", true, "messages to forward or drop"),
+                                 filterPort("open", true, "control messages: open or close"),
+                                 filterPort("out", false, "the messages that found it open")};
+  };
+  return type;
+}
+
 }  // namespace
 
 void registerGate(FilterRegistry& registry) {
-  registry.add("gate", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    return std::unique_ptr<Filter>(
-        std::make_unique<GateFilter>(context.params().getString("initially") == "open"));
-  });
+  addBuiltin(registry,
+             {gateType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+                return std::unique_ptr<Filter>(std::make_unique<GateFilter>(
+                    context.params().getString("initially") == "open"));
+              }});
 }
 
 }  // namespace vrflow::daemon::filters

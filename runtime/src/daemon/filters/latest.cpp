@@ -66,13 +66,38 @@ class LatestFilter final : public Filter {
   MessageRef last_;
 };
 
+app::FilterType latestType() {
+  FilterType type;
+  type.name = "latest";
+  type.doc =
+      "Greedy sampling: keeps only the newest message of in (older ones are dropped at once, "
+      "so the producer never waits), and forwards it on out for each message of sync.";
+  const app::ParamSpec initialSync =
+      intParam("initial-sync", "1", 0, static_cast<double>(kMaxInitialMessages),
+               "sync messages assumed received at start-up (starts the reader -> sync cycle)");
+  type.params.push_back(initialSync);
+  type.params.push_back(boolParam("repeat", "false",
+                                  "answer a sync with the last forwarded message again when "
+                                  "nothing newer came (else the sync waits for one)"));
+  type.ports = [](const std::vector<Param>&) {
+    return std::vector<PortSpec>{filterPort("in", true, "messages to sample"),
+                                 filterPort("sync", true, "one message per wanted sample"),
+                                 filterPort("out", false, "the newest message, once per sync")};
+  };
+  type.initialMessages = [initialSync](const std::vector<Param>& params) {
+    return static_cast<int>(clampedInt(initialSync, params));
+  };
+  return type;
+}
+
 }  // namespace
 
 void registerLatest(FilterRegistry& registry) {
-  registry.add("latest", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    return std::unique_ptr<Filter>(
-        std::make_unique<LatestFilter>(context.params().getBool("repeat")));
-  });
+  addBuiltin(registry,
+             {latestType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+                return std::unique_ptr<Filter>(
+                    std::make_unique<LatestFilter>(context.params().getBool("repeat")));
+              }});
 }
 
 }  // namespace vrflow::daemon::filters

@@ -39,18 +39,33 @@ class MaxFrequencyFilter final : public Filter {
   uint64_t nextNs_ = 0;
 };
 
+app::FilterType maxFrequencyType() {
+  FilterType type;
+  type.name = "maxfrequency";
+  type.doc =
+      "Forwards in to out at most `frequency` times per second: two messages leave at least "
+      "1/frequency s apart. `wait` holds early messages (the producer is paced); `latest` "
+      "drops all but the newest pending one.";
+  type.params.push_back(floatParam("frequency", "30", 0.001, 1e6, "most messages per second"));
+  type.params.push_back(enumParam("mode", {"wait", "latest"}, "what happens to early messages"));
+  type.ports = inToOut;
+  return type;
+}
+
 }  // namespace
 
 void registerMaxFrequency(FilterRegistry& registry) {
-  registry.add("maxfrequency", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const double frequency = context.params().getFloat("frequency");
-    if (!(frequency > 0.0) || !std::isfinite(frequency)) {
-      return makeError("filter '" + context.name() + "': frequency must be a positive number");
-    }
-    const auto periodNs = static_cast<uint64_t>(std::llround(1e9 / frequency));
-    return std::unique_ptr<Filter>(std::make_unique<MaxFrequencyFilter>(
-        periodNs, context.params().getString("mode") == "latest"));
-  });
+  addBuiltin(
+      registry,
+      {maxFrequencyType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+         const double frequency = context.params().getFloat("frequency");
+         if (!(frequency > 0.0) || !std::isfinite(frequency)) {
+           return makeError("filter '" + context.name() + "': frequency must be a positive number");
+         }
+         const auto periodNs = static_cast<uint64_t>(std::llround(1e9 / frequency));
+         return std::unique_ptr<Filter>(std::make_unique<MaxFrequencyFilter>(
+             periodNs, context.params().getString("mode") == "latest"));
+       }});
 }
 
 }  // namespace vrflow::daemon::filters

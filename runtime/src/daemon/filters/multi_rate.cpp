@@ -282,21 +282,59 @@ class DecimateFilter final : public Filter {
   GroupState group_;     // their objects and resources (merge)
 };
 
+constexpr double kMaxRepeat = 1000000;
+
+app::FilterType repeatType() {
+  FilterType type;
+  type.name = "repeat";
+  type.doc =
+      "Multi-rate input: each message of in leaves count times, copy j with time step dt/count, "
+      "simulation time t + j*dt/count and iteration i*count + j, so the module behind it runs "
+      "count iterations per message.";
+  type.params.push_back(intParam("count", "10", 1, kMaxRepeat, "copies per message (k)"));
+  type.ports = inToOut;
+  return type;
+}
+
+app::FilterType decimateType() {
+  FilterType type;
+  type.name = "decimate";
+  type.doc =
+      "Multi-rate output: forwards only the last of every count messages of in. With restamp, "
+      "its iteration becomes the group's number and its time step the sum of the group's.";
+  type.params.push_back(intParam("count", "10", 1, kMaxRepeat, "messages per group (k)"));
+  type.params.push_back(boolParam("restamp", "true",
+                                  "iteration = group number, time step = the group's total (a "
+                                  "copy); false forwards the message untouched, by reference"));
+  type.params.push_back(boolParam("merge", "true",
+                                  "the objects and resources of the dropped messages are folded "
+                                  "into the forwarded one (an add and later updates become one "
+                                  "add), so no state is lost; events of dropped messages are not "
+                                  "kept"));
+  type.ports = inToOut;
+  return type;
+}
+
 }  // namespace
 
 void registerMultiRate(FilterRegistry& registry) {
-  registry.add("repeat", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const long count = context.params().getInt("count");
-    if (count < 1) return makeError("filter '" + context.name() + "': count must be >= 1");
-    return std::unique_ptr<Filter>(std::make_unique<RepeatFilter>(static_cast<uint64_t>(count)));
-  });
-  registry.add("decimate", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const long count = context.params().getInt("count");
-    if (count < 1) return makeError("filter '" + context.name() + "': count must be >= 1");
-    return std::unique_ptr<Filter>(std::make_unique<DecimateFilter>(
-        static_cast<uint64_t>(count), context.params().getBool("restamp"),
-        context.params().getBool("merge")));
-  });
+  addBuiltin(registry,
+             {repeatType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+                const long count = context.params().getInt("count");
+                if (count < 1)
+                  return makeError("filter '" + context.name() + "': count must be >= 1");
+                return std::unique_ptr<Filter>(
+                    std::make_unique<RepeatFilter>(static_cast<uint64_t>(count)));
+              }});
+  addBuiltin(registry,
+             {decimateType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+                const long count = context.params().getInt("count");
+                if (count < 1)
+                  return makeError("filter '" + context.name() + "': count must be >= 1");
+                return std::unique_ptr<Filter>(std::make_unique<DecimateFilter>(
+                    static_cast<uint64_t>(count), context.params().getBool("restamp"),
+                    context.params().getBool("merge")));
+              }});
 }
 
 }  // namespace vrflow::daemon::filters

@@ -51,13 +51,28 @@ class MultiplexFilter final : public Filter {
   uint64_t sent_ = 0;
 };
 
+app::FilterType multiplexType() {
+  FilterType type;
+  type.name = "multiplex";
+  type.doc =
+      "Forwards each message of in0..in{N-1} to out as it comes (one input after the other "
+      "when several wait), renumbered: the iteration stamp counts the messages sent.";
+  declareNumberedInputs(type, "messages to forward", "every message, in arrival order");
+  type.params.push_back(
+      boolParam("renumber", "true",
+                "stamp each message's iteration with the count of messages sent (a "
+                "copy); false forwards them untouched, by reference"));
+  return type;
+}
+
 }  // namespace
 
 void registerMultiplex(FilterRegistry& registry) {
-  registry.add("multiplex", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    return std::unique_ptr<Filter>(
-        std::make_unique<MultiplexFilter>(context.params().getBool("renumber")));
-  });
+  addBuiltin(registry,
+             {multiplexType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+                return std::unique_ptr<Filter>(
+                    std::make_unique<MultiplexFilter>(context.params().getBool("renumber")));
+              }});
 }
 
 }  // namespace vrflow::daemon::filters

@@ -83,14 +83,56 @@ class UnrotateFilter final : public Filter {
   std::vector<HeadIteration> heads_;
 };
 
+app::FilterType rotateType() {
+  FilterType type;
+  type.name = "rotate";
+  type.doc =
+      "Dispatches the messages of in round-robin to out0..out{N-1}: message k goes to "
+      "out{k mod N} (waiting for that output when it is full), by reference.";
+  const app::ParamSpec outputCount =
+      intParam("outputs", "2", 1, kMaxPorts, "number of outputs N (workers)");
+  type.params.push_back(outputCount);
+  type.ports = [outputCount](const std::vector<Param>& params) {
+    std::vector<PortSpec> ports{filterPort("in", true, "messages to dispatch")};
+    for (auto& port : numberedPorts("out", clampedInt(outputCount, params), false,
+                                    "every N-th message, to one worker")) {
+      ports.push_back(std::move(port));
+    }
+    return ports;
+  };
+  return type;
+}
+
+app::FilterType unrotateType() {
+  FilterType type;
+  type.name = "unrotate";
+  type.doc =
+      "Puts the results of N workers fed by a rotate back in the original order on out. "
+      "`iteration`: the pending message with the smallest iteration stamp goes first (ties: "
+      "lower input first), once every open input has one; `round-robin`: in0, in1, ... in "
+      "turn.";
+  const app::ParamSpec inputCount =
+      intParam("inputs", "2", 1, kMaxPorts, "number of inputs N (workers)");
+  type.params.push_back(inputCount);
+  type.params.push_back(
+      enumParam("order", {"iteration", "round-robin"}, "how the original order is found back"));
+  type.ports = [inputCount](const std::vector<Param>& params) {
+    auto ports = numberedPorts("in", clampedInt(inputCount, params), true, "one worker's results");
+    ports.push_back(filterPort("out", false, "every result, in the original order"));
+    return ports;
+  };
+  return type;
+}
+
 }  // namespace
 
 void registerRotate(FilterRegistry& registry) {
-  registry.add("rotate", factoryOf<RotateFilter>());
-  registry.add("unrotate", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    return std::unique_ptr<Filter>(std::make_unique<UnrotateFilter>(
-        context.inputCount(), context.params().getString("order") != "round-robin"));
-  });
+  addBuiltin(registry, {rotateType(), factoryOf<RotateFilter>()});
+  addBuiltin(registry,
+             {unrotateType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+                return std::unique_ptr<Filter>(std::make_unique<UnrotateFilter>(
+                    context.inputCount(), context.params().getString("order") != "round-robin"));
+              }});
 }
 
 }  // namespace vrflow::daemon::filters

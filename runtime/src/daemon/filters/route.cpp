@@ -405,21 +405,62 @@ class RouteFilter final : public Filter {
   std::unordered_map<uint64_t, Bytes> resources_;  // latest chunk of every resource, verbatim
 };
 
+app::FilterType routeType() {
+  FilterType type;
+  type.name = "route";
+  type.doc =
+      "Dynamic routing by bounding volume: receiver k publishes its volume of interest on "
+      "interest{k} (string user stamp `stamp`: \"minx miny minz maxx maxy maxz\", \"all\" or "
+      "\"none\"); out{k} gets the chunks of objects whose bounds meet it, the full state of "
+      "an object when it enters, and the resources those objects refer to, once.";
+  const app::ParamSpec outputCount =
+      intParam("outputs", "1", 1, static_cast<double>(kMaxFilterPorts), "number of receivers N");
+  type.params.push_back(outputCount);
+  type.params.push_back(
+      stringParam("stamp", "interest", "name of the string user stamp holding the volume"));
+  type.params.push_back(enumParam("initially", {"none", "all"},
+                                  "the volume of every receiver before its first interest"));
+  type.params.push_back(enumParam("unbounded", {"all", "drop"},
+                                  "objects whose bounds are unknown: to every receiver that has "
+                                  "a volume, or to none"));
+  type.ports = [outputCount](const std::vector<Param>& params) {
+    const long long n = clampedInt(outputCount, params);
+    std::vector<PortSpec> ports{filterPort("in", true, "the sender's messages")};
+    for (auto& port : numberedPorts("interest", n, true, "a receiver's volume of interest")) {
+      port.gating = false;  // out{k} leaves without it: a receiver -> interest cycle is fine
+      ports.push_back(std::move(port));
+    }
+    for (auto& port : numberedPorts("out", n, false, "what one receiver's volume meets")) {
+      ports.push_back(std::move(port));
+    }
+    return ports;
+  };
+  type.check = [](const std::vector<Param>& params) -> std::optional<std::string> {
+    if (paramString(params, "stamp", "interest").empty()) {
+      return "parameter 'stamp' must name a user stamp (e.g. \"interest\")";
+    }
+    return std::nullopt;
+  };
+  return type;
+}
+
 }  // namespace
 
 void registerRoute(FilterRegistry& registry) {
-  registry.add("route", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const std::string initially = context.params().getString("initially");
-    const std::string unbounded = context.params().getString("unbounded");
-    if (initially != "none" && initially != "all") {
-      return makeError("filter '" + context.name() + "': initially must be none or all");
-    }
-    if (unbounded != "all" && unbounded != "drop") {
-      return makeError("filter '" + context.name() + "': unbounded must be all or drop");
-    }
-    return std::unique_ptr<Filter>(std::make_unique<RouteFilter>(
-        context.params().getString("stamp"), initially == "all", unbounded == "all"));
-  });
+  addBuiltin(
+      registry,
+      {routeType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+         const std::string initially = context.params().getString("initially");
+         const std::string unbounded = context.params().getString("unbounded");
+         if (initially != "none" && initially != "all") {
+           return makeError("filter '" + context.name() + "': initially must be none or all");
+         }
+         if (unbounded != "all" && unbounded != "drop") {
+           return makeError("filter '" + context.name() + "': unbounded must be all or drop");
+         }
+         return std::unique_ptr<Filter>(std::make_unique<RouteFilter>(
+             context.params().getString("stamp"), initially == "all", unbounded == "all"));
+       }});
 }
 
 }  // namespace vrflow::daemon::filters

@@ -249,42 +249,122 @@ class ScatterFilter final : public Filter {
   std::vector<std::pair<uint32_t, uint32_t>> targets_;
 };
 
+app::FilterType scatterType() {
+  FilterType type;
+  type.name = "scatter";
+  type.doc =
+      "Splits each message of in into N parts, one per output out0..out{N-1}, each with the "
+      "message's stamps (a part may be empty). `chunk`: N contiguous runs of chunks of "
+      "near-equal count; `id`: chunk to out{splitmix64(id) mod N}; `type`: objects of the "
+      "k-th name of `types` to out{k}, other chunks by `others`; `bounds`: objects to every "
+      "slab of `axis` cut at `cuts` that their bounds (a point: its position) meet, an object "
+      "without bounds in a message where its latest bounds sent it, other chunks by `others`; "
+      "`size`: every raw resource cut into N parts of whole `element-size` elements, each a "
+      "raw resource of the same id prefixed by its u64 offset and u64 total size.";
+  const app::ParamSpec outputCount = intParam("outputs", "2", 1, kMaxPorts, "number of outputs N");
+  type.params.push_back(outputCount);
+  type.params.push_back(
+      enumParam("by", {"chunk", "id", "type", "bounds", "size"}, "how chunks are split"));
+  type.params.push_back(intParam("element-size", "1", 1, 1 << 30,
+                                 "by=size: bytes per element; parts hold whole elements"));
+  type.params.push_back(
+      stringParam("types", "", "by=type: N object type names, comma-separated, one per output"));
+  type.params.push_back(
+      enumParam("axis", {"x", "y", "z"}, "by=bounds: the axis the cuts are taken along"));
+  type.params.push_back(
+      stringParam("cuts", "",
+                  "by=bounds: N-1 strictly increasing numbers, comma-separated; out{k} is the slab "
+                  "[cut{k-1}, cut{k}), out0 unbounded below, out{N-1} unbounded above"));
+  type.params.push_back(enumParam("others", {"all", "drop"},
+                                  "chunks not split by type, bounds or size (by=type, bounds, "
+                                  "size) go to every output (all) or nowhere (drop)"));
+  type.ports = [outputCount](const std::vector<Param>& params) {
+    std::vector<PortSpec> ports{filterPort("in", true, "messages to split")};
+    for (auto& port : numberedPorts("out", clampedInt(outputCount, params), false,
+                                    "one part of every message")) {
+      ports.push_back(std::move(port));
+    }
+    return ports;
+  };
+  type.check = [outputCount](const std::vector<Param>& params) -> std::optional<std::string> {
+    const std::string by = paramString(params, "by", "chunk");
+    const bool byType = by == "type";
+    const auto names = splitList(paramString(params, "types", ""));
+    const auto cuts = splitList(paramString(params, "cuts", ""));
+    if (by != "bounds" && !cuts.empty()) return "parameter 'cuts' applies only with by=\"bounds\"";
+    if (by == "bounds") {
+      const long long outputs = clampedInt(outputCount, params);
+      if (static_cast<long long>(cuts.size()) + 1 != outputs) {
+        return "by=\"bounds\" needs N-1 numbers in 'cuts' for N outputs: " +
+               std::to_string(outputs) + " outputs, " + std::to_string(cuts.size()) + " cuts";
+      }
+      double previous = 0;
+      for (std::size_t k = 0; k < cuts.size(); ++k) {
+        char* end = nullptr;
+        const double v = std::strtod(cuts[k].c_str(), &end);
+        if (end == cuts[k].c_str() || *end != '\0' || !std::isfinite(v)) {
+          return "'cuts': '" + cuts[k] + "' is not a finite number";
+        }
+        if (k > 0 && v <= previous) return "'cuts' must be strictly increasing";
+        previous = v;
+      }
+    }
+    if (!byType) {
+      if (!names.empty()) return "parameter 'types' applies only with by=\"type\"";
+      return std::nullopt;
+    }
+    const long long outputs = clampedInt(outputCount, params);
+    if (static_cast<long long>(names.size()) != outputs) {
+      return "by=\"type\" needs one type name in 'types' per output: " + std::to_string(outputs) +
+             " outputs, " + std::to_string(names.size()) + " names";
+    }
+    return std::nullopt;
+  };
+  return type;
+}
+
 }  // namespace
 
 void registerScatter(FilterRegistry& registry) {
-  registry.add("scatter", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    const std::string by = context.params().getString("by");
-    const SplitBy split = by == "id"       ? SplitBy::Id
-                          : by == "type"   ? SplitBy::Type
-                          : by == "bounds" ? SplitBy::Bounds
-                          : by == "size"   ? SplitBy::Size
-                                           : SplitBy::Chunk;
-    std::vector<uint32_t> typeIds;
-    for (const auto& name : app::splitList(context.params().getString("types"))) {
-      typeIds.push_back(msg::fnv1a32(name));
-    }
-    if (split == SplitBy::Type && typeIds.size() != context.outputCount()) {
-      return makeError("filter '" + context.name() + "': by=type needs one type name per output");
-    }
-    const std::string axisName = context.params().getString("axis");
-    const int axis = axisName == "y" ? 1 : axisName == "z" ? 2 : 0;
-    std::vector<double> cuts;
-    for (const auto& text : app::splitList(context.params().getString("cuts"))) {
-      char* end = nullptr;
-      const double v = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0' || !std::isfinite(v) ||
-          (!cuts.empty() && v <= cuts.back())) {
-        return makeError("filter '" + context.name() + "': bad 'cuts' value '" + text + "'");
-      }
-      cuts.push_back(v);
-    }
-    if (split == SplitBy::Bounds && cuts.size() + 1 != context.outputCount()) {
-      return makeError("filter '" + context.name() + "': by=bounds needs N-1 cuts for N outputs");
-    }
-    return std::unique_ptr<Filter>(std::make_unique<ScatterFilter>(
-        split, std::move(typeIds), context.params().getString("others") != "drop", axis,
-        std::move(cuts), static_cast<uint64_t>(context.params().getInt("element-size"))));
-  });
+  addBuiltin(
+      registry,
+      {scatterType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+         const std::string by = context.params().getString("by");
+         const SplitBy split = by == "id"       ? SplitBy::Id
+                               : by == "type"   ? SplitBy::Type
+                               : by == "bounds" ? SplitBy::Bounds
+                               : by == "size"   ? SplitBy::Size
+                                                : SplitBy::Chunk;
+         std::vector<uint32_t> typeIds;
+         for (const auto& name : app::splitList(context.params().getString("types"))) {
+           typeIds.push_back(msg::fnv1a32(name));
+         }
+         if (split == SplitBy::Type && typeIds.size() != context.outputCount()) {
+           return makeError("filter '" + context.name() +
+                            "': by=type needs one type name per output");
+         }
+         const std::string axisName = context.params().getString("axis");
+         const int axis = axisName == "y" ? 1 : axisName == "z" ? 2 : 0;
+         std::vector<double> cuts;
+         for (const auto& text : app::splitList(context.params().getString("cuts"))) {
+           char* end = nullptr;
+           const double v = std::strtod(text.c_str(), &end);
+           if (end == text.c_str() || *end != '\0' || !std::isfinite(v) ||
+               (!cuts.empty() && v <= cuts.back())) {
+             return makeError("filter '" + context.name() + "': bad 'cuts' value '" + text + "'");
+           }
+           cuts.push_back(v);
+         }
+         if (split == SplitBy::Bounds && cuts.size() + 1 != context.outputCount()) {
+           return makeError("filter '" + context.name() +
+                            "': by=bounds needs N-1 cuts for N outputs");
+         }
+         return std::unique_ptr<Filter>(std::make_unique<ScatterFilter>(
+             split, std::move(typeIds), context.params().getString("others") != "drop", axis,
+             std::move(cuts),
+             static_cast<uint64_t>(
+                 static_cast<uint64_t>(context.params().getInt("element-size")))));
+       }});
 }
 
 }  // namespace vrflow::daemon::filters

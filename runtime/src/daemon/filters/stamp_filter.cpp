@@ -79,13 +79,31 @@ class StampFilter final : public Filter {
   uint64_t skipped_ = 0;
 };
 
+app::FilterType stampFilterType() {
+  FilterType type;
+  type.name = "stampfilter";
+  type.doc =
+      "For each message of order, forwards the message of in whose iteration stamp it names "
+      "(its integer user stamp `stamp`, else its own iteration stamp); older messages of in "
+      "are dropped, an order whose message is gone is skipped.";
+  type.params.push_back(
+      stringParam("stamp", "iteration", "the order's integer user stamp that names the iteration"));
+  type.ports = [](const std::vector<Param>&) {
+    return std::vector<PortSpec>{filterPort("in", true, "candidate messages, by iteration"),
+                                 filterPort("order", true, "which iteration to forward next"),
+                                 filterPort("out", false, "the ordered messages")};
+  };
+  return type;
+}
+
 }  // namespace
 
 void registerStampFilter(FilterRegistry& registry) {
-  registry.add("stampfilter", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    return std::unique_ptr<Filter>(
-        std::make_unique<StampFilter>(context.params().getString("stamp")));
-  });
+  addBuiltin(registry, {stampFilterType(),
+                        [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+                          return std::unique_ptr<Filter>(
+                              std::make_unique<StampFilter>(context.params().getString("stamp")));
+                        }});
 }
 
 }  // namespace vrflow::daemon::filters

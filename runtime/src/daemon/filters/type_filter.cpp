@@ -58,17 +58,39 @@ class TypeFilter final : public Filter {
   bool dropOthers_;
 };
 
+app::FilterType typeFilterType() {
+  FilterType type;
+  type.name = "typefilter";
+  type.doc =
+      "Forwards in to out without the object chunks whose type is not listed in `types`; "
+      "resource and event chunks pass unless drop-others. A message whose chunks all go "
+      "still leaves (empty), so the consumer keeps its rate.";
+  type.params.push_back(stringParam("types", "", "object type names to keep, comma-separated"));
+  type.params.push_back(boolParam("drop-others", "false", "also drop resource and event chunks"));
+  type.ports = inToOut;
+  type.check = [](const std::vector<Param>& params) -> std::optional<std::string> {
+    if (splitList(paramString(params, "types", "")).empty()) {
+      return "parameter 'types' must list at least one object type name (e.g. \"rigid, "
+             "point\")";
+    }
+    return std::nullopt;
+  };
+  return type;
+}
+
 }  // namespace
 
 void registerTypeFilter(FilterRegistry& registry) {
-  registry.add("typefilter", [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
-    std::vector<uint32_t> typeIds;
-    for (const auto& name : app::splitList(context.params().getString("types"))) {
-      typeIds.push_back(msg::fnv1a32(name));
-    }
-    return std::unique_ptr<Filter>(
-        std::make_unique<TypeFilter>(std::move(typeIds), context.params().getBool("drop-others")));
-  });
+  addBuiltin(
+      registry,
+      {typeFilterType(), [](const FilterContext& context) -> Result<std::unique_ptr<Filter>> {
+         std::vector<uint32_t> typeIds;
+         for (const auto& name : app::splitList(context.params().getString("types"))) {
+           typeIds.push_back(msg::fnv1a32(name));
+         }
+         return std::unique_ptr<Filter>(std::make_unique<TypeFilter>(
+             std::move(typeIds), context.params().getBool("drop-others")));
+       }});
 }
 
 }  // namespace vrflow::daemon::filters
