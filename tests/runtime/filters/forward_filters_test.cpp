@@ -37,7 +37,7 @@ TEST(FilterHarness, GivesTheFilterThePortsItsDeclarationListsForItsParameters) {
   ASSERT_TRUE(h);
   EXPECT_EQ(h->inputNames(), (std::vector<std::string>{"in0", "in1", "in2"}));
   EXPECT_EQ(h->outputNames(), (std::vector<std::string>{"out"}));
-  EXPECT_EQ(h->param("stamps", "?"), "");  // the declared default
+  EXPECT_EQ(h->params().getString("stamps"), "");  // the declared default
 }
 
 TEST(FilterRegistry, TheCatalogListsEveryTypeOfTheRegistryButThePortFilters) {
