@@ -111,7 +111,7 @@ class Node final : public FilterContext {
   bool outputEnded(std::size_t o) const override;
   bool runCountsIterations() const override;
   /// When the run is traced, records which parts a joined message was made of (trace arrows).
-  void recordMerge(std::span<const msg::MessageView> views);
+  void recordMerge(std::span<const msg::MessageView> views) override;
   Result<MessageRef> compose(std::size_t sizeHint,
                              const std::function<void(msg::MessageBuilder&)>& fill) override;
   uint64_t nowNs() const override;

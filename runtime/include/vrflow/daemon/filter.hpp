@@ -12,6 +12,7 @@
 #include "vrflow/base/result.hpp"
 #include "vrflow/daemon/message_ref.hpp"
 #include "vrflow/message/builder.hpp"
+#include "vrflow/message/reader.hpp"
 
 namespace vrflow::daemon {
 
@@ -50,6 +51,9 @@ class FilterContext {
   /// then serve their newest message again after their data has ended, so that their consumer
   /// reaches its count (docs/filters.md).
   virtual bool runCountsIterations() const = 0;
+  /// When the run is traced, records which parts a joined message was made of (the trace's
+  /// arrows); a context that does not trace ignores it.
+  virtual void recordMerge(std::span<const msg::MessageView> views) { (void)views; }
 
   /// A new message with no chunk (for initial messages and signals), made with compose().
   Result<MessageRef> makeEmpty(uint64_t iteration, bool stampsOnly);

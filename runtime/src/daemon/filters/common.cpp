@@ -1,7 +1,6 @@
 #include <algorithm>
 #include <variant>
 
-#include "../graph.hpp"
 #include "filters.hpp"
 #include "vrflow/base/assert.hpp"
 
@@ -105,7 +104,7 @@ Result<MessageRef> join(FilterContext& context, std::span<const MessageRef> part
   }
   if (views.empty()) return makeError("filter '" + context.name() + "': nothing to join");
   // A traced run draws an arrow from every part of a joined message (the daemon's nodes only).
-  if (auto* node = dynamic_cast<Node*>(&context)) node->recordMerge(views);
+  context.recordMerge(views);
   msg::Stamps stamps = views.front().stamps().toStamps();
   for (const auto& view : views) {
     stamps.iteration = std::max(stamps.iteration, view.stamps().iteration);
