@@ -252,19 +252,15 @@ Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {
         "    <connection from=\"send.out\" to=\"recv.in\" capacity=\"" +
             std::to_string(streamQueueDepth(bytes)) + "\"/>\n");
     if (failure = launch(dir / "stream.xml", dir / "packages", settings); !failure) break;
-    std::vector<std::int64_t> samples;
-    std::ifstream rttFile(rtt);
-    for (std::int64_t ns = 0; rttFile >> ns;) samples.push_back(ns);
-    double msgsPerS = 0;
-    std::ifstream(rate) >> msgsPerS;
-    if (samples.empty()) {
-      failure = makeError("vrflow-tcp: no round trip measured at " + size + " bytes");
+    auto result = readPeerResult(
+        "vrflow-tcp", bytes, rtt.string(), rate.string(),
+        "module -> daemon (127.0.0.1) -> TCP -> daemon (127.0.0.2) -> module via vrflow launch "
+        "--backend local; writev from and read into shared memory, credit flow control");
+    if (!result) {
+      failure = result.error();
       break;
     }
-    results.push_back(makeResult(
-        "vrflow-tcp", bytes, samples, msgsPerS,
-        "module -> daemon (127.0.0.1) -> TCP -> daemon (127.0.0.2) -> module via vrflow launch "
-        "--backend local; writev from and read into shared memory, credit flow control"));
+    results.push_back(std::move(*result));
   }
   std::error_code ec;
   fs::remove_all(dir, ec);

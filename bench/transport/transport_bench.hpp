@@ -74,6 +74,13 @@ BenchResult makeResult(std::string transport, std::size_t bytes,
                        const std::vector<std::int64_t>& roundTripNs, double msgsPerS,
                        std::string detail);
 
+/// The result of one size of a run of the vrflow peer (vrflow_bench_module): ping's round trips
+/// (ns, one a line) in `rttFile`, the receiver's messages/s in `rateFile`; an error naming
+/// `transport` and the size when no round trip was measured.
+Result<BenchResult> readPeerResult(const std::string& transport, std::size_t bytes,
+                                   const std::string& rttFile, const std::string& rateFile,
+                                   std::string detail);
+
 /// "CPU model, N cores" of this machine, from /proc/cpuinfo and the online CPU count.
 std::string machineDescription();
 

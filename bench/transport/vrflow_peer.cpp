@@ -73,6 +73,20 @@ Status runOnce(const app::Application& application, const app::Catalog& catalog,
 
 }  // namespace
 
+Result<BenchResult> readPeerResult(const std::string& transport, std::size_t bytes,
+                                   const std::string& rttFile, const std::string& rateFile,
+                                   std::string detail) {
+  std::vector<std::int64_t> samples;
+  std::ifstream rtt(rttFile);
+  for (std::int64_t ns = 0; rtt >> ns;) samples.push_back(ns);
+  double msgsPerS = 0;
+  std::ifstream(rateFile) >> msgsPerS;
+  if (samples.empty()) {
+    return makeError(transport + ": no round trip measured at " + std::to_string(bytes) + " bytes");
+  }
+  return makeResult(transport, bytes, samples, msgsPerS, std::move(detail));
+}
+
 Result<std::vector<BenchResult>> runVrflow(const BenchSettings& settings) {
   auto catalog = benchCatalog();
   if (!catalog) return catalog.error();
@@ -120,19 +134,14 @@ Result<std::vector<BenchResult>> runVrflow(const BenchSettings& settings) {
     stream.connections = {link};
     if (failure = runOnce(stream, *catalog, settings); !failure) break;
 
-    std::vector<std::int64_t> samples;
-    std::ifstream rttFile(rtt);
-    for (std::int64_t ns = 0; rttFile >> ns;) samples.push_back(ns);
-    double msgsPerS = 0;
-    std::ifstream(rate) >> msgsPerS;
-    if (samples.empty()) {
-      failure = makeError("vrflow-shm: no round trip measured at " + size + " bytes");
+    auto result = readPeerResult("vrflow-shm", bytes, rtt, rate,
+                                 "module -> daemon -> module over a memfd segment, default "
+                                 "filters, futex wake-ups; payload re-sent by handle");
+    if (!result) {
+      failure = result.error();
       break;
     }
-    results.push_back(
-        makeResult("vrflow-shm", bytes, samples, msgsPerS,
-                   "module -> daemon -> module over a memfd segment, default filters, "
-                   "futex wake-ups; payload re-sent by handle"));
+    results.push_back(std::move(*result));
   }
   std::error_code ec;
   fs::remove_all(dir, ec);
