@@ -206,9 +206,7 @@ Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {
   if (mkdtemp(pattern) == nullptr) return makeError("vrflow-tcp: cannot make a temporary folder");
   const fs::path dir(pattern);
   writeManifest(dir / "packages");
-  std::vector<BenchResult> results;
-  Status failure;
-  for (const std::size_t bytes : settings.sizes) {
+  return runEachSize(settings, dir, [&](std::size_t bytes) -> Result<BenchResult> {
     const IterationPlan plan = iterationPlan(bytes, settings.quick);
     const std::string size = std::to_string(bytes), warmup = std::to_string(plan.warmupMessages);
     const fs::path rtt = dir / ("rtt-" + size), rate = dir / ("rate-" + size);
@@ -233,7 +231,9 @@ Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {
             "      <param name=\"role\" value=\"pong\"/>\n    </module>\n",
         "    <connection from=\"ping.out\" to=\"pong.in\"/>\n"
         "    <connection from=\"pong.out\" to=\"ping.in\"/>\n");
-    if (failure = launch(dir / "pingpong.xml", dir / "packages", settings); !failure) break;
+    if (Status ran = launch(dir / "pingpong.xml", dir / "packages", settings); !ran) {
+      return ran.error();
+    }
     std::ofstream(dir / "stream.xml") << twoHosts(
         "bench-tcp-stream",
         "    <module id=\"send\" package=\"bench\" type=\"peer\" host=\"a\">\n"
@@ -251,21 +251,14 @@ Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {
             rate.string() + "\"/>\n    </module>\n",
         "    <connection from=\"send.out\" to=\"recv.in\" capacity=\"" +
             std::to_string(streamQueueDepth(bytes)) + "\"/>\n");
-    if (failure = launch(dir / "stream.xml", dir / "packages", settings); !failure) break;
-    auto result = readPeerResult(
+    if (Status ran = launch(dir / "stream.xml", dir / "packages", settings); !ran) {
+      return ran.error();
+    }
+    return readPeerResult(
         "vrflow-tcp", bytes, rtt.string(), rate.string(),
         "module -> daemon (127.0.0.1) -> TCP -> daemon (127.0.0.2) -> module via vrflow launch "
         "--backend local; writev from and read into shared memory, credit flow control");
-    if (!result) {
-      failure = result.error();
-      break;
-    }
-    results.push_back(std::move(*result));
-  }
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  if (!failure) return failure.error();
-  return results;
+  });
 }
 
 }  // namespace vrflow::bench

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -80,6 +82,12 @@ BenchResult makeResult(std::string transport, std::size_t bytes,
 Result<BenchResult> readPeerResult(const std::string& transport, std::size_t bytes,
                                    const std::string& rttFile, const std::string& rateFile,
                                    std::string detail);
+
+/// Calls `runSize` for each of the settings' sizes, in order, and collects the results; stops at
+/// the first error and returns it. Removes `dir` (the run's temporary folder) in both cases.
+Result<std::vector<BenchResult>> runEachSize(
+    const BenchSettings& settings, const std::filesystem::path& dir,
+    const std::function<Result<BenchResult>(std::size_t bytes)>& runSize);
 
 /// "CPU model, N cores" of this machine, from /proc/cpuinfo and the online CPU count.
 std::string machineDescription();

@@ -526,24 +526,17 @@ Result<Edit> pasteXml(const app::Application& app, std::string_view xml, double 
     return app::findHost(after, host) != nullptr ? host : after.hosts.front().id;
   };
   std::vector<std::string> ids;
-  for (auto m : part->modules) {
-    m.id = fresh(m.id);
-    m.host = hostHere(m.host);
-    ids.push_back(m.id);
-    after.modules.push_back(std::move(m));
-  }
-  for (auto f : part->filters) {
-    f.id = fresh(f.id);
-    f.host = hostHere(f.host);
-    ids.push_back(f.id);
-    after.filters.push_back(std::move(f));
-  }
-  for (auto i : part->instances) {
-    i.id = fresh(i.id);
-    i.host = hostHere(i.host);
-    ids.push_back(i.id);
-    after.instances.push_back(std::move(i));
-  }
+  auto paste = [&](auto nodes, auto& into) {
+    for (auto& node : nodes) {
+      node.id = fresh(node.id);
+      node.host = hostHere(node.host);
+      ids.push_back(node.id);
+      into.push_back(std::move(node));
+    }
+  };
+  paste(part->modules, after.modules);
+  paste(part->filters, after.filters);
+  paste(part->instances, after.instances);
   for (auto c : part->connections) {
     if (renamed.count(c.from.node) == 0 || renamed.count(c.to.node) == 0) continue;
     c.from.node = renamed[c.from.node];

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "enum_names.hpp"
 #include "text_util.hpp"
 
 namespace vrflow::app {
@@ -35,6 +36,18 @@ std::optional<std::vector<std::string_view>> splitVec3(std::string_view text) {
   if (parts.size() != 3) return std::nullopt;
   return parts;
 }
+
+constexpr detail::EnumName<ParamType> kParamTypeNames[] = {
+    {ParamType::Int, "int"},       {ParamType::Float, "float"}, {ParamType::Bool, "bool"},
+    {ParamType::String, "string"}, {ParamType::Enum, "enum"},   {ParamType::Vec3, "vec3"},
+    {ParamType::File, "file"}};
+constexpr detail::EnumName<FileAccess> kFileAccessNames[] = {{FileAccess::Input, "input"},
+                                                             {FileAccess::Output, "output"}};
+constexpr detail::EnumName<ModuleKind> kModuleKindNames[] = {{ModuleKind::Animator, "animator"},
+                                                             {ModuleKind::Interactor, "interactor"},
+                                                             {ModuleKind::Viewer, "viewer"},
+                                                             {ModuleKind::Input, "input"},
+                                                             {ModuleKind::Other, "other"}};
 
 }  // namespace
 
@@ -69,74 +82,27 @@ const ParamSpec* FilterType::findParam(std::string_view paramName) const {
 }
 
 std::string toString(ParamType type) {
-  switch (type) {
-    case ParamType::Int:
-      return "int";
-    case ParamType::Float:
-      return "float";
-    case ParamType::Bool:
-      return "bool";
-    case ParamType::String:
-      return "string";
-    case ParamType::Enum:
-      return "enum";
-    case ParamType::Vec3:
-      return "vec3";
-    case ParamType::File:
-      return "file";
-  }
-  return "string";
+  return detail::nameOf(kParamTypeNames, type, "string");
 }
 
 std::optional<ParamType> parseParamType(std::string_view text) {
-  for (const ParamType type : {ParamType::Int, ParamType::Float, ParamType::Bool, ParamType::String,
-                               ParamType::Enum, ParamType::Vec3, ParamType::File}) {
-    if (toString(type) == text) return type;
-  }
-  return std::nullopt;
+  return detail::valueNamed(kParamTypeNames, text);
 }
 
 std::string toString(FileAccess access) {
-  switch (access) {
-    case FileAccess::Input:
-      return "input";
-    case FileAccess::Output:
-      return "output";
-    case FileAccess::Unstated:
-      return "";
-  }
-  return "";
+  return detail::nameOf(kFileAccessNames, access, "");  // Unstated has no spelling
 }
 
 std::optional<FileAccess> parseFileAccess(std::string_view text) {
-  for (const FileAccess access : {FileAccess::Input, FileAccess::Output}) {
-    if (toString(access) == text) return access;
-  }
-  return std::nullopt;
+  return detail::valueNamed(kFileAccessNames, text);
 }
 
 std::string toString(ModuleKind kind) {
-  switch (kind) {
-    case ModuleKind::Animator:
-      return "animator";
-    case ModuleKind::Interactor:
-      return "interactor";
-    case ModuleKind::Viewer:
-      return "viewer";
-    case ModuleKind::Input:
-      return "input";
-    case ModuleKind::Other:
-      return "other";
-  }
-  return "other";
+  return detail::nameOf(kModuleKindNames, kind, "other");
 }
 
 std::optional<ModuleKind> parseModuleKind(std::string_view text) {
-  for (const ModuleKind kind : {ModuleKind::Animator, ModuleKind::Interactor, ModuleKind::Viewer,
-                                ModuleKind::Input, ModuleKind::Other}) {
-    if (toString(kind) == text) return kind;
-  }
-  return std::nullopt;
+  return detail::valueNamed(kModuleKindNames, text);
 }
 
 std::optional<std::string> checkParamValue(const ParamSpec& spec, std::string_view value) {
