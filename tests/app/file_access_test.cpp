@@ -253,6 +253,12 @@ Application oneModuleOf(const std::string& package, const std::string& type) {
   return app;
 }
 
+// Module type "m" of the manifest written by writeManifest(), read into `catalog`; nullptr when
+// the manifest does not load.
+const ModuleType* readModuleType(Catalog& catalog, const std::string& manifest) {
+  return catalog.addPackageFile(manifest).ok() ? catalog.findModule("pkg", "m") : nullptr;
+}
+
 void writeProgram(const std::string& path) {
   fs::create_directories(fs::path(path).parent_path());
   std::ofstream(path) << "#!/bin/sh\n";
@@ -263,8 +269,7 @@ TEST(Executables, RelativePathIsResolvedFromTheManifestFolderEvenWhenMissing) {
   ScratchDir dir;
   const std::string manifest = writeManifest(dir.file("share/pkg"), "../../bin/x");
   Catalog catalog;
-  ASSERT_TRUE(catalog.addPackageFile(manifest).ok());
-  const ModuleType* type = catalog.findModule("pkg", "m");
+  const ModuleType* type = readModuleType(catalog, manifest);
   ASSERT_NE(type, nullptr);
   EXPECT_EQ(type->executable, dir.file("bin/x"));
 
@@ -276,6 +281,21 @@ TEST(Executables, RelativePathIsResolvedFromTheManifestFolderEvenWhenMissing) {
                                      "' (No such file or directory), resolved from " + manifest +
                                      ":2 against the manifest's folder");
   EXPECT_TRUE(checkModuleFiles(app, catalog).empty());  // validate does not ask for it
+}
+
+// A manifest in `folder` naming `executable`, with a program at `program`: the module type's
+// executable is `program`, and `vrflow run`'s check of executables passes.
+void expectResolvedAndStartable(const std::string& folder, const std::string& executable,
+                                const std::string& program) {
+  const std::string manifest = writeManifest(folder, executable);
+  writeProgram(program);
+  Catalog catalog;
+  const ModuleType* type = readModuleType(catalog, manifest);
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->executable, program);
+  EXPECT_TRUE(
+      checkModuleFiles(oneModuleOf("pkg", "m"), catalog, ModuleFileChecks{.executables = true})
+          .empty());
 }
 
 TEST(Executables, BareNameIsFoundInTheBinFolderOfTheBuildTree) {
@@ -297,16 +317,8 @@ TEST(Executables, BareNameIsFoundInTheBinFolderOfTheBuildTree) {
 
 TEST(Executables, BareNameIsFoundInTheBinFolderOfAnInstalledLayout) {
   ScratchDir prefix;
-  const std::string manifest = writeManifest(prefix.file("share/vrflow/packages/pkg"), "tool");
-  writeProgram(prefix.file("bin/tool"));
-  Catalog catalog;
-  ASSERT_TRUE(catalog.addPackageFile(manifest).ok());
-  const ModuleType* type = catalog.findModule("pkg", "m");
-  ASSERT_NE(type, nullptr);
-  EXPECT_EQ(type->executable, prefix.file("bin/tool"));
-  EXPECT_TRUE(
-      checkModuleFiles(oneModuleOf("pkg", "m"), catalog, ModuleFileChecks{.executables = true})
-          .empty());
+  expectResolvedAndStartable(prefix.file("share/vrflow/packages/pkg"), "tool",
+                             prefix.file("bin/tool"));
 }
 
 TEST(Executables, BareNameInThePackagesFolderComesBeforeTheLayoutsBin) {
@@ -315,9 +327,9 @@ TEST(Executables, BareNameInThePackagesFolderComesBeforeTheLayoutsBin) {
   writeProgram(prefix.file("bin/tool"));
   writeProgram(prefix.file("share/vrflow/packages/pkg/tool"));
   Catalog catalog;
-  ASSERT_TRUE(catalog.addPackageFile(manifest).ok());
-  EXPECT_EQ(catalog.findModule("pkg", "m")->executable,
-            prefix.file("share/vrflow/packages/pkg/tool"));
+  const ModuleType* type = readModuleType(catalog, manifest);
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->executable, prefix.file("share/vrflow/packages/pkg/tool"));
 }
 
 TEST(Executables, MissingBareNameNamesTheManifestLineAndTheFoldersLookedIn) {
@@ -345,8 +357,7 @@ TEST(Executables, BareNameOutsideAnInstalledLayoutSkipsTheLayoutsBin) {
   const std::string manifest = writeManifest(dir.file("pkg"), "absent");
   writeProgram(dir.file("bin/absent"));  // ../bin of an ordinary folder is not a layout's bin
   Catalog catalog;
-  ASSERT_TRUE(catalog.addPackageFile(manifest).ok());
-  const ModuleType* type = catalog.findModule("pkg", "m");
+  const ModuleType* type = readModuleType(catalog, manifest);
   ASSERT_NE(type, nullptr);
   EXPECT_EQ(type->executable, "absent");
   const std::vector<std::string> expected{dir.file("pkg"),
@@ -356,14 +367,7 @@ TEST(Executables, BareNameOutsideAnInstalledLayoutSkipsTheLayoutsBin) {
 
 TEST(Executables, PathWithASlashStaysRelativeToTheManifest) {
   ScratchDir dir;
-  const std::string manifest = writeManifest(dir.file("pkg"), "tools/x");
-  writeProgram(dir.file("pkg/tools/x"));
-  Catalog catalog;
-  ASSERT_TRUE(catalog.addPackageFile(manifest).ok());
-  EXPECT_EQ(catalog.findModule("pkg", "m")->executable, dir.file("pkg/tools/x"));
-  EXPECT_TRUE(
-      checkModuleFiles(oneModuleOf("pkg", "m"), catalog, ModuleFileChecks{.executables = true})
-          .empty());
+  expectResolvedAndStartable(dir.file("pkg"), "tools/x", dir.file("pkg/tools/x"));
 }
 
 // --- Echoed values ---
