@@ -208,9 +208,7 @@ Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {
   if (mkdtemp(pattern) == nullptr) return makeError("vrflow-tcp: cannot make a temporary folder");
   const fs::path dir(pattern);
   writeManifest(dir / "packages");
-  std::vector<BenchResult> results;
-  Status failure;
-  for (const std::size_t bytes : settings.sizes) {
+  return runEachSize(settings, dir, [&](std::size_t bytes) -> Result<BenchResult> {
     const IterationPlan plan = iterationPlan(bytes, settings.quick);
     const std::string size = std::to_string(bytes), warmup = std::to_string(plan.warmupMessages);
     const fs::path rtt = dir / ("rtt-" + size), rate = dir / ("rate-" + size);
@@ -235,7 +233,9 @@ Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {
             "      <param name=\"role\" value=\"pong\"/>\n    </module>\n",
         "    <connection from=\"ping.out\" to=\"pong.in\"/>\n"
         "    <connection from=\"pong.out\" to=\"ping.in\"/>\n");
-    if (failure = launch(dir / "pingpong.xml", dir / "packages", settings); !failure) break;
+    if (Status ran = launch(dir / "pingpong.xml", dir / "packages", settings); !ran) {
+      return ran.error();
+    }
     std::ofstream(dir / "stream.xml") << twoHosts(
         "bench-tcp-stream",
         "    <module id=\"send\" package=\"bench\" type=\"peer\" host=\"a\">\n"
@@ -253,25 +253,14 @@ Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {
             rate.string() + "\"/>\n    </module>\n",
         "    <connection from=\"send.out\" to=\"recv.in\" capacity=\"" +
             std::to_string(streamQueueDepth(bytes)) + "\"/>\n");
-    if (failure = launch(dir / "stream.xml", dir / "packages", settings); !failure) break;
-    std::vector<std::int64_t> samples;
-    std::ifstream rttFile(rtt);
-    for (std::int64_t ns = 0; rttFile >> ns;) samples.push_back(ns);
-    double msgsPerS = 0;
-    std::ifstream(rate) >> msgsPerS;
-    if (samples.empty()) {
-      failure = makeError("vrflow-tcp: no round trip measured at " + size + " bytes");
-      break;
+    if (Status ran = launch(dir / "stream.xml", dir / "packages", settings); !ran) {
+      return ran.error();
     }
-    results.push_back(makeResult(
-        "vrflow-tcp", bytes, samples, msgsPerS,
+    return readPeerResult(
+        "vrflow-tcp", bytes, rtt.string(), rate.string(),
         "module -> daemon (127.0.0.1) -> TCP -> daemon (127.0.0.2) -> module via vrflow launch "
-        "--backend local; writev from and read into shared memory, credit flow control"));
-  }
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  if (!failure) return failure.error();
-  return results;
+        "--backend local; writev from and read into shared memory, credit flow control");
+  });
 }
 
 }  // namespace vrflow::bench

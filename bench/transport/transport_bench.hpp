@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -73,6 +75,19 @@ double p99Ns(std::vector<std::int64_t> samplesNs);
 BenchResult makeResult(std::string transport, std::size_t bytes,
                        const std::vector<std::int64_t>& roundTripNs, double msgsPerS,
                        std::string detail);
+
+/// The result of one size of a run of the vrflow peer (vrflow_bench_module): ping's round trips
+/// (ns, one a line) in `rttFile`, the receiver's messages/s in `rateFile`; an error naming
+/// `transport` and the size when no round trip was measured.
+Result<BenchResult> readPeerResult(const std::string& transport, std::size_t bytes,
+                                   const std::string& rttFile, const std::string& rateFile,
+                                   std::string detail);
+
+/// Calls `runSize` for each of the settings' sizes, in order, and collects the results; stops at
+/// the first error and returns it. Removes `dir` (the run's temporary folder) in both cases.
+Result<std::vector<BenchResult>> runEachSize(
+    const BenchSettings& settings, const std::filesystem::path& dir,
+    const std::function<Result<BenchResult>(std::size_t bytes)>& runSize);
 
 /// "CPU model, N cores" of this machine, from /proc/cpuinfo and the online CPU count.
 std::string machineDescription();

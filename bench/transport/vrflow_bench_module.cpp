@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 
 namespace {
 
@@ -26,10 +27,7 @@ int main() {
   vrflow::Module module;
   auto& in = module.addInput("in");
   auto& out = module.addOutput("out");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-bench-peer: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  if (!initOrReport(module, "vrflow-bench-peer")) return 2;
   const std::string role = module.params().getString("role");
   const auto size = static_cast<std::size_t>(module.params().getInt("size"));
   const auto warmup = static_cast<uint64_t>(module.params().getInt("warmup"));

@@ -84,15 +84,46 @@ Status runOnce(const app::Application& application, const app::Catalog& catalog,
 
 }  // namespace
 
+Result<BenchResult> readPeerResult(const std::string& transport, std::size_t bytes,
+                                   const std::string& rttFile, const std::string& rateFile,
+                                   std::string detail) {
+  std::vector<std::int64_t> samples;
+  std::ifstream rtt(rttFile);
+  for (std::int64_t ns = 0; rtt >> ns;) samples.push_back(ns);
+  double msgsPerS = 0;
+  std::ifstream(rateFile) >> msgsPerS;
+  if (samples.empty()) {
+    return makeError(transport + ": no round trip measured at " + std::to_string(bytes) + " bytes");
+  }
+  return makeResult(transport, bytes, samples, msgsPerS, std::move(detail));
+}
+
+Result<std::vector<BenchResult>> runEachSize(
+    const BenchSettings& settings, const std::filesystem::path& dir,
+    const std::function<Result<BenchResult>(std::size_t bytes)>& runSize) {
+  std::vector<BenchResult> results;
+  Status failure;
+  for (const std::size_t bytes : settings.sizes) {
+    auto result = runSize(bytes);
+    if (!result) {
+      failure = result.error();
+      break;
+    }
+    results.push_back(std::move(*result));
+  }
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  if (!failure) return failure.error();
+  return results;
+}
+
 Result<std::vector<BenchResult>> runVrflow(const BenchSettings& settings) {
   auto catalog = benchCatalog();
   if (!catalog) return catalog.error();
   char pattern[] = "/tmp/vrflow-bench-XXXXXX";
   if (mkdtemp(pattern) == nullptr) return makeError("cannot make a temporary folder");
   const fs::path dir(pattern);
-  std::vector<BenchResult> results;
-  Status failure;
-  for (const std::size_t bytes : settings.sizes) {
+  return runEachSize(settings, dir, [&](std::size_t bytes) -> Result<BenchResult> {
     const IterationPlan plan = iterationPlan(bytes, settings.quick);
     const std::string size = std::to_string(bytes);
     const std::string warmup = std::to_string(plan.warmupMessages);
@@ -115,7 +146,7 @@ Result<std::vector<BenchResult>> runVrflow(const BenchSettings& settings) {
     pingPong.modules[0].params.push_back(
         {"count", std::to_string(plan.warmupMessages + plan.pingPongs + 1), {}});
     // The iteration limit is per run, so ping stops itself by count: see vrflow_bench_module.
-    if (failure = runOnce(pingPong, *catalog, settings); !failure) break;
+    if (Status ran = runOnce(pingPong, *catalog, settings); !ran) return ran.error();
 
     // Streaming: send -> recv with backpressure, queue depth as the peers use it.
     const auto rate = (dir / ("rate-" + size)).string();
@@ -129,26 +160,12 @@ Result<std::vector<BenchResult>> runVrflow(const BenchSettings& settings) {
     auto link = connection("send.out", "recv.in");
     link.capacity = static_cast<int>(streamQueueDepth(bytes));
     stream.connections = {link};
-    if (failure = runOnce(stream, *catalog, settings); !failure) break;
+    if (Status ran = runOnce(stream, *catalog, settings); !ran) return ran.error();
 
-    std::vector<std::int64_t> samples;
-    std::ifstream rttFile(rtt);
-    for (std::int64_t ns = 0; rttFile >> ns;) samples.push_back(ns);
-    double msgsPerS = 0;
-    std::ifstream(rate) >> msgsPerS;
-    if (samples.empty()) {
-      failure = makeError("vrflow-shm: no round trip measured at " + size + " bytes");
-      break;
-    }
-    results.push_back(
-        makeResult("vrflow-shm", bytes, samples, msgsPerS,
-                   "module -> daemon -> module over a memfd segment, default filters, "
-                   "futex wake-ups; payload re-sent by handle"));
-  }
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  if (!failure) return failure.error();
-  return results;
+    return readPeerResult("vrflow-shm", bytes, rtt, rate,
+                          "module -> daemon -> module over a memfd segment, default "
+                          "filters, futex wake-ups; payload re-sent by handle");
+  });
 }
 
 }  // namespace vrflow::bench

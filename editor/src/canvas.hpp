@@ -6,6 +6,7 @@
 #include <QColor>
 #include <QGraphicsItem>
 #include <QGraphicsView>
+#include <QPainterPath>
 #include <functional>
 #include <map>
 #include <optional>
@@ -34,6 +35,9 @@ inline constexpr const char* kHostMime = "application/x-vrflow-host";
 QColor colorOfData(const std::string& data);
 /// The colour of the host at `index` in the application's host list.
 QColor colorOfHost(std::size_t index);
+/// The curve of a connection from an output at `from` to an input at `to` (around, below both
+/// ends, when it goes back).
+QPainterPath connectionCurve(QPointF from, QPointF to);
 
 /// What the canvas draws, besides the application.
 struct CanvasState {

@@ -24,18 +24,12 @@
 #include <sstream>
 
 #include "canvas.hpp"
+#include "qt_text.hpp"
 #include "vrflow/editor/edit.hpp"
 
 namespace vrflow::editor::gui {
 
 namespace {
-
-QString q(const std::string& text) {
-  return QString::fromStdString(text);
-}
-std::string s(const QString& text) {
-  return text.toStdString();
-}
 
 QString kindGroup(app::ModuleKind kind) {
   switch (kind) {
@@ -109,17 +103,18 @@ void Palette::setCatalog(const app::Catalog& catalog) {
     groups[name] = group;
   }
   for (const app::ModuleType* type : catalog.moduleTypes()) {
-    auto* item = new QTreeWidgetItem(groups[kindGroup(type->kind)],
-                                     QStringList{q(type->type) + "  (" + q(type->package) + ")"});
-    item->setData(0, kSpecRole, "module " + q(type->package) + " " + q(type->type));
-    item->setToolTip(
-        0, q(type->package + "/" + type->type) + (type->doc.empty() ? "" : "\n" + q(type->doc)));
+    auto* item =
+        new QTreeWidgetItem(groups[kindGroup(type->kind)],
+                            QStringList{qtText(type->type) + "  (" + qtText(type->package) + ")"});
+    item->setData(0, kSpecRole, "module " + qtText(type->package) + " " + qtText(type->type));
+    item->setToolTip(0, qtText(type->package + "/" + type->type) +
+                            (type->doc.empty() ? "" : "\n" + qtText(type->doc)));
     item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsDragEnabled);
   }
   for (const app::FilterType* type : catalog.filterTypes()) {
-    auto* item = new QTreeWidgetItem(groups["Filters"], QStringList{q(type->name)});
-    item->setData(0, kSpecRole, "filter " + q(type->name));
-    item->setToolTip(0, q(type->name) + (type->doc.empty() ? "" : "\n" + q(type->doc)));
+    auto* item = new QTreeWidgetItem(groups["Filters"], QStringList{qtText(type->name)});
+    item->setData(0, kSpecRole, "filter " + qtText(type->name));
+    item->setToolTip(0, qtText(type->name) + (type->doc.empty() ? "" : "\n" + qtText(type->doc)));
     item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsDragEnabled);
   }
   for (auto& [name, group] : groups) {
@@ -267,10 +262,10 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
     }
     case app::ParamType::Enum: {
       auto* box = new QComboBox;
-      for (const auto& choice : spec.choices) box->addItem(q(choice));
-      box->setCurrentText(q(shown));
+      for (const auto& choice : spec.choices) box->addItem(qtText(choice));
+      box->setCurrentText(qtText(shown));
       connect(box, &QComboBox::activated, this,
-              [box, emitValue] { emitValue(s(box->currentText())); });
+              [box, emitValue] { emitValue(stdText(box->currentText())); });
       widget = box;
       break;
     }
@@ -307,44 +302,45 @@ QWidget* PropertiesPanel::editorFor(const app::ParamSpec& spec, const std::strin
       auto* row = new QWidget;
       auto* h = new QHBoxLayout(row);
       h->setContentsMargins(0, 0, 0, 0);
-      auto* edit = new QLineEdit(q(shown));
+      auto* edit = new QLineEdit(qtText(shown));
       edit->setObjectName("text");
       auto* browse = new QToolButton;
       browse->setText("\u2026");
       h->addWidget(edit);
       h->addWidget(browse);
       connect(edit, &QLineEdit::editingFinished, this,
-              [edit, emitValue] { emitValue(s(edit->text())); });
+              [edit, emitValue] { emitValue(stdText(edit->text())); });
       connect(browse, &QToolButton::clicked, this, [this, edit, emitValue] {
         const QString file =
             QFileDialog::getSaveFileName(this, "Choose a file", edit->text(), QString(), nullptr,
                                          QFileDialog::DontConfirmOverwrite);
         if (!file.isEmpty()) {
           edit->setText(file);
-          emitValue(s(file));
+          emitValue(stdText(file));
         }
       });
       widget = row;
       break;
     }
     case app::ParamType::String: {
-      auto* edit = new QLineEdit(q(shown));
+      auto* edit = new QLineEdit(qtText(shown));
       connect(edit, &QLineEdit::editingFinished, this,
-              [edit, emitValue] { emitValue(s(edit->text())); });
+              [edit, emitValue] { emitValue(stdText(edit->text())); });
       widget = edit;
       break;
     }
   }
-  widget->setObjectName("param:" + q(name));
+  widget->setObjectName("param:" + qtText(name));
   // Spin boxes with wide ranges ask for much width: let them shrink to the panel.
   for (auto* box : widget->findChildren<QAbstractSpinBox*>())
     box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
   if (auto* box = qobject_cast<QAbstractSpinBox*>(widget))
     box->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
   widget->setMinimumWidth(60);
-  QString tip = q(spec.doc);
-  tip += (tip.isEmpty() ? "" : "\n") + QString("type: ") + q(app::toString(spec.type));
-  tip += "\ndefault: " + (spec.defaultValue.empty() ? QString("(empty)") : q(spec.defaultValue));
+  QString tip = qtText(spec.doc);
+  tip += (tip.isEmpty() ? "" : "\n") + QString("type: ") + qtText(app::toString(spec.type));
+  tip +=
+      "\ndefault: " + (spec.defaultValue.empty() ? QString("(empty)") : qtText(spec.defaultValue));
   if (spec.min) tip += QString("\nmin: %1").arg(*spec.min);
   if (spec.max) tip += QString("\nmax: %1").arg(*spec.max);
   widget->setToolTip(tip);
@@ -382,33 +378,33 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
   if (module != nullptr) {
     params = &module->params;
     host = module->host;
-    typeText = "module " + q(module->package + "/" + module->type);
+    typeText = "module " + qtText(module->package + "/" + module->type);
     if (const auto* type = catalog.findModule(module->package, module->type)) {
       specs = &type->params;
-      doc = q(type->doc);
+      doc = qtText(type->doc);
     } else {
       doc = "Unknown module type: no installed package declares it.";
     }
   } else if (filter != nullptr) {
     params = &filter->params;
     host = filter->host;
-    typeText = "filter " + q(filter->type);
+    typeText = "filter " + qtText(filter->type);
     if (const auto* type = catalog.findFilter(filter->type)) {
       specs = &type->params;
-      doc = q(type->doc);
+      doc = qtText(type->doc);
     } else {
       doc = "Unknown filter type.";
     }
   } else {
     params = &instance->params;
     host = instance->host;
-    typeText = "composite " + q(instance->composite);
+    typeText = "composite " + qtText(instance->composite);
   }
 
-  auto* id = new QLineEdit(q(node));
+  auto* id = new QLineEdit(qtText(node));
   id->setObjectName("id");
   connect(id, &QLineEdit::editingFinished, this, [this, id, node] {
-    if (s(id->text()) != node) Q_EMIT renameRequested(node, s(id->text()));
+    if (stdText(id->text()) != node) Q_EMIT renameRequested(node, stdText(id->text()));
   });
   form->addRow("Id", id);
   auto* type = new QLabel("<b>" + typeText.toHtmlEscaped() + "</b>");
@@ -421,10 +417,10 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
   }
   auto* hosts = new QComboBox;
   hosts->setObjectName("host");
-  for (const auto& h : app.hosts) hosts->addItem(q(h.id));
-  hosts->setCurrentText(q(app::effectiveHost(app, host)));
+  for (const auto& h : app.hosts) hosts->addItem(qtText(h.id));
+  hosts->setCurrentText(qtText(app::effectiveHost(app, host)));
   connect(hosts, &QComboBox::activated, this,
-          [this, hosts, node] { Q_EMIT hostChosen(node, s(hosts->currentText())); });
+          [this, hosts, node] { Q_EMIT hostChosen(node, stdText(hosts->currentText())); });
   form->addRow("Host", hosts);
 
   auto* heading = new QLabel("<b>Parameters</b>");
@@ -440,13 +436,13 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
       h->addWidget(editor, 1);
       auto* reset = new QToolButton;
       reset->setText("\u21ba");
-      reset->setToolTip("Reset to the default (" + q(spec.defaultValue) + ")");
+      reset->setToolTip("Reset to the default (" + qtText(spec.defaultValue) + ")");
       reset->setEnabled(p != nullptr);
       const std::string name = spec.name;
       connect(reset, &QToolButton::clicked, this,
               [this, node, name] { Q_EMIT parameterEdited(node, name, ""); });
       h->addWidget(reset);
-      auto* label = new QLabel(q(spec.name) + (p == nullptr ? "" : " \u2022"));
+      auto* label = new QLabel(qtText(spec.name) + (p == nullptr ? "" : " \u2022"));
       label->setToolTip(editor->toolTip());
       if (p == nullptr) label->setStyleSheet("color: #777;");
       form->addRow(label, row);
@@ -460,7 +456,7 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
     spec.name = p.name;
     spec.doc = specs == nullptr ? "" : "Not declared by the type: validation reports it.";
     QWidget* editor = editorFor(spec, p.value, true);
-    form->addRow(q(p.name), editor);
+    form->addRow(qtText(p.name), editor);
   }
   if (module != nullptr) {
     const auto* mtype = catalog.findModule(module->package, module->type);
@@ -469,7 +465,7 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
       for (const auto& port : mtype->ports) {
         if (!port.isInput) continue;
         auto* box = new QSpinBox;
-        box->setObjectName("initial:" + q(port.name));
+        box->setObjectName("initial:" + qtText(port.name));
         box->setRange(0, 1000);
         box->setValue(app::inputConfigOrDefault(*module, port.name).initialMessages);
         box->setKeyboardTracking(false);
@@ -479,7 +475,7 @@ void PropertiesPanel::show(const app::Application& app, const app::Catalog& cata
         connect(box, &QSpinBox::editingFinished, this, [this, box, node, portName] {
           Q_EMIT initialMessagesEdited(node, portName, box->value());
         });
-        form->addRow(q(port.name), box);
+        form->addRow(qtText(port.name), box);
       }
     }
   }
@@ -526,7 +522,7 @@ HostsPanel::HostsPanel(QWidget* parent) : QWidget(parent) {
   connect(table_, &QTableWidget::itemChanged, this, [this](QTableWidgetItem* item) {
     if (filling_ || item->row() < 0 || static_cast<std::size_t>(item->row()) >= ids_.size()) return;
     const std::string host = ids_[static_cast<std::size_t>(item->row())];
-    const std::string text = s(item->text());
+    const std::string text = stdText(item->text());
     const int column = item->column();
     // Applied after the table is done with its item (the refresh replaces the rows).
     QTimer::singleShot(0, this, [this, host, text, column] {
@@ -554,10 +550,10 @@ void HostsPanel::show(const app::Application& app) {
     swatch->setBackground(colorOfHost(i));
     swatch->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsDragEnabled);
     table_->setItem(row, 0, swatch);
-    auto* id = new QTableWidgetItem(q(app.hosts[i].id));
+    auto* id = new QTableWidgetItem(qtText(app.hosts[i].id));
     id->setFlags(id->flags() | Qt::ItemIsDragEnabled);
     table_->setItem(row, 1, id);
-    table_->setItem(row, 2, new QTableWidgetItem(q(app.hosts[i].address)));
+    table_->setItem(row, 2, new QTableWidgetItem(qtText(app.hosts[i].address)));
   }
   if (current >= 0 && current < table_->rowCount()) table_->setCurrentCell(current, 1);
   filling_ = false;

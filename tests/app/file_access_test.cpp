@@ -18,6 +18,7 @@
 #include "vrflow/app/app.hpp"
 #include "vrflow/base/echo.hpp"
 #include "vrflow/daemon/filter_registry.hpp"
+#include "vrflow/base/executable_dir.hpp"
 
 namespace vrflow::app {
 namespace {
@@ -229,30 +230,51 @@ TEST(FileParameters, PrepareOutputPathCreatesFoldersOnlyInsideTheWorkingFolder) 
   EXPECT_TRUE(fs::is_directory(dir.file("a/b")));
 }
 
-// --- Relative executables ---
+// --- Executables ---
 
-TEST(Executables, RelativePathIsResolvedFromTheManifestFolderEvenWhenMissing) {
-  ScratchDir dir;
-  fs::create_directories(dir.file("share/pkg"));
-  const std::string manifest = dir.file("share/pkg/vrflow-package.xml");
-  std::ofstream(manifest) << R"(<package name="pkg">
-  <module type="m" executable="../../bin/x"/>
-</package>
-)";
-  Catalog catalog = daemon::makeCatalog();
-  ASSERT_TRUE(catalog.addPackageFile(manifest).ok());
-  const ModuleType* type = catalog.findModule("pkg", "m");
-  ASSERT_NE(type, nullptr);
-  EXPECT_EQ(type->executable, dir.file("bin/x"));
+// A manifest under `folder` declaring module type "m" with `executable`, and an
+// application with one module "m1" of it.
+std::string writeManifest(const std::string& folder, const std::string& executable) {
+  fs::create_directories(folder);
+  const std::string manifest = folder + "/vrflow-package.xml";
+  std::ofstream(manifest) << "<package name=\"pkg\">\n  <module type=\"m\" executable=\"" +
+                                 executable + "\"/>\n</package>\n";
+  return manifest;
+}
 
+Application oneModuleOf(const std::string& package, const std::string& type) {
   Application app;
   app.hosts.push_back(Host{"localhost", "127.0.0.1", {}});
   Module module;
   module.id = "m1";
-  module.package = "pkg";
-  module.type = "m";
+  module.package = package;
+  module.type = type;
   module.host = "localhost";
   app.modules.push_back(module);
+  return app;
+}
+
+// Module type "m" of the manifest written by writeManifest(), read into `catalog`; nullptr when
+// the manifest does not load.
+const ModuleType* readModuleType(Catalog& catalog, const std::string& manifest) {
+  return catalog.addPackageFile(manifest).ok() ? catalog.findModule("pkg", "m") : nullptr;
+}
+
+void writeProgram(const std::string& path) {
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path) << "#!/bin/sh\n";
+  fs::permissions(path, fs::perms::owner_all);
+}
+
+TEST(Executables, RelativePathIsResolvedFromTheManifestFolderEvenWhenMissing) {
+  ScratchDir dir;
+  const std::string manifest = writeManifest(dir.file("share/pkg"), "../../bin/x");
+  Catalog catalog;
+  const ModuleType* type = readModuleType(catalog, manifest);
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->executable, dir.file("bin/x"));
+
+  const Application app = oneModuleOf("pkg", "m");
   const auto problems = checkModuleFiles(app, catalog, ModuleFileChecks{.executables = true});
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems[0].message, "module 'm1' (pkg/m): cannot start its executable '" +
@@ -260,6 +282,93 @@ TEST(Executables, RelativePathIsResolvedFromTheManifestFolderEvenWhenMissing) {
                                      "' (No such file or directory), resolved from " + manifest +
                                      ":2 against the manifest's folder");
   EXPECT_TRUE(checkModuleFiles(app, catalog).empty());  // validate does not ask for it
+}
+
+// A manifest in `folder` naming `executable`, with a program at `program`: the module type's
+// executable is `program`, and `vrflow run`'s check of executables passes.
+void expectResolvedAndStartable(const std::string& folder, const std::string& executable,
+                                const std::string& program) {
+  const std::string manifest = writeManifest(folder, executable);
+  writeProgram(program);
+  Catalog catalog;
+  const ModuleType* type = readModuleType(catalog, manifest);
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->executable, program);
+  EXPECT_TRUE(
+      checkModuleFiles(oneModuleOf("pkg", "m"), catalog, ModuleFileChecks{.executables = true})
+          .empty());
+}
+
+TEST(Executables, BareNameIsFoundInTheBinFolderOfTheBuildTree) {
+  // The build tree has an install's shape: build/share/vrflow/packages/core/ and build/bin.
+  const fs::path bin = executableDir();
+  ASSERT_FALSE(bin.empty());
+  const std::string manifest =
+      (bin.parent_path() / "share/vrflow/packages/core/vrflow-package.xml").string();
+  Catalog catalog;
+  ASSERT_TRUE(catalog.addPackageFile(manifest).ok());
+  const ModuleType* source = catalog.findModule("core", "source");
+  ASSERT_NE(source, nullptr);
+  EXPECT_EQ(source->executable, (bin / "vrflow-core-source").string());
+  EXPECT_TRUE(source->executableSearched.empty());
+  EXPECT_TRUE(checkModuleFiles(oneModuleOf("core", "source"), catalog,
+                               ModuleFileChecks{.executables = true})
+                  .empty());
+}
+
+TEST(Executables, BareNameIsFoundInTheBinFolderOfAnInstalledLayout) {
+  ScratchDir prefix;
+  expectResolvedAndStartable(prefix.file("share/vrflow/packages/pkg"), "tool",
+                             prefix.file("bin/tool"));
+}
+
+TEST(Executables, BareNameInThePackagesFolderComesBeforeTheLayoutsBin) {
+  ScratchDir prefix;
+  const std::string manifest = writeManifest(prefix.file("share/vrflow/packages/pkg"), "tool");
+  writeProgram(prefix.file("bin/tool"));
+  writeProgram(prefix.file("share/vrflow/packages/pkg/tool"));
+  Catalog catalog;
+  const ModuleType* type = readModuleType(catalog, manifest);
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->executable, prefix.file("share/vrflow/packages/pkg/tool"));
+}
+
+TEST(Executables, MissingBareNameNamesTheManifestLineAndTheFoldersLookedIn) {
+  ScratchDir prefix;
+  const std::string manifest = writeManifest(prefix.file("share/vrflow/packages/pkg"), "absent");
+  Catalog catalog;
+  ASSERT_TRUE(catalog.addPackageFile(manifest).ok());  // reading a catalog needs no build
+  const ModuleType* type = catalog.findModule("pkg", "m");
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->executable, "absent");
+  const Application app = oneModuleOf("pkg", "m");
+  const auto problems = checkModuleFiles(app, catalog, ModuleFileChecks{.executables = true});
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].message,
+            "module 'm1' (pkg/m): no executable 'absent' (declared at " + manifest +
+                ":2) in the package's folder, its layout's bin folder or beside this program; "
+                "looked in " +
+                prefix.file("share/vrflow/packages/pkg") + ", " + prefix.file("bin") + ", " +
+                executableDir().lexically_normal().string());
+  EXPECT_TRUE(checkModuleFiles(app, catalog).empty());  // validate does not ask for it
+}
+
+TEST(Executables, BareNameOutsideAnInstalledLayoutSkipsTheLayoutsBin) {
+  ScratchDir dir;
+  const std::string manifest = writeManifest(dir.file("pkg"), "absent");
+  writeProgram(dir.file("bin/absent"));  // ../bin of an ordinary folder is not a layout's bin
+  Catalog catalog;
+  const ModuleType* type = readModuleType(catalog, manifest);
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->executable, "absent");
+  const std::vector<std::string> expected{dir.file("pkg"),
+                                          executableDir().lexically_normal().string()};
+  EXPECT_EQ(type->executableSearched, expected);
+}
+
+TEST(Executables, PathWithASlashStaysRelativeToTheManifest) {
+  ScratchDir dir;
+  expectResolvedAndStartable(dir.file("pkg"), "tools/x", dir.file("pkg/tools/x"));
 }
 
 // --- Echoed values ---

@@ -391,21 +391,28 @@ Result<Edit> addHost(const app::Application& app, std::string id, std::string ad
   return makeEdit("Add host " + id, app, std::move(after));
 }
 
+namespace {
+
+// Puts every module, filter and composite instance placed on host `from` on host `to`.
+void moveNodesToHost(app::Application& app, std::string_view from, const std::string& to) {
+  auto move = [&](auto& nodes) {
+    for (auto& node : nodes) {
+      if (node.host == from) node.host = to;
+    }
+  };
+  move(app.modules);
+  move(app.filters);
+  move(app.instances);
+}
+
+}  // namespace
+
 Result<Edit> removeHost(const app::Application& app, std::string_view id) {
   if (app::findHost(app, id) == nullptr) return makeError("no host '" + std::string(id) + "'");
   if (app.hosts.size() == 1) return makeError("the last host cannot be removed");
   app::Application after = app;
   eraseById(after.hosts, id);
-  const std::string first = after.hosts.front().id;
-  for (auto& m : after.modules) {
-    if (m.host == id) m.host = first;
-  }
-  for (auto& f : after.filters) {
-    if (f.host == id) f.host = first;
-  }
-  for (auto& i : after.instances) {
-    if (i.host == id) i.host = first;
-  }
+  moveNodesToHost(after, id, after.hosts.front().id);
   return makeEdit("Remove host " + std::string(id), app, std::move(after));
 }
 
@@ -418,15 +425,7 @@ Result<Edit> renameHost(const app::Application& app, std::string_view id, std::s
   for (auto& h : after.hosts) {
     if (h.id == id) h.id = newId;
   }
-  for (auto& m : after.modules) {
-    if (m.host == id) m.host = newId;
-  }
-  for (auto& f : after.filters) {
-    if (f.host == id) f.host = newId;
-  }
-  for (auto& i : after.instances) {
-    if (i.host == id) i.host = newId;
-  }
+  moveNodesToHost(after, id, newId);
   return makeEdit("Rename host " + std::string(id) + " to " + newId, app, std::move(after));
 }
 
@@ -527,24 +526,17 @@ Result<Edit> pasteXml(const app::Application& app, std::string_view xml, double 
     return app::findHost(after, host) != nullptr ? host : after.hosts.front().id;
   };
   std::vector<std::string> ids;
-  for (auto m : part->modules) {
-    m.id = fresh(m.id);
-    m.host = hostHere(m.host);
-    ids.push_back(m.id);
-    after.modules.push_back(std::move(m));
-  }
-  for (auto f : part->filters) {
-    f.id = fresh(f.id);
-    f.host = hostHere(f.host);
-    ids.push_back(f.id);
-    after.filters.push_back(std::move(f));
-  }
-  for (auto i : part->instances) {
-    i.id = fresh(i.id);
-    i.host = hostHere(i.host);
-    ids.push_back(i.id);
-    after.instances.push_back(std::move(i));
-  }
+  auto paste = [&](auto nodes, auto& into) {
+    for (auto& node : nodes) {
+      node.id = fresh(node.id);
+      node.host = hostHere(node.host);
+      ids.push_back(node.id);
+      into.push_back(std::move(node));
+    }
+  };
+  paste(part->modules, after.modules);
+  paste(part->filters, after.filters);
+  paste(part->instances, after.instances);
   for (auto c : part->connections) {
     if (renamed.count(c.from.node) == 0 || renamed.count(c.to.node) == 0) continue;
     c.from.node = renamed[c.from.node];

@@ -20,6 +20,7 @@
 #include "vrflow/fluid/solver.hpp"
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 #include "world.hpp"
 
 namespace {
@@ -102,10 +103,7 @@ int main(int argc, char** argv) {
   auto& forcesOut = module.addOutput("forces");
   auto& objectsOut = module.addOutput("fluid");
   auto& interestOut = module.addOutput("interest");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-fluid: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  if (!initOrReport(module, "vrflow-fluid")) return 2;
   fluid::FluidSettings s;
   s.nx = static_cast<int>(module.params().getInt("nx"));
   s.ny = static_cast<int>(module.params().getInt("ny"));

@@ -278,17 +278,29 @@ template <int L, typename Cell>
   for (int step = std::max(L - 1, span); step < span + L - 1; ++step) edge(step);
 }
 
+// What both sweeps read: the grid's y and z strides and the preconditioner's arrays.
+struct SweepArrays {
+  SweepArrays(const Grid& g, const PcgWorkspace& w)
+      : sy(static_cast<std::size_t>(g.nx)),
+        sz(sy * static_cast<std::size_t>(g.ny)),
+        pc(w.pc.data()),
+        axpc(w.axpc.data()),
+        aypc(w.aypc.data()),
+        azpc(w.azpc.data()) {}
+  std::size_t sy, sz;
+  const double* pc;
+  const double* axpc;
+  const double* aypc;
+  const double* azpc;
+};
+
 // The forward sweep (L t = r) over the rows of one wave, lane l at cell i = lo + step - l.
 // Cells of the span that are not unknowns (pivot 0) get t = 0, as they hold. The recurrence
 // along x is one multiply-add: the pivot is applied to the rest and to the coupling before.
 template <int L>
 VRFLOW_FLUID_HOT void forwardWave(const Grid& g, const PcgWorkspace& w,
                                   const PcgWorkspace::Wave& wave, const double* r, double* t) {
-  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
-  const double* pc = w.pc.data();
-  const double* axpc = w.axpc.data();
-  const double* aypc = w.aypc.data();
-  const double* azpc = w.azpc.data();
+  const auto [sy, sz, pc, axpc, aypc, azpc] = SweepArrays(g, w);
   const Lanes<L> lanes(g, w.rows, wave);
   double before[L] = {};
   const auto cell = [&](int l, int at) __attribute__((always_inline)) {
@@ -314,11 +326,7 @@ VRFLOW_FLUID_HOT void forwardWave(const Grid& g, const PcgWorkspace& w,
 template <int L>
 VRFLOW_FLUID_HOT void backwardWave(const Grid& g, const PcgWorkspace& w,
                                    const PcgWorkspace::Wave& wave, const double* t, double* z) {
-  const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
-  const double* pc = w.pc.data();
-  const double* axpc = w.axpc.data();
-  const double* aypc = w.aypc.data();
-  const double* azpc = w.azpc.data();
+  const auto [sy, sz, pc, axpc, aypc, azpc] = SweepArrays(g, w);
   const Lanes<L> lanes(g, w.rows, wave);
   double after[L] = {};
   const auto cell = [&](int l, int at) __attribute__((always_inline)) {

@@ -13,12 +13,8 @@ int main() {
   using namespace vrflow::massspring;
   const char* program = "vrflow-massspring-animator";
   Module module;
-  auto& events = module.addInput("events");
-  auto& objects = module.addOutput("objects");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "%s: %s\n", program, status.error().message.c_str());
-    return 2;
-  }
+  const auto ports = startAnimator(module, program);
+  if (!ports) return 2;
   modules::Params params(module, program);
   StepOptions options;
   options.dt = params.number("dt");
@@ -75,7 +71,7 @@ int main() {
   bool warnedStretch = false;
   while (module.wait()) {
     std::fill(external.begin(), external.end(), 0.0);
-    const Message& received = module.get(events);
+    const Message& received = module.get(ports->events);
     if (received.valid()) {
       for (const auto chunk : received.view()) {
         const auto event = chunk.asEvent();
@@ -128,7 +124,7 @@ int main() {
     builder.setSimTime(time);
     builder.setTimeStep(options.dt);
     writeNet(builder, id, net, module.iteration() == 0);
-    if (!module.put(objects, std::move(out))) break;
+    if (!module.put(ports->objects, std::move(out))) break;
   }
   if (!stateFile.empty()) {
     if (auto status = saveNet(net, stateFile); !status) {

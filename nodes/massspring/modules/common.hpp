@@ -1,7 +1,7 @@
 #pragma once
 
-// Helpers shared by the mass-spring modules: parameter parsing with clear errors, and sending
-// per-node forces as "massspring node forces" events.
+// Helpers shared by the mass-spring modules: parameter parsing with clear errors, sending
+// per-node forces as "massspring node forces" events, and the loop of the interactors.
 
 #include <cmath>
 #include <cstdio>
@@ -9,11 +9,14 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vrflow/massspring/events.hpp"
+#include "vrflow/massspring/objects.hpp"
 #include "vrflow/message/builder.hpp"
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 
 namespace vrflow::massspring::modules {
 
@@ -96,5 +99,35 @@ class Warnings {
   std::string program_;
   std::string last_;
 };
+
+/// A message holding one node-forces event per net (addNodeForces), with `extraBytes` reserved
+/// for what the caller adds after them.
+inline OutgoingMessage nodeForcesMessage(Module& module,
+                                         const std::map<std::uint64_t, std::vector<double>>& forces,
+                                         std::size_t extraBytes = 0) {
+  std::size_t nodes = 0;
+  for (const auto& [id, f] : forces) nodes += f.size() / 3;
+  auto out = module.newMessage(128 + nodes * 40 + extraBytes);
+  addNodeForces(out.builder(), forces);
+  return out;
+}
+
+/// The loop of an interactor: each iteration brings its copy of the scene up to date from the
+/// objects port (a message it cannot apply is warned about, and the module goes on) and puts
+/// the message `forcesOf(scene)` builds on the forces port. Returns the module's exit status.
+template <typename ForcesOf>
+int runInteractor(Module& module, const InteractorPorts& ports, const std::string& program,
+                  ForcesOf forcesOf) {
+  SceneCopy scene;
+  Warnings warnings(program);
+  while (module.wait()) {
+    if (const Message& received = module.get(ports.objects); received.valid()) {
+      if (auto status = scene.apply(received.view()); !status)
+        warnings.warn(status.error().message);
+    }
+    if (!module.put(ports.forces, forcesOf(std::as_const(scene)))) break;
+  }
+  return module.exitStatus();
+}
 
 }  // namespace vrflow::massspring::modules

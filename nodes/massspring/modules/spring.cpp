@@ -16,24 +16,13 @@ int main() {
   using namespace vrflow::massspring;
   const char* program = "vrflow-massspring-spring";
   Module module;
-  auto& objects = module.addInput("objects");
-  auto& forces = module.addOutput("forces");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "%s: %s\n", program, status.error().message.c_str());
-    return 2;
-  }
+  const auto ports = startInteractor(module, program);
+  if (!ports) return 2;
   modules::Params params(module, program);
   const double scale = params.number("scale");
   if (params.report()) return 2;
-  SceneCopy scene;
-  modules::Warnings warnings(program);
-  while (module.wait()) {
-    if (const Message& received = module.get(objects); received.valid()) {
-      if (auto status = scene.apply(received.view()); !status)
-        warnings.warn(status.error().message);
-    }
+  return modules::runInteractor(module, *ports, program, [&](const SceneCopy& scene) {
     std::map<std::uint64_t, std::vector<double>> total;
-    std::size_t nodes = 0;
     for (const auto& [id, net] : scene.nets()) {
       auto& f = total[id];
       f.assign(3 * net.nodeCount(), 0.0);
@@ -41,11 +30,7 @@ int main() {
       if (scale != 1.0) {
         for (auto& value : f) value *= scale;
       }
-      nodes += net.nodeCount();
     }
-    auto out = module.newMessage(128 + nodes * 40);
-    modules::addNodeForces(out.builder(), total);
-    if (!module.put(forces, std::move(out))) break;
-  }
-  return module.exitStatus();
+    return modules::nodeForcesMessage(module, total);
+  });
 }

@@ -8,18 +8,15 @@
 #include <map>
 
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 #include "vrflow/rigid/messages.hpp"
 #include "vrflow/rigid/scene.hpp"
 
 int main() {
   using namespace vrflow;
   Module module;
-  auto& events = module.addInput("events");
-  auto& objects = module.addOutput("objects");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-rigid-animator: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  const auto ports = startAnimator(module, "vrflow-rigid-animator");
+  if (!ports) return 2;
   const double dt = module.params().getFloat("dt");
   if (!(dt > 0)) {
     std::fprintf(stderr, "vrflow-rigid-animator: dt must be positive\n");
@@ -58,7 +55,7 @@ int main() {
   }
   std::uint64_t steps = 0;
   while (module.wait()) {
-    const Message& received = module.get(events);
+    const Message& received = module.get(ports->events);
     if (received.valid()) {
       for (const auto chunk : received.view()) {
         const auto event = chunk.asEvent();
@@ -82,7 +79,7 @@ int main() {
       for (const auto& change : changes)
         rigid::writeUpdate(builder, *state.find(change.id), change);
     }
-    if (!module.put(objects, std::move(out))) break;
+    if (!module.put(ports->objects, std::move(out))) break;
   }
   if (const auto path = module.params().getString("state-file"); !path.empty()) {
     std::FILE* file = std::fopen(path.c_str(), "w");

@@ -7,18 +7,15 @@
 
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 #include "vrflow/rigid/force_field.hpp"
 #include "vrflow/rigid/messages.hpp"
 
 int main() {
   using namespace vrflow;
   Module module;
-  auto& objects = module.addInput("objects");
-  auto& forces = module.addOutput("forces");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-rigid-forcefield: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  const auto ports = startInteractor(module, "vrflow-rigid-forcefield");
+  if (!ports) return 2;
   auto field = rigid::ForceField::parse(module.params().getString("field"));
   if (!field) {
     std::fprintf(stderr, "vrflow-rigid-forcefield: parameter 'field': %s\n",
@@ -42,7 +39,7 @@ int main() {
   const double fallbackDt = module.params().getFloat("dt");
   std::map<std::uint64_t, rigid::FieldTarget> targets;  // by id, for a fixed order
   while (module.wait()) {
-    const Message& received = module.get(objects);
+    const Message& received = module.get(ports->objects);
     if (received.valid()) {
       for (const auto chunk : received.view()) {
         const auto object = chunk.asObject();
@@ -76,7 +73,7 @@ int main() {
       if (!std::isfinite(target.mass)) continue;
       out.builder().addForce(id, field->forceOn(target, dt));
     }
-    if (!module.put(forces, std::move(out))) break;
+    if (!module.put(ports->forces, std::move(out))) break;
   }
   return module.exitStatus();
 }

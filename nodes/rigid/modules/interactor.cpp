@@ -4,18 +4,15 @@
 #include <cstdio>
 
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 #include "vrflow/rigid/contact_solver.hpp"
 #include "vrflow/rigid/messages.hpp"
 
 int main() {
   using namespace vrflow;
   Module module;
-  auto& objects = module.addInput("objects");
-  auto& forces = module.addOutput("forces");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-rigid-interactor: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  const auto ports = startInteractor(module, "vrflow-rigid-interactor");
+  if (!ports) return 2;
   rigid::ContactParams params;
   params.gravity = module.params().getVec3("gravity");
   params.restitution = module.params().getFloat("restitution");
@@ -28,7 +25,7 @@ int main() {
   rigid::RigidContactSolver solver(params);
   rigid::RigidObjectCopy copy;
   while (module.wait()) {
-    const Message& received = module.get(objects);
+    const Message& received = module.get(ports->objects);
     std::vector<std::uint64_t> deleted;
     if (received.valid()) {
       if (auto status = copy.apply(received.view(), &deleted); !status) {
@@ -54,7 +51,7 @@ int main() {
     const auto impulses = solver.solve(dt);
     auto out = module.newMessage(64 + impulses.size() * 112);
     for (const auto& [id, event] : impulses) out.builder().addForce(id, event);
-    if (!module.put(forces, std::move(out))) break;
+    if (!module.put(ports->forces, std::move(out))) break;
   }
   return module.exitStatus();
 }

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 #include "vrflow/viewer/frame_writer.hpp"
 #include "vrflow/viewer/renderer.hpp"
 #include "vrflow/viewer/view_volume.hpp"
@@ -55,10 +56,7 @@ int main() {
   Module module;
   auto& objects = module.addInput("objects");
   auto& interest = module.addOutput("interest");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-viewer: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  if (!initOrReport(module, "vrflow-viewer")) return 2;
   ParamProblems params(module);
   const Parameters& values = module.params();
   viewer::RenderSettings render;

@@ -7,6 +7,7 @@
 
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 
 namespace {
 
@@ -20,12 +21,8 @@ struct Point {
 int main() {
   using namespace vrflow;
   Module module;
-  auto& events = module.addInput("events");
-  auto& objects = module.addOutput("objects");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-core-points: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  const auto ports = startAnimator(module, "vrflow-core-points");
+  if (!ports) return 2;
   const auto count = module.params().getInt("count");
   const double mass = module.params().getFloat("mass");
   const double dt = module.params().getFloat("dt");
@@ -45,7 +42,7 @@ int main() {
   double time = 0.0;
   while (module.wait()) {
     for (auto& p : points) p.force = {0, 0, 0};
-    const Message& received = module.get(events);
+    const Message& received = module.get(ports->events);
     if (log.is_open()) {
       log << module.id() << " " << module.iteration() << " <- ";
       if (received.valid()) {
@@ -90,7 +87,7 @@ int main() {
             .set(msg::PointParam::kVelocity, p.velocity);
       }
     }
-    if (!module.put(objects, std::move(out))) break;
+    if (!module.put(ports->objects, std::move(out))) break;
   }
   return module.exitStatus();
 }

@@ -8,15 +8,13 @@
 #include "vrflow/base/file_access.hpp"
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 
 int main() {
   using namespace vrflow;
   Module module;
   auto& in = module.addInput("in");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-core-recorder: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  if (!initOrReport(module, "vrflow-core-recorder")) return 2;
   const std::string path = module.params().getString("file");
   // A missing folder is created only inside the run's working folder.
   if (auto folder = prepareOutputPath(path); !folder) {

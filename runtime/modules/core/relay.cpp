@@ -5,16 +5,14 @@
 #include <thread>
 
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 
 int main() {
   using namespace vrflow;
   Module module;
   auto& in = module.addInput("in");
   auto& out = module.addOutput("out");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-core-relay: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  if (!initOrReport(module, "vrflow-core-relay")) return 2;
   const auto delay = std::chrono::milliseconds(module.params().getInt("delay-ms"));
   while (module.wait()) {
     if (delay.count() > 0) std::this_thread::sleep_for(delay);

@@ -6,15 +6,13 @@
 #include <vector>
 
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 
 int main() {
   using namespace vrflow;
   Module module;
   auto& out = module.addOutput("out");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-core-source: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  if (!initOrReport(module, "vrflow-core-source")) return 2;
   const auto size = static_cast<std::size_t>(module.params().getInt("size"));
   const auto count = static_cast<uint64_t>(module.params().getInt("count"));
   std::vector<std::byte> payload(size < 8 ? 8 : size);

@@ -6,16 +6,13 @@
 
 #include "interactor_common.hpp"
 #include "vrflow/module/module.hpp"
+#include "vrflow/module/start.hpp"
 
 int main() {
   using namespace vrflow;
   Module module;
-  auto& objects = module.addInput("objects");
-  auto& forces = module.addOutput("forces");
-  if (auto status = module.init(); !status) {
-    std::fprintf(stderr, "vrflow-core-spring: %s\n", status.error().message.c_str());
-    return 2;
-  }
+  const auto ports = startInteractor(module, "vrflow-core-spring");
+  if (!ports) return 2;
   const double k = module.params().getFloat("stiffness");
   const double c = module.params().getFloat("damping");
   const double rest = module.params().getFloat("rest");
@@ -27,7 +24,7 @@ int main() {
   bool anchored = false;
   msg::Vec3 anchor{};
   while (module.wait()) {
-    const Message& received = module.get(objects);
+    const Message& received = module.get(ports->objects);
     if (log.is_open()) {
       const auto stamps = received->stamps();
       log << module.id() << " " << module.iteration() << " <- " << stamps.source << "@"
@@ -68,7 +65,7 @@ int main() {
       out.builder().addForce(id,
                              msg::ForceEvent{f, {0, 0, 0}, points[id].position, module.timeStep()});
     }
-    if (!module.put(forces, std::move(out))) break;
+    if (!module.put(ports->forces, std::move(out))) break;
   }
   return module.exitStatus();
 }

@@ -216,34 +216,13 @@ namespace detail {
 std::optional<Application> readApplication(std::string_view xml, const std::string& fileName,
                                            std::vector<Diagnostic>& found) {
   const SourceText source(xml, fileName);
-  if (std::optional<Diagnostic> problem = encodingProblem(source)) {
-    found.push_back(std::move(*problem));
-    return std::nullopt;
-  }
-  pugi::xml_document document;
-  const pugi::xml_parse_result parsed =
-      document.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
-  if (!parsed) {
-    found.push_back(parseFailure(source, parsed));
-    return std::nullopt;
-  }
-  const ReadContext context{source, found};
   Application app;
   app.file = fileName;
-  bool rootSeen = false;
-  for (const pugi::xml_node& node : document.children()) {
-    if (node.type() != pugi::node_element) continue;
-    if (rootSeen) {
-      context.error(source.element(node),
-                    "unexpected element <" + std::string(node.name()) + "> after the root element");
-    } else if (std::string_view(node.name()) != "application") {
-      context.error(source.element(node),
-                    "root element must be <application>, found <" + std::string(node.name()) + ">");
-    } else {
-      readRoot(context, node, app);
-    }
-    rootSeen = true;
-  }
+  const bool read = readDocument(source, "application", found,
+                                 [&](const ReadContext& context, const pugi::xml_node& root) {
+                                   readRoot(context, root, app);
+                                 });
+  if (!read) return std::nullopt;
   applyHostDefaults(app);
   return app;
 }

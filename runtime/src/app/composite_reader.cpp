@@ -293,34 +293,12 @@ void readInstances(const ReadContext& context, const pugi::xml_node& section, Ap
 std::optional<Composite> readCompositeFile(std::string_view xml, const std::string& fileName,
                                            std::vector<Diagnostic>& problems) {
   const SourceText source(xml, fileName);
-  if (std::optional<Diagnostic> problem = encodingProblem(source)) {
-    problems.push_back(std::move(*problem));
-    return std::nullopt;
-  }
-  pugi::xml_document document;
-  const pugi::xml_parse_result parsed =
-      document.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
-  if (!parsed) {
-    problems.push_back(parseFailure(source, parsed));
-    return std::nullopt;
-  }
-  const ReadContext context{source, problems};
   Composite composite;
-  bool rootSeen = false;
-  for (const pugi::xml_node& node : document.children()) {
-    if (node.type() != pugi::node_element) continue;
-    if (rootSeen) {
-      context.error(source.element(node),
-                    "unexpected element <" + std::string(node.name()) + "> after the root element");
-    } else if (std::string_view(node.name()) != "composite") {
-      context.error(source.element(node),
-                    "root element must be <composite>, found <" + std::string(node.name()) + ">");
-    } else {
-      composite = readComposite(context, node, true);
-    }
-    rootSeen = true;
-  }
-  if (!rootSeen) context.error(source.at(0), "no root element <composite>");
+  const bool read = readDocument(source, "composite", problems,
+                                 [&](const ReadContext& context, const pugi::xml_node& root) {
+                                   composite = readComposite(context, root, true);
+                                 });
+  if (!read) return std::nullopt;
   return composite;
 }
 

@@ -187,4 +187,39 @@ Diagnostic parseFailure(const SourceText& source, const pugi::xml_parse_result& 
   return Diagnostic{loc, Diagnostic::Error, result.description()};
 }
 
+bool readDocument(const SourceText& source, std::string_view rootName,
+                  std::vector<Diagnostic>& problems,
+                  const std::function<void(const ReadContext&, const pugi::xml_node&)>& readRoot) {
+  if (std::optional<Diagnostic> problem = encodingProblem(source)) {
+    problems.push_back(std::move(*problem));
+    return false;
+  }
+  const std::string_view xml = source.text();
+  pugi::xml_document document;
+  const pugi::xml_parse_result parsed =
+      document.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+  if (!parsed) {
+    problems.push_back(parseFailure(source, parsed));
+    return false;
+  }
+  const ReadContext context{source, problems};
+  const std::string root(rootName);
+  bool rootSeen = false;
+  for (const pugi::xml_node& node : document.children()) {
+    if (node.type() != pugi::node_element) continue;
+    if (rootSeen) {
+      context.error(source.element(node),
+                    "unexpected element <" + std::string(node.name()) + "> after the root element");
+    } else if (node.name() != root) {
+      context.error(source.element(node), "root element must be <" + root + ">, found <" +
+                                              std::string(node.name()) + ">");
+    } else {
+      readRoot(context, node);
+    }
+    rootSeen = true;
+  }
+  if (!rootSeen) context.error(source.at(0), "no root element <" + root + ">");
+  return true;
+}
+
 }  // namespace vrflow::app::detail

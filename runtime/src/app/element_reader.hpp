@@ -91,4 +91,11 @@ std::string readTextElement(const ReadContext& context, const pugi::xml_node& no
 /// The diagnostic for a document pugixml could not parse: its description at its offset.
 Diagnostic parseFailure(const SourceText& source, const pugi::xml_parse_result& result);
 
+/// Reads a whole document whose root must be <`rootName`>: calls `readRoot` for that root and
+/// reports another root, an element after the root or no root at all. False, with the problem
+/// reported, when the text is not UTF-8 or not XML (nothing was read).
+bool readDocument(const SourceText& source, std::string_view rootName,
+                  std::vector<Diagnostic>& problems,
+                  const std::function<void(const ReadContext&, const pugi::xml_node&)>& readRoot);
+
 }  // namespace vrflow::app::detail

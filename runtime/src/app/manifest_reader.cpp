@@ -1,11 +1,13 @@
 #include "manifest_reader.hpp"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "element_reader.hpp"
 #include "source_text.hpp"
 #include "text_util.hpp"
 #include "vrflow/app/diagnostic.hpp"
+#include "vrflow/base/executable_dir.hpp"
 
 namespace vrflow::app::detail {
 namespace {
@@ -95,20 +97,48 @@ ParamSpec readParamSpec(const ReadContext& context, const pugi::xml_node& node) 
   return param;
 }
 
-// A relative path (one with a '/') is always taken from the manifest's folder, whether the file
-// is there yet or not (a module not built yet must fail naming that path, not the text written).
-// A bare name is the file beside the manifest when there is one, else a program looked up on
-// PATH when the module starts.
-std::string resolveExecutable(const std::string& executable, const std::string& manifestFile) {
+// The `bin` folder of the layout a manifest sits in: <prefix>/share/vrflow/GROUP/NAME/ (an
+// install, or the build tree, which has the same shape) gives <prefix>/bin; empty elsewhere.
+std::filesystem::path layoutBinFolder(const std::filesystem::path& manifestFolder) {
+  const std::filesystem::path vrflowFolder = manifestFolder.parent_path().parent_path();
+  const std::filesystem::path shareFolder = vrflowFolder.parent_path();
+  if (vrflowFolder.filename() != "vrflow" || shareFolder.filename() != "share") return {};
+  return shareFolder.parent_path() / "bin";
+}
+
+// Where a manifest's executable is: a path with a '/' is taken from the manifest's folder,
+// whether the file is there yet or not (a module not built yet must fail naming that path, not
+// the text written); a bare name is looked up in the package's folder, then in the `bin` folder
+// of its layout, then beside the running program. A bare name found nowhere stays as written,
+// with the folders looked in, for checkModuleFiles() to report.
+void resolveExecutable(ModuleType& type, const std::string& executable,
+                       const std::string& manifestFile) {
   namespace fs = std::filesystem;
-  if (executable.empty() || fs::path(executable).is_absolute()) return executable;
+  type.executable = executable;
+  if (executable.empty() || fs::path(executable).is_absolute()) return;
   std::error_code ec;
-  const fs::path folder = fs::absolute(fs::path(manifestFile), ec).parent_path();
-  if (ec) return executable;
-  const fs::path candidate = (folder / executable).lexically_normal();
-  if (executable.find('/') != std::string::npos) return candidate.string();
-  if (fs::is_regular_file(candidate, ec)) return candidate.string();
-  return executable;
+  const fs::path folder = fs::absolute(fs::path(manifestFile), ec).parent_path().lexically_normal();
+  if (ec) return;
+  if (executable.find('/') != std::string::npos) {
+    type.executable = (folder / executable).lexically_normal().string();
+    return;
+  }
+  std::vector<fs::path> folders{folder, layoutBinFolder(folder), executableDir()};
+  for (const fs::path& candidate : folders) {
+    if (candidate.empty()) continue;
+    const std::string where = candidate.lexically_normal().string();
+    if (std::find(type.executableSearched.begin(), type.executableSearched.end(), where) !=
+        type.executableSearched.end()) {
+      continue;
+    }
+    const fs::path file = candidate / executable;
+    if (fs::is_regular_file(file, ec)) {
+      type.executable = file.lexically_normal().string();
+      type.executableSearched.clear();
+      return;
+    }
+    type.executableSearched.push_back(where);
+  }
 }
 
 ModuleType readModuleType(const ReadContext& context, const pugi::xml_node& node,
@@ -117,7 +147,7 @@ ModuleType readModuleType(const ReadContext& context, const pugi::xml_node& node
   ModuleType type;
   type.package = package;
   type.type = reader.required("type");
-  type.executable = resolveExecutable(reader.required("executable"), context.source.file());
+  resolveExecutable(type, reader.required("executable"), context.source.file());
   type.kind = reader.keyword("kind", ModuleKind::Other, parseModuleKind,
                              "animator, interactor, viewer, input, other");
   type.loc = reader.loc();

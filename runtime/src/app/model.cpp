@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "enum_names.hpp"
 #include "text_util.hpp"
 
 namespace vrflow::app {
@@ -13,6 +14,15 @@ auto findById(Items& items, std::string_view id) -> decltype(&items.front()) {
       std::find_if(items.begin(), items.end(), [&](const auto& item) { return item.id == id; });
   return it == items.end() ? nullptr : &*it;
 }
+
+constexpr detail::EnumName<QueuePolicy> kQueuePolicyNames[] = {
+    {QueuePolicy::Block, "block"},
+    {QueuePolicy::DropOldest, "drop-oldest"},
+    {QueuePolicy::DropNewest, "drop-newest"}};
+constexpr detail::EnumName<InputMode> kInputModeNames[] = {{InputMode::Fifo, "fifo"},
+                                                           {InputMode::Latest, "latest"}};
+constexpr detail::EnumName<EndItTiming> kEndItTimingNames[] = {
+    {EndItTiming::AfterIteration, "after-iteration"}, {EndItTiming::AfterWait, "after-wait"}};
 
 }  // namespace
 
@@ -159,42 +169,27 @@ std::optional<Endpoint> parseEndpoint(std::string_view text) {
 }
 
 std::string toString(QueuePolicy policy) {
-  switch (policy) {
-    case QueuePolicy::Block:
-      return "block";
-    case QueuePolicy::DropOldest:
-      return "drop-oldest";
-    case QueuePolicy::DropNewest:
-      return "drop-newest";
-  }
-  return "block";
+  return detail::nameOf(kQueuePolicyNames, policy, "block");
 }
 
 std::optional<QueuePolicy> parseQueuePolicy(std::string_view text) {
-  if (text == "block") return QueuePolicy::Block;
-  if (text == "drop-oldest") return QueuePolicy::DropOldest;
-  if (text == "drop-newest") return QueuePolicy::DropNewest;
-  return std::nullopt;
+  return detail::valueNamed(kQueuePolicyNames, text);
 }
 
 std::string toString(InputMode mode) {
-  return mode == InputMode::Latest ? "latest" : "fifo";
+  return detail::nameOf(kInputModeNames, mode, "fifo");
 }
 
 std::optional<InputMode> parseInputMode(std::string_view text) {
-  if (text == "fifo") return InputMode::Fifo;
-  if (text == "latest") return InputMode::Latest;
-  return std::nullopt;
+  return detail::valueNamed(kInputModeNames, text);
 }
 
 std::string toString(EndItTiming timing) {
-  return timing == EndItTiming::AfterWait ? "after-wait" : "after-iteration";
+  return detail::nameOf(kEndItTimingNames, timing, "after-iteration");
 }
 
 std::optional<EndItTiming> parseEndItTiming(std::string_view text) {
-  if (text == "after-iteration") return EndItTiming::AfterIteration;
-  if (text == "after-wait") return EndItTiming::AfterWait;
-  return std::nullopt;
+  return detail::valueNamed(kEndItTimingNames, text);
 }
 
 std::string effectiveHost(const Application& app, const std::string& host) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "enum_names.hpp"
 #include "text_util.hpp"
 
 namespace vrflow::app {
@@ -17,6 +18,14 @@ std::optional<std::string> checkRange(const ParamSpec& spec, double value, std::
   }
   return std::nullopt;
 }
+
+constexpr detail::EnumName<FileAccess> kFileAccessNames[] = {{FileAccess::Input, "input"},
+                                                             {FileAccess::Output, "output"}};
+constexpr detail::EnumName<ModuleKind> kModuleKindNames[] = {{ModuleKind::Animator, "animator"},
+                                                             {ModuleKind::Interactor, "interactor"},
+                                                             {ModuleKind::Viewer, "viewer"},
+                                                             {ModuleKind::Input, "input"},
+                                                             {ModuleKind::Other, "other"}};
 
 }  // namespace
 
@@ -51,46 +60,19 @@ const ParamSpec* FilterType::findParam(std::string_view paramName) const {
 }
 
 std::string toString(FileAccess access) {
-  switch (access) {
-    case FileAccess::Input:
-      return "input";
-    case FileAccess::Output:
-      return "output";
-    case FileAccess::Unstated:
-      return "";
-  }
-  return "";
+  return detail::nameOf(kFileAccessNames, access, "");  // Unstated has no spelling
 }
 
 std::optional<FileAccess> parseFileAccess(std::string_view text) {
-  for (const FileAccess access : {FileAccess::Input, FileAccess::Output}) {
-    if (toString(access) == text) return access;
-  }
-  return std::nullopt;
+  return detail::valueNamed(kFileAccessNames, text);
 }
 
 std::string toString(ModuleKind kind) {
-  switch (kind) {
-    case ModuleKind::Animator:
-      return "animator";
-    case ModuleKind::Interactor:
-      return "interactor";
-    case ModuleKind::Viewer:
-      return "viewer";
-    case ModuleKind::Input:
-      return "input";
-    case ModuleKind::Other:
-      return "other";
-  }
-  return "other";
+  return detail::nameOf(kModuleKindNames, kind, "other");
 }
 
 std::optional<ModuleKind> parseModuleKind(std::string_view text) {
-  for (const ModuleKind kind : {ModuleKind::Animator, ModuleKind::Interactor, ModuleKind::Viewer,
-                                ModuleKind::Input, ModuleKind::Other}) {
-    if (toString(kind) == text) return kind;
-  }
-  return std::nullopt;
+  return detail::valueNamed(kModuleKindNames, text);
 }
 
 Result<ParamValue> parseParamValue(const ParamSpec& spec, std::string_view text) {

@@ -53,11 +53,22 @@ void checkFileParam(const ParamSpec& spec, const std::string& value, const Sourc
 
 void checkExecutable(const ModuleType& type, const Module& module,
                      std::vector<Diagnostic>& problems) {
-  if (type.executable.find('/') == std::string::npos) return;  // a bare name: found on PATH
-  if (::access(type.executable.c_str(), X_OK) == 0) return;
-  const std::string reason = std::strerror(errno);
   std::string manifest = type.loc.file;
   if (type.loc.line > 0) manifest += ":" + std::to_string(type.loc.line);
+  if (!type.executableSearched.empty()) {  // a bare name found in none of its folders
+    std::string folders;
+    for (const std::string& folder : type.executableSearched) {
+      folders += (folders.empty() ? "" : ", ") + folder;
+    }
+    problems.push_back({module.loc, Diagnostic::Error,
+                        moduleLabel(module) + ": no executable " + quotedValue(type.executable) +
+                            " (declared at " + manifest + ") in the package's folder, its " +
+                            "layout's bin folder or beside this program; looked in " + folders});
+    return;
+  }
+  if (type.executable.find('/') == std::string::npos) return;  // a manifest without a file
+  if (::access(type.executable.c_str(), X_OK) == 0) return;
+  const std::string reason = std::strerror(errno);
   problems.push_back({module.loc, Diagnostic::Error,
                       moduleLabel(module) + ": cannot start its executable " +
                           quotedValue(type.executable) + " (" + reason + "), resolved from " +

@@ -132,6 +132,16 @@ RenderMesh boxMesh(const Vec3& h) {
   return mesh;
 }
 
+// A shape made of vertices and the triangles over them (a convex hull or a triangle mesh).
+Shape trianglesShape(ShapeKind kind, std::vector<double> vertices,
+                     std::vector<std::uint32_t> triangles) {
+  Shape s;
+  s.kind = kind;
+  s.vertices = std::move(vertices);
+  s.indices = std::move(triangles);
+  return s;
+}
+
 }  // namespace
 
 Shape Shape::sphere(double radius) {
@@ -157,19 +167,11 @@ Shape Shape::capsule(double radius, double halfHeight) {
 }
 
 Shape Shape::convexHull(std::vector<double> vertices, std::vector<std::uint32_t> triangles) {
-  Shape s;
-  s.kind = ShapeKind::ConvexHull;
-  s.vertices = std::move(vertices);
-  s.indices = std::move(triangles);
-  return s;
+  return trianglesShape(ShapeKind::ConvexHull, std::move(vertices), std::move(triangles));
 }
 
 Shape Shape::triangleMesh(std::vector<double> vertices, std::vector<std::uint32_t> triangles) {
-  Shape s;
-  s.kind = ShapeKind::TriangleMesh;
-  s.vertices = std::move(vertices);
-  s.indices = std::move(triangles);
-  return s;
+  return trianglesShape(ShapeKind::TriangleMesh, std::move(vertices), std::move(triangles));
 }
 
 Status validateShape(const Shape& shape) {

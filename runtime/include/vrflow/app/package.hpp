@@ -65,8 +65,12 @@ struct ModuleType {
   std::string package;
   std::string type;
   /// Absolute for a path written with a '/' (resolved against the manifest's folder) or a bare
-  /// name found beside the manifest; otherwise the bare name, looked up on PATH at start.
+  /// name found in the package's folder, its layout's `bin` folder or beside the running
+  /// program (docs/application-format.md, "Package manifests"); else the bare name as written.
   std::string executable;
+  /// The folders a bare name was looked for in when none held it (checkModuleFiles() reports
+  /// them); empty when `executable` was resolved.
+  std::vector<std::string> executableSearched;
   ModuleKind kind = ModuleKind::Other;
   /// Empty, or the name of an int parameter: when a module's value of it is N > 1, the runtime
   /// starts the module as N MPI ranks through `mpirun` (rank 0 is the module vrflow talks to;
