@@ -24,6 +24,7 @@
 #include <cstdlib>
 #include <set>
 
+#include "qt_text.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/filter_registry.hpp"
@@ -35,18 +36,11 @@ namespace vrflow::editor::gui {
 
 namespace {
 
-QString q(const std::string& text) {
-  return QString::fromStdString(text);
-}
-std::string s(const QString& text) {
-  return text.toStdString();
-}
-
 // One edit on the undo stack.
 class EditCommand : public QUndoCommand {
  public:
   EditCommand(MainWindow* window, Edit edit)
-      : QUndoCommand(q(edit.label)), window_(window), edit_(std::move(edit)) {}
+      : QUndoCommand(qtText(edit.label)), window_(window), edit_(std::move(edit)) {}
   void redo() override {
     edit_.redo(window_->mutableApplication());
     window_->applicationChanged();
@@ -96,7 +90,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
     catalog_ = std::make_unique<app::Catalog>(std::move(*catalog));
   } else {
     catalog_ = std::make_unique<app::Catalog>(daemon::makeCatalog());
-    catalogProblems_ = q(catalog.error().message);
+    catalogProblems_ = qtText(catalog.error().message);
   }
 
   setCentralWidget(canvas_);
@@ -132,7 +126,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
           [this](const QString& spec, QPointF at) { addNode(spec, at); });
   connect(canvas_, &Canvas::hostDropped, this,
           [this](const QString& host, const std::string& node) {
-            apply(assignHost(app_, {node}, s(host)));
+            apply(assignHost(app_, {node}, stdText(host)));
           });
   connect(canvas_, &Canvas::deleteRequested, this, &MainWindow::deleteSelection);
   connect(canvas_, &Canvas::selectionChangedIds, this, &MainWindow::showSelection);
@@ -142,7 +136,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
             QMenu* hostsMenu = menu.addMenu("Run on host");
             for (const auto& h : app_.hosts) {
               const std::string id = h.id;
-              hostsMenu->addAction(q(id), this,
+              hostsMenu->addAction(qtText(id), this,
                                    [this, ids, id] { apply(assignHost(app_, ids, id)); });
             }
             menu.addAction("Duplicate", this, &MainWindow::duplicateSelection);
@@ -171,7 +165,8 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   connect(hosts_, &HostsPanel::addRequested, this, [this] {
     QString id = QString("host%1").arg(app_.hosts.size() + 1);
     QString address = "127.0.0.1";
-    if (reporter().newHost(this, id, address)) apply(addHost(app_, s(id), s(address)), false);
+    if (reporter().newHost(this, id, address))
+      apply(addHost(app_, stdText(id), stdText(address)), false);
   });
   connect(hosts_, &HostsPanel::removeRequested, this,
           [this](const std::string& host) { apply(removeHost(app_, host), false); });
@@ -207,7 +202,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
                             .arg(catalog_->filterTypes().size())
                             .arg(catalog_->manifestFiles().empty()
                                      ? QString("(no package found)")
-                                     : q(catalog_->manifestFiles().front()) +
+                                     : qtText(catalog_->manifestFiles().front()) +
                                            (catalog_->manifestFiles().size() > 1 ? ", ..." : "")));
 }
 
@@ -321,7 +316,7 @@ void MainWindow::computeFallbackLayout() {
 }
 
 void MainWindow::applicationChanged() {
-  if (!path_.isEmpty()) app_.file = s(path_);
+  if (!path_.isEmpty()) app_.file = stdText(path_);
   refresh();
 }
 
@@ -348,16 +343,16 @@ void MainWindow::refresh() {
   for (const auto& p : problems_) {
     const bool error = p.severity == app::Diagnostic::Error;
     (error ? errors : warnings) += 1;
-    QString where = q(p.node);
+    QString where = qtText(p.node);
     if (p.connection && *p.connection < app_.connections.size()) {
       const auto& c = app_.connections[*p.connection];
-      where = q(app::toString(c.from) + " \u2192 " + app::toString(c.to));
+      where = qtText(app::toString(c.from) + " \u2192 " + app::toString(c.to));
     }
     if (!p.cycle.empty()) where = "deadlock";
     auto* item = new QListWidgetItem(
         style()->standardIcon(error ? QStyle::SP_MessageBoxCritical : QStyle::SP_MessageBoxWarning),
-        (where.isEmpty() ? QString() : where + ": ") + q(p.message));
-    item->setToolTip(q(p.text));
+        (where.isEmpty() ? QString() : where + ": ") + qtText(p.message));
+    item->setToolTip(qtText(p.text));
     problemList_->addItem(item);
   }
   statusBar()->showMessage(errors + warnings == 0
@@ -392,7 +387,7 @@ void MainWindow::problemActivated(int row) {
 
 bool MainWindow::apply(Result<Edit> edit, bool quietWhenUnchanged) {
   if (!edit) {
-    const QString why = q(edit.error().message);
+    const QString why = qtText(edit.error().message);
     if (!(quietWhenUnchanged && why == "unchanged")) statusBar()->showMessage(why, 8000);
     return false;
   }
@@ -405,9 +400,11 @@ bool MainWindow::addNode(const QString& spec, QPointF at) {
   std::string id;
   bool ok = false;
   if (parts.size() == 3 && parts[0] == "module") {
-    ok = apply(addModule(app_, *catalog_, s(parts[1]), s(parts[2]), at.x(), at.y(), &id), false);
+    ok =
+        apply(addModule(app_, *catalog_, stdText(parts[1]), stdText(parts[2]), at.x(), at.y(), &id),
+              false);
   } else if (parts.size() == 2 && parts[0] == "filter") {
-    ok = apply(addFilter(app_, *catalog_, s(parts[1]), at.x(), at.y(), &id), false);
+    ok = apply(addFilter(app_, *catalog_, stdText(parts[1]), at.x(), at.y(), &id), false);
   }
   if (ok) canvas_->selectOnly({id});
   return ok;
@@ -443,13 +440,13 @@ void MainWindow::deleteSelection() {
 void MainWindow::copySelection() {
   const auto nodes = canvas_->selectedNodes();
   if (nodes.empty()) return;
-  QApplication::clipboard()->setText(q(copyAsXml(app_, nodes)));
+  QApplication::clipboard()->setText(qtText(copyAsXml(app_, nodes)));
   statusBar()->showMessage(QString("Copied %1 nodes as XML").arg(nodes.size()), 4000);
 }
 
 void MainWindow::paste() {
   std::vector<std::string> ids;
-  if (apply(pasteXml(app_, s(QApplication::clipboard()->text()), 40, 40, &ids), false))
+  if (apply(pasteXml(app_, stdText(QApplication::clipboard()->text()), 40, 40, &ids), false))
     canvas_->selectOnly(ids);
 }
 
@@ -499,7 +496,7 @@ void MainWindow::runApplication(int iterations) {
   if (program.isEmpty()) program = QCoreApplication::applicationDirPath() + "/vrflow";
   QStringList extra;
   if (iterations > 0) extra << "--iterations" << QString::number(iterations);
-  for (const auto& dir : options_.packageDirs) extra << "--packages" << q(dir);
+  for (const auto& dir : options_.packageDirs) extra << "--packages" << qtText(dir);
   lastRun_.reset();
   liveRates_.clear();
   canvas_->state().live.clear();
@@ -537,7 +534,7 @@ void MainWindow::finishRun(int exitCode) {
     summary = "Run stopped";
   } else {
     summary = QString("Run failed (exit %1)").arg(exitCode);
-    if (lastRun_ && !lastRun_->error.empty()) summary += ": " + q(lastRun_->error);
+    if (lastRun_ && !lastRun_->error.empty()) summary += ": " + qtText(lastRun_->error);
   }
   if (lastRun_ && lastRun_->wallSeconds > 0)
     summary += QString(" after %1 s").arg(lastRun_->wallSeconds, 0, 'f', 2);

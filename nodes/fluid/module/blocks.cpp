@@ -14,6 +14,7 @@
 #include <string>
 
 #include "vrflow/fluid/mpi_block_comm.hpp"
+#include "vrflow/ipc/join_contract.hpp"
 
 namespace vrflow::fluid {
 namespace {
@@ -298,7 +299,9 @@ int workerLoop(MPI_Comm world) {
 }  // namespace
 
 int mpirunRank() {
-  if (std::getenv("VRFLOW_MPI_RANKS") == nullptr) return -1;
+  // A module of several ranks is told so by the runtime's join contract (VRFLOW_MPI_RANKS).
+  const auto contract = ipc::JoinContract::decodeEnvironment();
+  if (!contract || contract->mpiRanks <= 0) return -1;
   for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK"}) {
     if (const char* rank = std::getenv(name)) return std::atoi(rank);
   }

@@ -1,4 +1,6 @@
 #pragma once
+// Internal to vrflow: not part of the module or filter SDK; it may change without notice
+// (docs/architecture.md, "The ABI of what outside code links").
 
 #include <chrono>
 #include <cstdint>
