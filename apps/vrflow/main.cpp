@@ -17,10 +17,10 @@
 
 #include "vrflow/app/package_files.hpp"
 #include "vrflow/app/writer.hpp"
+#include "vrflow/launcher/launch.hpp"
 #include "vrflow/run/events.hpp"
 #include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
-#include "vrflow/launcher/launch.hpp"
 
 namespace {
 

@@ -17,8 +17,8 @@
 #include "test_support.hpp"
 #include "vrflow/app/app.hpp"
 #include "vrflow/base/echo.hpp"
-#include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/base/executable_dir.hpp"
+#include "vrflow/daemon/filter_registry.hpp"
 
 namespace vrflow::app {
 namespace {

@@ -230,12 +230,13 @@ int overlappedIterations(const std::vector<std::string>& lines) {
 }
 
 // p -> c, and c.endIt -> initial(1) -> p.beginIt: with the default timing p and c alternate;
-// with endit="after-wait" (FlowVR's), p computes its next iteration while c computes.
+// with endit="after-wait" (FlowVR's), p computes its next iteration while c computes. c
+// computes 100 ms per iteration so that p is scheduled within it even on a loaded machine.
 TEST_F(Semantics, EndItAfterWaitLetsAProducerComputeWhileItsConsumerComputes) {
   for (const std::string timing : {"", "after-iteration", "after-wait"}) {
     std::remove(dir.file("phases.log").c_str());
     const auto result =
-        run(appXml(phases("p", "") + phases("c", paramXml("delay-ms", "20"),
+        run(appXml(phases("p", "") + phases("c", paramXml("delay-ms", "100"),
                                             timing.empty() ? "" : "endit=\"" + timing + "\""),
                    filterXml("pace", "initial"),
                    connectXml("p.out", "c.in") + connectXml("c.endIt", "pace.in") +
