@@ -178,10 +178,7 @@ struct Module::Impl {
   }
 };
 
-bool InputPort::connected() const {
-  return module_->impl_->slot.joined() && slot_ >= 0 && module_->impl_->slot.portConnected(slot_);
-}
-bool OutputPort::connected() const {
+bool Port::connected() const {
   return module_->impl_->slot.joined() && slot_ >= 0 && module_->impl_->slot.portConnected(slot_);
 }
 
@@ -261,21 +258,20 @@ Status Module::init() {
 
   // Match declared ports with the run's.
   std::vector<bool> declared(static_cast<std::size_t>(m.slot.portCount()), false);
-  for (auto& port : m.inputs) {
-    port.slot_ = m.slot.findPort(port.name_, true);
+  auto match = [&](Port& port, bool isInput) -> Status {
+    port.slot_ = m.slot.findPort(port.name_, isInput);
     if (port.slot_ < 0) {
-      return makeError("module '" + m.id + "' declares input port '" + port.name_ +
-                       "' that its package manifest does not list");
+      return makeError("module '" + m.id + "' declares " + (isInput ? "input" : "output") +
+                       " port '" + port.name_ + "' that its package manifest does not list");
     }
     declared[static_cast<std::size_t>(port.slot_)] = true;
+    return {};
+  };
+  for (auto& port : m.inputs) {
+    if (auto status = match(port, true); !status) return status;
   }
   for (auto& port : m.outputs) {
-    port.slot_ = m.slot.findPort(port.name_, false);
-    if (port.slot_ < 0) {
-      return makeError("module '" + m.id + "' declares output port '" + port.name_ +
-                       "' that its package manifest does not list");
-    }
-    declared[static_cast<std::size_t>(port.slot_)] = true;
+    if (auto status = match(port, false); !status) return status;
   }
   for (int i = 0; i < m.slot.portCount(); ++i) {
     const std::string_view name = m.slot.portName(i);
