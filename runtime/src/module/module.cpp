@@ -193,20 +193,21 @@ Module::~Module() {
   impl_->finish(ipc::EndCause::LeftLoop);
 }
 
-InputPort& Module::addInput(std::string name) {
+template <typename Ports>
+typename Ports::value_type& Module::declarePort(Ports& ports, std::string name) {
   VRFLOW_ASSERT(!impl_->initialized, "declare ports before init()");
-  auto& port = impl_->inputs.emplace_back();
+  auto& port = ports.emplace_back();
   port.name_ = std::move(name);
   port.module_ = this;
   return port;
 }
 
+InputPort& Module::addInput(std::string name) {
+  return declarePort(impl_->inputs, std::move(name));
+}
+
 OutputPort& Module::addOutput(std::string name) {
-  VRFLOW_ASSERT(!impl_->initialized, "declare ports before init()");
-  auto& port = impl_->outputs.emplace_back();
-  port.name_ = std::move(name);
-  port.module_ = this;
-  return port;
+  return declarePort(impl_->outputs, std::move(name));
 }
 
 Status Module::init() {

@@ -118,6 +118,9 @@ class Module {
  private:
   friend class Port;
   struct Impl;
+  /// Adds a port named `name` to `ports` (the inputs or the outputs); before init() only.
+  template <typename Ports>
+  typename Ports::value_type& declarePort(Ports& ports, std::string name);
   std::unique_ptr<Impl> impl_;
 };
 
