@@ -1,6 +1,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vrflow/launcher/launch.hpp"
+#include "vrflow/run/report_head.hpp"
 
 namespace vrflow::launcher {
 
@@ -64,13 +65,7 @@ std::string mergeReports(const app::Application& application, const std::vector<
   auto filters = collect("filters");
   std::stable_sort(filters.begin(), filters.end(),
                    [&](const auto& a, const auto& b) { return filterRank(a) < filterRank(b); });
-  ordered_json report;
-  report["format"] = "vrflow-run-report/1";
-  report["application"] = application.name;
-  report["file"] = application.file;
-  report["status"] = outcome.status;
-  report["error"] = outcome.error;
-  report["iterations_requested"] = iterations;
+  ordered_json report = run::reportHead(application, outcome, iterations);
   report["modules"] = modules;
   report["connections"] = connections;
   report["filters"] = filters;

@@ -97,6 +97,23 @@ std::optional<app::Composite> compositeFor(const app::Application& app, const ap
   return std::nullopt;
 }
 
+/// Adds `node` (a module or a filter) to a copy of `app` with a new id from `type`, on the
+/// first host, at (x, y) on the canvas: the edit labelled `label` and the id.
+template <typename Node>
+Result<Edit> addNode(const app::Application& app, std::vector<Node> app::Application::*nodes,
+                     Node node, std::string_view type, double x, double y, std::string* newId,
+                     const std::string& label) {
+  app::Application after = app;
+  ensureHost(after);
+  node.id = uniqueId(app, type);
+  node.type = type;
+  node.host = firstHost(after);
+  (after.*nodes).push_back(node);
+  setPosition(after, node.id, x, y);
+  if (newId != nullptr) *newId = node.id;
+  return makeEdit(label + node.id, app, std::move(after));
+}
+
 }  // namespace
 
 // ---- History ----------------------------------------------------------------------------
@@ -209,33 +226,17 @@ Result<Edit> addModule(const app::Application& app, const app::Catalog& catalog,
   if (catalog.findModule(package, type) == nullptr) {
     return makeError("no module type '" + std::string(package) + "/" + std::string(type) + "'");
   }
-  app::Application after = app;
-  ensureHost(after);
   app::Module module;
-  module.id = uniqueId(app, type);
   module.package = package;
-  module.type = type;
-  module.host = firstHost(after);
-  after.modules.push_back(module);
-  setPosition(after, module.id, x, y);
-  if (newId != nullptr) *newId = module.id;
-  return makeEdit("Add module " + module.id, app, std::move(after));
+  return addNode(app, &app::Application::modules, std::move(module), type, x, y, newId,
+                 "Add module ");
 }
 
 Result<Edit> addFilter(const app::Application& app, const app::Catalog& catalog,
                        std::string_view type, double x, double y, std::string* newId) {
   if (catalog.findFilter(type) == nullptr)
     return makeError("no filter type '" + std::string(type) + "'");
-  app::Application after = app;
-  ensureHost(after);
-  app::Filter filter;
-  filter.id = uniqueId(app, type);
-  filter.type = type;
-  filter.host = firstHost(after);
-  after.filters.push_back(filter);
-  setPosition(after, filter.id, x, y);
-  if (newId != nullptr) *newId = filter.id;
-  return makeEdit("Add filter " + filter.id, app, std::move(after));
+  return addNode(app, &app::Application::filters, app::Filter{}, type, x, y, newId, "Add filter ");
 }
 
 Result<Edit> removeNodes(const app::Application& app, const std::vector<std::string>& ids) {

@@ -9,21 +9,10 @@
 int main() {
   using namespace vrflow;
   using namespace vrflow::massspring;
-  const char* program = "vrflow-massspring-collision";
-  Module module;
-  const auto ports = startInteractor(module, program);
-  if (!ports) return 2;
-  modules::Params params(module, program);
-  ContactParams contact;
-  contact.thickness = params.number("thickness");
-  contact.beta = params.number("beta");
-  const double fallbackDt = params.number("dt");
-  contact.springMassWeight = params.number("spring-mass-weight");
-  if (params.report()) return 2;
-  ContactMemory memory;
-  return modules::runInteractor(module, *ports, program, [&](const SceneCopy& scene) {
-    contact.dt = module.timeStep() > 0 ? module.timeStep() : fallbackDt;
-    return modules::nodeForcesMessage(module,
-                                      netCollisions(scene.nets(), contact, &memory).nodeForces);
-  });
+  return modules::runContactInteractor(
+      "vrflow-massspring-collision", [](Module& module, const SceneCopy& scene,
+                                        const ContactParams& contact, ContactMemory* memory) {
+        return modules::nodeForcesMessage(module,
+                                          netCollisions(scene.nets(), contact, memory).nodeForces);
+      });
 }

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "vrflow/massspring/contact.hpp"
 #include "vrflow/massspring/events.hpp"
 #include "vrflow/massspring/objects.hpp"
 #include "vrflow/message/builder.hpp"
@@ -128,6 +129,29 @@ int runInteractor(Module& module, const InteractorPorts& ports, const std::strin
     if (!module.put(ports.forces, forcesOf(std::as_const(scene)))) break;
   }
   return module.exitStatus();
+}
+
+/// The whole main of a contact interactor (collision, rigid): starts the module, reads the
+/// contact parameters (thickness, beta, dt, spring-mass-weight; dt is the fallback time step
+/// when the run has none) and runs the interactor loop, where
+/// `forcesOf(scene, contact, &memory)` builds each forces message. Returns the exit status.
+template <typename ForcesOf>
+int runContactInteractor(const char* program, ForcesOf forcesOf) {
+  Module module;
+  const auto ports = startInteractor(module, program);
+  if (!ports) return 2;
+  Params params(module, program);
+  ContactParams contact;
+  contact.thickness = params.number("thickness");
+  contact.beta = params.number("beta");
+  const double fallbackDt = params.number("dt");
+  contact.springMassWeight = params.number("spring-mass-weight");
+  if (params.report()) return 2;
+  ContactMemory memory;
+  return runInteractor(module, *ports, program, [&](const SceneCopy& scene) {
+    contact.dt = module.timeStep() > 0 ? module.timeStep() : fallbackDt;
+    return forcesOf(module, scene, std::as_const(contact), &memory);
+  });
 }
 
 }  // namespace vrflow::massspring::modules

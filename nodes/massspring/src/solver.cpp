@@ -5,6 +5,22 @@
 #include <vector>
 
 namespace vrflow::massspring {
+namespace {
+
+/// Adds wa * (d0, d1, d2) * scale to the three values of node a and subtracts
+/// wb * (d0, d1, d2) * scale from those of node b (a, b: the nodes' first indices); scale 1
+/// leaves the products exact, as written out.
+void addOpposite(double* values, std::size_t a, std::size_t b, double wa, double wb, double d0,
+                 double d1, double d2, double scale = 1.0) {
+  values[a] += wa * d0 * scale;
+  values[a + 1] += wa * d1 * scale;
+  values[a + 2] += wa * d2 * scale;
+  values[b] -= wb * d0 * scale;
+  values[b + 1] -= wb * d1 * scale;
+  values[b + 2] -= wb * d2 * scale;
+}
+
+}  // namespace
 
 Status validateStepOptions(const StepOptions& o) {
   if (!(o.dt > 0) || !std::isfinite(o.dt))
@@ -32,12 +48,7 @@ void addSpringForces(const Net& net, std::span<const Spring> springs, std::span<
     const double relSpeed =
         (v[b] - v[a]) * u0 + (v[b + 1] - v[a + 1]) * u1 + (v[b + 2] - v[a + 2]) * u2;
     const double magnitude = s.stiffness * (length - s.restLength) + s.damping * relSpeed;
-    forces[a] += magnitude * u0;
-    forces[a + 1] += magnitude * u1;
-    forces[a + 2] += magnitude * u2;
-    forces[b] -= magnitude * u0;
-    forces[b + 1] -= magnitude * u1;
-    forces[b + 2] -= magnitude * u2;
+    addOpposite(forces.data(), a, b, magnitude, magnitude, u0, u1, u2);
   }
 }
 
@@ -77,18 +88,8 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
       // position change, divided by h, goes into the velocity.
       const double excess = (length - limit * (1 - 0.5 * kTolerance)) / (length * (wa + wb));
       const double ca = wa * excess, cb = wb * excess;
-      x[a] += ca * d0;
-      x[a + 1] += ca * d1;
-      x[a + 2] += ca * d2;
-      x[b] -= cb * d0;
-      x[b + 1] -= cb * d1;
-      x[b + 2] -= cb * d2;
-      v[a] += ca * d0 * invH;
-      v[a + 1] += ca * d1 * invH;
-      v[a + 2] += ca * d2 * invH;
-      v[b] -= cb * d0 * invH;
-      v[b + 1] -= cb * d1 * invH;
-      v[b + 2] -= cb * d2 * invH;
+      addOpposite(x, a, b, ca, cb, d0, d1, d2);
+      addOpposite(v, a, b, ca, cb, d0, d1, d2, invH);
     }
   }
   if (maxConstraintRatio(net) > 1.0 && feasible.size() == net.positions.size()) {

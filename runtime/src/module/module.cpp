@@ -178,10 +178,7 @@ struct Module::Impl {
   }
 };
 
-bool InputPort::connected() const {
-  return module_->impl_->slot.joined() && slot_ >= 0 && module_->impl_->slot.portConnected(slot_);
-}
-bool OutputPort::connected() const {
+bool Port::connected() const {
   return module_->impl_->slot.joined() && slot_ >= 0 && module_->impl_->slot.portConnected(slot_);
 }
 
@@ -196,20 +193,21 @@ Module::~Module() {
   impl_->finish(ipc::EndCause::LeftLoop);
 }
 
-InputPort& Module::addInput(std::string name) {
+template <typename Ports>
+typename Ports::value_type& Module::declarePort(Ports& ports, std::string name) {
   VRFLOW_ASSERT(!impl_->initialized, "declare ports before init()");
-  auto& port = impl_->inputs.emplace_back();
+  auto& port = ports.emplace_back();
   port.name_ = std::move(name);
   port.module_ = this;
   return port;
 }
 
+InputPort& Module::addInput(std::string name) {
+  return declarePort(impl_->inputs, std::move(name));
+}
+
 OutputPort& Module::addOutput(std::string name) {
-  VRFLOW_ASSERT(!impl_->initialized, "declare ports before init()");
-  auto& port = impl_->outputs.emplace_back();
-  port.name_ = std::move(name);
-  port.module_ = this;
-  return port;
+  return declarePort(impl_->outputs, std::move(name));
 }
 
 Status Module::init() {
@@ -261,21 +259,20 @@ Status Module::init() {
 
   // Match declared ports with the run's.
   std::vector<bool> declared(static_cast<std::size_t>(m.slot.portCount()), false);
-  for (auto& port : m.inputs) {
-    port.slot_ = m.slot.findPort(port.name_, true);
+  auto match = [&](Port& port, bool isInput) -> Status {
+    port.slot_ = m.slot.findPort(port.name_, isInput);
     if (port.slot_ < 0) {
-      return makeError("module '" + m.id + "' declares input port '" + port.name_ +
-                       "' that its package manifest does not list");
+      return makeError("module '" + m.id + "' declares " + (isInput ? "input" : "output") +
+                       " port '" + port.name_ + "' that its package manifest does not list");
     }
     declared[static_cast<std::size_t>(port.slot_)] = true;
+    return {};
+  };
+  for (auto& port : m.inputs) {
+    if (auto status = match(port, true); !status) return status;
   }
   for (auto& port : m.outputs) {
-    port.slot_ = m.slot.findPort(port.name_, false);
-    if (port.slot_ < 0) {
-      return makeError("module '" + m.id + "' declares output port '" + port.name_ +
-                       "' that its package manifest does not list");
-    }
-    declared[static_cast<std::size_t>(port.slot_)] = true;
+    if (auto status = match(port, false); !status) return status;
   }
   for (int i = 0; i < m.slot.portCount(); ++i) {
     const std::string_view name = m.slot.portName(i);

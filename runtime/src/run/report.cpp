@@ -4,6 +4,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "vrflow/run/report_head.hpp"
+
 namespace vrflow::run {
 namespace {
 
@@ -100,18 +102,24 @@ std::string shortModules(daemon::Daemon& daemon) {
   return text;
 }
 
-std::string reportJson(const app::Application& application, daemon::Daemon& daemon,
-                       const std::vector<ModuleEnd>& ends, const RunOutcome& outcome,
-                       const RunOptions& options, double wallSeconds,
-                       const std::vector<std::string>& warnings) {
-  using nlohmann::ordered_json;
-  ordered_json report;
+nlohmann::ordered_json reportHead(const app::Application& application, const RunOutcome& outcome,
+                                  uint64_t iterationsRequested) {
+  nlohmann::ordered_json report;
   report["format"] = "vrflow-run-report/1";
   report["application"] = application.name;
   report["file"] = application.file;
   report["status"] = outcome.status;
   report["error"] = outcome.error;
-  report["iterations_requested"] = options.iterations;
+  report["iterations_requested"] = iterationsRequested;
+  return report;
+}
+
+std::string reportJson(const app::Application& application, daemon::Daemon& daemon,
+                       const std::vector<ModuleEnd>& ends, const RunOutcome& outcome,
+                       const RunOptions& options, double wallSeconds,
+                       const std::vector<std::string>& warnings) {
+  using nlohmann::ordered_json;
+  ordered_json report = reportHead(application, outcome, options.iterations);
 
   ordered_json modules = ordered_json::array();
   for (std::size_t i = 0; i < daemon.modules().size(); ++i) {

@@ -43,9 +43,10 @@ namespace {
 
 // Starts `executable` as `ranks` ranks of one job through mpirun (VRFLOW_MPIRUN names another
 // launcher), with `contract` exported to every rank (the segment by its /proc path instead of
-// its descriptor: mpirun closes inherited descriptors).
+// its descriptor: mpirun closes inherited descriptors). `what` names the job in the error.
 Result<pid_t> spawnMpirun(const std::string& executable, int ranks, ipc::JoinContract contract,
-                          const std::string& backingDir, uint64_t memoryLimitBytes) {
+                          const std::string& backingDir, uint64_t memoryLimitBytes,
+                          const std::string& what) {
   const char* launcher = std::getenv("VRFLOW_MPIRUN");
   const std::string mpirun = launcher != nullptr && *launcher != '\0' ? launcher : "mpirun";
   contract.segmentPath =
@@ -81,7 +82,12 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, ipc::JoinCon
   }
   args.push_back(executable);
   // The limit is inherited by the ranks, which mpirun forks.
-  return spawnModule(mpirun, args, -1, environment, memoryLimitBytes);
+  auto pid = spawnModule(mpirun, args, -1, environment, memoryLimitBytes);
+  if (!pid) {
+    return makeError(pid.error().message + " (" + what +
+                     " is started through mpirun: install Open MPI, or set VRFLOW_MPIRUN)");
+  }
+  return pid;
 }
 
 }  // namespace
@@ -91,13 +97,8 @@ Result<pid_t> spawnMpiModule(const std::string& executable, int ranks,
                              uint64_t memoryLimitBytes) {
   ipc::JoinContract ranksContract = contract;
   ranksContract.mpiRanks = ranks;
-  auto pid = spawnMpirun(executable, ranks, ranksContract, backingDir, memoryLimitBytes);
-  if (!pid) {
-    return makeError(pid.error().message + " (a module of " + std::to_string(ranks) +
-                     " MPI ranks is started through mpirun: install Open MPI, or set "
-                     "VRFLOW_MPIRUN)");
-  }
-  return pid;
+  return spawnMpirun(executable, ranks, ranksContract, backingDir, memoryLimitBytes,
+                     "a module of " + std::to_string(ranks) + " MPI ranks");
 }
 
 Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>& slotIndices,
@@ -109,13 +110,8 @@ Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>&
   jobContract.moduleId.clear();
   jobContract.moduleIndices = slotIndices;
   const int ranks = static_cast<int>(slotIndices.size());
-  auto pid = spawnMpirun(executable, ranks, jobContract, backingDir, memoryLimitBytes);
-  if (!pid) {
-    return makeError(pid.error().message + " (an MPI job of " + std::to_string(ranks) +
-                     " modules is started through mpirun: install Open MPI, or set "
-                     "VRFLOW_MPIRUN)");
-  }
-  return pid;
+  return spawnMpirun(executable, ranks, jobContract, backingDir, memoryLimitBytes,
+                     "an MPI job of " + std::to_string(ranks) + " modules");
 }
 
 namespace {

@@ -14,32 +14,29 @@ namespace vrflow {
 
 class Module;
 
-/// An input port declared by a module.
-class InputPort {
+/// What the input and output ports of a module share: the name it declared and, once
+/// Module::init() ran, the run's port it stands for.
+class Port {
  public:
   const std::string& name() const { return name_; }
   /// True when the application connects something to this port.
   bool connected() const;
 
+ protected:
+  Port() = default;
+
  private:
   friend class Module;
   std::string name_;
   Module* module_ = nullptr;
   int slot_ = -1;
 };
+
+/// An input port declared by a module.
+class InputPort : public Port {};
 
 /// An output port declared by a module.
-class OutputPort {
- public:
-  const std::string& name() const { return name_; }
-  bool connected() const;
-
- private:
-  friend class Module;
-  std::string name_;
-  Module* module_ = nullptr;
-  int slot_ = -1;
-};
+class OutputPort : public Port {};
 
 /// A message being written straight into shared memory; hand it to Module::put().
 class OutgoingMessage {
@@ -119,9 +116,11 @@ class Module {
   int exitStatus() const;
 
  private:
-  friend class InputPort;
-  friend class OutputPort;
+  friend class Port;
   struct Impl;
+  /// Adds a port named `name` to `ports` (the inputs or the outputs); before init() only.
+  template <typename Ports>
+  typename Ports::value_type& declarePort(Ports& ports, std::string name);
   std::unique_ptr<Impl> impl_;
 };
 

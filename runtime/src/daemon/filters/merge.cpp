@@ -42,26 +42,32 @@ Result<std::unique_ptr<Filter>> makeMerge(const FilterContext& context) {
   return std::unique_ptr<Filter>(std::make_unique<MergeFilter>(std::move(*rules)));
 }
 
-FilterType mergeType() {
+/// merge and gather: one message from each of in0..in{N-1}, chunks concatenated in input
+/// order; the two differ only in their words.
+FilterType concatenatingType(std::string name, std::string doc, const char* inputDoc,
+                             const char* outputDoc) {
   FilterType type;
-  type.name = "merge";
-  type.doc = "Waits for one message on each of in0..in{N-1} and emits their concatenation on out.";
-  declareNumberedInputs(type, "one of the merged inputs", "the merged messages");
+  type.name = std::move(name);
+  type.doc = std::move(doc);
+  declareNumberedInputs(type, inputDoc, outputDoc);
   type.params.push_back(stampsParam());
   type.check = checkStamps;
   return type;
 }
 
+FilterType mergeType() {
+  return concatenatingType(
+      "merge",
+      "Waits for one message on each of in0..in{N-1} and emits their concatenation on out.",
+      "one of the merged inputs", "the merged messages");
+}
+
 FilterType gatherType() {
-  FilterType type;
-  type.name = "gather";
-  type.doc =
-      "Joins the parts made by a scatter: one message from each of in0..in{N-1}, chunks "
-      "concatenated in input order (the semantics of merge).";
-  declareNumberedInputs(type, "one part", "the joined messages");
-  type.params.push_back(stampsParam());
-  type.check = checkStamps;
-  return type;
+  return concatenatingType("gather",
+                           "Joins the parts made by a scatter: one message from each of "
+                           "in0..in{N-1}, chunks concatenated in input order (the semantics of "
+                           "merge).",
+                           "one part", "the joined messages");
 }
 
 }  // namespace
