@@ -94,6 +94,11 @@ app::ParamSpec stringParam(std::string name, std::string defaultValue, std::stri
   return param;
 }
 
+std::string declaredText(const app::ParamSpec& spec, const std::vector<app::Param>& params) {
+  const app::Param* given = app::findParam(params, spec.name);
+  return given != nullptr ? given->value : spec.defaultValue;
+}
+
 long long clampedInt(const app::ParamSpec& spec, const std::vector<app::Param>& params) {
   VRFLOW_ASSERT(spec.type == app::ParamType::Int && spec.min && spec.max,
                 "clampedInt needs an int parameter with a range");

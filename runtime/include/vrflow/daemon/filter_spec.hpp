@@ -65,6 +65,9 @@ app::ParamSpec stringParam(std::string name, std::string defaultValue, std::stri
 /// The value of int parameter `spec` in `params` (its default when absent or unreadable),
 /// clamped to the spec's range.
 long long clampedInt(const app::ParamSpec& spec, const std::vector<app::Param>& params);
+/// The text of `spec` in a filter's file parameters, or its declared default: what a type's
+/// `ports` and `check` read before validation, so that the default stays written once.
+std::string declaredText(const app::ParamSpec& spec, const std::vector<app::Param>& params);
 
 /// Parameter `stamps` of the merging filters (merge, gather), and its check.
 app::ParamSpec stampsParam();

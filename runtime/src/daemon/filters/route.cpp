@@ -416,8 +416,9 @@ app::FilterType routeType() {
   const app::ParamSpec outputCount =
       intParam("outputs", "1", 1, static_cast<double>(kMaxFilterPorts), "number of receivers N");
   type.params.push_back(outputCount);
-  type.params.push_back(
-      stringParam("stamp", "interest", "name of the string user stamp holding the volume"));
+  const app::ParamSpec stamp =
+      stringParam("stamp", "interest", "name of the string user stamp holding the volume");
+  type.params.push_back(stamp);
   type.params.push_back(enumParam("initially", {"none", "all"},
                                   "the volume of every receiver before its first interest"));
   type.params.push_back(enumParam("unbounded", {"all", "drop"},
@@ -435,8 +436,8 @@ app::FilterType routeType() {
     }
     return ports;
   };
-  type.check = [](const std::vector<Param>& params) -> std::optional<std::string> {
-    if (paramString(params, "stamp", "interest").empty()) {
+  type.check = [stamp](const std::vector<Param>& params) -> std::optional<std::string> {
+    if (declaredText(stamp, params).empty()) {
       return "parameter 'stamp' must name a user stamp (e.g. \"interest\")";
     }
     return std::nullopt;

@@ -263,8 +263,9 @@ app::FilterType scatterType() {
       "raw resource of the same id prefixed by its u64 offset and u64 total size.";
   const app::ParamSpec outputCount = intParam("outputs", "2", 1, kMaxPorts, "number of outputs N");
   type.params.push_back(outputCount);
-  type.params.push_back(
-      enumParam("by", {"chunk", "id", "type", "bounds", "size"}, "how chunks are split"));
+  const app::ParamSpec splitBy =
+      enumParam("by", {"chunk", "id", "type", "bounds", "size"}, "how chunks are split");
+  type.params.push_back(splitBy);
   type.params.push_back(intParam("element-size", "1", 1, 1 << 30,
                                  "by=size: bytes per element; parts hold whole elements"));
   type.params.push_back(
@@ -286,8 +287,9 @@ app::FilterType scatterType() {
     }
     return ports;
   };
-  type.check = [outputCount](const std::vector<Param>& params) -> std::optional<std::string> {
-    const std::string by = paramString(params, "by", "chunk");
+  type.check = [outputCount,
+                splitBy](const std::vector<Param>& params) -> std::optional<std::string> {
+    const std::string by = declaredText(splitBy, params);
     const bool byType = by == "type";
     const auto names = splitList(paramString(params, "types", ""));
     const auto cuts = splitList(paramString(params, "cuts", ""));
