@@ -24,7 +24,8 @@ daemon::MessageRef pointsAt(FilterHarness& h, uint64_t iteration, std::vector<do
 // The ids of the chunks of `message`.
 std::vector<uint64_t> idsOf(const daemon::MessageRef& message) {
   std::vector<uint64_t> ids;
-  for (const msg::ChunkView chunk : *message.view()) ids.push_back(chunk.id());
+  const auto view = message.view();  // the range below must not outlive the Result
+  for (const msg::ChunkView chunk : *view) ids.push_back(chunk.id());
   return ids;
 }
 
