@@ -16,6 +16,7 @@
 
 #include "monitor_files.hpp"
 #include "vrflow/launcher/launch.hpp"
+#include "vrflow/run/run_folders.hpp"
 
 namespace vrflow::launcher {
 namespace {
@@ -176,38 +177,7 @@ Result<std::vector<json>> liveLaunches() {
 }  // namespace
 
 Result<std::string> monitorDirectory() {
-  std::string dir;
-  if (const char* runtime = std::getenv("XDG_RUNTIME_DIR");
-      runtime != nullptr && *runtime != '\0') {
-    dir = std::string(runtime) + "/vrflow";
-  } else {
-    dir = "/tmp/vrflow-" + std::to_string(getuid());
-  }
-  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
-    return makeError("cannot create the monitor folder '" + dir + "': " + std::strerror(errno));
-  }
-  // As ssh and tmux do: a folder that someone else owns or may write to could hand our files
-  // (or links in their place) to another user.
-  struct stat info {};
-  if (lstat(dir.c_str(), &info) != 0) {
-    return makeError("cannot use the monitor folder '" + dir + "': " + std::strerror(errno));
-  }
-  if (!S_ISDIR(info.st_mode)) {
-    return makeError("the monitor folder '" + dir + "' is not a folder (a link or a file): " +
-                     "remove it, or set XDG_RUNTIME_DIR");
-  }
-  if (info.st_uid != getuid()) {
-    return makeError("the monitor folder '" + dir + "' belongs to uid " +
-                     std::to_string(info.st_uid) + ", not to you (uid " + std::to_string(getuid()) +
-                     "): remove it, or set XDG_RUNTIME_DIR");
-  }
-  if ((info.st_mode & (S_IWGRP | S_IWOTH)) != 0) {
-    char mode[8];
-    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(info.st_mode & 07777));
-    return makeError("the monitor folder '" + dir + "' may be written by others (mode " + mode +
-                     "): make it private with `chmod 700 " + dir + "`");
-  }
-  return dir;
+  return run::runtimeDirectory();
 }
 
 void removeStaleMonitorFiles(const std::string& dir) {

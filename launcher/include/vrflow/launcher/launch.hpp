@@ -49,6 +49,11 @@ struct LaunchOptions {
   bool progress = false;
   /// The launch's event stream, merged from every host's (docs/events.md); null: none.
   run::EventStream* events = nullptr;
+  /// This launch's id (run::newRunId); empty: none.
+  std::string runId;
+  /// The folder on the launcher's machine where every host's module logs are gathered
+  /// (<module>.log each); empty: none.
+  std::string logDir;
 };
 
 /// Merges the hosts' report shares into one report in the shape `vrflow run` writes (modules,

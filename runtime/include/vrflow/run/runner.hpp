@@ -56,6 +56,10 @@ struct RunOptions {
   /// Where the run's events go (docs/events.md): started, stats each second, warnings,
   /// module exits, end; null: nowhere.
   EventStream* events = nullptr;
+  /// This run's id (run::newRunId); empty: none (a test, or a daemon under the launcher).
+  std::string runId;
+  /// The folder of the modules' logs (<module>.log each); empty: none.
+  std::string logDir;
 };
 
 /// What happened, for the report and the exit code.
