@@ -191,11 +191,14 @@ int main(int argc, char** argv) {
   SharedOptions launchShared;
   addSharedOptions(*launch, launchShared);
   launch->add_option("--hosts", launchOptions.hostfile,
-                     "Hostfile: where each host runs (docs/launcher.md)");
+                     "Hostfile, vrflow's or Open MPI's: where each host runs (docs/launcher.md)");
   launch
       ->add_option("--backend", launchOptions.backend,
-                   "How daemons are started: local, ssh, mpirun")
-      ->check(CLI::IsMember({"local", "ssh", "mpirun"}));
+                   "How daemons are started: local, ssh, mpirun, slurm (inside an allocation)")
+      ->check(CLI::IsMember({"local", "ssh", "mpirun", "slurm"}));
+  launch->add_option("--mpirun-arg", launchOptions.mpirunArgs,
+                     "mpirun: one more word on mpirun's command line, before the ranks "
+                     "(repeatable; write --mpirun-arg=--oversubscribe for a word starting with -)");
   launch
       ->add_option("--iterations,-n", launchOptions.iterations,
                    "Stop after N iterations of every module")

@@ -1,3 +1,6 @@
+// Hostfiles in two formats: vrflow's (`HOST key=value...`, one line per host of the application)
+// and Open MPI's (`MACHINE [slots=N] [max_slots=N]`, the hosts of the application placed on the
+// machines' slots in order, as mpirun's by-slot mapping places ranks).
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -5,66 +8,196 @@
 #include "vrflow/launcher/launch.hpp"
 
 namespace vrflow::launcher {
+namespace {
+
+// One line that holds something: its number and its words (the comment cut off).
+struct Line {
+  int number = 0;
+  std::vector<std::string> words;
+};
+
+bool isOpenMpiKey(const std::string& key) {
+  return key == "slots" || key == "max_slots" || key == "max-slots";
+}
+
+std::string keyOf(const std::string& word) {
+  return word.substr(0, word.find('='));
+}
+
+// A whole number of slots, 1 to 1,000,000, or -1.
+int slotCount(const std::string& value) {
+  if (value.empty() || value.size() > 7 || value.find_first_not_of("0123456789") != value.npos) {
+    return -1;
+  }
+  const int n = std::stoi(value);
+  return n >= 1 && n <= 1'000'000 ? n : -1;
+}
+
+Result<HostEntry> vrflowLine(const Line& line, const std::string& path) {
+  auto fail = [&](const std::string& why) {
+    return makeError(path + ":" + std::to_string(line.number) + ": error: " + why);
+  };
+  HostEntry entry;
+  entry.line = line.number;
+  entry.host = line.words[0];
+  for (std::size_t w = 1; w < line.words.size(); ++w) {
+    const std::string& word = line.words[w];
+    const auto eq = word.find('=');
+    if (eq == std::string::npos) return fail("expected KEY=VALUE, got '" + word + "'");
+    const std::string key = word.substr(0, eq), value = word.substr(eq + 1);
+    if (key == "address") {
+      entry.address = value;
+    } else if (key == "node") {
+      entry.node = value;
+    } else if (key == "user") {
+      entry.user = value;
+    } else if (key == "ssh-port") {
+      try {
+        entry.sshPort = std::stoi(value);
+      } catch (...) {
+        entry.sshPort = -1;
+      }
+      if (entry.sshPort <= 0 || entry.sshPort > 65535) return fail("bad ssh-port '" + value + "'");
+    } else if (key == "identity") {
+      entry.identity = value;
+    } else if (key == "ssh-option") {
+      if (value.find('=') == std::string::npos)
+        return fail("ssh-option needs KEY=VALUE, got '" + value + "'");
+      entry.sshOptions.push_back(value);
+    } else if (key == "dir") {
+      entry.directory = value;
+    } else if (key == "daemon") {
+      entry.daemon = value;
+    } else if (key == "env") {
+      if (value.find('=') == std::string::npos)
+        return fail("env needs NAME=VALUE, got '" + value + "'");
+      entry.environment.push_back(value);
+    } else {
+      return fail("unknown key '" + key +
+                  "' (allowed: address, node, user, ssh-port, identity, ssh-option, dir, daemon, "
+                  "env)");
+    }
+  }
+  return entry;
+}
+
+// One machine of an Open MPI hostfile.
+struct Machine {
+  std::string name;
+  int slots = 1, maxSlots = 0;  ///< maxSlots 0: no more than `slots`
+  int line = 0;
+};
+
+Result<Machine> openMpiLine(const Line& line, const std::string& path) {
+  auto fail = [&](const std::string& why) {
+    return makeError(path + ":" + std::to_string(line.number) + ": error: " + why);
+  };
+  Machine machine;
+  machine.name = line.words[0];
+  machine.line = line.number;
+  for (std::size_t w = 1; w < line.words.size(); ++w) {
+    const std::string& word = line.words[w];
+    const auto eq = word.find('=');
+    const std::string key = keyOf(word);
+    if (eq == std::string::npos || !isOpenMpiKey(key)) {
+      return fail("unknown word '" + word +
+                  "' in an Open MPI hostfile (allowed: slots=N, max_slots=N)");
+    }
+    const int n = slotCount(word.substr(eq + 1));
+    if (n < 0) return fail("bad " + key + " '" + word.substr(eq + 1) + "' (a whole number >= 1)");
+    (key == "slots" ? machine.slots : machine.maxSlots) = n;
+  }
+  if (machine.maxSlots > 0 && machine.maxSlots < machine.slots) {
+    return fail("max_slots=" + std::to_string(machine.maxSlots) +
+                " is below slots=" + std::to_string(machine.slots));
+  }
+  return machine;
+}
+
+// The hosts of the application in file order on the machines' slots: each machine's slots=
+// first, in file order, then up to its max_slots=.
+Result<std::vector<HostEntry>> placeOnSlots(const std::vector<Machine>& machines,
+                                            const app::Application& application,
+                                            const std::string& path) {
+  std::vector<HostEntry> entries;
+  auto place = [&](const Machine& m, int count) {
+    for (int s = 0; s < count && entries.size() < application.hosts.size(); ++s) {
+      HostEntry entry;
+      entry.host = application.hosts[entries.size()].id;
+      entry.node = m.name;
+      entry.line = m.line;
+      entries.push_back(entry);
+    }
+  };
+  for (const auto& m : machines) place(m, m.slots);
+  for (const auto& m : machines) place(m, m.maxSlots > 0 ? m.maxSlots - m.slots : 0);
+  if (entries.size() < application.hosts.size()) {
+    return makeError(path + ": error: the Open MPI hostfile has " + std::to_string(entries.size()) +
+                     " slot(s) for the " + std::to_string(application.hosts.size()) + " hosts of " +
+                     application.file + " (raise slots= or max_slots=)");
+  }
+  return entries;
+}
+
+}  // namespace
 
 Result<std::vector<HostEntry>> readHostfile(const std::string& path,
                                             const app::Application& application) {
   std::ifstream in(path);
   if (!in) return makeError(path + ": cannot read the hostfile");
-  std::vector<HostEntry> entries;
-  std::set<std::string> seen;
+  std::vector<Line> lines;
   std::string text;
-  int line = 0;
-  auto fail = [&](const std::string& why) {
-    return makeError(path + ":" + std::to_string(line) + ": error: " + why);
-  };
-  while (std::getline(in, text)) {
-    ++line;
+  for (int number = 1; std::getline(in, text); ++number) {
     if (const auto hash = text.find('#'); hash != std::string::npos) text.resize(hash);
     std::istringstream words(text);
-    HostEntry entry;
-    entry.line = line;
-    if (!(words >> entry.host)) continue;
-    if (app::findHost(application, entry.host) == nullptr) {
-      return fail("no host '" + entry.host + "' in " + application.file);
-    }
-    if (!seen.insert(entry.host).second) return fail("host '" + entry.host + "' is listed twice");
-    std::string word;
-    while (words >> word) {
-      const auto eq = word.find('=');
-      if (eq == std::string::npos) return fail("expected KEY=VALUE, got '" + word + "'");
-      const std::string key = word.substr(0, eq), value = word.substr(eq + 1);
-      if (key == "address") {
-        entry.address = value;
-      } else if (key == "user") {
-        entry.user = value;
-      } else if (key == "ssh-port") {
-        try {
-          entry.sshPort = std::stoi(value);
-        } catch (...) {
-          entry.sshPort = -1;
-        }
-        if (entry.sshPort <= 0 || entry.sshPort > 65535)
-          return fail("bad ssh-port '" + value + "'");
-      } else if (key == "identity") {
-        entry.identity = value;
-      } else if (key == "ssh-option") {
-        if (value.find('=') == std::string::npos)
-          return fail("ssh-option needs KEY=VALUE, got '" + value + "'");
-        entry.sshOptions.push_back(value);
-      } else if (key == "dir") {
-        entry.directory = value;
-      } else if (key == "daemon") {
-        entry.daemon = value;
-      } else if (key == "env") {
-        if (value.find('=') == std::string::npos)
-          return fail("env needs NAME=VALUE, got '" + value + "'");
-        entry.environment.push_back(value);
-      } else {
-        return fail("unknown key '" + key +
-                    "' (allowed: address, user, ssh-port, identity, ssh-option, dir, daemon, env)");
+    Line line{number, {}};
+    for (std::string word; words >> word;) line.words.push_back(word);
+    if (!line.words.empty()) lines.push_back(line);
+  }
+  // The format: Open MPI's when a line has slots= or max_slots=, vrflow's otherwise. A line of
+  // the other format than the first line with a key is an error.
+  const Line* first = nullptr;
+  bool openMpi = false;
+  for (const auto& line : lines) {
+    for (std::size_t w = 1; w < line.words.size(); ++w) {
+      const bool mpiWord = isOpenMpiKey(keyOf(line.words[w]));
+      if (first == nullptr) {
+        first = &line;
+        openMpi = mpiWord;
+      } else if (mpiWord != openMpi) {
+        return makeError(path + ":" + std::to_string(line.number) + ": error: '" + line.words[w] +
+                         "' mixes the two hostfile formats: line " + std::to_string(first->number) +
+                         " makes this " +
+                         (openMpi ? "an Open MPI hostfile (MACHINE slots=N)"
+                                  : "a vrflow hostfile (HOST key=value)"));
       }
     }
-    entries.push_back(entry);
+  }
+  if (openMpi) {
+    std::vector<Machine> machines;
+    for (const auto& line : lines) {
+      auto machine = openMpiLine(line, path);
+      if (!machine) return machine.error();
+      machines.push_back(*machine);
+    }
+    return placeOnSlots(machines, application, path);
+  }
+  std::vector<HostEntry> entries;
+  std::set<std::string> seen;
+  for (const auto& line : lines) {
+    auto fail = [&](const std::string& why) {
+      return makeError(path + ":" + std::to_string(line.number) + ": error: " + why);
+    };
+    if (app::findHost(application, line.words[0]) == nullptr) {
+      return fail("no host '" + line.words[0] + "' in " + application.file +
+                  " (an Open MPI hostfile, naming machines, needs slots= on a line)");
+    }
+    if (!seen.insert(line.words[0]).second) {
+      return fail("host '" + line.words[0] + "' is listed twice");
+    }
+    auto entry = vrflowLine(line, path);
+    if (!entry) return entry.error();
+    entries.push_back(*entry);
   }
   return entries;
 }

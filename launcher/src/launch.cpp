@@ -103,6 +103,7 @@ void Launcher::stopAll() {
     const auto t = Clock::now();
     while (!allExited() && (round == 1 || secondsSince(t) < 2)) pump(20);
   }
+  cancelSlurmSteps();  // a killed srun leaves its step (and daemon) running
   // A daemon killed under mpirun may still be tearing down when mpirun is gone: the launcher is
   // their subreaper (run()), so it leaves only once every descendant has exited (5 s at most).
   const auto t = Clock::now();
@@ -210,18 +211,9 @@ run::RunOutcome Launcher::run() {
 }  // namespace detail
 
 run::RunOutcome launch(const app::Application& application, const LaunchOptions& options) {
-  if (options.backend != "local" && options.backend != "ssh" && options.backend != "mpirun") {
-    return {run::kExitInvalid, "failed", "--backend " + options.backend + ": unknown backend"};
-  }
   // Mistakes in what the user gave (exit 2, as an invalid application) before anything starts.
-  if (options.backend == "ssh" && options.hostfile.empty()) {
-    return {run::kExitInvalid, "failed",
-            "--backend ssh needs --hosts HOSTFILE (where each host is and how to log in)"};
-  }
-  if (!options.hostfile.empty()) {
-    if (auto read = readHostfile(options.hostfile, application); !read) {
-      return {run::kExitInvalid, "failed", read.error().message};
-    }
+  if (auto checked = detail::checkLaunch(application, options); !checked) {
+    return {run::kExitInvalid, "failed", checked.error().message};
   }
   detail::Launcher launcher(application, options);
   return launcher.run();

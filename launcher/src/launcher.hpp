@@ -1,8 +1,9 @@
 #pragma once
 
 // The launcher's inside, shared by its files: launch.cpp (the run, from start to the report),
-// start_daemons.cpp (starting one daemon per host: local, ssh, mpirun) and daemon_channel.cpp
-// (reading what the daemons say). Nothing outside launcher/src includes it.
+// start_daemons.cpp (starting one daemon per host: local, ssh, mpirun), slurm.cpp (the slurm
+// backend: the allocation's nodes, srun) and daemon_channel.cpp (reading what the daemons say).
+// Nothing outside launcher/src includes it.
 #include <sys/types.h>
 
 #include <chrono>
@@ -38,6 +39,7 @@ struct HostDaemon {
   int port = -1;
   bool viaSsh = false;
   bool viaMpirun = false;
+  bool viaSrun = false;
   bool connected = false, finished = false, exited = false;
   bool stopAnswered = false;  ///< it answered "stop"
   int finishedCode = 0;
@@ -55,10 +57,37 @@ struct HostDaemon {
     return "daemon of host '" + host + "' (" + bind +
            (viaSsh      ? ", ssh pid "
             : viaMpirun ? ", mpirun pid "
+            : viaSrun   ? ", srun pid "
                         : ", pid ") +
            std::to_string(pid) + ")";
   }
 };
+
+/// Where one host's daemon runs, as a backend decided it.
+struct Placement {
+  std::string node;  ///< mpirun, slurm: the machine (empty: this one, or the file's address)
+  std::string bind;  ///< the IPv4 address the daemon listens on, told to its peers
+  std::vector<std::string> environment;  ///< NAME=VALUE from the hostfile
+  const HostEntry* entry = nullptr;      ///< the host's hostfile line, if any
+};
+
+/// The IPv4 address of a machine name (getaddrinfo), or an error naming it.
+Result<std::string> ipv4Of(const std::string& name);
+
+/// The allocation a slurm launch runs in (SLURM_JOB_ID, SLURM_JOB_NODELIST): its nodes in
+/// order (`scontrol show hostnames`) and their addresses (NodeAddr, `scontrol show node`).
+struct SlurmAllocation {
+  std::string jobId;
+  std::vector<std::string> nodes;
+  std::vector<std::string> addresses;  ///< IPv4, one per node
+};
+
+/// The allocation this process runs in, or an error saying it runs in none.
+Result<SlurmAllocation> slurmAllocation();
+
+/// The checks of the command line and hostfile before anything starts (exit 2 when they fail):
+/// the backend's needs (ssh: a hostfile; slurm: an allocation), machines only where honoured.
+Status checkLaunch(const app::Application& application, const LaunchOptions& options);
 
 /// One launch: starts a daemon per host, relays the control channel, stops them all.
 class Launcher {
@@ -69,7 +98,15 @@ class Launcher {
 
  private:
   Status start();
-  Status startMpirun(const std::string& daemonPath, const net::Secret& secret);
+  Status startMpirun(const std::string& daemonPath, const net::Secret& secret,
+                     const std::vector<HostEntry>& entries);
+  // slurm: where host `index` runs, on the allocation's nodes in order or by the hostfile.
+  Result<Placement> slurmPlacement(const SlurmAllocation& allocation, std::size_t index,
+                                   const HostEntry* entry) const;
+  // slurm: srun's words before the daemon's, for one host on `node`.
+  std::vector<std::string> srunCommand(const std::string& node, const std::string& host) const;
+  // slurm: cancels the job steps of this launch's daemons still there (a killed srun leaves them).
+  void cancelSlurmSteps() const;
   // The options every daemon gets, whatever the backend: trace, peer timeout, iterations and
   // search paths (made absolute).
   void appendDaemonOptions(std::vector<std::string>& argv) const;

@@ -1,5 +1,5 @@
-// Starting the daemons of a launch, one per host: as local processes, through ssh, or all at
-// once through mpirun; then linking them (peers, connect, clock, go).
+// Starting the daemons of a launch, one per host: as local processes, through ssh or srun
+// (slurm.cpp), or all at once through mpirun; then linking them (peers, connect, clock, go).
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -86,9 +87,39 @@ void Launcher::appendDaemonOptions(std::vector<std::string>& argv) const {
   for (const auto& s : options_.overrides) argv.insert(argv.end(), {"--set", s});
 }
 
-// mpirun: one process starts every daemon (rank i serves host i); each connects back to a
-// control socket here and proves it holds the run secret, handed over in mpirun's environment.
-Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& secret) {
+// mpirun: one process starts every daemon, one application context per host (rank i serves
+// host i) on its machine, with its own --bind and -x NAME=VALUE; each connects back to a control
+// socket here and proves it holds the run secret, handed over in mpirun's environment.
+Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& secret,
+                             const std::vector<HostEntry>& entries) {
+  const std::size_t n = application_.hosts.size();
+  // Where each rank runs (`--host`) and binds: the hostfile's machine (node) and address=,
+  // else the file's address; a loopback address runs on this machine.
+  std::vector<std::string> targets, binds;
+  std::vector<std::vector<std::string>> environments(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const app::Host& host = application_.hosts[i];
+    std::string target = host.address, bind = host.address;
+    for (const auto& e : entries) {
+      if (e.host != host.id) continue;
+      if (!e.node.empty()) {
+        auto ip = ipv4Of(e.node);
+        if (!ip) {
+          return makeError(options_.hostfile + ":" + std::to_string(e.line) + ": error: host '" +
+                           host.id + "': " + ip.error().message);
+        }
+        target = e.node;
+        bind = *ip;
+      }
+      if (!e.address.empty()) {
+        if (e.node.empty()) target = e.address;
+        bind = e.address;
+      }
+      environments[i] = e.environment;
+    }
+    targets.push_back(target.rfind("127.", 0) == 0 ? "localhost" : target);
+    binds.push_back(bind);
+  }
   const int listenFd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
@@ -102,23 +133,25 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
   socklen_t len = sizeof addr;
   getsockname(listenFd, reinterpret_cast<sockaddr*>(&addr), &len);
   const std::string control = options_.controlAddress + ":" + std::to_string(ntohs(addr.sin_port));
-  const std::size_t n = application_.hosts.size();
-  bool loopback = true;
-  std::string hostList;
-  for (const auto& h : application_.hosts) {
-    loopback = loopback && h.address.rfind("127.", 0) == 0;
-    hostList += (hostList.empty() ? "" : ",") + h.address;
-  }
   std::error_code ec;
-  std::vector<std::string> argv{"mpirun", "-np", std::to_string(n), "-x", "VRFLOW_RUN_SECRET"};
-  for (const char* name : {"VRFLOW_PACKAGE_PATH", "VRFLOW_COMPOSITE_PATH", "VRFLOW_FILTER_PATH"}) {
-    if (std::getenv(name) != nullptr) argv.insert(argv.end(), {"-x", name});
+  std::vector<std::string> argv{"mpirun"};
+  argv.insert(argv.end(), options_.mpirunArgs.begin(), options_.mpirunArgs.end());
+  for (std::size_t i = 0; i < n; ++i) {
+    // Each context names its machine with as many slots as ranks go there.
+    const auto slots = std::count(targets.begin(), targets.end(), targets[i]);
+    if (i > 0) argv.push_back(":");
+    argv.insert(argv.end(), {"-np", "1", "--host", targets[i] + ":" + std::to_string(slots), "-x",
+                             "VRFLOW_RUN_SECRET"});
+    for (const char* name :
+         {"VRFLOW_PACKAGE_PATH", "VRFLOW_COMPOSITE_PATH", "VRFLOW_FILTER_PATH"}) {
+      if (std::getenv(name) != nullptr) argv.insert(argv.end(), {"-x", name});
+    }
+    for (const auto& e : environments[i]) argv.insert(argv.end(), {"-x", e});
+    argv.insert(argv.end(),
+                {daemonPath, std::filesystem::absolute(options_.appFile, ec).string(), "--host",
+                 application_.hosts[i].id, "--control-connect", control, "--bind", binds[i]});
+    appendDaemonOptions(argv);
   }
-  // Rank i runs on host i: all on this machine when every host is a loopback address.
-  argv.insert(argv.end(), {"--host", loopback ? "localhost:" + std::to_string(n) : hostList});
-  argv.insert(argv.end(), {daemonPath, std::filesystem::absolute(options_.appFile, ec).string(),
-                           "--control-connect", control});
-  appendDaemonOptions(argv);
   int toMpirun = -1, fromMpirun = -1;
   auto pid = spawnDaemon(argv, {"VRFLOW_RUN_SECRET=" + net::secretToHex(secret)}, toMpirun,
                          fromMpirun, /*stdoutToStderr=*/true);
@@ -132,7 +165,7 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
     HostDaemon d;
     d.index = static_cast<int>(i);
     d.host = application_.hosts[i].id;
-    d.bind = application_.hosts[i].address;
+    d.bind = binds[i];
     d.pid = *pid;
     d.viaMpirun = true;
     daemons_.push_back(std::move(d));
@@ -186,13 +219,47 @@ Status Launcher::startMpirun(const std::string& daemonPath, const net::Secret& s
   return {};
 }
 
+Status checkLaunch(const app::Application& application, const LaunchOptions& options) {
+  if (options.backend != "local" && options.backend != "ssh" && options.backend != "mpirun" &&
+      options.backend != "slurm") {
+    return makeError("--backend " + options.backend + ": unknown backend");
+  }
+  if (options.backend == "ssh" && options.hostfile.empty()) {
+    return makeError("--backend ssh needs --hosts HOSTFILE (where each host is and how to log in)");
+  }
+  if (!options.mpirunArgs.empty() && options.backend != "mpirun") {
+    return makeError("--mpirun-arg is for --backend mpirun (this launch uses " + options.backend +
+                     ")");
+  }
+  if (options.backend == "slurm") {
+    for (const char* name : {"SLURM_JOB_ID", "SLURM_JOB_NODELIST"}) {
+      if (std::getenv(name) == nullptr) {
+        return makeError(std::string("--backend slurm runs inside a Slurm allocation (salloc "
+                                     "or sbatch): ") +
+                         name + " is not set");
+      }
+    }
+  }
+  if (options.hostfile.empty()) return {};
+  auto entries = readHostfile(options.hostfile, application);
+  if (!entries) return entries.error();
+  if (options.backend == "local" || options.backend == "ssh") {
+    for (const auto& e : *entries) {
+      if (e.node.empty()) continue;
+      return makeError(options.hostfile + ":" + std::to_string(e.line) + ": error: host '" +
+                       e.host + "' is placed on machine '" + e.node +
+                       "' (node=, or an Open MPI hostfile): only --backend mpirun and slurm "
+                       "place hosts on machines");
+    }
+  }
+  return {};
+}
+
 Status Launcher::start() {
   const std::string daemonPath = (executableDir() / "vrflow-daemon").string();
   const bool ssh = options_.backend == "ssh";
+  const bool slurm = options_.backend == "slurm";
   std::vector<HostEntry> entries;
-  if (ssh && options_.hostfile.empty()) {
-    return makeError("--backend ssh needs --hosts HOSTFILE (where each host is and how to log in)");
-  }
   if (!options_.hostfile.empty()) {
     auto read = readHostfile(options_.hostfile, application_);
     if (!read) return read.error();
@@ -200,30 +267,51 @@ Status Launcher::start() {
   }
   const net::Secret secret = net::newSecret();
   if (options_.backend == "mpirun") {
-    if (auto status = startMpirun(daemonPath, secret); !status) return status;
+    if (auto status = startMpirun(daemonPath, secret, entries); !status) return status;
+  }
+  std::optional<SlurmAllocation> allocation;
+  if (slurm) {
+    auto found = slurmAllocation();
+    if (!found) return found.error();
+    allocation = *found;
+    if (application_.hosts.size() > allocation->nodes.size()) {
+      std::fprintf(stderr,
+                   "vrflow: %zu hosts on the %zu node(s) of slurm job %s: several daemons share "
+                   "a node\n",
+                   application_.hosts.size(), allocation->nodes.size(), allocation->jobId.c_str());
+    }
   }
   for (std::size_t i = 0; i < application_.hosts.size() && options_.backend != "mpirun"; ++i) {
     const app::Host& host = application_.hosts[i];
     HostDaemon d;
     d.index = static_cast<int>(i);
     d.host = host.id;
-    // local: every host on its own loopback address, as a cluster would be.
-    d.bind = "127.0.0." + std::to_string(i + 1);
-    std::vector<std::string> environment;
     const HostEntry* entry = nullptr;
     for (const auto& e : entries) {
-      if (e.host != host.id) continue;
-      entry = &e;
-      if (!e.address.empty()) d.bind = e.address;
-      environment = e.environment;
+      if (e.host == host.id) entry = &e;
+    }
+    Placement placement;
+    if (slurm) {
+      auto placed = slurmPlacement(*allocation, i, entry);
+      if (!placed) return placed.error();
+      placement = *placed;
+    } else {
+      // local: every host on its own loopback address, as a cluster would be.
+      placement.bind = "127.0.0." + std::to_string(i + 1);
+      if (entry != nullptr) {
+        if (!entry->address.empty()) placement.bind = entry->address;
+        placement.environment = entry->environment;
+      }
     }
     if (ssh) {
       if (entry == nullptr) {
         return makeError(options_.hostfile + ": error: no line for host '" + host.id +
                          "' (--backend ssh needs one per host)");
       }
-      if (entry->address.empty()) d.bind = host.address;
+      if (entry->address.empty()) placement.bind = host.address;
     }
+    d.bind = placement.bind;
+    std::vector<std::string> environment = placement.environment;
     std::error_code ec;
     const std::string appFile = std::filesystem::absolute(options_.appFile, ec).string();
     std::vector<std::string> argv{
@@ -259,6 +347,12 @@ Status Launcher::start() {
       argv = std::move(sshArgv);
       environment.clear();
       d.viaSsh = true;
+    }
+    if (slurm) {
+      // srun exports this environment (with the hostfile's env=) to the daemon.
+      auto srun = srunCommand(placement.node, host.id);
+      argv.insert(argv.begin(), srun.begin(), srun.end());
+      d.viaSrun = true;
     }
     auto pid = spawnDaemon(argv, environment, d.toDaemon, d.fromDaemon);
     if (!pid) return makeError("host '" + host.id + "': " + pid.error().message);

@@ -14,8 +14,10 @@ namespace vrflow::launcher {
 
 /// One line of a hostfile: where a host of the application really runs.
 struct HostEntry {
-  std::string host;                     ///< host id, as in the application file
-  std::string address;                  ///< overrides the file's address (where the daemon binds)
+  std::string host;     ///< host id, as in the application file
+  std::string address;  ///< overrides the file's address (where the daemon binds)
+  /// mpirun, slurm: the machine the daemon runs on (an Open MPI hostfile's line, or `node=`).
+  std::string node;
   std::string user;                     ///< ssh only
   int sshPort = 22;                     ///< ssh only
   std::string identity;                 ///< ssh only: private key file (ssh -i)
@@ -26,8 +28,11 @@ struct HostEntry {
   int line = 0;
 };
 
-/// Reads a hostfile: `HOST [address=A] [user=U] [ssh-port=P] [identity=FILE] [ssh-option=K=V]...
-/// [dir=PATH] [daemon=PATH] [env=NAME=VALUE]...` per line, `#` comments. Errors name FILE:LINE.
+/// Reads a hostfile, `#` comments and blank lines skipped. vrflow's format: `HOST [address=A]
+/// [node=N] [user=U] [ssh-port=P] [identity=FILE] [ssh-option=K=V]... [dir=PATH] [daemon=PATH]
+/// [env=NAME=VALUE]...` per line. Open MPI's, recognised by `slots=` or `max_slots=` on a line:
+/// `MACHINE [slots=N] [max_slots=M]` per line, the application's hosts placed on the slots in
+/// order (one entry per host, with `node`). Errors (a mixed or malformed line) name FILE:LINE.
 Result<std::vector<HostEntry>> readHostfile(const std::string& path,
                                             const app::Application& application);
 
@@ -35,7 +40,8 @@ Result<std::vector<HostEntry>> readHostfile(const std::string& path,
 struct LaunchOptions {
   std::string appFile;
   std::string hostfile;
-  std::string backend = "local";
+  std::string backend = "local";        ///< local, ssh, mpirun or slurm
+  std::vector<std::string> mpirunArgs;  ///< `--mpirun-arg`: passed to mpirun before the ranks
   uint64_t iterations = 0;
   std::string reportPath;
   std::string tracePath;                     ///< Chrome trace of every host; empty = none
