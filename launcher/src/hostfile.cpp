@@ -160,6 +160,7 @@ Result<std::vector<HostEntry>> readHostfile(const std::string& path,
   bool openMpi = false;
   for (const auto& line : lines) {
     for (std::size_t w = 1; w < line.words.size(); ++w) {
+      if (line.words[w].find('=') == std::string::npos) continue;  // no key: malformed below
       const bool mpiWord = isOpenMpiKey(keyOf(line.words[w]));
       if (first == nullptr) {
         first = &line;

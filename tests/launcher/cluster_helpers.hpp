@@ -1,0 +1,29 @@
+#pragma once
+
+// What the cluster tests (hostfile_test.cpp, slurm_test.cpp) share.
+
+#include <sys/types.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace vrflow::testing {
+
+/// A running vrflow-daemon as /proc shows it.
+struct DaemonSeen {
+  pid_t pid = -1;
+  std::string commandLine;  ///< its words, each followed by a space
+  std::string environment;  ///< "\nNAME=VALUE" each, then "\n"
+};
+
+/// The vrflow-daemon serving `host` of `appFile` (its command line names both), once it runs:
+/// waits up to 30 s; pid -1 when none appeared.
+DaemonSeen findDaemon(const std::string& appFile, const std::string& host);
+
+/// Whether a vrflow-daemon of `appFile` still runs.
+bool daemonOfFileRuns(const std::string& appFile);
+
+/// A report without its timings and without what names the file or the hosts.
+nlohmann::json deterministicPart(const std::string& reportPath);
+
+}  // namespace vrflow::testing
