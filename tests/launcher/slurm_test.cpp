@@ -254,6 +254,36 @@ TEST_F(Slurm, ADaemonKilledUnderSlurmIsNamedTheRunFailsAndNothingIsLeft) {
   EXPECT_EQ(slurm_->steps(), "");
 }
 
+TEST_F(Slurm, MoreHostsThanNodesShareNodesAndAHostfilePlacesAHostOnANamedNode) {
+  TempDir dir;
+  const std::string appFile =
+      dir.write("pipeline_3hosts.xml",
+                readFile(sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml"));
+  const std::string hosts = dir.write("hosts", "# a on the second node\na node=n2\n");
+  CommandResult result;
+  // Two nodes for three hosts: a on n2 (node=), b on n2 and c on n1 (host i on node i mod 2).
+  std::thread launch([&] {
+    result =
+        runCommand({"/usr/bin/salloc", "--nodes=2", "--time=2", binDir() + "/vrflow", "launch",
+                    appFile, "--backend", "slurm", "--hosts", hosts, "-n", "0", "--timeout", "6"},
+                   60);
+  });
+  const DaemonSeen a = findDaemon(appFile, "a");
+  const DaemonSeen b = findDaemon(appFile, "b");
+  const DaemonSeen c = findDaemon(appFile, "c");
+  launch.join();
+  EXPECT_EQ(result.exitCode, 3) << result.err;  // --timeout: the run went on until then
+  EXPECT_NE(result.err.find("vrflow: 3 hosts on the 2 node(s) of slurm job "), std::string::npos)
+      << result.err;
+  EXPECT_NE(a.environment.find("\nSLURMD_NODENAME=n2\n"), std::string::npos);
+  EXPECT_NE(a.commandLine.find("--bind 127.0.0.2 "), std::string::npos) << a.commandLine;
+  EXPECT_NE(b.environment.find("\nSLURMD_NODENAME=n2\n"), std::string::npos);
+  EXPECT_NE(c.environment.find("\nSLURMD_NODENAME=n1\n"), std::string::npos);
+  EXPECT_NE(c.commandLine.find("--bind 127.0.0.1 "), std::string::npos) << c.commandLine;
+  EXPECT_FALSE(daemonOfFileRuns(appFile));
+  EXPECT_EQ(slurm_->steps(), "");
+}
+
 TEST(SlurmBackend, OutsideAnAllocationIsOneClearErrorAndStartsNothing) {
   for (const char* name : {"SLURM_JOB_ID", "SLURM_JOB_NODELIST", "SLURM_JOBID"}) unsetenv(name);
   const auto result =
