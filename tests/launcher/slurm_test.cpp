@@ -215,10 +215,12 @@ TEST_F(Slurm, TheSampleSbatchScriptGivesTheSameDigestsAsARunOnOneHost) {
                               "--no-progress", "--report", dir.file("one.json")},
                              120);
   ASSERT_EQ(one.exitCode, 0) << one.err;
-  // The script runs `vrflow` from PATH, in the folder it was submitted from.
+  // The script runs `vrflow` from PATH, in the folder it was submitted from, which holds
+  // examples/ (here a link to the sources', so that what the run writes stays in `dir`).
+  ASSERT_EQ(symlink((sourceDir() + "/examples").c_str(), dir.file("examples").c_str()), 0);
   const std::string path = binDir() + ":" + std::getenv("PATH");
   const auto job = runCommand(
-      {"/usr/bin/sbatch", "--wait", "--chdir=" + sourceDir(), "--output=" + dir.file("job.out"),
+      {"/usr/bin/sbatch", "--wait", "--chdir=" + dir.path(), "--output=" + dir.file("job.out"),
        "--export=ALL,PATH=" + path +
            ",VRFLOW_ITERATIONS=100,VRFLOW_REPORT=" + dir.file("three.json"),
        sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.sbatch"},
