@@ -164,14 +164,32 @@ std::vector<std::string> Launcher::srunCommand(const std::string& node,
 void Launcher::cancelSlurmSteps() const {
   const char* job = std::getenv("SLURM_JOB_ID");
   if (options_.backend != "slurm" || job == nullptr) return;
-  auto steps = commandOutput({"squeue", "--noheader", "--steps", "--jobs", job, "--format=%i %j"});
-  if (!steps) return;
   const std::string prefix = "vrflow-" + std::to_string(getpid()) + "-";
-  std::istringstream lines(*steps);
-  for (std::string id, name; lines >> id >> name;) {
-    if (name.rfind(prefix, 0) != 0) continue;
+  // This launch's steps still listed, "ID NAME" each.
+  auto ours = [&] {
+    std::vector<std::pair<std::string, std::string>> found;
+    auto steps =
+        commandOutput({"squeue", "--noheader", "--steps", "--jobs", job, "--format=%i %j"});
+    std::istringstream lines(steps ? *steps : std::string());
+    for (std::string id, name; lines >> id >> name;) {
+      if (name.rfind(prefix, 0) == 0) found.emplace_back(id, name);
+    }
+    return found;
+  };
+  auto left = ours();
+  for (const auto& [id, name] : left) {
     std::fprintf(stderr, "vrflow: cancelling slurm step %s (%s)\n", id.c_str(), name.c_str());
     [[maybe_unused]] auto cancelled = commandOutput({"scancel", "--quiet", id});
+  }
+  // Gone once slurmctld says so (10 s at most: KillWait may let a task take its time).
+  const auto begin = Clock::now();
+  while (!left.empty() && secondsSince(begin) < 10) {
+    usleep(200'000);
+    left = ours();
+  }
+  for (const auto& [id, name] : left) {
+    std::fprintf(stderr, "vrflow: slurm step %s (%s) is still listed after scancel\n", id.c_str(),
+                 name.c_str());
   }
 }
 

@@ -14,9 +14,10 @@ std::string words(std::string text, char separator) {
   return text;
 }
 
-DaemonSeen daemonNow(const std::string& appFile, const std::string& host) {
+DaemonSeen daemonNow(const std::string& appFile, const std::string& host,
+                     const std::string& program) {
   for (const ProcessInfo& p : processTable()) {
-    if (p.name != "vrflow-daemon") continue;
+    if (p.name != program) continue;
     const std::string proc = "/proc/" + std::to_string(p.pid);
     const std::string commandLine = words(readFile(proc + "/cmdline"), ' ');
     if (commandLine.find(appFile + " ") == std::string::npos) continue;
@@ -28,16 +29,17 @@ DaemonSeen daemonNow(const std::string& appFile, const std::string& host) {
 
 }  // namespace
 
-DaemonSeen findDaemon(const std::string& appFile, const std::string& host) {
+DaemonSeen findDaemon(const std::string& appFile, const std::string& host,
+                      const std::string& program) {
   for (int i = 0; i < 300; ++i) {
-    if (DaemonSeen seen = daemonNow(appFile, host); seen.pid > 0) return seen;
+    if (DaemonSeen seen = daemonNow(appFile, host, program); seen.pid > 0) return seen;
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   return {};
 }
 
 bool daemonOfFileRuns(const std::string& appFile) {
-  return daemonNow(appFile, "").pid > 0;
+  return daemonNow(appFile, "", "vrflow-daemon").pid > 0;
 }
 
 nlohmann::json deterministicPart(const std::string& reportPath) {

@@ -17,8 +17,10 @@ struct DaemonSeen {
 };
 
 /// The vrflow-daemon serving `host` of `appFile` (its command line names both), once it runs:
-/// waits up to 30 s; pid -1 when none appeared.
-DaemonSeen findDaemon(const std::string& appFile, const std::string& host);
+/// waits up to 30 s; pid -1 when none appeared. `program`: another process name (srun, ssh)
+/// whose command line names both.
+DaemonSeen findDaemon(const std::string& appFile, const std::string& host,
+                      const std::string& program = "vrflow-daemon");
 
 /// Whether a vrflow-daemon of `appFile` still runs.
 bool daemonOfFileRuns(const std::string& appFile);

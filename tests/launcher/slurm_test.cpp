@@ -256,6 +256,34 @@ TEST_F(Slurm, ADaemonKilledUnderSlurmIsNamedTheRunFailsAndNothingIsLeft) {
   EXPECT_EQ(slurm_->steps(), "");
 }
 
+TEST_F(Slurm, AKilledSrunIsNamedAndItsStepIsCancelled) {
+  TempDir dir;
+  const std::string appFile =
+      dir.write("pipeline_3hosts.xml",
+                readFile(sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml"));
+  CommandResult result;
+  std::thread launch([&] {
+    result = runCommand({"/usr/bin/salloc", "--nodes=3", "--time=2", binDir() + "/vrflow", "launch",
+                         appFile, "--backend", "slurm", "-n", "0"},
+                        60);
+  });
+  // Killed, srun leaves its step (and host b's daemon) running: the launcher cancels it.
+  const DaemonSeen srun = findDaemon(appFile, "b", "srun");
+  EXPECT_GT(srun.pid, 0) << "no srun of host b appeared";
+  EXPECT_GT(findDaemon(appFile, "b").pid, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the run get going
+  if (srun.pid > 0) kill(srun.pid, SIGKILL);
+  launch.join();
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find("vrflow: daemon of host 'b' (127.0.0.2, srun pid " +
+                            std::to_string(srun.pid) + ") was killed by signal 9"),
+            std::string::npos)
+      << result.err;
+  EXPECT_NE(result.err.find("vrflow: cancelling slurm step "), std::string::npos) << result.err;
+  EXPECT_FALSE(daemonOfFileRuns(appFile));
+  EXPECT_EQ(slurm_->steps(), "");
+}
+
 TEST_F(Slurm, MoreHostsThanNodesShareNodesAndAHostfilePlacesAHostOnANamedNode) {
   TempDir dir;
   const std::string appFile =
