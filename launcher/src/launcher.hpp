@@ -82,6 +82,10 @@ struct SlurmAllocation {
   std::vector<std::string> addresses;  ///< IPv4, one per node
 };
 
+/// An error unless this process runs inside a Slurm allocation (SLURM_JOB_ID and
+/// SLURM_JOB_NODELIST set).
+Status insideSlurmAllocation();
+
 /// The allocation this process runs in, or an error saying it runs in none.
 Result<SlurmAllocation> slurmAllocation();
 

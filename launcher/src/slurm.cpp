@@ -83,14 +83,21 @@ Result<std::string> ipv4Of(const std::string& name) {
   return std::string(text);
 }
 
+Status insideSlurmAllocation() {
+  for (const char* name : {"SLURM_JOB_ID", "SLURM_JOB_NODELIST"}) {
+    if (std::getenv(name) == nullptr) {
+      return makeError(std::string("--backend slurm runs inside a Slurm allocation (salloc or "
+                                   "sbatch): ") +
+                       name + " is not set");
+    }
+  }
+  return {};
+}
+
 Result<SlurmAllocation> slurmAllocation() {
+  if (auto inside = insideSlurmAllocation(); !inside) return inside.error();
   const char* job = std::getenv("SLURM_JOB_ID");
   const char* list = std::getenv("SLURM_JOB_NODELIST");
-  if (job == nullptr || list == nullptr) {
-    return makeError(std::string("--backend slurm runs inside a Slurm allocation (salloc or "
-                                 "sbatch): ") +
-                     (job == nullptr ? "SLURM_JOB_ID" : "SLURM_JOB_NODELIST") + " is not set");
-  }
   SlurmAllocation allocation;
   allocation.jobId = job;
   auto names = commandOutput({"scontrol", "show", "hostnames", list});

@@ -232,13 +232,7 @@ Status checkLaunch(const app::Application& application, const LaunchOptions& opt
                      ")");
   }
   if (options.backend == "slurm") {
-    for (const char* name : {"SLURM_JOB_ID", "SLURM_JOB_NODELIST"}) {
-      if (std::getenv(name) == nullptr) {
-        return makeError(std::string("--backend slurm runs inside a Slurm allocation (salloc "
-                                     "or sbatch): ") +
-                         name + " is not set");
-      }
-    }
+    if (auto inside = insideSlurmAllocation(); !inside) return inside;
   }
   if (options.hostfile.empty()) return {};
   auto entries = readHostfile(options.hostfile, application);

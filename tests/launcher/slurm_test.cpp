@@ -314,6 +314,21 @@ TEST_F(Slurm, MoreHostsThanNodesShareNodesAndAHostfilePlacesAHostOnANamedNode) {
   EXPECT_EQ(slurm_->steps(), "");
 }
 
+TEST_F(Slurm, AHostfileNodeOutsideTheAllocationIsNamedWithItsLineAndNothingStarts) {
+  TempDir dir;
+  const std::string hosts = dir.write("hosts", "a\nb node=n9\n");
+  const auto result =
+      runCommand({"/usr/bin/salloc", "--nodes=2", "--time=2", binDir() + "/vrflow", "launch",
+                  sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml", "--backend",
+                  "slurm", "--hosts", hosts, "-n", "5"},
+                 60);
+  EXPECT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_NE(result.err.find(hosts + ":2: error: node 'n9' of host 'b' is not in slurm job "),
+            std::string::npos)
+      << result.err;
+  EXPECT_EQ(slurm_->steps(), "");
+}
+
 TEST(SlurmBackend, OutsideAnAllocationIsOneClearErrorAndStartsNothing) {
   for (const char* name : {"SLURM_JOB_ID", "SLURM_JOB_NODELIST", "SLURM_JOBID"}) unsetenv(name);
   const auto result =
