@@ -43,6 +43,10 @@ const char* const kPrograms[] = {"/usr/sbin/munged",  "/usr/sbin/slurmctld", "/u
                                  "/usr/bin/scontrol", "/usr/bin/squeue",     "/usr/bin/scancel",
                                  "/usr/bin/sinfo"};
 
+std::string threeHostsFile() {
+  return sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml";
+}
+
 // Why this machine cannot run the local Slurm, or "".
 std::string whyNoSlurm() {
   if (geteuid() != 0) return "the local Slurm runs its daemons as root (slurmd starts jobs)";
@@ -195,6 +199,34 @@ class LocalSlurm {
   std::vector<pid_t> pids_;
 };
 
+// `salloc --nodes=N vrflow launch COPY --backend slurm ARGS...`, running in a thread meanwhile,
+// of a copy of the example in `dir` (its daemons told apart from any other's by that path).
+class SallocLaunch {
+ public:
+  SallocLaunch(const TempDir& dir, int nodes, const std::vector<std::string>& args)
+      : appFile(dir.write("pipeline_3hosts.xml", readFile(threeHostsFile()))) {
+    std::vector<std::string> argv{"/usr/bin/salloc", "--nodes=" + std::to_string(nodes),
+                                  "--time=2",        binDir() + "/vrflow",
+                                  "launch",          appFile,
+                                  "--backend",       "slurm"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    thread_ = std::thread([this, argv] { result_ = runCommand(argv, 60); });
+  }
+  ~SallocLaunch() { result(); }
+  SallocLaunch(const SallocLaunch&) = delete;
+  SallocLaunch& operator=(const SallocLaunch&) = delete;
+  /// How it ended (waits for it: 60 s at most).
+  const CommandResult& result() {
+    if (thread_.joinable()) thread_.join();
+    return result_;
+  }
+  const std::string appFile;
+
+ private:
+  CommandResult result_;
+  std::thread thread_;
+};
+
 class Slurm : public ::testing::Test {
  protected:
   static void TearDownTestSuite() { slurm_.reset(); }
@@ -232,76 +264,51 @@ TEST_F(Slurm, TheSampleSbatchScriptGivesTheSameDigestsAsARunOnOneHost) {
 
 TEST_F(Slurm, ADaemonKilledUnderSlurmIsNamedTheRunFailsAndNothingIsLeft) {
   TempDir dir;
-  const std::string appFile =
-      dir.write("pipeline_3hosts.xml",
-                readFile(sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml"));
-  CommandResult result;
-  std::thread launch([&] {
-    result = runCommand({"/usr/bin/salloc", "--nodes=3", "--time=2", binDir() + "/vrflow", "launch",
-                         appFile, "--backend", "slurm", "-n", "0"},
-                        60);
-  });
-  const DaemonSeen b = findDaemon(appFile, "b");
+  SallocLaunch launch(dir, 3, {"-n", "0"});
+  const DaemonSeen b = findDaemon(launch.appFile, "b");
   EXPECT_GT(b.pid, 0) << "no daemon of host b appeared";
   // Host b on node n2, listening on n2's address.
   EXPECT_NE(b.commandLine.find("--bind 127.0.0.2 "), std::string::npos) << b.commandLine;
   EXPECT_NE(b.environment.find("\nSLURMD_NODENAME=n2\n"), std::string::npos);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the run get going
   if (b.pid > 0) kill(b.pid, SIGKILL);
-  launch.join();
+  const CommandResult& result = launch.result();
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find("vrflow: daemon of host 'b' (127.0.0.2, srun pid "), std::string::npos)
       << result.err;
-  EXPECT_FALSE(daemonOfFileRuns(appFile));
+  EXPECT_FALSE(daemonOfFileRuns(launch.appFile));
   EXPECT_EQ(slurm_->steps(), "");
 }
 
 TEST_F(Slurm, AKilledSrunIsNamedAndItsStepIsCancelled) {
   TempDir dir;
-  const std::string appFile =
-      dir.write("pipeline_3hosts.xml",
-                readFile(sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml"));
-  CommandResult result;
-  std::thread launch([&] {
-    result = runCommand({"/usr/bin/salloc", "--nodes=3", "--time=2", binDir() + "/vrflow", "launch",
-                         appFile, "--backend", "slurm", "-n", "0"},
-                        60);
-  });
+  SallocLaunch launch(dir, 3, {"-n", "0"});
   // Killed, srun leaves its step (and host b's daemon) running: the launcher cancels it.
-  const DaemonSeen srun = findDaemon(appFile, "b", "srun");
+  const DaemonSeen srun = findDaemon(launch.appFile, "b", "srun");
   EXPECT_GT(srun.pid, 0) << "no srun of host b appeared";
-  EXPECT_GT(findDaemon(appFile, "b").pid, 0);
+  EXPECT_GT(findDaemon(launch.appFile, "b").pid, 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the run get going
   if (srun.pid > 0) kill(srun.pid, SIGKILL);
-  launch.join();
+  const CommandResult& result = launch.result();
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find("vrflow: daemon of host 'b' (127.0.0.2, srun pid " +
                             std::to_string(srun.pid) + ") was killed by signal 9"),
             std::string::npos)
       << result.err;
   EXPECT_NE(result.err.find("vrflow: cancelling slurm step "), std::string::npos) << result.err;
-  EXPECT_FALSE(daemonOfFileRuns(appFile));
+  EXPECT_FALSE(daemonOfFileRuns(launch.appFile));
   EXPECT_EQ(slurm_->steps(), "");
 }
 
 TEST_F(Slurm, MoreHostsThanNodesShareNodesAndAHostfilePlacesAHostOnANamedNode) {
   TempDir dir;
-  const std::string appFile =
-      dir.write("pipeline_3hosts.xml",
-                readFile(sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml"));
   const std::string hosts = dir.write("hosts", "# a on the second node\na node=n2\n");
-  CommandResult result;
   // Two nodes for three hosts: a on n2 (node=), b on n2 and c on n1 (host i on node i mod 2).
-  std::thread launch([&] {
-    result =
-        runCommand({"/usr/bin/salloc", "--nodes=2", "--time=2", binDir() + "/vrflow", "launch",
-                    appFile, "--backend", "slurm", "--hosts", hosts, "-n", "0", "--timeout", "6"},
-                   60);
-  });
-  const DaemonSeen a = findDaemon(appFile, "a");
-  const DaemonSeen b = findDaemon(appFile, "b");
-  const DaemonSeen c = findDaemon(appFile, "c");
-  launch.join();
+  SallocLaunch launch(dir, 2, {"--hosts", hosts, "-n", "0", "--timeout", "6"});
+  const DaemonSeen a = findDaemon(launch.appFile, "a");
+  const DaemonSeen b = findDaemon(launch.appFile, "b");
+  const DaemonSeen c = findDaemon(launch.appFile, "c");
+  const CommandResult& result = launch.result();
   EXPECT_EQ(result.exitCode, 3) << result.err;  // --timeout: the run went on until then
   EXPECT_NE(result.err.find("vrflow: 3 hosts on the 2 node(s) of slurm job "), std::string::npos)
       << result.err;
@@ -310,7 +317,7 @@ TEST_F(Slurm, MoreHostsThanNodesShareNodesAndAHostfilePlacesAHostOnANamedNode) {
   EXPECT_NE(b.environment.find("\nSLURMD_NODENAME=n2\n"), std::string::npos);
   EXPECT_NE(c.environment.find("\nSLURMD_NODENAME=n1\n"), std::string::npos);
   EXPECT_NE(c.commandLine.find("--bind 127.0.0.1 "), std::string::npos) << c.commandLine;
-  EXPECT_FALSE(daemonOfFileRuns(appFile));
+  EXPECT_FALSE(daemonOfFileRuns(launch.appFile));
   EXPECT_EQ(slurm_->steps(), "");
 }
 
@@ -319,8 +326,7 @@ TEST_F(Slurm, AHostfileNodeOutsideTheAllocationIsNamedWithItsLineAndNothingStart
   const std::string hosts = dir.write("hosts", "a\nb node=n9\n");
   const auto result =
       runCommand({"/usr/bin/salloc", "--nodes=2", "--time=2", binDir() + "/vrflow", "launch",
-                  sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml", "--backend",
-                  "slurm", "--hosts", hosts, "-n", "5"},
+                  threeHostsFile(), "--backend", "slurm", "--hosts", hosts, "-n", "5"},
                  60);
   EXPECT_EQ(result.exitCode, 1) << result.err;
   EXPECT_NE(result.err.find(hosts + ":2: error: node 'n9' of host 'b' is not in slurm job "),
@@ -331,9 +337,7 @@ TEST_F(Slurm, AHostfileNodeOutsideTheAllocationIsNamedWithItsLineAndNothingStart
 
 TEST(SlurmBackend, OutsideAnAllocationIsOneClearErrorAndStartsNothing) {
   for (const char* name : {"SLURM_JOB_ID", "SLURM_JOB_NODELIST", "SLURM_JOBID"}) unsetenv(name);
-  const auto result =
-      runVrflow({"launch", sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml",
-                 "--backend", "slurm", "-n", "5"});
+  const auto result = runVrflow({"launch", threeHostsFile(), "--backend", "slurm", "-n", "5"});
   EXPECT_EQ(result.exitCode, 2);
   EXPECT_NE(result.err.find("--backend slurm runs inside a Slurm allocation (salloc or sbatch): "
                             "SLURM_JOB_ID is not set"),
