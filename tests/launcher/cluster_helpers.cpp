@@ -1,6 +1,9 @@
 #include "cluster_helpers.hpp"
 
+#include <sys/stat.h>
+
 #include <chrono>
+#include <cstdlib>
 #include <thread>
 
 #include "process_helpers.hpp"
@@ -36,6 +39,17 @@ DaemonSeen findDaemon(const std::string& appFile, const std::string& host,
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   return {};
+}
+
+void useOwnHome() {
+  static const TempDir home;
+  for (const auto& [variable, folder] :
+       {std::pair{"HOME", "home"}, std::pair{"XDG_RUNTIME_DIR", "runtime"},
+        std::pair{"XDG_STATE_HOME", "state"}}) {
+    const std::string path = home.file(folder);
+    mkdir(path.c_str(), 0700);
+    setenv(variable, path.c_str(), 1);
+  }
 }
 
 bool daemonOfFileRuns(const std::string& appFile) {

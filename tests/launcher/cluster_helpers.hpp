@@ -25,6 +25,10 @@ DaemonSeen findDaemon(const std::string& appFile, const std::string& host,
 /// Whether a vrflow-daemon of `appFile` still runs.
 bool daemonOfFileRuns(const std::string& appFile);
 
+/// Points HOME, XDG_RUNTIME_DIR and XDG_STATE_HOME of this process (and so of what it starts,
+/// Slurm jobs included) at folders (0700) of a temporary folder of its own, removed at exit.
+void useOwnHome();
+
 /// A report without its timings and without what names the file or the hosts.
 nlohmann::json deterministicPart(const std::string& reportPath);
 

@@ -113,6 +113,7 @@ TEST(Hostfile, MixedOrMalformedLinesAreOneErrorNamingFileAndLine) {
 }
 
 TEST(Hostfile, MachinesAreRefusedByTheBackendsThatRunEverythingHereOrOverSsh) {
+  useOwnHome();
   TempDir dir;
   const auto hosts = dir.write("hosts", "localhost slots=3\n");
   for (const std::string backend : {"local", "ssh"}) {
@@ -141,6 +142,7 @@ bool mpirunUsable() {
 }
 
 TEST(HostfileMpirun, AnOpenMpiHostfileAndMpirunArgsGiveTheSameDigestsAsOneHost) {
+  useOwnHome();
   if (!mpirunUsable()) GTEST_SKIP() << "mpirun is not installed";
   TempDir dir;
   const auto one = runVrflow({"run", sourceDir() + "/examples/pipeline/pipeline.xml", "-n", "60",
@@ -162,6 +164,7 @@ TEST(HostfileMpirun, AnOpenMpiHostfileAndMpirunArgsGiveTheSameDigestsAsOneHost) 
 }
 
 TEST(HostfileMpirun, TheHostfileAddressesAndEnvironmentReachTheDaemonsUnderMpirun) {
+  useOwnHome();
   if (!mpirunUsable()) GTEST_SKIP() << "mpirun is not installed";
   TempDir dir;
   // A copy of the application at a path of this test, to find its daemons among the machine's.

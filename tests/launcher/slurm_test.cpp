@@ -232,6 +232,7 @@ class Slurm : public ::testing::Test {
   static void TearDownTestSuite() { slurm_.reset(); }
   void SetUp() override {
     if (const std::string why = whyNoSlurm(); !why.empty()) GTEST_SKIP() << why;
+    useOwnHome();
     if (!slurm_) {
       slurm_ = std::make_unique<LocalSlurm>();
       ASSERT_EQ(slurm_->waitUntilIdle(), "");
@@ -336,6 +337,7 @@ TEST_F(Slurm, AHostfileNodeOutsideTheAllocationIsNamedWithItsLineAndNothingStart
 }
 
 TEST(SlurmBackend, OutsideAnAllocationIsOneClearErrorAndStartsNothing) {
+  useOwnHome();
   for (const char* name : {"SLURM_JOB_ID", "SLURM_JOB_NODELIST", "SLURM_JOBID"}) unsetenv(name);
   const auto result = runVrflow({"launch", threeHostsFile(), "--backend", "slurm", "-n", "5"});
   EXPECT_EQ(result.exitCode, 2);
