@@ -59,12 +59,19 @@ TEST(PackageFolders, MissingFolderIsAnErrorAtItsLineNamingTheResolvedPath) {
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 
+// `vrflow --packages cli validate app.xml`, package `pkg` declaring `cliType` in cli/ and
+// `fileType` in file/ (the file's <packages>), the file using `pkg/cliType`.
+CommandResult validateWithTwoPackages(const TempDir& dir, const std::string& cliType,
+                                      const std::string& fileType) {
+  writePackage(dir, "cli", cliType);
+  writePackage(dir, "file", fileType);
+  dir.write("app.xml", appUsing("file", cliType));
+  return vrflowIn(dir.path(), "--packages cli validate app.xml");
+}
+
 TEST(PackageFolders, CommandLineFolderComesFirstAndTheHiddenPackageIsReported) {
   TempDir dir;
-  writePackage(dir, "cli", "from-cli");
-  writePackage(dir, "file", "from-file");
-  dir.write("app.xml", appUsing("file", "from-cli"));
-  const auto ran = vrflowIn(dir.path(), "--packages cli validate app.xml");
+  const auto ran = validateWithTwoPackages(dir, "from-cli", "from-file");
   EXPECT_EQ(ran.exitCode, 0) << ran.err;
   EXPECT_NE(ran.err.find(
                 dir.file("file/pkg/vrflow-package.xml") + ": warning: package 'pkg' is not used: " +
@@ -80,10 +87,7 @@ TEST(PackageFolders, CommandLineFolderComesFirstAndTheHiddenPackageIsReported) {
 
 TEST(PackageFolders, IdenticalCopyOfAPackageIsNotReported) {
   TempDir dir;
-  writePackage(dir, "copy", "gen");
-  writePackage(dir, "file", "gen");
-  dir.write("app.xml", appUsing("file", "gen"));
-  const auto ran = vrflowIn(dir.path(), "--packages copy validate app.xml");
+  const auto ran = validateWithTwoPackages(dir, "gen", "gen");
   EXPECT_EQ(ran.exitCode, 0) << ran.err;
   EXPECT_EQ(ran.err, "");
 }

@@ -122,8 +122,8 @@ std::vector<std::string> examplesWithAReadme() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Examples, ExampleReadme, ::testing::ValuesIn(examplesWithAReadme()),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                           return info.param;
+                         [](const ::testing::TestParamInfo<std::string>& example) {
+                           return example.param;
                          });
 
 TEST(ExampleReadmes, ReaderJoinsContinuationLinesAndCutsIterations) {
