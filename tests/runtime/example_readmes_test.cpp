@@ -94,7 +94,6 @@ TEST_P(ExampleReadme, CommandsRunAsWrittenFromTheRepositoryRoot) {
   std::filesystem::create_directory_symlink(std::filesystem::path(binDir()).parent_path(),
                                             root.file("build"));
   std::filesystem::create_directory_symlink(sourceDir() + "/examples", root.file("examples"));
-  std::filesystem::create_directories(root.file("out"));
   for (const auto& block : blocks) {
     std::string script = "set -e\ncd " + root.path() + "\n";
     for (const std::string& line : block) {
