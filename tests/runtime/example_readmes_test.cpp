@@ -73,6 +73,8 @@ std::vector<std::vector<std::string>> commandBlocks(const std::string& readme) {
       continue;
     }
     std::string text = line.substr(4);
+    // A continuation line's indentation is not part of the command.
+    if (!pending.empty()) text.erase(0, text.find_first_not_of(' '));
     if (!text.empty() && text.back() == '\\') {
       pending += text.substr(0, text.size() - 1);
       continue;
@@ -131,9 +133,9 @@ TEST(ExampleReadmes, ReaderJoinsContinuationLinesAndCutsIterations) {
       "        --report r.json\n\n    a diagram line\n\n```sh\n    build/bin/vrflow run b\n```\n");
   ASSERT_EQ(blocks.size(), 1u);
   ASSERT_EQ(blocks[0].size(), 2u);
-  EXPECT_EQ(blocks[0][1], "../../build/bin/vrflow run a.xml -n 300         --report r.json");
+  EXPECT_EQ(blocks[0][1], "../../build/bin/vrflow run a.xml -n 300 --report r.json");
   EXPECT_EQ(withFewIterations(blocks[0][1]),
-            "../../build/bin/vrflow run a.xml -n 20         --report r.json");
+            "../../build/bin/vrflow run a.xml -n 20 --report r.json");
   EXPECT_EQ(withFewIterations("vrflow run a.xml --iterations 5"),
             "vrflow run a.xml --iterations 5");
 }
