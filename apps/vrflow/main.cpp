@@ -310,7 +310,7 @@ int main(int argc, char** argv) {
   };
   // A catalog that cannot be loaded is a mistake in what was given (exit 2), whatever the command.
   const auto invalid = [](const vrflow::run::Prepared& prepared, int code) {
-    return prepared.catalog ? code : vrflow::run::kExitInvalid;
+    return prepared.catalogFailed ? vrflow::run::kExitInvalid : code;
   };
   vrflow::run::Prepared prepared;
   if (validate->parsed()) {

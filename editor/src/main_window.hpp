@@ -119,6 +119,7 @@ class MainWindow : public QMainWindow {
 
  private:
   void buildMenus();
+  void addPackageFolders(const app::Application& app);
   void refresh();
   void updateTitle();
   void addRecent(const QString& path);

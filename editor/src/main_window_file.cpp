@@ -13,6 +13,7 @@
 #include <algorithm>
 
 #include "main_window.hpp"
+#include "vrflow/app/catalog.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/writer.hpp"
 
@@ -74,6 +75,7 @@ bool MainWindow::openFile(const QString& path) {
                                  : QString::fromStdString(loaded.error().message)));
     return false;
   }
+  addPackageFolders(*loaded);
   OpenedText opened{text, app::saveApplication(*loaded)};
   setDocument(std::move(*loaded), std::move(opened), QFileInfo(path).absoluteFilePath());
   addRecent(path_);
@@ -84,6 +86,20 @@ bool MainWindow::openFile(const QString& path) {
                            QString::fromStdString(app::formatDiagnostics(problems)));
   }
   return true;
+}
+
+// The file's <packages> folders join the palette, after the folders the editor started with.
+void MainWindow::addPackageFolders(const app::Application& app) {
+  std::vector<app::Diagnostic> missing;
+  const std::vector<std::string> folders = app::packageFolders(app, missing);
+  for (const app::Diagnostic& problem : missing) {
+    log_->appendPlainText(QString::fromStdString(app::formatDiagnostic(problem)));
+  }
+  if (folders.empty()) return;
+  if (const Status loaded = catalog_->loadSearchPath(folders); !loaded) {
+    log_->appendPlainText("Node packages: " + QString::fromStdString(loaded.error().message));
+  }
+  palette_->setCatalog(*catalog_);
 }
 
 bool MainWindow::save() {

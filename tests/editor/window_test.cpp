@@ -450,6 +450,16 @@ TEST_F(EditorWindow, EveryExampleOpensAndSavesUnchangedToTheSameBytes) {
   EXPECT_TRUE(reporter_.errors.isEmpty()) << reporter_.errors.join("\n").toStdString();
 }
 
+// multi_rate.xml names its own package folder (<packages path="."/>): the editor, started
+// without it, learns the package `multirate` when it opens the file.
+TEST_F(EditorWindow, OpeningAFileAddsItsPackageFoldersToThePalette) {
+  const QString path = sourceDir() + "/examples/multi_rate/multi_rate.xml";
+  ASSERT_TRUE(window_->openFile(path)) << reporter_.errors.join("\n").toStdString();
+  for (const auto& problem : window_->problems()) {
+    EXPECT_EQ(problem.message.find("unknown package"), std::string::npos) << problem.message;
+  }
+}
+
 TEST_F(EditorWindow, ShowsADeadlockCycleAsAnErrorOnCanvasAndInTheProblems) {
   pointsAndSpring();
   dragConnect("points.objects", "spring.objects");

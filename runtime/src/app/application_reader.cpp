@@ -16,8 +16,9 @@ namespace {
 using detail::ElementReader;
 using detail::ReadContext;
 
-constexpr std::array<std::string_view, 7> kSections = {
-    "hosts", "composites", "modules", "instances", "filters", "connections", "editor"};
+// `packages` may be written several times, before every other section.
+constexpr std::array<std::string_view, 8> kSections = {
+    "packages", "hosts", "composites", "modules", "instances", "filters", "connections", "editor"};
 
 // Reports text or elements inside an element that holds neither.
 void expectEmpty(const ReadContext& context, const pugi::xml_node& node) {
@@ -130,8 +131,21 @@ EditorNode readEditorNode(const ReadContext& context, const pugi::xml_node& node
   return editorNode;
 }
 
+PackageFolder readPackageFolder(const ReadContext& context, const pugi::xml_node& node) {
+  const ElementReader reader(context, node, {"path"});
+  PackageFolder folder;
+  folder.path = reader.required("path");
+  folder.loc = reader.loc();
+  expectEmpty(context, node);
+  return folder;
+}
+
 void readSection(const ReadContext& context, const pugi::xml_node& section, Application& app) {
   const std::string_view name = section.name();
+  if (name == "packages") {
+    app.packages.push_back(readPackageFolder(context, section));
+    return;
+  }
   const ElementReader reader(context, section, {});
   if (name == "hosts") {
     detail::forEachChild(context, section, {"host"}, [&](const pugi::xml_node& child) {
@@ -169,24 +183,25 @@ void readRoot(const ReadContext& context, const pugi::xml_node& root, Applicatio
   }
   // Sections are optional but keep their order (as in the XSD); each appears once.
   std::size_t next = 0;
-  detail::forEachChild(context, root,
-                       std::vector<std::string_view>(kSections.begin(), kSections.end()),
-                       [&](const pugi::xml_node& section) {
-                         std::size_t index = 0;
-                         while (kSections[index] != section.name()) ++index;
-                         if (index < next) {
-                           const bool repeated = index + 1 == next;
-                           context.error(context.source.element(section),
-                                         repeated ? "<" + std::string(section.name()) +
-                                                        "> appears twice; merge the two sections"
-                                                  : "<" + std::string(section.name()) +
-                                                        "> is out of order (sections go: hosts, "
-                                                        "composites, modules, instances, filters, "
-                                                        "connections, editor)");
-                         }
-                         next = std::max(next, index + 1);
-                         readSection(context, section, app);
-                       });
+  detail::forEachChild(
+      context, root, std::vector<std::string_view>(kSections.begin(), kSections.end()),
+      [&](const pugi::xml_node& section) {
+        std::size_t index = 0;
+        while (kSections[index] != section.name()) ++index;
+        const bool anotherFolder = index == 0 && next <= 1;
+        if (index < next && !anotherFolder) {
+          const bool repeated = index + 1 == next;
+          context.error(context.source.element(section),
+                        repeated ? "<" + std::string(section.name()) +
+                                       "> appears twice; merge the two sections"
+                                 : "<" + std::string(section.name()) +
+                                       "> is out of order (sections go: packages, hosts, "
+                                       "composites, modules, instances, filters, "
+                                       "connections, editor)");
+        }
+        next = std::max(next, index + 1);
+        readSection(context, section, app);
+      });
 }
 
 // What the runtime relies on after loading: at least one host, and a host for everything.

@@ -37,6 +37,12 @@ void writeHosts(std::string& out, const Application& app) {
   closeTag(out, 1, "hosts");
 }
 
+void writePackageFolders(std::string& out, const Application& app) {
+  for (const PackageFolder& folder : app.packages) {
+    Tag(out, 1, "packages").attribute("path", folder.path).close();
+  }
+}
+
 std::string defaultHost(const Application& app) {
   return app.hosts.empty() ? std::string() : app.hosts.front().id;
 }
@@ -129,14 +135,15 @@ std::string saveApplication(const Application& app) {
   Tag root(out, 0, "application");
   if (!app.name.empty()) root.attribute("name", app.name);
   root.attribute("version", "1");
-  const bool empty = onlyImplicitHost(app) && app.composites.empty() && app.modules.empty() &&
-                     app.instances.empty() && app.filters.empty() && app.connections.empty() &&
-                     app.editor.empty();
+  const bool empty = app.packages.empty() && onlyImplicitHost(app) && app.composites.empty() &&
+                     app.modules.empty() && app.instances.empty() && app.filters.empty() &&
+                     app.connections.empty() && app.editor.empty();
   if (empty) {
     root.close();
     return out;
   }
   root.open();
+  writePackageFolders(out, app);
   writeHosts(out, app);
   detail::writeComposites(out, app);
   writeModules(out, app);

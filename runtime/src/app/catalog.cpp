@@ -63,7 +63,12 @@ Status Catalog::addPackageFileImpl(const std::string& path, bool firstWins) {
     if (!manifest) return manifest.error();
     for (const auto& [package, file] : packageFiles_) {
       if (package != manifest->name) continue;
-      if (firstWins) return {};
+      if (firstWins) {
+        // A copy of the same manifest (the build tree's copy of a source folder) hides nothing.
+        const Result<std::string> used = detail::readWholeFile(file);
+        if (!used || *used != *content) hidden_.push_back({package, file, canonical});
+        return {};
+      }
       return makeError(path + ": error: package '" + package + "' is already loaded from " + file);
     }
     for (ModuleType& type : manifest->modules) modules_.push_back(std::move(type));
@@ -200,6 +205,36 @@ std::vector<PortSpec> Catalog::portsOf(const Module& module) const {
 std::vector<PortSpec> Catalog::portsOf(const Filter& filter) const {
   const FilterType* type = findFilter(filter.type);
   return type ? type->portsFor(filter.params) : std::vector<PortSpec>{};
+}
+
+std::vector<std::string> packageFolders(const Application& app, std::vector<Diagnostic>& problems) {
+  std::vector<std::string> folders;
+  for (const PackageFolder& folder : app.packages) {
+    const std::string path = packageFolderPath(app, folder);
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+      folders.push_back(path);
+      continue;
+    }
+    const std::string absolute = std::filesystem::absolute(path, ec).lexically_normal().string();
+    std::string message = "package folder '" + folder.path + "'";
+    if (!ec && absolute != folder.path) message += " (" + absolute + ")";
+    message += " is not a folder; <packages path> is taken from the application file's folder";
+    problems.push_back({folder.loc.attribute("path"), Diagnostic::Error, std::move(message)});
+  }
+  return folders;
+}
+
+std::vector<Diagnostic> hiddenPackageWarnings(const Catalog& catalog) {
+  std::vector<Diagnostic> warnings;
+  for (const HiddenPackage& hidden : catalog.hiddenPackages()) {
+    warnings.push_back(
+        {SourceLocation(hidden.hiddenManifest, 0, 0), Diagnostic::Warning,
+         "package '" + hidden.package + "' is not used: " + hidden.usedManifest +
+             " comes first on the search path (--packages, the application's <packages>, "
+             "$VRFLOW_PACKAGE_PATH, the installed packages)"});
+  }
+  return warnings;
 }
 
 std::vector<std::string> searchPathFromEnvironment(const char* variable) {

@@ -242,6 +242,7 @@ InstancePorts Expander::expandInstance(const std::string& id, const std::string&
 Application Expander::run() {
   Application flat;
   flat.name = app_.name;
+  flat.packages = app_.packages;
   flat.hosts = app_.hosts;
   flat.file = app_.file;
   flat.modules = app_.modules;

@@ -1,6 +1,7 @@
 #include "vrflow/app/model.hpp"
 
 #include <algorithm>
+#include <filesystem>
 
 #include "enum_names.hpp"
 #include "text_util.hpp"
@@ -195,6 +196,12 @@ std::optional<EndItTiming> parseEndItTiming(std::string_view text) {
 std::string effectiveHost(const Application& app, const std::string& host) {
   if (!host.empty() || app.hosts.empty()) return host;
   return app.hosts.front().id;
+}
+
+std::string packageFolderPath(const Application& app, const PackageFolder& folder) {
+  const std::filesystem::path path(folder.path);
+  if (path.is_absolute() || app.file.empty()) return folder.path;
+  return (std::filesystem::path(app.file).parent_path() / path).lexically_normal().string();
 }
 
 }  // namespace vrflow::app

@@ -28,19 +28,27 @@ Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs) {
 
 Prepared prepare(const PrepareSettings& settings) {
   Prepared prepared;
-  if (settings.validate) {
-    auto catalog = loadCatalog(settings.packageDirs);
-    if (!catalog) {
-      prepared.error = settings.program + ": " + catalog.error().message;
-      return prepared;
-    }
-    prepared.catalog = std::move(*catalog);
-  }
   std::vector<app::Diagnostic>& problems = prepared.diagnostics;
   auto application = app::loadApplicationFile(settings.file, &problems);
   if (!application) {
     prepared.error = application.error().message;  // it names the file
     return prepared;
+  }
+  if (settings.validate) {
+    // The command line's folders come first, then the file's own (loadCatalog adds the rest).
+    std::vector<std::string> dirs = settings.packageDirs;
+    for (std::string& folder : app::packageFolders(*application, problems)) {
+      dirs.push_back(std::move(folder));
+    }
+    auto catalog = loadCatalog(dirs);
+    if (!catalog) {
+      prepared.error = settings.program + ": " + catalog.error().message;
+      prepared.catalogFailed = true;
+      return prepared;
+    }
+    auto hidden = app::hiddenPackageWarnings(*catalog);
+    problems.insert(problems.end(), hidden.begin(), hidden.end());
+    prepared.catalog = std::move(*catalog);
   }
   // Settings of the file's own composite instances change what the expansion makes.
   std::vector<std::string> moduleSettings = settings.overrides;

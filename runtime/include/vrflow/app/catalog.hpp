@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "vrflow/app/diagnostic.hpp"
 #include "vrflow/app/model.hpp"
 #include "vrflow/app/package.hpp"
 #include "vrflow/base/result.hpp"
@@ -14,6 +15,14 @@ namespace vrflow::app {
 
 /// The name of a node package's manifest file.
 inline constexpr std::string_view kManifestFileName = "vrflow-package.xml";
+
+/// A package that loadSearchPath() did not load because an earlier folder has a package of the
+/// same name with a different manifest (an identical copy is not reported).
+struct HiddenPackage {
+  std::string package;
+  std::string usedManifest;    ///< the manifest loaded, from the earlier folder
+  std::string hiddenManifest;  ///< the manifest left out
+};
 
 /// Every module type and filter type an application may use: the node packages' manifests plus
 /// the filter types that daemon::makeCatalog() fills in (declared beside their code). Pointers it
@@ -34,8 +43,11 @@ class Catalog {
   /// Reads every manifest it can and reports all failures together.
   Status addPackageDir(const std::string& dir);
   /// addPackageDir() on each folder in order, like PATH: a package already loaded from an
-  /// earlier folder hides later ones with the same name. Folders that do not exist are skipped.
+  /// earlier folder hides later ones with the same name (hiddenPackages() lists those whose
+  /// manifest differs). Folders that do not exist are skipped.
   Status loadSearchPath(const std::vector<std::string>& dirs);
+  /// The packages loadSearchPath() left out for a different one of the same name, in order.
+  const std::vector<HiddenPackage>& hiddenPackages() const { return hidden_; }
 
   /// Registers a module type built in code; beginIt/endIt are added when missing. Fails when
   /// `package/type` is already known.
@@ -74,7 +86,17 @@ class Catalog {
   std::deque<FilterType> filters_;
   std::vector<std::string> manifests_;
   std::vector<std::pair<std::string, std::string>> packageFiles_;  // package -> manifest
+  std::vector<HiddenPackage> hidden_;
 };
+
+/// The folders the application's `<packages>` name (packageFolderPath()), in file order; each
+/// one that is not a folder is reported in `problems` as an error at its `path` attribute and
+/// left out.
+std::vector<std::string> packageFolders(const Application& app, std::vector<Diagnostic>& problems);
+
+/// A warning at each package hidden by another of the same name (Catalog::hiddenPackages()),
+/// naming the one used and the order of the search path.
+std::vector<Diagnostic> hiddenPackageWarnings(const Catalog& catalog);
 
 /// The directories listed in environment variable `variable` (':'-separated), in order.
 std::vector<std::string> searchPathFromEnvironment(const char* variable = "VRFLOW_PACKAGE_PATH");

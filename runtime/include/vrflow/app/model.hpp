@@ -107,9 +107,19 @@ struct EditorNode {
   SourceLocation loc;
 };
 
+/// A folder of node packages the file names (`<packages path="..."/>`): searched like a
+/// --packages folder, after the command line's and before $VRFLOW_PACKAGE_PATH and the installed
+/// packages (docs/application-format.md, "Package folders"). `path` is kept as written; a
+/// relative one is taken from the folder of the file (packageFolderPath()).
+struct PackageFolder {
+  std::string path;
+  SourceLocation loc;
+};
+
 /// A whole application file. Every vector keeps the order of the file.
 struct Application {
   std::string name;
+  std::vector<PackageFolder> packages;
   std::vector<Host> hosts;
   std::vector<Composite> composites;  ///< defined in the file; see expandComposites()
   std::vector<Module> modules;
@@ -191,6 +201,10 @@ std::optional<InputMode> parseInputMode(std::string_view text);
 std::string toString(EndItTiming timing);
 /// The timing written `text`, or nullopt.
 std::optional<EndItTiming> parseEndItTiming(std::string_view text);
+
+/// The folder `folder` names: its path as written when absolute or when the application has no
+/// file, else taken from the folder of `app.file`.
+std::string packageFolderPath(const Application& app, const PackageFolder& folder);
 
 /// The host a module or filter runs on: `host`, or the first host when empty.
 std::string effectiveHost(const Application& app, const std::string& host);

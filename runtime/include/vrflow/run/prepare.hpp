@@ -26,8 +26,9 @@ Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs);
 
 /// What prepare() does, and with what.
 struct PrepareSettings {
-  std::string file;                        ///< the application file
-  std::vector<std::string> packageDirs;    ///< --packages, searched before the defaults
+  std::string file;  ///< the application file
+  /// --packages, searched before the file's <packages> folders and the defaults
+  std::vector<std::string> packageDirs;
   std::vector<std::string> compositeDirs;  ///< --composites, searched after the file's folder
   std::vector<std::string> overrides;      ///< --set ID.PARAM=VALUE, in order
   /// Load the catalog and the application's plugins, and validate. Without: load, expand and
@@ -47,6 +48,8 @@ struct Prepared {
   /// An error that stopped the preparation before its diagnostics were complete (the catalog,
   /// a file that cannot be read, a bad --set), as one line to print; empty when none.
   std::string error;
+  /// True when `error` is that the node packages could not be loaded.
+  bool catalogFailed = false;
   /// True when the application is ready (no error, no diagnostic of severity error).
   bool ok() const { return application.has_value(); }
 };
