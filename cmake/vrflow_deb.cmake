@@ -16,6 +16,8 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS_PRIVATE_DIRS ${PROJECT_BINARY_DIR}/lib)
 # A shlibs file and the ldconfig trigger, for the shared libraries in /usr/lib.
 set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS ON)
+# `vrflow launch` starts daemons over ssh; the fluid's MPI blocks run under mpirun.
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "openssh-client, openmpi-bin")
 # What building a module or filter plugin against the installed SDK uses, and the manifest check.
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "g++, cmake, pkg-config, libxml2-utils")
 include(CPack)
