@@ -42,24 +42,15 @@ install_relocated() {
 
 # The JSON report $1 says the run ended well, after $2 iterations of each module.
 expect_report_ok() {
-  python3 - "$1" "$2" <<'PY' || fail "report $1"
-import json, sys
-report = json.load(open(sys.argv[1]))
-assert report["status"] == "ok", report["status"]
-for module in report["modules"]:
-    assert module["iterations"] == int(sys.argv[2]), module
-PY
+  grep -q '^  "status": "ok",$' "$1" || fail "report $1: the run did not end well: $(head -8 "$1")"
+  awk -v n="$2" '/^      "iterations": / { modules++; if ($2 != n ",") wrong++ }
+    END { exit !(modules > 0 && wrong == 0) }' "$1" ||
+    fail "report $1: not every module ran $2 iterations"
 }
 
 # The oscillator's CSV $1 follows x(t) = x0 cos(2 t) (examples/minimal_module/README.md).
 expect_oscillation() {
-  python3 - "$1" <<'PY' || fail "$1 does not follow x0 cos(2 t)"
-import math, sys
-lines = open(sys.argv[1]).read().splitlines()[1:]
-assert len(lines) > 0
-for i, line in enumerate(lines):
-    f = line.split(",")
-    t, x, x0 = float(f[3]), float(f[6]), float(i % 3)
-    assert abs(x - x0 * math.cos(2 * t)) < 5e-3, line
-PY
+  awk -F, 'NR > 1 { x0 = (NR - 2) % 3; d = $7 - x0 * cos(2 * $4); if (d < 0) d = -d;
+             if (d > 5e-3) { print "off at: " $0; bad = 1 }; rows++ }
+           END { exit !(rows > 0 && !bad) }' "$1" || fail "$1 does not follow x0 cos(2 t)"
 }
