@@ -13,9 +13,10 @@ PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-r
   libgtest-dev libpugixml-dev libcli11-dev \
   nlohmann-json3-dev libxxhash-dev libzmq3-dev libopenmpi-dev openmpi-bin libxml2-utils procps \
   libbullet-dev libeigen3-dev libosmesa6-dev libpng-dev qt6-base-dev libgraphviz-dev \
-  libsodium-dev openssh-server openssh-client clang-format munge slurmctld slurmd slurm-client
+  libsodium-dev openssh-server openssh-client clang-format dpkg-dev \
+  munge slurmctld slurmd slurm-client
 
-.PHONY: deps build test check format demo clean
+.PHONY: deps build test check format demo clean install
 
 deps:
 	@missing=$$(for p in $(PACKAGES); do \
@@ -70,6 +71,12 @@ demo: build
 	@QT_QPA_PLATFORM=offscreen $(BUILD)/bin/vrflow-editor examples/paper_scene/paper_scene_fluid.xml \
 	  --screenshot out/demo/editor.png >/dev/null 2>&1 || echo "(no editor screenshot)"
 	@echo "demo results in out/demo/: $$(cd out/demo && ls demo.mp4 2>/dev/null || echo PNG frames), frame.png, editor.png, report.json"
+
+# Installs the build into PREFIX (default /usr/local): programs, libraries, the SDK's headers, the
+# node packages, schemas, the CMake and pkg-config files (docs/install.md).
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
 
 clean:
 	rm -rf $(BUILD) out

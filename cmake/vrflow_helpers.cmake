@@ -15,10 +15,16 @@ if(VRFLOW_HEAVY_VALIDATION)
   target_compile_definitions(vrflow_warnings INTERFACE VRFLOW_HEAVY_VALIDATION=1)
 endif()
 
+# The layers that outside code links (docs/install.md): installed with an export (vrflow::NAME in
+# lib/cmake/vrflow/vrflowTargets.cmake). vrflow::module is the module SDK, vrflow::daemon the
+# filter SDK; app and net are exported because the daemon's link interface names them.
+set(VRFLOW_EXPORTED_LIBRARIES module app net daemon)
+
 # vrflow_add_library(NAME [SHARED] SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...] [INCLUDE dir]
 #                    [PRIVATE_INCLUDE dir]): SHARED makes one of vrflow's layers (docs/architecture.md),
-# a shared library with a version and an soname (libvrflow_NAME.so.0); without it a static
-# library, for what only one program or module links (a node package's solver).
+# a shared library with a version and an soname (libvrflow_NAME.so.0), installed in <prefix>/lib;
+# without it a static library, for what only one program or module links (a node package's
+# solver), never installed.
 function(vrflow_add_library name)
   cmake_parse_arguments(ARG "SHARED" "INCLUDE" "PRIVATE_INCLUDE;SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
   if(ARG_SHARED)
@@ -43,8 +49,17 @@ function(vrflow_add_library name)
   if(NOT ARG_PRIVATE_INCLUDE)
     set(ARG_PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src)
   endif()
-  target_include_directories(vrflow_${name} PUBLIC ${ARG_INCLUDE} PRIVATE ${ARG_PRIVATE_INCLUDE})
+  target_include_directories(vrflow_${name} PUBLIC $<BUILD_INTERFACE:${ARG_INCLUDE}>
+    PRIVATE ${ARG_PRIVATE_INCLUDE})
   target_link_libraries(vrflow_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE vrflow_warnings ${ARG_PRIVATE_DEPS})
+  if(name IN_LIST VRFLOW_EXPORTED_LIBRARIES)
+    set_target_properties(vrflow_${name} PROPERTIES EXPORT_NAME ${name})
+    target_compile_features(vrflow_${name} INTERFACE cxx_std_20)
+    target_include_directories(vrflow_${name} INTERFACE $<INSTALL_INTERFACE:include>)
+    install(TARGETS vrflow_${name} EXPORT vrflowTargets LIBRARY DESTINATION lib)
+  elseif(ARG_SHARED)
+    install(TARGETS vrflow_${name} LIBRARY DESTINATION lib NAMELINK_SKIP)
+  endif()
 endfunction()
 
 # vrflow_add_executable(NAME SOURCES ... [DEPS ...])
@@ -52,19 +67,6 @@ function(vrflow_add_executable name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE vrflow_warnings ${ARG_DEPS})
-endfunction()
-
-# vrflow_add_filter_plugin(NAME SOURCES ... [OUTPUT_DIRECTORY dir]): a filter plugin, a shared
-# library that `vrflow` and `vrflow-daemon` load at run time. It links the filter SDK
-# (libvrflow_daemon.so), which the loading program links too: one copy of each registry.
-function(vrflow_add_filter_plugin name)
-  cmake_parse_arguments(ARG "" "OUTPUT_DIRECTORY" "SOURCES" ${ARGN})
-  add_library(${name} MODULE ${ARG_SOURCES})
-  target_link_libraries(${name} PRIVATE vrflow_warnings vrflow::daemon)
-  set_target_properties(${name} PROPERTIES PREFIX "lib")
-  if(ARG_OUTPUT_DIRECTORY)
-    set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY})
-  endif()
 endfunction()
 
 # vrflow_add_test(NAME SOURCES ... DEPS ... LABELS ...): one GoogleTest executable, registered
@@ -83,19 +85,6 @@ function(vrflow_add_test name)
     TEST_PREFIX "${ARG_PREFIX}"
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
     DISCOVERY_TIMEOUT 60)
-endfunction()
-
-# vrflow_install_package(NAME MANIFEST): puts a node package's manifest where the `vrflow`
-# command finds it (<build>/share/vrflow/packages/NAME/); executables stay in <build>/bin.
-function(vrflow_install_package name manifest)
-  configure_file(${manifest} ${PROJECT_BINARY_DIR}/share/vrflow/packages/${name}/vrflow-package.xml COPYONLY)
-endfunction()
-
-# vrflow_install_composite(FILE): puts a composite a node package ships (NAME.vrc.xml) where the
-# `vrflow` command and the editor find it (<build>/share/vrflow/composites/, searched last).
-function(vrflow_install_composite file)
-  get_filename_component(name ${file} NAME)
-  configure_file(${file} ${PROJECT_BINARY_DIR}/share/vrflow/composites/${name} COPYONLY)
 endfunction()
 
 # vrflow_require(FOUND_VAR WHAT PACKAGES OPTION): stops the configuration when a dependency of a
