@@ -5,6 +5,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -273,6 +274,9 @@ std::optional<run::RunOutcome> ControlLink::poll() {
 }
 
 std::vector<std::string> ControlLink::drain(const run::RunOutcome& outcome) {
+  // The modules' last lines were sent (the supervisor read their pipes to the end): what was
+  // dropped of them is said before this host's end.
+  for (const auto& dropped : takeDropped()) send(dropped);
   send(net::ControlEvent::finished(outcome.exitCode, outcome.status, outcome.error));
   std::vector<std::string> warnings;
   // Keep routing (messages for the other hosts) until the launcher says every host is done.
@@ -344,6 +348,43 @@ void ControlLink::stats(const std::string& json) {
 
 void ControlLink::event(const std::string& line) {
   send(net::ControlEvent::payload(net::ControlEvent::Kind::Event, line));
+}
+
+std::vector<net::ControlEvent> ControlLink::takeDropped() {
+  std::vector<net::ControlEvent> events;
+  std::lock_guard lock(budget_.mutex);
+  for (auto& [module, count] : budget_.dropped) {
+    if (count > 0) events.push_back(net::ControlEvent::droppedLines(module, count));
+  }
+  budget_.dropped.clear();
+  return events;
+}
+
+void ControlLink::output(const std::string& module, std::string_view text) {
+  std::vector<net::ControlEvent> events;
+  {
+    std::lock_guard lock(budget_.mutex);
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - budget_.refilled).count();
+    budget_.refilled = now;
+    budget_.lines =
+        std::min(2 * kOutputLinesPerSecond, budget_.lines + seconds * kOutputLinesPerSecond);
+    budget_.bytes =
+        std::min(2 * kOutputBytesPerSecond, budget_.bytes + seconds * kOutputBytesPerSecond);
+    const auto size = static_cast<double>(text.size());
+    if (budget_.lines < 1 || budget_.bytes < size) {
+      ++budget_.dropped[module];
+      return;
+    }
+    budget_.lines -= 1;
+    budget_.bytes -= size;
+    for (auto& [id, count] : budget_.dropped) {
+      if (count > 0) events.push_back(net::ControlEvent::droppedLines(id, count));
+    }
+    budget_.dropped.clear();
+  }
+  events.push_back(net::ControlEvent::output(module, std::string(text)));
+  for (const auto& e : events) send(e);
 }
 
 void ControlLink::report(const std::string& json) {
