@@ -13,6 +13,7 @@
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/message/ids.hpp"
 #include "vrflow/net/control.hpp"
+#include "vrflow/run/log.hpp"
 
 namespace vrflow::tools {
 namespace {
@@ -156,8 +157,8 @@ void ControlLink::readLoop(int fd, const std::string& host, const std::shared_pt
   while (readLine(fd, line)) {
     auto command = net::parseControlCommand(line);
     if (!command) {
-      std::fprintf(stderr, "vrflow-daemon (host %s): ignored a line of the launcher: %s\n",
-                   host.c_str(), command.error().message.c_str());
+      run::logWarning("vrflow-daemon (host " + host +
+                      "): ignored a line of the launcher: " + command.error().message);
       continue;
     }
     // Answered here, at once, whatever the main thread is doing: the launcher kills a daemon
@@ -227,8 +228,8 @@ Status ControlLink::ready() {
     }
   }
   if (auto status = transport_->connectPeers(peers); !status) {
-    std::fprintf(stderr, "vrflow-daemon (host %s): cannot link to the other hosts: %s\n",
-                 host_.c_str(), status.error().message.c_str());
+    run::logError("vrflow-daemon (host " + host_ +
+                  "): cannot link to the other hosts: " + status.error().message);
     send(net::ControlEvent::error(status.error().message));
     return status;
   }
@@ -255,7 +256,7 @@ Status ControlLink::stoppedBeforeStart(const net::ControlCommand& command) {
   const std::string why = command.kind == Kind::Stop
                               ? "stopped by the launcher before the start"
                               : "the launcher closed the control channel before the start";
-  std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", host_.c_str(), why.c_str());
+  run::logWarning("vrflow-daemon (host " + host_ + "): " + why);
   return makeError(why);
 }
 

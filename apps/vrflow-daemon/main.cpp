@@ -218,7 +218,11 @@ int main(int argc, char** argv) {
   }
   options.wholeApplication = &*application;
   const auto outcome = vrflow::run::runApplication(local, catalog, options);
-  if (link) return outcome.exitCode;  // the launcher reports
+  if (link) {
+    // The launcher reports the error; the failed module's last lines reach its terminal here.
+    if (!outcome.detail.empty()) vrflow::run::logError(outcome.detail);
+    return outcome.exitCode;
+  }
   if (outcome.exitCode != 0) vrflow::run::logError("vrflow-daemon: " + outcome.error);
   if (!outcome.detail.empty()) vrflow::run::logError(outcome.detail);
   return outcome.exitCode;

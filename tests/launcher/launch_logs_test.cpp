@@ -67,6 +67,22 @@ TEST_F(LaunchLogsTest, EveryHostsModuleLinesArriveInTheLaunchersLogFolder) {
   EXPECT_TRUE(contains(readFile(logs + "/vrflow.log"), ", logs in " + logs));
 }
 
+TEST_F(LaunchLogsTest, AModuleThatCrashesOnAnotherHostShowsItsLastLinesOnTheLaunchersTerminal) {
+  const std::string logs = dir.file("logs");
+  const std::string file = dir.write("app.xml", threeHostsApp("<param name=\"lines\" value=\"2\"/>"
+                                                              "<param name=\"crash\" value=\"3\"/>",
+                                                              dir.path()));
+  const auto result = runVrflow({"launch", file, "-n", "50", "--log-dir", logs}, 120);
+  ASSERT_EQ(result.exitCode, 1) << result.err;
+  EXPECT_TRUE(contains(result.err, "was killed by signal 11")) << result.err;
+  EXPECT_TRUE(contains(result.err,
+                       "vrflow: the last 5 lines of module 'ta':\n  out 1\n  err 1\n"
+                       "  out 2\n  err 2\n  about to crash\n"))
+      << result.err;
+  EXPECT_EQ(readLines(logs + "/ta.log"),
+            (std::vector<std::string>{"out 1", "err 1", "out 2", "err 2", "about to crash"}));
+}
+
 TEST_F(LaunchLogsTest, AFloodingModulesLinesOverTheForwardingRateAreCountedAsDropped) {
   const std::string logs = dir.file("logs");
   const std::string file =

@@ -101,8 +101,8 @@ TEST_F(LogsTest, CrashedModulesFailureNamesItsLogFileAndShowsItsLastLines) {
   const auto result = runVrflow({"run", file, "-n", "50", "--log-dir", logs, "--report", report});
   ASSERT_EQ(result.exitCode, 1) << result.err;
   EXPECT_TRUE(contains(result.err, "was killed by signal 11")) << result.err;
-  EXPECT_TRUE(contains(result.err, "vrflow: module 'talk' logs to " + logs +
-                                       "/talk.log; its last 10 lines:\n"
+  EXPECT_TRUE(contains(result.err, "vrflow: the last 10 lines of module 'talk' (its log: " + logs +
+                                       "/talk.log):\n"
                                        "  err 8\n  out 9\n  err 9\n  out 10\n  err 10\n"
                                        "  out 11\n  err 11\n  out 12\n  err 12\n"
                                        "  about to crash\n"))
@@ -114,7 +114,7 @@ TEST_F(LogsTest, CrashedModulesFailureNamesItsLogFileAndShowsItsLastLines) {
   EXPECT_EQ(lines.back(), "about to crash");
   // The report's error stays one line, without the log.
   const auto json = nlohmann::json::parse(readFile(report));
-  EXPECT_FALSE(contains(json["error"].get<std::string>(), "logs to")) << json["error"];
+  EXPECT_FALSE(contains(json["error"].get<std::string>(), "its log")) << json["error"];
 }
 
 TEST_F(LogsTest, ModulesInheritNoDescriptorButTheirSegment) {

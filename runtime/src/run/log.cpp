@@ -59,9 +59,10 @@ struct Current {
   std::shared_ptr<spdlog::logger> logger = makeLogger(LogLevel::Info, nullptr);
 };
 
+// Never destroyed: a thread may still log while the process exits.
 Current& current() {
-  static Current instance;
-  return instance;
+  static Current* const instance = new Current;  // NOLINT(cppcoreguidelines-owning-memory)
+  return *instance;
 }
 
 std::shared_ptr<spdlog::logger> logger() {

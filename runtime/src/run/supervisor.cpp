@@ -341,11 +341,10 @@ std::string Supervisor::failureDetail() const {
   const auto& module = daemon_.modules()[static_cast<std::size_t>(failed_)];
   const std::string file = logs_.logFile(module.id);
   const std::vector<std::string> lines = logs_.lastLines(module.id);
-  std::string text = "vrflow: module '" + module.id + "' ";
-  text += file.empty() ? std::string("(no log folder)") : "logs to " + file;
-  if (lines.empty()) return text + "; it printed nothing";
-  text +=
-      "; its last " + std::to_string(lines.size()) + " line" + (lines.size() == 1 ? "" : "s") + ":";
+  const std::string log = file.empty() ? "" : " (its log: " + file + ")";
+  if (lines.empty()) return "vrflow: module '" + module.id + "' printed nothing" + log;
+  std::string text = "vrflow: the last " + std::to_string(lines.size()) + " line" +
+                     (lines.size() == 1 ? "" : "s") + " of module '" + module.id + "'" + log + ":";
   for (const auto& line : lines) text += "\n  " + line;
   return text;
 }
