@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -105,6 +106,34 @@ TEST_F(LaunchLogsTest, AFloodingModulesLinesOverTheForwardingRateAreCountedAsDro
   }
   EXPECT_GT(dropped, 0u);
   EXPECT_EQ(arrived + dropped, kLines);
+}
+
+TEST_F(LaunchLogsTest, ADaemonGivenALogDirKeepsItsHostsOwnCopy) {
+  const std::string logs = dir.file("host-logs");
+  const std::string file = dir.write(
+      "app.xml",
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"one\" version=\"1\">\n"
+      "  <hosts><host id=\"a\" address=\"127.0.0.1\"/></hosts>\n  <modules>\n"
+      "    <module id=\"ta\" package=\"testing\" type=\"chatter\" host=\"a\">"
+      "<param name=\"lines\" value=\"2\"/></module>\n"
+      "    <module id=\"ra\" package=\"core\" type=\"recorder\" host=\"a\">"
+      "<param name=\"file\" value=\"" +
+          dir.file("a.csv") +
+          "\"/></module>\n  </modules>\n"
+          "  <connections><connection from=\"ta.out\" to=\"ra.in\"/></connections>\n"
+          "</application>\n");
+  const auto result = runCommand({binDir() + "/vrflow-daemon", file, "--host", "a", "--packages",
+                                  binDir() + "/../test-packages", "-n", "5", "--log-dir", logs,
+                                  "--log-level", "debug"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(readLines(logs + "/ta.log"),
+            (std::vector<std::string>{"out 1", "err 1", "out 2", "err 2"}));
+  EXPECT_TRUE(contains(result.err, "[ta@a] err 2\n")) << result.err;
+  EXPECT_TRUE(std::filesystem::exists(logs + "/vrflow.log"));
+  const auto refused = runCommand({binDir() + "/vrflow-daemon", file, "--host", "a", "--packages",
+                                   binDir() + "/../test-packages", "--log-dir", file});
+  EXPECT_EQ(refused.exitCode, 2);
+  EXPECT_TRUE(contains(refused.err, "cannot use the log folder '" + file + "'")) << refused.err;
 }
 
 }  // namespace
