@@ -5,6 +5,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -12,6 +13,7 @@
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/message/ids.hpp"
 #include "vrflow/net/control.hpp"
+#include "vrflow/run/log.hpp"
 
 namespace vrflow::tools {
 namespace {
@@ -155,8 +157,8 @@ void ControlLink::readLoop(int fd, const std::string& host, const std::shared_pt
   while (readLine(fd, line)) {
     auto command = net::parseControlCommand(line);
     if (!command) {
-      std::fprintf(stderr, "vrflow-daemon (host %s): ignored a line of the launcher: %s\n",
-                   host.c_str(), command.error().message.c_str());
+      run::logWarning("vrflow-daemon (host " + host +
+                      "): ignored a line of the launcher: " + command.error().message);
       continue;
     }
     // Answered here, at once, whatever the main thread is doing: the launcher kills a daemon
@@ -226,8 +228,8 @@ Status ControlLink::ready() {
     }
   }
   if (auto status = transport_->connectPeers(peers); !status) {
-    std::fprintf(stderr, "vrflow-daemon (host %s): cannot link to the other hosts: %s\n",
-                 host_.c_str(), status.error().message.c_str());
+    run::logError("vrflow-daemon (host " + host_ +
+                  "): cannot link to the other hosts: " + status.error().message);
     send(net::ControlEvent::error(status.error().message));
     return status;
   }
@@ -254,7 +256,7 @@ Status ControlLink::stoppedBeforeStart(const net::ControlCommand& command) {
   const std::string why = command.kind == Kind::Stop
                               ? "stopped by the launcher before the start"
                               : "the launcher closed the control channel before the start";
-  std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", host_.c_str(), why.c_str());
+  run::logWarning("vrflow-daemon (host " + host_ + "): " + why);
   return makeError(why);
 }
 
@@ -273,6 +275,9 @@ std::optional<run::RunOutcome> ControlLink::poll() {
 }
 
 std::vector<std::string> ControlLink::drain(const run::RunOutcome& outcome) {
+  // The modules' last lines were sent (the supervisor read their pipes to the end): what was
+  // dropped of them is said before this host's end.
+  for (const auto& dropped : takeDropped()) send(dropped);
   send(net::ControlEvent::finished(outcome.exitCode, outcome.status, outcome.error));
   std::vector<std::string> warnings;
   // Keep routing (messages for the other hosts) until the launcher says every host is done.
@@ -344,6 +349,43 @@ void ControlLink::stats(const std::string& json) {
 
 void ControlLink::event(const std::string& line) {
   send(net::ControlEvent::payload(net::ControlEvent::Kind::Event, line));
+}
+
+std::vector<net::ControlEvent> ControlLink::takeDropped() {
+  std::vector<net::ControlEvent> events;
+  std::lock_guard lock(budget_.mutex);
+  for (auto& [module, count] : budget_.dropped) {
+    if (count > 0) events.push_back(net::ControlEvent::droppedLines(module, count));
+  }
+  budget_.dropped.clear();
+  return events;
+}
+
+void ControlLink::output(const std::string& module, std::string_view text) {
+  std::vector<net::ControlEvent> events;
+  {
+    std::lock_guard lock(budget_.mutex);
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - budget_.refilled).count();
+    budget_.refilled = now;
+    budget_.lines =
+        std::min(2 * kOutputLinesPerSecond, budget_.lines + seconds * kOutputLinesPerSecond);
+    budget_.bytes =
+        std::min(2 * kOutputBytesPerSecond, budget_.bytes + seconds * kOutputBytesPerSecond);
+    const auto size = static_cast<double>(text.size());
+    if (budget_.lines < 1 || budget_.bytes < size) {
+      ++budget_.dropped[module];
+      return;
+    }
+    budget_.lines -= 1;
+    budget_.bytes -= size;
+    for (auto& [id, count] : budget_.dropped) {
+      if (count > 0) events.push_back(net::ControlEvent::droppedLines(id, count));
+    }
+    budget_.dropped.clear();
+  }
+  events.push_back(net::ControlEvent::output(module, std::string(text)));
+  for (const auto& e : events) send(e);
 }
 
 void ControlLink::report(const std::string& json) {

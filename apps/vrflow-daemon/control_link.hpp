@@ -1,11 +1,14 @@
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -43,6 +46,12 @@ class ControlLink final : public run::HostLink {
   void stats(const std::string& json) override;
   /// Sends a line of this host's event stream to the launcher, which merges every host's.
   void event(const std::string& line);
+  /// Sends a line a module printed to the launcher, within kOutputLinesPerSecond and
+  /// kOutputBytesPerSecond (with bursts of twice that); the lines over it are counted, and the
+  /// count is sent ("dropped MODULE N") before the next line sent, or at the end.
+  void output(const std::string& module, std::string_view text) override;
+  static constexpr double kOutputLinesPerSecond = 2000;
+  static constexpr double kOutputBytesPerSecond = 2 * 1024 * 1024;
 
  private:
   ControlLink(int in, int out) : in_(in), out_(out) { inbox_->out = out; }
@@ -53,6 +62,17 @@ class ControlLink final : public run::HostLink {
   /// After "quit": waits until the connections crossing hosts are over (or a stop comes);
   /// returns a warning for those still open.
   std::vector<std::string> settle();
+
+  /// The counts of lines not forwarded, as "dropped" events (and reset).
+  std::vector<net::ControlEvent> takeDropped();
+  /// The rate limit of output(): its budgets, refilled with time, and what it dropped.
+  struct OutputBudget {
+    std::mutex mutex;
+    double lines = 2 * kOutputLinesPerSecond;
+    double bytes = 2 * kOutputBytesPerSecond;
+    std::chrono::steady_clock::time_point refilled = std::chrono::steady_clock::now();
+    std::map<std::string, uint64_t> dropped;
+  } budget_;
 
   /// Stops before "go" ("stop" or the end of input): says so on stderr; the error.
   Status stoppedBeforeStart(const net::ControlCommand& command);

@@ -15,6 +15,7 @@
 
 #include "control_link.hpp"
 #include "vrflow/run/events.hpp"
+#include "vrflow/run/log.hpp"
 #include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 
@@ -59,10 +60,29 @@ int main(int argc, char** argv) {
   cli.add_option("--peer-timeout", peerTimeout,
                  "A link to another host silent this long is declared lost (seconds)")
       ->check(CLI::PositiveNumber);
+  cli.add_option("--log-dir", options.logDir,
+                 "Keep this host's module logs (MODULE.log) and the daemon's (vrflow.log) in DIR "
+                 "(made, mode 0700, if missing); under the launcher, they also reach its machine");
+  std::string logLevel = "info";
+  cli.add_option("--log-level", logLevel,
+                 "The daemon's own lines shown and logged: trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return cli.exit(e) == 0 ? 0 : vrflow::run::kExitInvalid;
+  }
+  if (!options.logDir.empty()) {
+    if (auto made = vrflow::run::prepareLogDirectory(options.logDir); !made) {
+      std::fprintf(stderr, "vrflow-daemon: %s\n", made.error().message.c_str());
+      return vrflow::run::kExitInvalid;
+    }
+  }
+  if (auto status =
+          vrflow::run::setupLogging(*vrflow::run::parseLogLevel(logLevel), options.logDir);
+      !status) {
+    std::fprintf(stderr, "vrflow-daemon: %s\n", status.error().message.c_str());
+    return vrflow::run::kExitInvalid;
   }
 
   vrflow::run::Prepared prepared = vrflow::run::prepare({.file = file,
@@ -198,7 +218,12 @@ int main(int argc, char** argv) {
   }
   options.wholeApplication = &*application;
   const auto outcome = vrflow::run::runApplication(local, catalog, options);
-  if (link) return outcome.exitCode;  // the launcher reports
-  if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow-daemon: %s\n", outcome.error.c_str());
+  if (link) {
+    // The launcher reports the error; the failed module's last lines reach its terminal here.
+    if (!outcome.detail.empty()) vrflow::run::logError(outcome.detail);
+    return outcome.exitCode;
+  }
+  if (outcome.exitCode != 0) vrflow::run::logError("vrflow-daemon: " + outcome.error);
+  if (!outcome.detail.empty()) vrflow::run::logError(outcome.detail);
   return outcome.exitCode;
 }

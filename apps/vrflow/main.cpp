@@ -19,7 +19,9 @@
 #include "vrflow/app/writer.hpp"
 #include "vrflow/launcher/launch.hpp"
 #include "vrflow/run/events.hpp"
+#include "vrflow/run/log.hpp"
 #include "vrflow/run/prepare.hpp"
+#include "vrflow/run/run_folders.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace {
@@ -131,6 +133,39 @@ std::optional<vrflow::app::Application> loadFlat(vrflow::run::PrepareSettings se
   return flat;
 }
 
+// --log-dir and --log-level of `run` and `launch` (docs/logs.md).
+void addLogOptions(CLI::App& command, std::string& logDir, std::string& logLevel) {
+  command.add_option("--log-dir", logDir,
+                     "Write the modules' logs (MODULE.log) and the runtime's (vrflow.log) to DIR "
+                     "(made, mode 0700, if missing; default: a folder per run, printed at start)");
+  command
+      .add_option("--log-level", logLevel,
+                  "The runtime's own lines shown and logged: trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+}
+
+// Gives the run of `application` its id and log folder (the default one, made now, when none
+// was given), sends the runtime's lines there too, and says where they are. False when the
+// folder cannot be used (said on stderr).
+bool startLogs(const std::string& application, const std::string& level, std::string& runId,
+               std::string& logDir) {
+  runId = vrflow::run::newRunId(application);
+  if (logDir.empty()) {
+    logDir = vrflow::run::defaultLogDirectory(runId);
+    if (auto made = vrflow::run::prepareLogDirectory(logDir); !made) {
+      std::fprintf(stderr, "vrflow: %s\n", made.error().message.c_str());
+      return false;
+    }
+  }
+  auto status = vrflow::run::setupLogging(*vrflow::run::parseLogLevel(level), logDir);
+  if (!status) {
+    std::fprintf(stderr, "vrflow: %s\n", status.error().message.c_str());
+    return false;
+  }
+  vrflow::run::logInfo("vrflow: run " + runId + ", logs in " + logDir);
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -179,6 +214,8 @@ int main(int argc, char** argv) {
       ->transform(CLI::AsSizeValue(false));
   run->add_option("--trace", options.tracePath,
                   "Write a Chrome/Perfetto trace (modules' wait/compute spans, messages as flows)");
+  std::string logLevel = "info";
+  addLogOptions(*run, options.logDir, logLevel);
   std::string eventsTarget;
   run->add_option("--events", eventsTarget,
                   "Write the run's events as JSON lines to FILE, or to stdout with '-' "
@@ -220,6 +257,7 @@ int main(int argc, char** argv) {
           "--module-memory-limit", launchOptions.moduleMemoryBytes,
           "Cap each module's data memory (e.g. 2G, 512M); hitting it is named as the cause")
       ->transform(CLI::AsSizeValue(false));
+  addLogOptions(*launch, launchOptions.logDir, logLevel);
   launch
       ->add_option("--peer-timeout", launchOptions.peerTimeoutSeconds,
                    "A host silent this long (no heartbeat) is declared lost (seconds, > 0)")
@@ -295,6 +333,17 @@ int main(int argc, char** argv) {
       return vrflow::run::kExitInvalid;
     }
   }
+  // A log folder given is made and checked with the other outputs, before anything starts.
+  std::string* logDir = run->parsed()      ? &options.logDir
+                        : launch->parsed() ? &launchOptions.logDir
+                                           : nullptr;
+  if (logDir != nullptr && !logDir->empty()) {
+    if (auto made = vrflow::run::prepareLogDirectory(*logDir); !made) {
+      std::fprintf(stderr, "vrflow: %s\n", made.error().message.c_str());
+      if (events) events->end({vrflow::run::kExitInvalid, "invalid", made.error().message});
+      return vrflow::run::kExitInvalid;
+    }
+  }
   // An application that cannot run still ends its event stream, with its first problem.
   const auto refused = [&](const vrflow::run::Prepared& prepared) {
     if (events) {
@@ -324,8 +373,13 @@ int main(int argc, char** argv) {
     launchOptions.packageDirs = shared.packageDirs;
     launchOptions.compositeDirs = shared.compositeDirs;
     launchOptions.overrides = shared.overrides;
+    launchOptions.logLevel = logLevel;
+    if (!startLogs(flat->name, logLevel, launchOptions.runId, launchOptions.logDir)) {
+      return vrflow::run::kExitInvalid;
+    }
     const auto outcome = vrflow::launcher::launch(*flat, launchOptions);
-    if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
+    if (outcome.exitCode != 0) vrflow::run::logError("vrflow: " + outcome.error);
+    vrflow::run::shutdownLogging();
     return outcome.exitCode;
   }
   auto settings = shared.settings(runFile, /*validate=*/true);
@@ -335,7 +389,12 @@ int main(int argc, char** argv) {
   const vrflow::app::Catalog& catalog = *prepared.catalog;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
   options.progress = !noProgress && isatty(STDERR_FILENO) != 0;
+  if (!startLogs(application->name, logLevel, options.runId, options.logDir)) {
+    return vrflow::run::kExitInvalid;
+  }
   const auto outcome = vrflow::run::runApplication(*application, catalog, options);
-  if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
+  if (outcome.exitCode != 0) vrflow::run::logError("vrflow: " + outcome.error);
+  if (!outcome.detail.empty()) vrflow::run::logError(outcome.detail);
+  vrflow::run::shutdownLogging();
   return outcome.exitCode;
 }

@@ -9,6 +9,7 @@
 
 #include "launcher.hpp"
 #include "vrflow/run/events.hpp"
+#include "vrflow/run/log.hpp"
 
 namespace vrflow::launcher::detail {
 namespace {
@@ -69,12 +70,30 @@ void Launcher::onLine(HostDaemon& d, const std::string& line) {
     case Kind::Trace:
       d.trace = std::move(event.text);
       break;
+    case Kind::Output:
+    case Kind::Dropped:
+      onOutput(d, event);
+      break;
     case Kind::Clock:
       // "clock T0 Td": our send time echoed with the daemon's clock; the daemon read its clock
       // about half-way through the round trip.
       d.clockOffsetNs = event.clockDaemonNs - (event.clockSentNs + steadyNs()) / 2;
       d.clockKnown = true;
       break;
+  }
+}
+
+void Launcher::onOutput(const HostDaemon& d, const net::ControlEvent& event) {
+  auto index = logs_.add(event.module, d.host);
+  if (!index) {
+    if (!logsRefused_) run::logWarning("vrflow: warning: " + index.error().message);
+    logsRefused_ = true;
+    return;
+  }
+  if (event.kind == net::ControlEvent::Kind::Dropped) {
+    logs_.note(*index, run::droppedNote(event.dropped));
+  } else {
+    logs_.line(*index, event.text);
   }
 }
 
@@ -158,6 +177,7 @@ void Launcher::pump(int timeoutMs) {
       d.toDaemon = -1;
     }
   }
+  logs_.flush();
 }
 
 }  // namespace vrflow::launcher::detail

@@ -13,6 +13,7 @@
 #include "launcher.hpp"
 #include "monitor_files.hpp"
 #include "vrflow/run/events.hpp"
+#include "vrflow/run/log.hpp"
 #include "vrflow/run/trace.hpp"
 
 namespace vrflow::launcher {
@@ -43,7 +44,7 @@ void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
   if (failure_ && (failureIsRoot_ || !rootCause)) return;
   if (!failure_) failureAt_ = Clock::now();
   // Said when seen: stopping the other hosts takes a moment, and the cause must not wait for it.
-  std::fprintf(stderr, "vrflow: %s; stopping every host\n", outcome.error.c_str());
+  run::logError("vrflow: " + outcome.error + "; stopping every host");
   failure_ = std::move(outcome);
   failureIsRoot_ = rootCause;
 }
@@ -66,8 +67,8 @@ void Launcher::publish() {
     // Chosen once: a folder that may not be trusted is refused (the launch goes on unseen).
     auto dir = monitorDirectory();
     if (!dir) {
-      std::fprintf(stderr, "vrflow: warning: `vrflow monitor` will not show this launch: %s\n",
-                   dir.error().message.c_str());
+      run::logWarning("vrflow: warning: `vrflow monitor` will not show this launch: " +
+                      dir.error().message);
     } else {
       removeStaleMonitorFiles(*dir);
     }
@@ -91,8 +92,10 @@ void Launcher::stopAll() {
   while (!allAnswered() && secondsSince(begin) < kStopAnswerSeconds) pump(20);
   for (const auto& d : daemons_) {
     if (d.exited || d.stopAnswered) continue;
-    std::fprintf(stderr, "vrflow: the %s did not answer \"stop\" within %g s: killed\n",
-                 d.name().c_str(), kStopAnswerSeconds);
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", kStopAnswerSeconds);
+    run::logWarning("vrflow: the " + d.name() + " did not answer \"stop\" within " + text +
+                    " s: killed");
     kill(-d.pid, SIGKILL);
   }
   while (!allExited() && secondsSince(begin) < kStopExitSeconds) pump(20);
@@ -130,6 +133,12 @@ run::RunOutcome Launcher::run() {
   // Orphans of the run (the daemons of an mpirun that died) become our children, to be reaped.
   prctl(PR_SET_CHILD_SUBREAPER, 1);
   const auto begin = Clock::now();
+  // Every module has its log file here from the start, even one that prints nothing.
+  for (const auto& m : application_.modules) {
+    if (auto added = logs_.add(m.id, app::effectiveHost(application_, m.host)); !added) {
+      run::logWarning("vrflow: warning: " + added.error().message);
+    }
+  }
 
   if (auto status = start(); !status) {
     failWith({run::kExitRunFailed, "failed", status.error().message}, true);

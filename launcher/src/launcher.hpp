@@ -17,6 +17,7 @@
 #include "vrflow/launcher/launch.hpp"
 #include "vrflow/net/control.hpp"
 #include "vrflow/net/transport.hpp"
+#include "vrflow/run/module_logs.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace vrflow::launcher::detail {
@@ -97,7 +98,12 @@ Status checkLaunch(const app::Application& application, const LaunchOptions& opt
 class Launcher {
  public:
   Launcher(const app::Application& application, const LaunchOptions& options)
-      : application_(application), options_(options) {}
+      : application_(application),
+        options_(options),
+        logs_({.logDir = options.logDir,
+               .echo = true,
+               .colour = run::ModuleLogs::colourOnTerminal(),
+               .forward = {}}) {}
   run::RunOutcome run();
 
  private:
@@ -116,6 +122,8 @@ class Launcher {
   void appendDaemonOptions(std::vector<std::string>& argv) const;
   void pump(int timeoutMs);
   void onLine(HostDaemon& d, const std::string& line);
+  /// A module's line (or its dropped count) that `d` forwarded: printed and logged here.
+  void onOutput(const HostDaemon& d, const net::ControlEvent& event);
   void failWith(run::RunOutcome outcome, bool rootCause);
   void stopAll();
   void publish();
@@ -130,6 +138,8 @@ class Launcher {
 
   const app::Application& application_;
   const LaunchOptions& options_;
+  run::ModuleLogs logs_;      ///< every host's module lines, gathered on this machine
+  bool logsRefused_ = false;  ///< a module's log file could not be made (said once)
   std::vector<HostDaemon> daemons_;
   int signalFd_ = -1;
   std::optional<run::RunOutcome> failure_;

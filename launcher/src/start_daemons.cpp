@@ -83,6 +83,7 @@ void Launcher::appendDaemonOptions(std::vector<std::string>& argv) const {
   for (const auto& c : options_.compositeDirs) {
     argv.insert(argv.end(), {"--composites", std::filesystem::absolute(c, ec).string()});
   }
+  argv.insert(argv.end(), {"--log-level", options_.logLevel});
   // Each daemon reads the file itself: the command line's parameters go with it.
   for (const auto& s : options_.overrides) argv.insert(argv.end(), {"--set", s});
 }

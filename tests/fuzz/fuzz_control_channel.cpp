@@ -69,6 +69,15 @@ void eventLine(std::string_view line) {
             reparsed->text == event->text);
       break;
     }
+    case ControlEvent::Kind::Output:
+    case ControlEvent::Kind::Dropped: {
+      // A module's line comes back whole, spaces and all; its module id has none.
+      check(!event->module.empty() && event->module.find(' ') == std::string::npos);
+      auto reparsed = vrflow::net::parseControlEvent(vrflow::net::toLine(*event));
+      check(reparsed.ok() && reparsed->kind == event->kind && reparsed->module == event->module &&
+            reparsed->text == event->text && reparsed->dropped == event->dropped);
+      break;
+    }
     case ControlEvent::Kind::Error:
     case ControlEvent::Kind::Report:
     case ControlEvent::Kind::Stats:

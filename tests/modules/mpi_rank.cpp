@@ -39,6 +39,9 @@ int run(int argc, char** argv) {
                  status.error().message.c_str());
     return 2;  // without MPI_Finalize: mpirun ends the job's other ranks
   }
+  // For the log tests: each rank's line goes to its own module's log.
+  std::printf("joined as rank %d of %d\n", rank, size);
+  std::fflush(stdout);
   const auto crashAt = static_cast<uint64_t>(module.params().getInt("crash-at"));
   const uint64_t point = module.newId();
   const auto& type = msg::pointType();

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -113,10 +114,20 @@ TEST_F(MpiJobRun, ModulesOfOneJobAreTheRanksOfOneMpirunInModuleOrder) {
   for (const auto& id : ids) modules += recorder(id, dir.file(id + ".csv"));
   const auto file = dir.write("jobs.xml", application(kOneHost, modules, connections));
   setenv("VRFLOW_MPIRUN", loggingMpirun(dir).c_str(), 1);
-  const auto result = runVrflow(
-      {"run", file, "--iterations", "6", "--no-progress", "--report", dir.file("report.json")},
-      120);
+  const auto result = runVrflow({"run", file, "--iterations", "6", "--no-progress", "--report",
+                                 dir.file("report.json"), "--log-dir", dir.file("logs")},
+                                120);
   ASSERT_EQ(result.exitCode, 0) << result.err;
+  // mpirun tags each line with its rank: rank r's lines go to the log of the job's module r.
+  for (const auto& [id, line] :
+       std::map<std::string, std::string>{{"b0", "joined as rank 0 of 3"},
+                                          {"b1", "joined as rank 1 of 3"},
+                                          {"b2", "joined as rank 2 of 3"},
+                                          {"solo", "joined as rank 0 of 1"}}) {
+    const auto lines = readLines(dir.file("logs/" + id + ".log"));
+    EXPECT_NE(std::find(lines.begin(), lines.end(), line), lines.end()) << id << ": " << line;
+    EXPECT_NE(result.err.find("[" + id + "@"), std::string::npos) << result.err;
+  }
 
   const std::map<std::string, Seen> expected{{"b0", {"b0", 0, 3, 3}},
                                              {"b1", {"b1", 1, 3, 3}},

@@ -23,6 +23,18 @@ const bool gSubreaper = [] { return prctl(PR_SET_CHILD_SUBREAPER, 1) == 0; }();
 
 }  // namespace
 
+namespace {
+
+// The runs of a test write their default log folders (docs/logs.md) under a state folder of
+// the test process, removed when it ends, never under the user's home; a test may set its own.
+struct TestStateFolder {
+  TempDir dir;
+  TestStateFolder() { setenv("XDG_STATE_HOME", dir.path().c_str(), 0); }
+};
+const TestStateFolder gStateFolder;
+
+}  // namespace
+
 std::string binDir() {
   if (const char* dir = std::getenv("VRFLOW_BIN_DIR")) return dir;
   // The test executables are built into the same folder as the commands they run.

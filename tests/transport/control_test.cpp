@@ -75,6 +75,23 @@ TEST(ControlCodec, FinishedKeepsAnEmptyOrSpacedErrorWhole) {
   EXPECT_EQ(failed.text, "module 'a' exited with status 3");
 }
 
+TEST(ControlCodec, ModuleOutputKeepsItsTextAsPrintedEvenEmptyOrSpaced) {
+  EXPECT_EQ(toLine(ControlEvent::output("sim", "  step 3 done ")), "output sim   step 3 done ");
+  const ControlEvent spaced = reparsed(ControlEvent::output("sim", "  step 3 done "));
+  EXPECT_EQ(spaced.kind, EventKind::Output);
+  EXPECT_EQ(spaced.module, "sim");
+  EXPECT_EQ(spaced.text, "  step 3 done ");
+  EXPECT_EQ(reparsed(ControlEvent::output("sim", "")).text, "");
+  const ControlEvent dropped = reparsed(ControlEvent::droppedLines("sim", 12345678901ULL));
+  EXPECT_EQ(dropped.kind, EventKind::Dropped);
+  EXPECT_EQ(dropped.module, "sim");
+  EXPECT_EQ(dropped.dropped, 12345678901ULL);
+  for (const char* bad :
+       {"output", "output sim", "dropped sim", "dropped sim -1", "dropped sim 3 x"}) {
+    EXPECT_FALSE(parseControlEvent(bad).ok()) << bad;
+  }
+}
+
 TEST(ControlCodec, ANewlineInFreeTextDoesNotStartALineOfItsOwn) {
   const std::string line = toLine(ControlEvent::finished(1, "failed", "first\nstop"));
   EXPECT_EQ(line.find('\n'), std::string::npos);

@@ -151,6 +151,26 @@ Result<ControlEvent> parseControlEvent(std::string_view line) {
     e.kind = ControlEvent::Kind::Clock;
     return e;
   }
+  if (word == "output") {
+    // "output MODULE TEXT": the text is what the module printed, possibly empty.
+    const Split s = split(line, 2);
+    if (s.words.size() != 2 || !s.hasRest || s.words[1].empty()) {
+      return malformed("expected 'output MODULE TEXT'", line);
+    }
+    e.kind = ControlEvent::Kind::Output;
+    e.module = std::string(s.words[1]);
+    e.text = std::string(s.rest);
+    return e;
+  }
+  if (word == "dropped") {
+    const Split s = split(line, 3);
+    if (s.words.size() != 3 || s.hasRest || s.words[1].empty() || !number(s.words[2], e.dropped)) {
+      return malformed("expected 'dropped MODULE COUNT'", line);
+    }
+    e.kind = ControlEvent::Kind::Dropped;
+    e.module = std::string(s.words[1]);
+    return e;
+  }
   if (word == "finished") {
     // "finished CODE STATUS ERROR": the error is free text, possibly empty.
     const Split s = split(line, 3);
@@ -267,6 +287,20 @@ ControlEvent ControlEvent::clock(int64_t sentNs, int64_t daemonNs) {
   return e;
 }
 
+ControlEvent ControlEvent::output(std::string module, std::string text) {
+  ControlEvent e = bare(Kind::Output);
+  e.module = std::move(module);
+  e.text = std::move(text);
+  return e;
+}
+
+ControlEvent ControlEvent::droppedLines(std::string module, uint64_t count) {
+  ControlEvent e = bare(Kind::Dropped);
+  e.module = std::move(module);
+  e.dropped = count;
+  return e;
+}
+
 std::string toLine(const ControlEvent& event) {
   using Kind = ControlEvent::Kind;
   // Free text ends the line: a newline in it would start a line of its own.
@@ -296,6 +330,10 @@ std::string toLine(const ControlEvent& event) {
     case Kind::Clock:
       return "clock " + std::to_string(event.clockSentNs) + " " +
              std::to_string(event.clockDaemonNs);
+    case Kind::Output:
+      return "output " + event.module + " " + text;
+    case Kind::Dropped:
+      return "dropped " + event.module + " " + std::to_string(event.dropped);
   }
   return {};
 }

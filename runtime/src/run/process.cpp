@@ -1,6 +1,7 @@
 #include "vrflow/run/process.hpp"
 
 #include <fcntl.h>
+#include <linux/close_range.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
@@ -72,6 +73,10 @@ Result<pid_t> spawnProcess(const ProcessSettings& settings) {
     signal(SIGPIPE, SIG_DFL);
     if (settings.stdinFd >= 0) dup2(settings.stdinFd, STDIN_FILENO);
     if (settings.stdoutFd >= 0) dup2(settings.stdoutFd, STDOUT_FILENO);
+    if (settings.stderrFd >= 0) dup2(settings.stderrFd, STDERR_FILENO);
+    // Nothing else this process holds reaches the child (log files, pipes of other modules,
+    // descriptors inherited without close-on-exec from whoever started vrflow).
+    close_range(3, ~0U, CLOSE_RANGE_CLOEXEC);
     if (settings.inheritFd >= 0) fcntl(settings.inheritFd, F_SETFD, 0);
     if (settings.memoryLimitBytes > 0) {
       const rlimit limit{settings.memoryLimitBytes, settings.memoryLimitBytes};

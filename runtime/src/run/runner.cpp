@@ -24,6 +24,7 @@
 #include "vrflow/daemon/daemon.hpp"
 #include "vrflow/message/ids.hpp"
 #include "vrflow/run/events.hpp"
+#include "vrflow/run/log.hpp"
 #include "vrflow/run/trace.hpp"
 
 namespace vrflow::run {
@@ -128,7 +129,7 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
     }
   }
   for (const auto& w : warnings) {
-    std::fprintf(stderr, "vrflow: warning: %s\n", w.c_str());
+    logWarning("vrflow: warning: " + w);
     if (options.events != nullptr) options.events->warning(w);
   }
   if (options.events != nullptr) options.events->end(outcome);

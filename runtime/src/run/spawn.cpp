@@ -21,7 +21,7 @@ namespace vrflow::run {
 
 Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::string>& args,
                           int inheritFd, const std::vector<std::string>& extraEnvironment,
-                          uint64_t memoryLimitBytes) {
+                          uint64_t memoryLimitBytes, int outputFd) {
   std::vector<std::string> envStrings;
   for (char** e = environ; *e != nullptr; ++e) {
     if (ipc::JoinContract::isContractEntry(*e)) {
@@ -35,6 +35,8 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
   settings.argv.insert(settings.argv.end(), args.begin(), args.end());
   settings.environment = std::move(envStrings);
   settings.inheritFd = inheritFd;
+  settings.stdoutFd = outputFd;
+  settings.stderrFd = outputFd;
   settings.memoryLimitBytes = memoryLimitBytes;
   return spawnProcess(settings);
 }
@@ -45,7 +47,7 @@ namespace {
 // launcher), with `contract` exported to every rank (the segment by its /proc path instead of
 // its descriptor: mpirun closes inherited descriptors). `what` names the job in the error.
 Result<pid_t> spawnMpirun(const std::string& executable, int ranks, ipc::JoinContract contract,
-                          const std::string& backingDir, uint64_t memoryLimitBytes,
+                          const std::string& backingDir, uint64_t memoryLimitBytes, int outputFd,
                           const std::string& what) {
   const char* launcher = std::getenv("VRFLOW_MPIRUN");
   const std::string mpirun = launcher != nullptr && *launcher != '\0' ? launcher : "mpirun";
@@ -70,6 +72,8 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, ipc::JoinCon
     // The ranks' shared-memory files go to a folder the runtime removes, even after kill -9.
     args.insert(args.end(), {"--mca", "btl_vader_backing_directory", backingDir});
   }
+  // Captured output: each line names the rank that wrote it (ModuleOutput routes it).
+  if (outputFd >= 0) args.push_back("--tag-output");
   if (geteuid() == 0) {
     environment.push_back("OMPI_ALLOW_RUN_AS_ROOT=1");
     environment.push_back("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1");
@@ -82,7 +86,7 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, ipc::JoinCon
   }
   args.push_back(executable);
   // The limit is inherited by the ranks, which mpirun forks.
-  auto pid = spawnModule(mpirun, args, -1, environment, memoryLimitBytes);
+  auto pid = spawnModule(mpirun, args, -1, environment, memoryLimitBytes, outputFd);
   if (!pid) {
     return makeError(pid.error().message + " (" + what +
                      " is started through mpirun: install Open MPI, or set VRFLOW_MPIRUN)");
@@ -94,23 +98,23 @@ Result<pid_t> spawnMpirun(const std::string& executable, int ranks, ipc::JoinCon
 
 Result<pid_t> spawnMpiModule(const std::string& executable, int ranks,
                              const ipc::JoinContract& contract, const std::string& backingDir,
-                             uint64_t memoryLimitBytes) {
+                             uint64_t memoryLimitBytes, int outputFd) {
   ipc::JoinContract ranksContract = contract;
   ranksContract.mpiRanks = ranks;
-  return spawnMpirun(executable, ranks, ranksContract, backingDir, memoryLimitBytes,
+  return spawnMpirun(executable, ranks, ranksContract, backingDir, memoryLimitBytes, outputFd,
                      "a module of " + std::to_string(ranks) + " MPI ranks");
 }
 
 Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>& slotIndices,
                           const ipc::JoinContract& contract, const std::string& backingDir,
-                          uint64_t memoryLimitBytes) {
+                          uint64_t memoryLimitBytes, int outputFd) {
   ipc::JoinContract jobContract = contract;
   // One process per module: the modules' own index and id would name rank 0's to every rank.
   jobContract.moduleIndex = -1;
   jobContract.moduleId.clear();
   jobContract.moduleIndices = slotIndices;
   const int ranks = static_cast<int>(slotIndices.size());
-  return spawnMpirun(executable, ranks, jobContract, backingDir, memoryLimitBytes,
+  return spawnMpirun(executable, ranks, jobContract, backingDir, memoryLimitBytes, outputFd,
                      "an MPI job of " + std::to_string(ranks) + " modules");
 }
 

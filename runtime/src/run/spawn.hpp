@@ -15,9 +15,10 @@ namespace vrflow::run {
 /// runtime, which stops modules in order), killed if the runtime dies, with the segment's
 /// descriptor inherited and the given extra environment. `memoryLimitBytes` (0: none) caps the
 /// process's data memory (RLIMIT_DATA: heap and private mappings, not the shared segment).
+/// `outputFd` (-1: this process's) becomes its stdout and stderr (ModuleOutput::add()).
 Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::string>& args,
                           int inheritFd, const std::vector<std::string>& extraEnvironment,
-                          uint64_t memoryLimitBytes = 0);
+                          uint64_t memoryLimitBytes = 0, int outputFd = -1);
 
 /// Starts `executable` as `ranks` MPI ranks of one job through Open MPI's `mpirun` (the
 /// environment variable VRFLOW_MPIRUN names another launcher; found on PATH otherwise), as
@@ -27,10 +28,11 @@ Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::
 /// instead (rank 0 opens it and joins as the module; the others are its workers), and
 /// JoinContract::mpiRanks = ranks. The whole contract is exported to the ranks (`-x`).
 /// `backingDir` (see MpiBackingFolder; empty: Open MPI's default, /dev/shm) receives the
-/// shared-memory files of Open MPI's vader transport.
+/// shared-memory files of Open MPI's vader transport. With an `outputFd` (mpirun's stdout and
+/// stderr), mpirun tags each line with its rank (--tag-output: "[JOB,RANK]<stdout>:TEXT").
 Result<pid_t> spawnMpiModule(const std::string& executable, int ranks,
                              const ipc::JoinContract& contract, const std::string& backingDir,
-                             uint64_t memoryLimitBytes = 0);
+                             uint64_t memoryLimitBytes = 0, int outputFd = -1);
 
 /// Starts the modules of one MPI job (app::MpiJob), one per rank, as one `mpirun -np N` of
 /// `executable` with N = slotIndices.size(), the options, launcher and segment path of
@@ -40,7 +42,7 @@ Result<pid_t> spawnMpiModule(const std::string& executable, int ranks,
 /// no mpiRanks (every rank is a module, none a worker).
 Result<pid_t> spawnMpiJob(const std::string& executable, const std::vector<int>& slotIndices,
                           const ipc::JoinContract& contract, const std::string& backingDir,
-                          uint64_t memoryLimitBytes = 0);
+                          uint64_t memoryLimitBytes = 0, int outputFd = -1);
 
 /// The folder of a runtime's MPI jobs' shared-memory files (Open MPI's vader segments, which
 /// its ranks cannot unlink when they die with the runtime): /dev/shm/ompi-job.<runtime pid>.XXXXXX,

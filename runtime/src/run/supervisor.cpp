@@ -10,13 +10,27 @@
 
 #include "vrflow/base/assert.hpp"
 #include "vrflow/run/events.hpp"
+#include "vrflow/run/log.hpp"
 
 namespace vrflow::run::detail {
 
 Supervisor::Supervisor(const app::Application& application, const app::Catalog& catalog,
                        const RunOptions& options, daemon::Daemon& daemon,
                        std::vector<app::MpiJob> jobs)
-    : application_(application), catalog_(catalog), options_(options), daemon_(daemon) {
+    : application_(application),
+      catalog_(catalog),
+      options_(options),
+      daemon_(daemon),
+      // Under the launcher the lines go to it (which prints them), not to this host's stderr.
+      logs_({.logDir = options.logDir,
+             .echo = options.hostLink == nullptr,
+             .colour = options.hostLink == nullptr && ModuleLogs::colourOnTerminal(),
+             .forward =
+                 options.hostLink == nullptr
+                     ? std::function<void(const std::string&, std::string_view)>()
+                     : [link = options.hostLink](const std::string& module, std::string_view text) {
+                         link->output(module, text);
+                       }}) {
   // Modules and slots follow the application's module order (Daemon::create).
   VRFLOW_ASSERT(daemon_.modules().size() == application_.modules.size(),
                 "one daemon module per application module");
@@ -75,7 +89,13 @@ bool Supervisor::startJob(std::size_t jobIndex, ipc::JoinContract contract, RunO
     outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + backing.error().message};
     return false;
   }
-  auto pid = spawnMpiJob(first.executable, slots, contract, *backing, options_.moduleMemoryBytes);
+  std::vector<std::size_t> logIndices;
+  for (const std::size_t m : job.modules) logIndices.push_back(logIndex_[m]);
+  const int output = outputPipe(logIndices, /*mpiTagged=*/true, outcome);
+  if (output < 0) return false;
+  auto pid =
+      spawnMpiJob(first.executable, slots, contract, *backing, options_.moduleMemoryBytes, output);
+  close(output);
   if (!pid) {
     outcome = {kExitRunFailed, "failed", jobLabel(job, 0) + ": " + pid.error().message};
     return false;
@@ -125,12 +145,14 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
       }
       if (first == children_.size()) first = i;
       job = child.job;
+      // Its last lines are still in its pipe: failureDetail() reads them after the run.
     }
     if (first == children_.size()) continue;  // not a process of this run
     const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
     if ((clean && notJoined.empty()) || stopping || outcome.exitCode != kExitOk) continue;
     outcome.exitCode = kExitRunFailed;
     outcome.status = "failed";
+    failed_ = static_cast<long>(first);
     const std::string memory =
         outOfMemory.empty() ? "" : ": module '" + outOfMemory + "' " + memoryCause();
     if (job >= 0) {
@@ -213,6 +235,11 @@ RunOutcome Supervisor::run() {
   }
   const int fd = daemon_.segment().fd();
   children_.resize(daemon_.modules().size());
+  for (const auto& module : daemon_.modules()) {
+    auto index = logs_.add(module.id, module.host);
+    if (!index) return {kExitRunFailed, "failed", index.error().message};
+    logIndex_.push_back(*index);
+  }
   for (std::size_t i = 0; i < daemon_.modules().size(); ++i) {
     if (children_[i].alive) continue;  // started with its MPI job
     const auto& module = daemon_.modules()[i];
@@ -232,10 +259,13 @@ RunOutcome Supervisor::run() {
                  "module '" + module.id + "': " + backing.error().message};
       break;
     }
+    const int output = outputPipe({logIndex_[i]}, viaMpirun, outcome);
+    if (output < 0) break;
     auto pid = viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, contract, *backing,
-                                          options_.moduleMemoryBytes)
+                                          options_.moduleMemoryBytes, output)
                          : spawnModule(module.executable, {}, fd, contract.encode(),
-                                       options_.moduleMemoryBytes);
+                                       options_.moduleMemoryBytes, output);
+    close(output);
     if (!pid) {
       outcome = {kExitRunFailed, "failed", "module '" + module.id + "': " + pid.error().message};
       break;
@@ -277,7 +307,7 @@ RunOutcome Supervisor::run() {
     }
     std::string detail;
     if (lingering(detail)) {
-      std::fprintf(stderr, "vrflow: warning: %s\n", detail.c_str());
+      logWarning("vrflow: warning: " + detail);
       if (options_.events != nullptr) options_.events->warning(detail);
       break;  // their work is done: stopAll() ends them, and the run counts as a success
     }
@@ -291,8 +321,32 @@ RunOutcome Supervisor::run() {
   }
   if (displayed_) showProgress(true);
   stopAll();
+  // Every process ended: what they printed last is read to the end of their pipes (a process
+  // they left behind holding one open is waited for briefly).
+  output_.finish(/*seconds=*/2);
+  if (outcome.exitCode != kExitOk && failed_ >= 0) outcome.detail = failureDetail();
   publishStats(/*now=*/true);  // the final counts, every module ended
   return outcome;
+}
+
+int Supervisor::outputPipe(const std::vector<std::size_t>& modules, bool mpiTagged,
+                           RunOutcome& outcome) {
+  auto fd = output_.add(modules, mpiTagged);
+  if (fd) return *fd;
+  outcome = {kExitRunFailed, "failed", fd.error().message};
+  return -1;
+}
+
+std::string Supervisor::failureDetail() const {
+  const auto& module = daemon_.modules()[static_cast<std::size_t>(failed_)];
+  const std::string file = logs_.logFile(module.id);
+  const std::vector<std::string> lines = logs_.lastLines(module.id);
+  const std::string log = file.empty() ? "" : " (its log: " + file + ")";
+  if (lines.empty()) return "vrflow: module '" + module.id + "' printed nothing" + log;
+  std::string text = "vrflow: the last " + std::to_string(lines.size()) + " line" +
+                     (lines.size() == 1 ? "" : "s") + " of module '" + module.id + "'" + log + ":";
+  for (const auto& line : lines) text += "\n  " + line;
+  return text;
 }
 
 }  // namespace vrflow::run::detail

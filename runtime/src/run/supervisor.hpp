@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "module_output.hpp"
 #include "report.hpp"
 #include "spawn.hpp"
 #include "vrflow/app/catalog.hpp"
@@ -101,6 +102,14 @@ class Supervisor {
   std::vector<int> jobOf_;         ///< per module: its index in jobs_, or -1
   std::vector<Child> children_;
   MpiBackingFolder mpiFolder_;  ///< removed after every process of the run ended (~Supervisor)
+  ModuleLogs logs_;             ///< where the modules' lines go (terminal, files, launcher)
+  ModuleOutput output_{logs_};  ///< reads the modules' pipes into logs_
+  std::vector<std::size_t> logIndex_;  ///< per module: its index in logs_
+  long failed_ = -1;                   ///< the module whose end failed the run, if any
+  /// A pipe for the process of `modules` (module indices), the write end or -1 with `outcome`.
+  int outputPipe(const std::vector<std::size_t>& modules, bool mpiTagged, RunOutcome& outcome);
+  /// The failed module's log file and last lines (RunOutcome::detail).
+  std::string failureDetail() const;
   Clock::time_point start_ = Clock::now();
   uint64_t lastIterationSum_ = 0;
   Clock::time_point lastProgress_ = Clock::now();

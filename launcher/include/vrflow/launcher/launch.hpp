@@ -60,6 +60,8 @@ struct LaunchOptions {
   /// The folder on the launcher's machine where every host's module logs are gathered
   /// (<module>.log each); empty: none.
   std::string logDir;
+  /// `--log-level` of every daemon (run::parseLogLevel's words).
+  std::string logLevel = "info";
 };
 
 /// Merges the hosts' report shares into one report in the shape `vrflow run` writes (modules,

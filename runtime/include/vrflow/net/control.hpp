@@ -58,7 +58,9 @@ struct ControlEvent {
     Stats,
     Trace,
     Event,
-    Clock
+    Clock,
+    Output,
+    Dropped
   };
   Kind kind = Kind::Connected;
   int hostIndex = -1;  ///< Hello: the host the daemon serves
@@ -69,6 +71,8 @@ struct ControlEvent {
   /// Hello: the proof (controlProof(), hex).
   std::string text;
   int64_t clockSentNs = 0, clockDaemonNs = 0;  ///< Clock: the launcher's time echoed, the daemon's
+  std::string module;    ///< Output/Dropped: the id of the module that printed (no spaces)
+  uint64_t dropped = 0;  ///< Dropped: how many of its lines were not forwarded
 
   /// An event without arguments: Connected, Stopping.
   static ControlEvent bare(Kind kind);
@@ -86,6 +90,10 @@ struct ControlEvent {
   static ControlEvent payload(Kind kind, std::string json);
   /// "clock SENT DAEMON": the launcher's time echoed, with the daemon's steady clock.
   static ControlEvent clock(int64_t sentNs, int64_t daemonNs);
+  /// "output MODULE TEXT": a line module MODULE printed (docs/logs.md); TEXT may be empty.
+  static ControlEvent output(std::string module, std::string text);
+  /// "dropped MODULE COUNT": COUNT lines of MODULE were not forwarded (over the rate limit).
+  static ControlEvent droppedLines(std::string module, uint64_t count);
 };
 
 /// Parses a daemon's line; an error naming the line for an unknown event or malformed arguments.

@@ -22,6 +22,7 @@ struct ProcessSettings {
   std::vector<std::string> environment;
   int stdinFd = -1;    ///< becomes its standard input; -1: this process's
   int stdoutFd = -1;   ///< becomes its standard output; -1: this process's
+  int stderrFd = -1;   ///< becomes its standard error; -1: this process's
   int inheritFd = -1;  ///< a close-on-exec descriptor it keeps open; -1: none
   /// Caps its data memory (RLIMIT_DATA: heap and private mappings, not shared segments); 0: none.
   uint64_t memoryLimitBytes = 0;
@@ -29,7 +30,8 @@ struct ProcessSettings {
 
 /// Starts a process in its own process group (Ctrl-C reaches only its parent, which stops it in
 /// order), killed if this process dies (PR_SET_PDEATHSIG), with every signal unblocked and
-/// SIGPIPE at its default. An executable that cannot be found or run is an error naming it,
+/// SIGPIPE at its default; of this process's descriptors it keeps only its standard ones and
+/// `inheritFd`. An executable that cannot be found or run is an error naming it,
 /// before anything starts.
 Result<pid_t> spawnProcess(const ProcessSettings& settings);
 

@@ -6,6 +6,8 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "vrflow/app/catalog.hpp"
@@ -64,9 +66,18 @@ struct RunOptions {
 
 /// What happened, for the report and the exit code.
 struct RunOutcome {
+  RunOutcome() = default;
+  RunOutcome(int code, std::string word, std::string message, std::string more = {})
+      : exitCode(code),
+        status(std::move(word)),
+        error(std::move(message)),
+        detail(std::move(more)) {}
+
   int exitCode = kExitOk;
   std::string status = "ok";  ///< ok, failed, deadlock, stalled, timeout, interrupted
   std::string error;          ///< one line a person can act on; empty on success
+  /// For the terminal only, never the report: the failed module's log file and last lines.
+  std::string detail;
 };
 
 /// What a daemon started by `vrflow launch` adds to a run: links to the other hosts' daemons
@@ -89,6 +100,12 @@ class HostLink {
   virtual void trace(const std::string& json) = 0;
   /// About once a second: live counters of this host's modules and connections (JSON).
   virtual void stats(const std::string& json) = 0;
+  /// A line that module `module` of this host printed, from the thread that reads the modules'
+  /// output (docs/logs.md): the launcher prints and keeps it. Ignored by default.
+  virtual void output(const std::string& module, std::string_view text) {
+    (void)module;
+    (void)text;
+  }
 };
 
 /// How many iterations each module of the whole `application` runs in `outer` outer

@@ -1,0 +1,148 @@
+#include "vrflow/run/log.hpp"
+
+#include <spdlog/logger.h>
+#include <spdlog/sinks/basic_file_sink.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+
+#include "vrflow/run/module_logs.hpp"
+
+namespace vrflow::run {
+namespace {
+
+constexpr std::array<std::string_view, 6> kLevelWords = {"trace", "debug", "info",
+                                                         "warn",  "error", "off"};
+
+spdlog::level::level_enum spdlogLevel(LogLevel level) {
+  switch (level) {
+    case LogLevel::Trace:
+      return spdlog::level::trace;
+    case LogLevel::Debug:
+      return spdlog::level::debug;
+    case LogLevel::Info:
+      return spdlog::level::info;
+    case LogLevel::Warn:
+      return spdlog::level::warn;
+    case LogLevel::Error:
+      return spdlog::level::err;
+    case LogLevel::Off:
+      break;
+  }
+  return spdlog::level::off;
+}
+
+std::shared_ptr<spdlog::logger> makeLogger(LogLevel level,
+                                           std::shared_ptr<spdlog::sinks::sink> file) {
+  auto terminal = std::make_shared<spdlog::sinks::stderr_color_sink_mt>(
+      ModuleLogs::colourOnTerminal() ? spdlog::color_mode::always : spdlog::color_mode::never);
+  terminal->set_pattern("%H:%M:%S.%e %^%l%$ %v");
+  std::vector<spdlog::sink_ptr> sinks{terminal};
+  if (file) sinks.push_back(std::move(file));
+  auto logger = std::make_shared<spdlog::logger>("vrflow", sinks.begin(), sinks.end());
+  logger->set_level(spdlogLevel(level));
+  logger->flush_on(spdlog::level::trace);  // every line reaches the file, even before a crash
+  return logger;
+}
+
+// The logger of this process, replaced by setupLogging(); copied under the lock by each line.
+struct Current {
+  std::mutex mutex;
+  std::shared_ptr<spdlog::logger> logger = makeLogger(LogLevel::Info, nullptr);
+};
+
+// Never destroyed: a thread may still log while the process exits.
+Current& current() {
+  static Current* const instance = new Current;  // NOLINT(cppcoreguidelines-owning-memory)
+  return *instance;
+}
+
+std::shared_ptr<spdlog::logger> logger() {
+  Current& c = current();
+  std::lock_guard lock(c.mutex);
+  return c.logger;
+}
+
+}  // namespace
+
+Result<LogLevel> parseLogLevel(std::string_view word) {
+  for (std::size_t i = 0; i < kLevelWords.size(); ++i) {
+    if (kLevelWords[i] == word) return static_cast<LogLevel>(i);
+  }
+  return makeError("unknown log level '" + std::string(word) +
+                   "' (expected trace, debug, info, warn, error or off)");
+}
+
+Status setupLogging(LogLevel level, const std::string& logDir) {
+  std::shared_ptr<spdlog::sinks::sink> file;
+  if (!logDir.empty()) {
+    const std::string path = logDir + "/vrflow.log";
+    try {
+      file = std::make_shared<spdlog::sinks::basic_file_sink_mt>(path);
+    } catch (const spdlog::spdlog_ex& e) {
+      return makeError("cannot write the log '" + path + "': " + e.what());
+    }
+    file->set_pattern("%Y-%m-%d %H:%M:%S.%e %l [%P] %v");
+  }
+  auto made = makeLogger(level, std::move(file));
+  Current& c = current();
+  std::lock_guard lock(c.mutex);
+  c.logger = std::move(made);
+  return {};
+}
+
+void shutdownLogging() {
+  auto made = makeLogger(LogLevel::Info, nullptr);
+  Current& c = current();
+  std::lock_guard lock(c.mutex);
+  made->set_level(c.logger->level());
+  c.logger = std::move(made);
+}
+
+Status prepareLogDirectory(const std::string& dir) {
+  const std::string what = "cannot use the log folder '" + dir + "': ";
+  struct stat info {};
+  if (stat(dir.c_str(), &info) != 0) {
+    if (errno != ENOENT) return makeError(what + std::strerror(errno));
+    std::error_code ec;
+    const std::filesystem::path path(dir);
+    if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), ec);
+    if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
+      return makeError(what + std::strerror(errno));
+    }
+    if (stat(dir.c_str(), &info) != 0) return makeError(what + std::strerror(errno));
+  }
+  if (!S_ISDIR(info.st_mode)) return makeError(what + "it is not a folder");
+  if (access(dir.c_str(), W_OK | X_OK) != 0) return makeError(what + "it is not writable");
+  return {};
+}
+
+void logTrace(const std::string& text) {
+  logger()->trace(text);
+}
+
+void logDebug(const std::string& text) {
+  logger()->debug(text);
+}
+
+void logInfo(const std::string& text) {
+  logger()->info(text);
+}
+
+void logWarning(const std::string& text) {
+  logger()->warn(text);
+}
+
+void logError(const std::string& text) {
+  logger()->error(text);
+}
+
+}  // namespace vrflow::run
