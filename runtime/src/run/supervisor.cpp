@@ -108,8 +108,7 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
       Child& child = children_[i];
       if (child.pid != pid || !child.alive) continue;
       child.alive = false;
-      child.end.exit = WIFEXITED(status) ? "status " + std::to_string(WEXITSTATUS(status))
-                                         : "signal " + std::to_string(WTERMSIG(status));
+      recordExit(child.end, status);
       daemon_.moduleEnded(static_cast<int>(i));
       const auto& module = daemon_.modules()[i];
       if (notJoined.empty() &&

@@ -60,7 +60,7 @@ class Supervisor {
     int mpiRanks = 0;  ///< above 1: `pid` is the mpirun that runs this many ranks
     int job = -1;      ///< index in jobs_: `pid` is the mpirun of that job, shared by its modules
     bool alive = false;
-    ModuleEnd end{"not started", ""};
+    ModuleEnd end{"not started", "", std::nullopt, std::nullopt};
   };
   std::string jobLabel(const app::MpiJob& job, pid_t mpirun) const;
   std::optional<std::string> refusedWithoutMpirun() const;
