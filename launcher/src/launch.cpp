@@ -43,7 +43,7 @@ void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
   if (failure_ && (failureIsRoot_ || !rootCause)) return;
   if (!failure_) failureAt_ = Clock::now();
   // Said when seen: stopping the other hosts takes a moment, and the cause must not wait for it.
-  std::fprintf(stderr, "vrflow: %s; stopping every host\n", outcome.error.c_str());
+  run::printAboveProgress("vrflow: " + outcome.error + "; stopping every host");
   failure_ = std::move(outcome);
   failureIsRoot_ = rootCause;
 }
@@ -91,8 +91,10 @@ void Launcher::stopAll() {
   while (!allAnswered() && secondsSince(begin) < kStopAnswerSeconds) pump(20);
   for (const auto& d : daemons_) {
     if (d.exited || d.stopAnswered) continue;
-    std::fprintf(stderr, "vrflow: the %s did not answer \"stop\" within %g s: killed\n",
-                 d.name().c_str(), kStopAnswerSeconds);
+    char within[32];
+    std::snprintf(within, sizeof within, "%g s", kStopAnswerSeconds);
+    run::printAboveProgress("vrflow: the " + d.name() + " did not answer \"stop\" within " +
+                            within + ": killed");
     kill(-d.pid, SIGKILL);
   }
   while (!allExited() && secondsSince(begin) < kStopExitSeconds) pump(20);
@@ -111,6 +113,29 @@ void Launcher::stopAll() {
     const pid_t pid = waitpid(-1, &status, WNOHANG);
     if (pid < 0 || secondsSince(t) >= 5) break;  // ECHILD: nothing is left
     if (pid == 0) usleep(20'000);
+  }
+}
+
+void Launcher::showProgress(const run::RunOutcome* end) {
+  if (end == nullptr ? !progress_.due() : options_.progress == run::ProgressMode::Off) return;
+  if (options_.iterations > 0 && moduleTargets_.empty()) {
+    moduleTargets_ = run::moduleIterations(application_, options_.iterations);
+  }
+  std::vector<run::ModuleProgress> modules;
+  for (const auto& d : daemons_) {
+    const auto stats = nlohmann::json::parse(d.stats, nullptr, false);
+    if (stats.is_discarded() || !stats.contains("modules")) continue;
+    for (const auto& m : stats["modules"]) {
+      const auto target = moduleTargets_.find(m.value("id", std::string()));
+      modules.push_back({m.value("iterations", uint64_t{0}),
+                         target != moduleTargets_.end() ? target->second : 0});
+    }
+  }
+  const uint64_t done = run::outerIterationsDone(modules, options_.iterations);
+  if (end != nullptr) {
+    progress_.finish(done, end->status);
+  } else {
+    progress_.update(done);
   }
 }
 
@@ -149,6 +174,7 @@ run::RunOutcome Launcher::run() {
       failWith({run::kExitTimeout, "timeout", text}, true);
       break;
     }
+    showProgress();
     if (secondsSince(lastPublish_) >= 1.0) {
       publish();
       lastPublish_ = Clock::now();
@@ -168,6 +194,7 @@ run::RunOutcome Launcher::run() {
     if (d.fromDaemon >= 0) close(d.fromDaemon);
   }
   run::RunOutcome outcome = failure_.value_or(run::RunOutcome{});
+  showProgress(&outcome);  // every daemon ended: their last statistics are in
   if (!options_.reportPath.empty()) {
     std::vector<std::string> parts;
     for (const auto& d : daemons_) {

@@ -255,7 +255,7 @@ RunOutcome Supervisor::run() {
       break;
     }
     reap(outcome, false);
-    showProgress(false);
+    showProgress();
     drainTraces();
     publishStats();
     if (options_.timeoutSeconds > 0 && secondsSince(start_) > options_.timeoutSeconds) {
@@ -276,7 +276,7 @@ RunOutcome Supervisor::run() {
     }
     std::string detail;
     if (lingering(detail)) {
-      std::fprintf(stderr, "vrflow: warning: %s\n", detail.c_str());
+      printAboveProgress("vrflow: warning: " + detail);
       if (options_.events != nullptr) options_.events->warning(detail);
       break;  // their work is done: stopAll() ends them, and the run counts as a success
     }
@@ -288,7 +288,7 @@ RunOutcome Supervisor::run() {
       if (auto stalled = noProgress()) outcome = *stalled;
     }
   }
-  if (displayed_) showProgress(true);
+  showProgress(&outcome);
   stopAll();
   publishStats(/*now=*/true);  // the final counts, every module ended
   return outcome;

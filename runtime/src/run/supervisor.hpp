@@ -19,6 +19,7 @@
 #include "vrflow/app/model.hpp"
 #include "vrflow/app/mpi_job.hpp"
 #include "vrflow/daemon/daemon.hpp"
+#include "vrflow/run/progress.hpp"
 #include "vrflow/run/runner.hpp"
 #include "vrflow/run/trace.hpp"
 
@@ -77,7 +78,8 @@ class Supervisor {
   bool notJoined(std::string& detail);
   bool lingering(std::string& detail);
   Clock::time_point finishedSince_{};
-  void showProgress(bool final);
+  /// The progress line (progress.hpp): redrawn about once a second; with `end`, its summary.
+  void showProgress(const RunOutcome* end = nullptr);
   /// Once a second (or now, when `now`): the statistics to the launcher (hostLink) and the
   /// event stream.
   void publishStats(bool now = false);
@@ -104,9 +106,7 @@ class Supervisor {
   Clock::time_point start_ = Clock::now();
   uint64_t lastIterationSum_ = 0;
   Clock::time_point lastProgress_ = Clock::now();
-  Clock::time_point lastDisplay_ = Clock::now();
-  std::vector<uint64_t> lastDisplayIterations_;
-  bool displayed_ = false;
+  ProgressLine progress_{options_.progress, options_.iterations};
 
  public:
   std::vector<ModuleEnd> ends() const {
