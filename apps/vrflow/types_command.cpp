@@ -34,6 +34,12 @@ std::string summary(const std::string& doc, std::size_t width) {
   return line;
 }
 
+// `text` without the spaces at its end (a column left empty).
+std::string trimmed(std::string text) {
+  text.erase(text.find_last_not_of(' ') + 1);
+  return text;
+}
+
 ordered_json portsJson(const std::vector<app::PortSpec>& ports) {
   ordered_json array = ordered_json::array();
   for (const auto& p : ports) {
@@ -97,10 +103,10 @@ void printPorts(const std::vector<app::PortSpec>& ports, const char* note) {
       if (p.isInput != inputs || implicitPort(p)) continue;
       std::string flags = p.required ? "required" : "";
       if (p.stampsOnly) flags += flags.empty() ? "stamps only" : ", stamps only";
-      char line[512];
-      std::snprintf(line, sizeof line, "    %-16s %-14s %-10s %s\n", p.name.c_str(), p.data.c_str(),
-                    flags.c_str(), summary(p.doc, 60).c_str());
-      lines += line;
+      char line[256];
+      std::snprintf(line, sizeof line, "    %-16s %-14s %-10s ", p.name.c_str(), p.data.c_str(),
+                    flags.c_str());
+      lines += trimmed(line + p.doc) + "\n";
     }
     if (lines.empty()) continue;
     std::printf("  %s%s:\n%s", inputs ? "inputs" : "outputs", note, lines.c_str());
@@ -119,9 +125,10 @@ void printParams(const std::vector<app::ParamSpec>& params) {
               (p.max ? number(*p.max) : std::string("inf")) + "]";
     }
     const std::string value = p.defaultValue.empty() ? "(none)" : p.defaultValue;
-    std::printf("    %-16s %-7s default %-10s %-16s %s\n", p.name.c_str(),
-                app::toString(p.type).c_str(), value.c_str(), range.c_str(),
-                summary(p.doc, 60).c_str());
+    char line[512];
+    std::snprintf(line, sizeof line, "    %-16s %-7s default %-10s %-16s ", p.name.c_str(),
+                  app::toString(p.type).c_str(), value.c_str(), range.c_str());
+    std::printf("%s\n", trimmed(line + p.doc).c_str());
   }
 }
 
@@ -163,7 +170,8 @@ CLI::App* addTypesCommand(CLI::App& cli, TypesOptions& into) {
 int runTypes(const TypesOptions& options) {
   // The filter types of the process before any plugin is loaded are the built-in ones.
   std::set<std::string> builtIn;
-  for (const auto* f : daemon::makeCatalog().filterTypes()) builtIn.insert(f->name);
+  const app::Catalog builtInCatalog = daemon::makeCatalog();  // alive while its types are read
+  for (const auto* f : builtInCatalog.filterTypes()) builtIn.insert(f->name);
   auto loaded = run::loadCatalog(options.packageDirs);
   if (!loaded) {
     std::fprintf(stderr, "vrflow: %s\n", loaded.error().message.c_str());

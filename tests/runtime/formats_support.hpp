@@ -27,7 +27,7 @@ inline std::string relayPipeline(const TempDir& dir, const std::string& relay = 
 
 /// Validates the report at `path`: exit code 0 when valid, else 1 with each violation on stdout.
 inline CommandResult validateReport(const std::string& path) {
-  return runCommand({"python3", sourceDir() + "/tests/runtime/check_report_schema.py",
+  return runCommand({"/usr/bin/python3", sourceDir() + "/tests/runtime/check_report_schema.py",
                      sourceDir() + "/runtime/schema/vrflow-report.schema.json", path});
 }
 

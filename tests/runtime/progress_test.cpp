@@ -43,7 +43,9 @@ TEST(Progress, NotOnATerminalARunEndsWithOneSummaryLine) {
 TEST(Progress, TheSummaryLineNamesAFailedRunsStatus) {
   TempDir dir;
   const auto result =
-      runVrflow({"run", relayPipeline(dir), "-n", "100000", "--timeout", "1.5"}, 60);
+      runVrflow({"run", relayPipeline(dir, "core/relay", paramXml("delay-ms", "10")), "-n",
+                 "100000", "--timeout", "1.5"},
+                60);
   ASSERT_EQ(result.exitCode, 3) << result.err;
   const std::regex summary(
       "vrflow: [0-9]+ of 100000 iterations in [0-9.]+ s \\([0-9.]+ it/s\\), status timeout\n");
@@ -56,7 +58,7 @@ TEST(Progress, OnATerminalALiveLineShowsIterationsOfNRateAndTimeLeft) {
   const std::string command =
       quoted(binDir() + "/vrflow") + " --packages " + quoted(binDir() + "/../test-packages") +
       " run " + quoted(relayPipeline(dir, "core/relay", paramXml("delay-ms", "100"))) + " -n 30";
-  const auto result = runCommand({"script", "-qec", command, "/dev/null"}, 60);
+  const auto result = runCommand({"/usr/bin/script", "-qec", command, "/dev/null"}, 60);
   ASSERT_EQ(result.exitCode, 0) << result.out << result.err;
   const std::regex live(
       "\r\\[vrflow [0-9]+s\\] [0-9]+/30 iterations \\([0-9]+%\\), [0-9.]+ it/s, ([0-9]+s|\\?) "
