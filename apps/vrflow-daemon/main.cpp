@@ -14,6 +14,8 @@
 #include <set>
 
 #include "control_link.hpp"
+#include "vrflow/base/version.hpp"
+#include "vrflow/net/control.hpp"
 #include "vrflow/run/events.hpp"
 #include "vrflow/run/log.hpp"
 #include "vrflow/run/prepare.hpp"
@@ -67,6 +69,12 @@ int main(int argc, char** argv) {
   cli.add_option("--log-level", logLevel,
                  "The daemon's own lines shown and logged: trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  std::string launcherVersion;
+  cli.add_option("--launcher-version", launcherVersion,
+                 "The launcher's version (vrflow launch passes it): refuse to serve under a "
+                 "launcher of another version");
+  cli.set_version_flag("--version", std::string(vrflow::versionText()),
+                       "Print the version and exit");
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -131,6 +139,18 @@ int main(int argc, char** argv) {
   if (vrflow::app::findHost(*application, host) == nullptr && host != "localhost") {
     std::fprintf(stderr, "vrflow-daemon: %s: no host '%s' in the application\n", file.c_str(),
                  host.c_str());
+    return vrflow::run::kExitInvalid;
+  }
+  // Hosts of one launch must run the same vrflow: the control lines, the frames between daemons
+  // and the report shares are only known to agree within one version.
+  if (!launcherVersion.empty() && launcherVersion != vrflow::versionText()) {
+    const std::string text = "vrflow-daemon here is vrflow " + std::string(vrflow::versionText()) +
+                             ", the launcher is vrflow " + launcherVersion +
+                             ": install the same vrflow on every host";
+    std::fprintf(stderr, "vrflow-daemon (host %s): %s\n", host.c_str(), text.c_str());
+    // On the control channel too, so that the launcher's one message names this host.
+    if (control)
+      std::printf("%s\n", vrflow::net::toLine(vrflow::net::ControlEvent::error(text)).c_str());
     return vrflow::run::kExitInvalid;
   }
 

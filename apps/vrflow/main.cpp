@@ -15,8 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "types_command.hpp"
 #include "vrflow/app/package_files.hpp"
 #include "vrflow/app/writer.hpp"
+#include "vrflow/base/version.hpp"
 #include "vrflow/launcher/launch.hpp"
 #include "vrflow/run/events.hpp"
 #include "vrflow/run/log.hpp"
@@ -166,12 +168,22 @@ bool startLogs(const std::string& application, const std::string& level, std::st
   return true;
 }
 
+// What stderr shows of a run: a live line on a terminal, else one summary line at the end.
+vrflow::run::ProgressMode progressMode(bool noProgress) {
+  if (noProgress) return vrflow::run::ProgressMode::Off;
+  return isatty(STDERR_FILENO) != 0 ? vrflow::run::ProgressMode::Live
+                                    : vrflow::run::ProgressMode::Summary;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);  // a closed stderr must not kill the run before its report
   CLI::App cli{"vrflow: run data-flow networks of physics modules"};
   cli.require_subcommand(1);
+  // `vrflow --version` is answered before main() (vrflow/base/version.hpp); the flag is here for
+  // --help and for `--version` among other arguments.
+  cli.set_version_flag("--version", vrflow::versionLine("vrflow"), "Print the version and exit");
   // The common options are accepted before the subcommand and after it (each subcommand's
   // --help lists them); both are used, those before first.
   SharedOptions before;
@@ -208,7 +220,8 @@ int main(int argc, char** argv) {
       ->check(positiveSeconds());
   run->add_option("--shm-size", shmMiB, "Shared-memory segment size in MiB (sparse)")
       ->check(CLI::Range(1.0, 262144.0));
-  run->add_flag("--no-progress", noProgress, "Do not show live progress on a terminal");
+  run->add_flag("--no-progress", noProgress,
+                "Show no progress (on a terminal a live line, else a summary line at the end)");
   run->add_option("--module-memory-limit", options.moduleMemoryBytes,
                   "Cap each module's data memory (e.g. 2G, 512M); hitting it is named as the cause")
       ->transform(CLI::AsSizeValue(false));
@@ -245,6 +258,8 @@ int main(int argc, char** argv) {
       ->add_option("--timeout", launchOptions.timeoutSeconds,
                    "Fail if the run lasts longer (seconds, > 0; without it, no limit)")
       ->check(positiveSeconds(" (leave --timeout out to run without a time limit)"));
+  launch->add_flag("--no-progress", noProgress,
+                   "Show no progress (on a terminal a live line, else a summary line at the end)");
   launch->add_option("--control-address", launchOptions.controlAddress,
                      "mpirun: this machine's address as the daemons reach it (default 127.0.0.1)");
   launch->add_option("--trace", launchOptions.tracePath,
@@ -271,6 +286,8 @@ int main(int argc, char** argv) {
   monitorCommand->add_option("--events", monitorSource,
                              "Show an event stream (FILE, or '-' for stdin) instead of the "
                              "running launches (docs/events.md)");
+  vrflow::apps::TypesOptions typesOptions;
+  auto* typesCommand = vrflow::apps::addTypesCommand(cli, typesOptions);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -282,6 +299,11 @@ int main(int argc, char** argv) {
     return monitorSource.empty()
                ? vrflow::launcher::monitor(monitorOnce, monitorJson)
                : vrflow::launcher::monitorEvents(monitorSource, monitorOnce, monitorJson);
+  }
+  if (typesCommand->parsed()) {
+    typesOptions.packageDirs.insert(typesOptions.packageDirs.begin(), before.packageDirs.begin(),
+                                    before.packageDirs.end());
+    return vrflow::apps::runTypes(typesOptions);
   }
   SharedOptions shared = before;
   for (const SharedOptions* after : {&validateShared, &expandShared, &runShared}) {
@@ -377,6 +399,7 @@ int main(int argc, char** argv) {
     if (!startLogs(flat->name, logLevel, launchOptions.runId, launchOptions.logDir)) {
       return vrflow::run::kExitInvalid;
     }
+    launchOptions.progress = progressMode(noProgress);
     const auto outcome = vrflow::launcher::launch(*flat, launchOptions);
     if (outcome.exitCode != 0) vrflow::run::logError("vrflow: " + outcome.error);
     vrflow::run::shutdownLogging();
@@ -388,10 +411,10 @@ int main(int argc, char** argv) {
   if (!application) return refused(prepared);
   const vrflow::app::Catalog& catalog = *prepared.catalog;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
-  options.progress = !noProgress && isatty(STDERR_FILENO) != 0;
   if (!startLogs(application->name, logLevel, options.runId, options.logDir)) {
     return vrflow::run::kExitInvalid;
   }
+  options.progress = progressMode(noProgress);
   const auto outcome = vrflow::run::runApplication(*application, catalog, options);
   if (outcome.exitCode != 0) vrflow::run::logError("vrflow: " + outcome.error);
   if (!outcome.detail.empty()) vrflow::run::logError(outcome.detail);

@@ -3,17 +3,24 @@
 #include <QCommandLineParser>
 #include <QEventLoop>
 #include <cstdio>
+#include <string>
 
 #include "main_window.hpp"
+#include "vrflow/base/version.hpp"
 
 int main(int argc, char** argv) {
   QApplication application(argc, argv);
   QApplication::setApplicationName("vrflow-editor");
   QApplication::setOrganizationName("vrflow");
+  // `vrflow-editor --version` alone is answered before main(), without a display
+  // (vrflow/base/version.hpp); -v and --version among other options come here.
+  QApplication::setApplicationVersion(
+      QString::fromStdString("(vrflow " + std::string(vrflow::versionText()) + ")"));
   QCommandLineParser parser;
   parser.setApplicationDescription(
       "vrflow node editor: lay out, validate, save and run applications");
   parser.addHelpOption();
+  parser.addVersionOption();
   parser.addPositionalArgument("APP.xml", "Application file to open");
   QCommandLineOption screenshot("screenshot", "Render the window to OUT.png and exit", "OUT.png");
   QCommandLineOption packages("packages", "Extra folder of node packages (repeatable)", "DIR");

@@ -118,6 +118,29 @@ void Launcher::stopAll() {
   }
 }
 
+void Launcher::showProgress(const run::RunOutcome* end) {
+  if (end == nullptr ? !progress_.due() : options_.progress == run::ProgressMode::Off) return;
+  if (options_.iterations > 0 && moduleTargets_.empty()) {
+    moduleTargets_ = run::moduleIterations(application_, options_.iterations);
+  }
+  std::vector<run::ModuleProgress> modules;
+  for (const auto& d : daemons_) {
+    const auto stats = nlohmann::json::parse(d.stats, nullptr, false);
+    if (stats.is_discarded() || !stats.contains("modules")) continue;
+    for (const auto& m : stats["modules"]) {
+      const auto target = moduleTargets_.find(m.value("id", std::string()));
+      modules.push_back({m.value("iterations", uint64_t{0}),
+                         target != moduleTargets_.end() ? target->second : 0});
+    }
+  }
+  const uint64_t done = run::outerIterationsDone(modules, options_.iterations);
+  if (end != nullptr) {
+    progress_.finish(done, end->status);
+  } else {
+    progress_.update(done);
+  }
+}
+
 run::RunOutcome Launcher::run() {
   sigset_t signals, previous;
   sigemptyset(&signals);
@@ -159,6 +182,7 @@ run::RunOutcome Launcher::run() {
       failWith({run::kExitTimeout, "timeout", text}, true);
       break;
     }
+    showProgress();
     if (secondsSince(lastPublish_) >= 1.0) {
       publish();
       lastPublish_ = Clock::now();
@@ -178,6 +202,7 @@ run::RunOutcome Launcher::run() {
     if (d.fromDaemon >= 0) close(d.fromDaemon);
   }
   run::RunOutcome outcome = failure_.value_or(run::RunOutcome{});
+  showProgress(&outcome);  // every daemon ended: their last statistics are in
   if (!options_.reportPath.empty()) {
     std::vector<std::string> parts;
     for (const auto& d : daemons_) {

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "vrflow/net/control.hpp"
 #include "vrflow/net/transport.hpp"
 #include "vrflow/run/module_logs.hpp"
+#include "vrflow/run/progress.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace vrflow::launcher::detail {
@@ -127,6 +129,9 @@ class Launcher {
   void failWith(run::RunOutcome outcome, bool rootCause);
   void stopAll();
   void publish();
+  /// The progress line (run/progress.hpp) from the hosts' last statistics; with `end`, its
+  /// summary.
+  void showProgress(const run::RunOutcome* end = nullptr);
   Clock::time_point lastPublish_{};
   std::optional<std::string> monitorDir_;  ///< where publish() writes; unset: not yet chosen
   bool allExited() const {
@@ -147,6 +152,9 @@ class Launcher {
   Clock::time_point failureAt_;
   bool interrupted_ = false;
   bool stopping_ = false;
+  run::ProgressLine progress_{options_.progress, options_.iterations};
+  /// Per module: its iterations for the launch's -n (run::moduleIterations); empty without -n.
+  std::map<std::string, uint64_t, std::less<>> moduleTargets_;
 };
 
 }  // namespace vrflow::launcher::detail

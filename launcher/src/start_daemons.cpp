@@ -14,6 +14,7 @@
 
 #include "launcher.hpp"
 #include "vrflow/base/executable_dir.hpp"
+#include "vrflow/base/version.hpp"
 #include "vrflow/run/process.hpp"
 
 namespace vrflow::launcher::detail {
@@ -68,6 +69,8 @@ Result<pid_t> spawnDaemon(const std::vector<std::string>& argv,
 
 void Launcher::appendDaemonOptions(std::vector<std::string>& argv) const {
   std::error_code ec;
+  // Every daemon refuses to serve a launcher of another vrflow (docs/report.md, "Versions").
+  argv.insert(argv.end(), {"--launcher-version", std::string(versionText())});
   if (!options_.tracePath.empty()) argv.push_back("--trace");
   char timeout[32];
   std::snprintf(timeout, sizeof timeout, "%g", options_.peerTimeoutSeconds);

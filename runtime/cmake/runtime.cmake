@@ -60,6 +60,7 @@ vrflow_add_library(run SHARED
     src/run/supervisor.cpp
     src/run/stall_check.cpp
     src/run/live_stats.cpp
+    src/run/progress.cpp
     src/run/events.cpp
     src/run/run_folders.cpp
     src/run/log.cpp

@@ -44,6 +44,10 @@ std::string joinNames(const std::vector<std::string>& names, std::size_t limit) 
   return joined;
 }
 
+}  // namespace vrflow::app::detail
+
+namespace vrflow::app {
+
 std::optional<std::string> closestName(std::string_view word,
                                        const std::vector<std::string>& candidates) {
   // Long inputs are not typos of short names; also keeps the quadratic distance cheap.
@@ -52,7 +56,7 @@ std::optional<std::string> closestName(std::string_view word,
   std::size_t bestDistance = 3;
   for (const std::string& candidate : candidates) {
     if (candidate.size() > 64) continue;
-    const std::size_t distance = editDistance(word, candidate);
+    const std::size_t distance = detail::editDistance(word, candidate);
     if (distance < bestDistance && distance * 2 < std::max(word.size(), candidate.size())) {
       best = candidate;
       bestDistance = distance;
@@ -60,6 +64,10 @@ std::optional<std::string> closestName(std::string_view word,
   }
   return best;
 }
+
+}  // namespace vrflow::app
+
+namespace vrflow::app::detail {
 
 std::string didYouMean(std::string_view word, const std::vector<std::string>& candidates) {
   const auto closest = closestName(word, candidates);

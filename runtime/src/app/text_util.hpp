@@ -5,15 +5,14 @@
 #include <string_view>
 #include <vector>
 
+#include "vrflow/app/closest_name.hpp"
+
 namespace vrflow::app::detail {
 
 /// "a, b, c" (at most `limit` names, then "and N more"); "none" when empty.
 std::string joinNames(const std::vector<std::string>& names, std::size_t limit = 12);
 
-/// The candidate closest to `word` when it is a plausible typo of it (edit distance at most 2
-/// and less than half the word), or nullopt.
-std::optional<std::string> closestName(std::string_view word,
-                                       const std::vector<std::string>& candidates);
+using app::closestName;  // vrflow/app/closest_name.hpp
 
 /// "; did you mean 'x'?" when a close candidate exists, else "".
 std::string didYouMean(std::string_view word, const std::vector<std::string>& candidates);

@@ -1,6 +1,5 @@
 // What a run shows while it runs: the progress line for people, the statistics for the
 // launcher and the event stream, the modules' traces.
-#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -85,33 +84,20 @@ void Supervisor::publishStats(bool now) {
   lastStats_ = Clock::now();
 }
 
-void Supervisor::showProgress(bool final) {
-  if (!options_.progress) return;
-  const auto now = Clock::now();
-  const double dt = std::chrono::duration<double>(now - lastDisplay_).count();
-  if (!final && dt < 1.0) return;
-  std::string line = "\r[vrflow " + std::to_string(static_cast<int>(secondsSince(start_))) + "s]";
-  // The same counters as the statistics of the event stream and `vrflow monitor`.
-  const nlohmann::json modules = statsSnapshot()["modules"];
-  lastDisplayIterations_.resize(modules.size(), 0);
-  for (std::size_t i = 0; i < modules.size(); ++i) {
-    const uint64_t it = modules[i]["iterations"].get<uint64_t>();
-    const double rate = dt > 0 ? static_cast<double>(it - lastDisplayIterations_[i]) / dt : 0.0;
-    lastDisplayIterations_[i] = it;
-    char text[128];
-    std::snprintf(text, sizeof text, "  %s %.0f it/s", modules[i]["id"].get<std::string>().c_str(),
-                  rate);
-    line += text;
+void Supervisor::showProgress(const RunOutcome* end) {
+  if (end == nullptr ? !progress_.due() : options_.progress == ProgressMode::Off) return;
+  // The modules' counters, as the statistics of the event stream and `vrflow monitor` show them.
+  std::vector<ModuleProgress> modules;
+  for (const auto& module : daemon_.modules()) {
+    const ipc::ModuleSlotDaemon slot = daemon_.slot(module.slotIndex);
+    modules.push_back({slot.iterations(), slot.iterationLimit()});
   }
-  winsize ws{};
-  if (ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 10 && line.size() > ws.ws_col) {
-    line.resize(ws.ws_col);
+  const uint64_t done = outerIterationsDone(modules, options_.iterations);
+  if (end != nullptr) {
+    progress_.finish(done, end->status);
+  } else {
+    progress_.update(done);
   }
-  line += "\033[K";
-  std::fputs(line.c_str(), stderr);
-  if (final) std::fputs("\n", stderr);
-  displayed_ = true;
-  lastDisplay_ = now;
 }
 
 }  // namespace vrflow::run::detail

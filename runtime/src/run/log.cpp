@@ -1,8 +1,8 @@
 #include "vrflow/run/log.hpp"
 
 #include <spdlog/logger.h>
+#include <spdlog/sinks/base_sink.h>
 #include <spdlog/sinks/basic_file_sink.h>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -15,6 +15,7 @@
 #include <mutex>
 
 #include "vrflow/run/module_logs.hpp"
+#include "vrflow/run/progress.hpp"
 
 namespace vrflow::run {
 namespace {
@@ -40,10 +41,48 @@ spdlog::level::level_enum spdlogLevel(LogLevel level) {
   return spdlog::level::off;
 }
 
+// The terminal's sink: each line goes above the live progress line (printAboveProgress), its
+// level coloured on a terminal.
+class TerminalSink final : public spdlog::sinks::base_sink<std::mutex> {
+ public:
+  explicit TerminalSink(bool colour) : colour_(colour) {}
+
+ protected:
+  void sink_it_(const spdlog::details::log_msg& msg) override {
+    spdlog::memory_buf_t formatted;
+    formatter_->format(msg, formatted);
+    std::string line(formatted.data(), formatted.size());
+    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+    if (colour_ && msg.color_range_end > msg.color_range_start &&
+        msg.color_range_end <= line.size()) {
+      line.insert(msg.color_range_end, "\033[0m");
+      line.insert(msg.color_range_start, colourOf(msg.level));
+    }
+    printAboveProgress(line);
+  }
+  void flush_() override { std::fflush(stderr); }
+
+ private:
+  static const char* colourOf(spdlog::level::level_enum level) {
+    switch (level) {
+      case spdlog::level::trace:
+      case spdlog::level::debug:
+        return "\033[36m";  // cyan
+      case spdlog::level::info:
+        return "\033[32m";  // green
+      case spdlog::level::warn:
+        return "\033[33;1m";  // bold yellow
+      default:
+        return "\033[31;1m";  // bold red
+    }
+  }
+
+  bool colour_;
+};
+
 std::shared_ptr<spdlog::logger> makeLogger(LogLevel level,
                                            std::shared_ptr<spdlog::sinks::sink> file) {
-  auto terminal = std::make_shared<spdlog::sinks::stderr_color_sink_mt>(
-      ModuleLogs::colourOnTerminal() ? spdlog::color_mode::always : spdlog::color_mode::never);
+  auto terminal = std::make_shared<TerminalSink>(ModuleLogs::colourOnTerminal());
   terminal->set_pattern("%H:%M:%S.%e %^%l%$ %v");
   std::vector<spdlog::sink_ptr> sinks{terminal};
   if (file) sinks.push_back(std::move(file));

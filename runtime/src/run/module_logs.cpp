@@ -1,5 +1,7 @@
 #include "vrflow/run/module_logs.hpp"
 
+#include "vrflow/run/progress.hpp"
+
 #include <unistd.h>
 
 #include <array>
@@ -105,7 +107,9 @@ void ModuleLogs::note(std::size_t module, std::string_view text) {
 void ModuleLogs::flush() {
   std::lock_guard lock(mutex_);
   if (!pending_.empty()) {
-    std::fwrite(pending_.data(), 1, pending_.size(), stderr);
+    // Above the live progress line when one shows (it is redrawn below them).
+    if (pending_.back() == '\n') pending_.pop_back();
+    printAboveProgress(pending_);
     std::fflush(stderr);
     pending_.clear();
   }

@@ -1,9 +1,12 @@
 #include "report.hpp"
 
+#include <sys/wait.h>
+
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "vrflow/base/version.hpp"
 #include "vrflow/run/report_head.hpp"
 
 namespace vrflow::run {
@@ -29,6 +32,18 @@ std::string hex(uint64_t value) {
 }
 
 }  // namespace
+
+void recordExit(ModuleEnd& end, int waitStatus) {
+  end.exitCode.reset();
+  end.signal.reset();
+  if (WIFEXITED(waitStatus)) {
+    end.exitCode = WEXITSTATUS(waitStatus);
+    end.exit = "status " + std::to_string(*end.exitCode);
+  } else {
+    end.signal = WTERMSIG(waitStatus);
+    end.exit = "signal " + std::to_string(*end.signal);
+  }
+}
 
 std::string endCauseName(uint32_t cause) {
   switch (static_cast<ipc::EndCause>(cause)) {
@@ -106,9 +121,11 @@ nlohmann::ordered_json reportHead(const app::Application& application, const Run
                                   uint64_t iterationsRequested) {
   nlohmann::ordered_json report;
   report["format"] = "vrflow-run-report/1";
+  report["vrflow_version"] = versionText();
   report["application"] = application.name;
   report["file"] = application.file;
   report["status"] = outcome.status;
+  report["exit_code"] = outcome.exitCode;
   report["error"] = outcome.error;
   report["iterations_requested"] = iterationsRequested;
   return report;
@@ -130,10 +147,14 @@ std::string reportJson(const app::Application& application, daemon::Daemon& daem
     m["id"] = module.id;
     m["host"] = module.host;
     m["iterations"] = iterations;
+    m["exit_code"] = nullptr;
+    m["signal"] = nullptr;
     if (i >= ends.size()) {
       m["exit"] = "not started";  // stopped before "go"
     } else {
       m["exit"] = ends[i].exit;
+      if (ends[i].exitCode) m["exit_code"] = *ends[i].exitCode;
+      if (ends[i].signal) m["signal"] = *ends[i].signal;
       if (!ends[i].cause.empty()) m["cause"] = ends[i].cause;
     }
     m["end"] = endCauseName(static_cast<uint32_t>(slot.endCause()));

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,7 +14,13 @@ namespace vrflow::run {
 struct ModuleEnd {
   std::string exit;   ///< "status 0", "signal 9", "running" (killed at stop)
   std::string cause;  ///< why it ended, when the runtime knows more than `exit` (empty if not)
+  std::optional<int> exitCode;  ///< the status it exited with; none if killed or not reaped
+  std::optional<int> signal;    ///< the signal that killed it; none if it exited
 };
+
+/// Records how a reaped module process ended (`waitStatus` as waitpid() gives it): the text
+/// "status N" or "signal N" and the number.
+void recordExit(ModuleEnd& end, int waitStatus);
 
 /// Why a module ended, in words ("iteration count", "end of input", ...; ipc::EndCause).
 std::string endCauseName(uint32_t cause);

@@ -128,8 +128,7 @@ void Supervisor::reap(RunOutcome& outcome, bool stopping) {
       Child& child = children_[i];
       if (child.pid != pid || !child.alive) continue;
       child.alive = false;
-      child.end.exit = WIFEXITED(status) ? "status " + std::to_string(WEXITSTATUS(status))
-                                         : "signal " + std::to_string(WTERMSIG(status));
+      recordExit(child.end, status);
       daemon_.moduleEnded(static_cast<int>(i));
       const auto& module = daemon_.modules()[i];
       if (notJoined.empty() &&
@@ -286,7 +285,7 @@ RunOutcome Supervisor::run() {
       break;
     }
     reap(outcome, false);
-    showProgress(false);
+    showProgress();
     drainTraces();
     publishStats();
     if (options_.timeoutSeconds > 0 && secondsSince(start_) > options_.timeoutSeconds) {
@@ -319,7 +318,7 @@ RunOutcome Supervisor::run() {
       if (auto stalled = noProgress()) outcome = *stalled;
     }
   }
-  if (displayed_) showProgress(true);
+  showProgress(&outcome);
   stopAll();
   // Every process ended: what they printed last is read to the end of their pipes (a process
   // they left behind holding one open is waited for briefly).

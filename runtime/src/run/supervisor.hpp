@@ -20,6 +20,7 @@
 #include "vrflow/app/model.hpp"
 #include "vrflow/app/mpi_job.hpp"
 #include "vrflow/daemon/daemon.hpp"
+#include "vrflow/run/progress.hpp"
 #include "vrflow/run/runner.hpp"
 #include "vrflow/run/trace.hpp"
 
@@ -61,7 +62,7 @@ class Supervisor {
     int mpiRanks = 0;  ///< above 1: `pid` is the mpirun that runs this many ranks
     int job = -1;      ///< index in jobs_: `pid` is the mpirun of that job, shared by its modules
     bool alive = false;
-    ModuleEnd end{"not started", ""};
+    ModuleEnd end{"not started", "", std::nullopt, std::nullopt};
   };
   std::string jobLabel(const app::MpiJob& job, pid_t mpirun) const;
   std::optional<std::string> refusedWithoutMpirun() const;
@@ -78,7 +79,8 @@ class Supervisor {
   bool notJoined(std::string& detail);
   bool lingering(std::string& detail);
   Clock::time_point finishedSince_{};
-  void showProgress(bool final);
+  /// The progress line (progress.hpp): redrawn about once a second; with `end`, its summary.
+  void showProgress(const RunOutcome* end = nullptr);
   /// Once a second (or now, when `now`): the statistics to the launcher (hostLink) and the
   /// event stream.
   void publishStats(bool now = false);
@@ -113,9 +115,7 @@ class Supervisor {
   Clock::time_point start_ = Clock::now();
   uint64_t lastIterationSum_ = 0;
   Clock::time_point lastProgress_ = Clock::now();
-  Clock::time_point lastDisplay_ = Clock::now();
-  std::vector<uint64_t> lastDisplayIterations_;
-  bool displayed_ = false;
+  ProgressLine progress_{options_.progress, options_.iterations};
 
  public:
   std::vector<ModuleEnd> ends() const {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "vrflow/base/version.hpp"
 #include "vrflow/message/ids.hpp"
 
 namespace vrflow::run {
@@ -252,7 +253,9 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
   json trace;
   trace["traceEvents"] = std::move(events);
   trace["displayTimeUnit"] = "ms";
-  trace["otherData"] = {{"application", application.name}, {"dropped_events", dropped}};
+  trace["otherData"] = {{"application", application.name},
+                        {"vrflow_version", versionText()},
+                        {"dropped_events", dropped}};
   return trace.dump();
 }
 

@@ -52,7 +52,7 @@ struct LaunchOptions {
   uint64_t moduleMemoryBytes = 0;  ///< run::RunOptions::moduleMemoryBytes of every host
   std::vector<std::string> packageDirs, compositeDirs;
   std::vector<std::string> overrides;  ///< `--set ID.PARAM=VALUE`, applied by every daemon
-  bool progress = false;
+  run::ProgressMode progress = run::ProgressMode::Off;  ///< what stderr shows of the launch
   /// The launch's event stream, merged from every host's (docs/events.md); null: none.
   run::EventStream* events = nullptr;
   /// This launch's id (run::newRunId); empty: none.

@@ -11,8 +11,8 @@
 
 namespace vrflow::run {
 
-/// The report's leading fields, in their order: format, application, file, status, error,
-/// iterations_requested.
+/// The report's leading fields, in their order: format, vrflow_version, application, file,
+/// status, exit_code, error, iterations_requested (docs/report.md).
 nlohmann::ordered_json reportHead(const app::Application& application, const RunOutcome& outcome,
                                   uint64_t iterationsRequested);
 

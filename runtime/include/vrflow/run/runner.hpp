@@ -12,6 +12,7 @@
 
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/model.hpp"
+#include "vrflow/run/progress.hpp"
 
 namespace vrflow::daemon {
 struct DaemonOptions;
@@ -44,12 +45,12 @@ struct RunOptions {
   /// Caps each module process's data memory (RLIMIT_DATA); 0 = no cap. A module that runs out
   /// under it is reported with the cap as the cause.
   uint64_t moduleMemoryBytes = 0;
-  std::string reportPath;        ///< JSON report; empty = none
-  bool progress = false;         ///< live iterations/s on stderr
-  double stopGraceSeconds = 2;   ///< after a stop request, before SIGTERM then SIGKILL
-  double joinSeconds = 20;       ///< a module must call Module::init() within this
-  double lingerSeconds = 5;      ///< a module that finished must exit within this
-  HostLink* hostLink = nullptr;  ///< set by vrflow-daemon under the launcher
+  std::string reportPath;                     ///< JSON report; empty = none
+  ProgressMode progress = ProgressMode::Off;  ///< what stderr shows of the run (progress.hpp)
+  double stopGraceSeconds = 2;                ///< after a stop request, before SIGTERM then SIGKILL
+  double joinSeconds = 20;                    ///< a module must call Module::init() within this
+  double lingerSeconds = 5;                   ///< a module that finished must exit within this
+  HostLink* hostLink = nullptr;               ///< set by vrflow-daemon under the launcher
   /// The whole application when runApplication() gets one host's share (vrflow-daemon), to
   /// name the feeders on other hosts in deadlock reports; null: the application given.
   const app::Application* wholeApplication = nullptr;
