@@ -39,8 +39,7 @@ int main() {
   }
   const auto lines = module.params().getInt("lines");
   for (long i = 1; i <= lines; ++i) {
-    std::printf("out %ld\n", i);
-    std::fflush(stdout);
+    std::printf("out %ld\n", i);  // not flushed: a module's stdout is line-buffered
     std::fprintf(stderr, "err %ld\n", i);
   }
   if (module.params().getInt("fds") != 0) printDescriptors();
@@ -53,8 +52,10 @@ int main() {
     std::printf("flood done\n");
   }
   const std::string partial = module.params().getString("partial");
-  if (!partial.empty()) std::printf("%s", partial.c_str());
-  std::fflush(stdout);
+  if (!partial.empty()) {
+    std::printf("%s", partial.c_str());
+    std::fflush(stdout);
+  }
   const auto crashAt = static_cast<uint64_t>(module.params().getInt("crash"));
   while (module.wait()) {
     if (crashAt > 0 && module.iteration() == crashAt) {

@@ -210,6 +210,21 @@ OutputPort& Module::addOutput(std::string name) {
   return declarePort(impl_->outputs, std::move(name));
 }
 
+namespace {
+
+// A module's standard output is a pipe to its runtime, which logs it (docs/logs.md): make it
+// line-buffered before main() prints anything, so that a module that crashes loses no line it
+// printed (the C library would otherwise hold up to 4 KiB). Only in a process the runtime
+// started as a module (its join contract in the environment).
+__attribute__((constructor)) void lineBufferedStandardOutput() {
+  if (std::getenv("VRFLOW_MODULE_INDEX") != nullptr ||
+      std::getenv("VRFLOW_MODULE_INDICES") != nullptr) {
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  }
+}
+
+}  // namespace
+
 Status Module::init() {
   Impl& m = *impl_;
   // The supervisor's contract: which segment, and which slot of it is this module's. A module

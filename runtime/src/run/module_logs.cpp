@@ -1,13 +1,13 @@
 #include "vrflow/run/module_logs.hpp"
 
-#include "vrflow/run/progress.hpp"
-
 #include <unistd.h>
 
 #include <array>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+
+#include "vrflow/run/progress.hpp"
 
 namespace vrflow::run {
 namespace {
