@@ -15,11 +15,13 @@
 #include <string>
 #include <vector>
 
+#include "runs_commands.hpp"
 #include "vrflow/app/package_files.hpp"
 #include "vrflow/app/writer.hpp"
 #include "vrflow/launcher/launch.hpp"
 #include "vrflow/run/events.hpp"
 #include "vrflow/run/prepare.hpp"
+#include "vrflow/run/run_folders.hpp"
 #include "vrflow/run/runner.hpp"
 
 namespace {
@@ -222,14 +224,19 @@ int main(int argc, char** argv) {
                    "A host silent this long (no heartbeat) is declared lost (seconds, > 0)")
       ->check(positiveSeconds());
   auto* monitorCommand =
-      cli.add_subcommand("monitor", "Show live statistics of the running launches");
+      cli.add_subcommand("monitor", "Show live statistics of a running run or launch");
   bool monitorOnce = false, monitorJson = false;
+  std::string monitorRun;
+  monitorCommand->add_option("RUN", monitorRun,
+                             "Run id, or any unique start of it (default: the only running run)");
   monitorCommand->add_flag("--once", monitorOnce, "Print one snapshot and exit");
   monitorCommand->add_flag("--json", monitorJson, "Print the raw snapshots (JSON lines)");
   std::string monitorSource;
   monitorCommand->add_option("--events", monitorSource,
                              "Show an event stream (FILE, or '-' for stdin) instead of the "
-                             "running launches (docs/events.md)");
+                             "running runs (docs/events.md)");
+  vrflow::cli::RunsCommands runsCommands;
+  vrflow::cli::addRunsCommands(cli, runsCommands);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -237,9 +244,10 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
+  if (const auto code = vrflow::cli::runRunsCommand(runsCommands)) return *code;
   if (monitorCommand->parsed()) {
     return monitorSource.empty()
-               ? vrflow::launcher::monitor(monitorOnce, monitorJson)
+               ? vrflow::launcher::monitor(monitorRun, monitorOnce, monitorJson)
                : vrflow::launcher::monitorEvents(monitorSource, monitorOnce, monitorJson);
   }
   SharedOptions shared = before;
@@ -321,6 +329,8 @@ int main(int argc, char** argv) {
     launchOptions.packageDirs = shared.packageDirs;
     launchOptions.compositeDirs = shared.compositeDirs;
     launchOptions.overrides = shared.overrides;
+    launchOptions.runId = vrflow::run::newRunId(flat->name);
+    launchOptions.logDir = vrflow::run::defaultLogDirectory(launchOptions.runId);
     const auto outcome = vrflow::launcher::launch(*flat, launchOptions);
     if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
     return outcome.exitCode;
@@ -332,6 +342,8 @@ int main(int argc, char** argv) {
   const vrflow::app::Catalog& catalog = *prepared.catalog;
   options.segmentBytes = static_cast<std::size_t>(shmMiB * 1024 * 1024);
   options.progress = !noProgress && isatty(STDERR_FILENO) != 0;
+  options.runId = vrflow::run::newRunId(application->name);
+  options.logDir = vrflow::run::defaultLogDirectory(options.runId);
   const auto outcome = vrflow::run::runApplication(*application, catalog, options);
   if (outcome.exitCode != 0) std::fprintf(stderr, "vrflow: %s\n", outcome.error.c_str());
   return outcome.exitCode;

@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "launcher.hpp"
-#include "monitor_files.hpp"
 #include "vrflow/run/events.hpp"
+#include "vrflow/run/registry.hpp"
 #include "vrflow/run/trace.hpp"
 
 namespace vrflow::launcher {
@@ -46,34 +46,6 @@ void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
   std::fprintf(stderr, "vrflow: %s; stopping every host\n", outcome.error.c_str());
   failure_ = std::move(outcome);
   failureIsRoot_ = rootCause;
-}
-
-// Rewrites this launch's monitor file (atomically: write, then rename).
-void Launcher::publish() {
-  std::string text = "{\"application\":" + nlohmann::json(application_.name).dump() +
-                     ",\"file\":" + nlohmann::json(application_.file).dump() +
-                     ",\"launcher_pid\":" + std::to_string(getpid()) + ",\"hosts\":[";
-  for (std::size_t i = 0; i < daemons_.size(); ++i) {
-    const auto& d = daemons_[i];
-    text += (i ? "," : "") + std::string("{\"host\":") + nlohmann::json(d.host).dump() +
-            ",\"address\":" + nlohmann::json(d.bind).dump() +
-            ",\"daemon_pid\":" + std::to_string(d.pid) +
-            ",\"now\":" + (d.stats.empty() ? "null" : d.stats) +
-            ",\"before\":" + (d.previousStats.empty() ? "null" : d.previousStats) + "}";
-  }
-  text += "]}";
-  if (!monitorDir_) {
-    // Chosen once: a folder that may not be trusted is refused (the launch goes on unseen).
-    auto dir = monitorDirectory();
-    if (!dir) {
-      std::fprintf(stderr, "vrflow: warning: `vrflow monitor` will not show this launch: %s\n",
-                   dir.error().message.c_str());
-    } else {
-      removeStaleMonitorFiles(*dir);
-    }
-    monitorDir_ = dir ? *dir : std::string();
-  }
-  if (!monitorDir_->empty()) publishMonitorFile(*monitorDir_, text);
 }
 
 void Launcher::stopAll() {
@@ -129,11 +101,20 @@ run::RunOutcome Launcher::run() {
   // Orphans of the run (the daemons of an mpirun that died) become our children, to be reaped.
   prctl(PR_SET_CHILD_SUBREAPER, 1);
   const auto begin = Clock::now();
+  // The launch registers, its merged events feeding the registry (docs/operations.md).
+  std::optional<run::RegisteredRun> registered;
+  events_ = options_.events;
+  if (!options_.runId.empty()) {
+    registered.emplace(run::identityOf(application_, "launch", options_.runId, options_.iterations,
+                                       options_.logDir),
+                       options_.events);
+    events_ = registered->events();
+  }
 
   if (auto status = start(); !status) {
     failWith({run::kExitRunFailed, "failed", status.error().message}, true);
-  } else if (options_.events != nullptr) {
-    options_.events->started(application_);  // every host said "go"
+  } else if (events_ != nullptr) {
+    events_->started(application_);  // every host said "go"
   }
   bool quitSent = false;
   while (!allExited()) {
@@ -149,10 +130,6 @@ run::RunOutcome Launcher::run() {
       failWith({run::kExitTimeout, "timeout", text}, true);
       break;
     }
-    if (secondsSince(lastPublish_) >= 1.0) {
-      publish();
-      lastPublish_ = Clock::now();
-    }
     bool allFinished = true;
     for (const auto& d : daemons_) allFinished = allFinished && d.finished;
     if (allFinished && !quitSent) {
@@ -162,7 +139,6 @@ run::RunOutcome Launcher::run() {
     }
   }
   stopAll();
-  if (monitorDir_ && !monitorDir_->empty()) removeMonitorFile(*monitorDir_);
   for (auto& d : daemons_) {
     if (d.toDaemon >= 0) close(d.toDaemon);
     if (d.fromDaemon >= 0) close(d.fromDaemon);
@@ -203,7 +179,7 @@ run::RunOutcome Launcher::run() {
   while (sigtimedwait(&signals, nullptr, &zero) > 0) {
   }
   sigprocmask(SIG_SETMASK, &previous, nullptr);
-  if (options_.events != nullptr) options_.events->end(outcome);
+  if (events_ != nullptr) events_->end(outcome);
   return outcome;
 }
 

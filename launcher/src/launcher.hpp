@@ -42,7 +42,6 @@ struct HostDaemon {
   bool stopAnswered = false;  ///< it answered "stop"
   int finishedCode = 0;
   std::string finishedStatus, finishedError, report, exitText, trace;
-  std::string stats, previousStats;  ///< the last two "stats" lines (vrflow monitor)
   bool clockKnown = false;
   int64_t clockOffsetNs = 0;  ///< the daemon's steady clock minus ours
 
@@ -77,9 +76,6 @@ class Launcher {
   void onLine(HostDaemon& d, const std::string& line);
   void failWith(run::RunOutcome outcome, bool rootCause);
   void stopAll();
-  void publish();
-  Clock::time_point lastPublish_{};
-  std::optional<std::string> monitorDir_;  ///< where publish() writes; unset: not yet chosen
   bool allExited() const {
     for (const auto& d : daemons_) {
       if (!d.exited) return false;
@@ -89,6 +85,8 @@ class Launcher {
 
   const app::Application& application_;
   const LaunchOptions& options_;
+  /// Where the launch's events go: options_.events, tee'd to the registry (run()).
+  run::EventStream* events_ = nullptr;
   std::vector<HostDaemon> daemons_;
   int signalFd_ = -1;
   std::optional<run::RunOutcome> failure_;
