@@ -36,7 +36,8 @@ std::string renderLaunch(const json& launch) {
   std::ostringstream out;
   char line[256];
   out << launch.value("application", "?") << "  (" << launch.value("file", "");
-  if (launch.contains("launcher_pid")) out << ", pid " << launch.value("launcher_pid", 0);
+  if (launch.contains("launcher_pid")) out << ", launcher pid " << launch.value("launcher_pid", 0);
+  if (launch.contains("pid")) out << ", pid " << launch.value("pid", 0);
   out << ")\n";
   std::snprintf(line, sizeof line, "%-8s %-16s %10s %6s %-16s %6s %10s\n", "HOST", "MODULE", "IT/S",
                 "WAIT%", "STATE", "CPU%", "RSS MiB");
@@ -133,7 +134,7 @@ int monitor(const std::string& runPrefix, bool once, bool asJson) {
       return 1;
     }
     json shown = json::parse(record->state.toJson());
-    shown["launcher_pid"] = record->identity.pid;
+    shown[record->identity.kind == "launch" ? "launcher_pid" : "pid"] = record->identity.pid;
     if (!once && !asJson && isatty(STDOUT_FILENO)) std::fputs("\033[H\033[2J", stdout);
     std::fputs(((asJson ? shown.dump() : renderLaunch(shown)) + "\n").c_str(), stdout);
     if (!record->running) std::printf("%s\n", record->state.endLine().c_str());

@@ -7,7 +7,7 @@
 namespace vrflow::launcher {
 
 /// The table `vrflow monitor` prints for one run: `launch` holds "application", "file",
-/// "launcher_pid" (optional) and "hosts", each with "host" and its last two statistics
+/// "launcher_pid" or "pid" (optional) and "hosts", each with "host" and its last two statistics
 /// snapshots "now" and "before" (null when not yet known): run::RunState's JSON.
 std::string renderLaunch(const nlohmann::json& launch);
 
