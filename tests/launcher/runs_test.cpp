@@ -300,6 +300,32 @@ TEST_F(RunsTest, AmbiguousAndUnknownIdsAreRefusedNamingTheCandidates) {
   EXPECT_EQ(second.result().exitCode, 130);
 }
 
+TEST_F(RunsTest, OnlyTheLastFiftyEndedRunsAreKept) {
+  const auto first = runVrflow({"run", pipelineFile(), "-n", "5"}, 60);
+  ASSERT_EQ(first.exitCode, 0) << first.err;
+  const json ended = list(/*all=*/true);
+  ASSERT_EQ(ended.size(), 1u);
+  // 55 older runs, as the first left its record (copies of it, started earlier).
+  const std::string runs = dir.file("state/vrflow/runs/");
+  const std::string id = ended[0]["id"];
+  for (int i = 0; i < 55; ++i) {
+    const std::string older = "older-" + std::to_string(100 + i);
+    std::filesystem::copy(runs + id, runs + older);
+    json record = json::parse(readFile(runs + older + "/run.json"));
+    record["id"] = older;
+    record["start_time"] = record["start_time"].get<int64_t>() - 1000 + i;
+    std::ofstream(runs + older + "/run.json") << record.dump();
+  }
+  const auto last = runVrflow({"run", pipelineFile(), "-n", "5"}, 60);
+  ASSERT_EQ(last.exitCode, 0) << last.err;
+  const json kept = list(/*all=*/true);
+  ASSERT_EQ(kept.size(), 50u);
+  // The oldest went: the 7 first copies; the two real runs are the newest.
+  EXPECT_EQ(kept[0]["id"], "older-107");
+  EXPECT_EQ(kept[48]["id"], id);
+  EXPECT_EQ(kept[49]["state"], "ok");
+}
+
 TEST_F(RunsTest, LogsFollowPrintsNewLinesAndEndsWithTheRun) {
   Background run({"run", pipelineFile(), "--timeout", "60"});
   const json running = waitForRunning(1);
