@@ -88,14 +88,15 @@ class RunsTest : public ::testing::Test {
     return json::parse(shown.out, nullptr, false);
   }
 
-  // Waits until `count` runs are running and each has statistics; their records.
+  // Waits until `count` runs are running and each has two statistics snapshots (a rate);
+  // their records.
   json waitForRunning(std::size_t count) {
     json runs;
     for (int i = 0; i < 200; ++i) {
       runs = list();
       bool ready = runs.is_array() && runs.size() == count;
       for (const auto& r : ready ? runs : json::array()) {
-        ready = ready && r["state"] == "running" && r["iterations"].get<uint64_t>() > 0;
+        ready = ready && r["state"] == "running" && r["rate"].get<double>() > 0;
       }
       if (ready) return runs;
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
