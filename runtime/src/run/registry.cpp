@@ -184,9 +184,10 @@ std::string moveToEnded(const std::string& folder, const std::string& id) {
   if (!ended) return {};
   const std::string target = *ended + "/" + id;
   std::error_code ignored;
-  std::filesystem::remove_all(target, ignored);  // a run of the same id, long ago
   if (rename(folder.c_str(), target.c_str()) != 0) {
-    if (errno != EXDEV) return {};  // gone: another reader moved it
+    // Gone (ENOENT: its run, or another reader, moved it first), or already there: a target
+    // is never removed, since it may be the run's own record, moved an instant ago.
+    if (errno != EXDEV) return {};
     // Another file system: copied, then removed.
     if (mkdir(target.c_str(), 0700) != 0) return {};
     for (const char* name : {"run.json", "state.json"}) {
