@@ -81,9 +81,12 @@ function(vrflow_add_test name)
   # Tests find the commands beside their own executable (build/bin) and the sources here.
   target_compile_definitions(${name} PRIVATE VRFLOW_TEST_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   # PREFIX names a second build of the same tests apart from the first ("PREFIX.Suite.Test").
+  # The runs the tests start keep their records and logs in the build, not in the user's home
+  # (docs/operations.md).
   gtest_discover_tests(${name}
     TEST_PREFIX "${ARG_PREFIX}"
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+      ENVIRONMENT "XDG_STATE_HOME=${PROJECT_BINARY_DIR}/test-state"
     DISCOVERY_TIMEOUT 60)
 endfunction()
 

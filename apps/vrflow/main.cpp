@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "runs_commands.hpp"
 #include "types_command.hpp"
 #include "vrflow/app/package_files.hpp"
 #include "vrflow/app/writer.hpp"
@@ -278,16 +279,21 @@ int main(int argc, char** argv) {
                    "A host silent this long (no heartbeat) is declared lost (seconds, > 0)")
       ->check(positiveSeconds());
   auto* monitorCommand =
-      cli.add_subcommand("monitor", "Show live statistics of the running launches");
+      cli.add_subcommand("monitor", "Show live statistics of a running run or launch");
   bool monitorOnce = false, monitorJson = false;
+  std::string monitorRun;
+  monitorCommand->add_option("RUN", monitorRun,
+                             "Run id, or any unique start of it (default: the only running run)");
   monitorCommand->add_flag("--once", monitorOnce, "Print one snapshot and exit");
   monitorCommand->add_flag("--json", monitorJson, "Print the raw snapshots (JSON lines)");
   std::string monitorSource;
   monitorCommand->add_option("--events", monitorSource,
                              "Show an event stream (FILE, or '-' for stdin) instead of the "
-                             "running launches (docs/events.md)");
+                             "running runs (docs/events.md)");
   vrflow::apps::TypesOptions typesOptions;
   auto* typesCommand = vrflow::apps::addTypesCommand(cli, typesOptions);
+  vrflow::cli::RunsCommands runsCommands;
+  vrflow::cli::addRunsCommands(cli, runsCommands);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -295,9 +301,10 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : vrflow::run::kExitInvalid;
   }
 
+  if (const auto code = vrflow::cli::runRunsCommand(runsCommands)) return *code;
   if (monitorCommand->parsed()) {
     return monitorSource.empty()
-               ? vrflow::launcher::monitor(monitorOnce, monitorJson)
+               ? vrflow::launcher::monitor(monitorRun, monitorOnce, monitorJson)
                : vrflow::launcher::monitorEvents(monitorSource, monitorOnce, monitorJson);
   }
   if (typesCommand->parsed()) {

@@ -60,12 +60,10 @@ void Launcher::onLine(HostDaemon& d, const std::string& line) {
       d.report = std::move(event.text);
       break;
     case Kind::Stats:
-      if (options_.events != nullptr) options_.events->stats(event.text, d.host);
-      d.previousStats = std::move(d.stats);
-      d.stats = std::move(event.text);
+      if (events_ != nullptr) events_->stats(event.text, d.host);
       break;
     case Kind::Event:
-      if (options_.events != nullptr) options_.events->relay(event.text, d.host);
+      if (events_ != nullptr) events_->relay(event.text, d.host);
       break;
     case Kind::Trace:
       d.trace = std::move(event.text);

@@ -11,9 +11,9 @@
 #include <nlohmann/json.hpp>
 
 #include "launcher.hpp"
-#include "monitor_files.hpp"
 #include "vrflow/run/events.hpp"
 #include "vrflow/run/log.hpp"
+#include "vrflow/run/registry.hpp"
 #include "vrflow/run/trace.hpp"
 
 namespace vrflow::launcher {
@@ -47,34 +47,6 @@ void Launcher::failWith(run::RunOutcome outcome, bool rootCause) {
   run::logError("vrflow: " + outcome.error + "; stopping every host");
   failure_ = std::move(outcome);
   failureIsRoot_ = rootCause;
-}
-
-// Rewrites this launch's monitor file (atomically: write, then rename).
-void Launcher::publish() {
-  std::string text = "{\"application\":" + nlohmann::json(application_.name).dump() +
-                     ",\"file\":" + nlohmann::json(application_.file).dump() +
-                     ",\"launcher_pid\":" + std::to_string(getpid()) + ",\"hosts\":[";
-  for (std::size_t i = 0; i < daemons_.size(); ++i) {
-    const auto& d = daemons_[i];
-    text += (i ? "," : "") + std::string("{\"host\":") + nlohmann::json(d.host).dump() +
-            ",\"address\":" + nlohmann::json(d.bind).dump() +
-            ",\"daemon_pid\":" + std::to_string(d.pid) +
-            ",\"now\":" + (d.stats.empty() ? "null" : d.stats) +
-            ",\"before\":" + (d.previousStats.empty() ? "null" : d.previousStats) + "}";
-  }
-  text += "]}";
-  if (!monitorDir_) {
-    // Chosen once: a folder that may not be trusted is refused (the launch goes on unseen).
-    auto dir = monitorDirectory();
-    if (!dir) {
-      run::logWarning("vrflow: warning: `vrflow monitor` will not show this launch: " +
-                      dir.error().message);
-    } else {
-      removeStaleMonitorFiles(*dir);
-    }
-    monitorDir_ = dir ? *dir : std::string();
-  }
-  if (!monitorDir_->empty()) publishMonitorFile(*monitorDir_, text);
 }
 
 void Launcher::stopAll() {
@@ -162,11 +134,20 @@ run::RunOutcome Launcher::run() {
       run::logWarning("vrflow: warning: " + added.error().message);
     }
   }
+  // The launch registers, its merged events feeding the registry (docs/operations.md).
+  std::optional<run::RegisteredRun> registered;
+  events_ = options_.events;
+  if (!options_.runId.empty()) {
+    registered.emplace(run::identityOf(application_, "launch", options_.runId, options_.iterations,
+                                       options_.logDir),
+                       options_.events);
+    events_ = registered->events();
+  }
 
   if (auto status = start(); !status) {
     failWith({run::kExitRunFailed, "failed", status.error().message}, true);
-  } else if (options_.events != nullptr) {
-    options_.events->started(application_);  // every host said "go"
+  } else if (events_ != nullptr) {
+    events_->started(application_);  // every host said "go"
   }
   bool quitSent = false;
   while (!allExited()) {
@@ -183,10 +164,6 @@ run::RunOutcome Launcher::run() {
       break;
     }
     showProgress();
-    if (secondsSince(lastPublish_) >= 1.0) {
-      publish();
-      lastPublish_ = Clock::now();
-    }
     bool allFinished = true;
     for (const auto& d : daemons_) allFinished = allFinished && d.finished;
     if (allFinished && !quitSent) {
@@ -196,7 +173,6 @@ run::RunOutcome Launcher::run() {
     }
   }
   stopAll();
-  if (monitorDir_ && !monitorDir_->empty()) removeMonitorFile(*monitorDir_);
   for (auto& d : daemons_) {
     if (d.toDaemon >= 0) close(d.toDaemon);
     if (d.fromDaemon >= 0) close(d.fromDaemon);
@@ -238,7 +214,7 @@ run::RunOutcome Launcher::run() {
   while (sigtimedwait(&signals, nullptr, &zero) > 0) {
   }
   sigprocmask(SIG_SETMASK, &previous, nullptr);
-  if (options_.events != nullptr) options_.events->end(outcome);
+  if (events_ != nullptr) events_->end(outcome);
   return outcome;
 }
 

@@ -47,7 +47,6 @@ struct HostDaemon {
   bool stopAnswered = false;  ///< it answered "stop"
   int finishedCode = 0;
   std::string finishedStatus, finishedError, report, exitText, trace;
-  std::string stats, previousStats;  ///< the last two "stats" lines (vrflow monitor)
   bool clockKnown = false;
   int64_t clockOffsetNs = 0;  ///< the daemon's steady clock minus ours
 
@@ -128,12 +127,9 @@ class Launcher {
   void onOutput(const HostDaemon& d, const net::ControlEvent& event);
   void failWith(run::RunOutcome outcome, bool rootCause);
   void stopAll();
-  void publish();
   /// The progress line (run/progress.hpp) from the hosts' last statistics; with `end`, its
   /// summary.
   void showProgress(const run::RunOutcome* end = nullptr);
-  Clock::time_point lastPublish_{};
-  std::optional<std::string> monitorDir_;  ///< where publish() writes; unset: not yet chosen
   bool allExited() const {
     for (const auto& d : daemons_) {
       if (!d.exited) return false;
@@ -145,6 +141,8 @@ class Launcher {
   const LaunchOptions& options_;
   run::ModuleLogs logs_;      ///< every host's module lines, gathered on this machine
   bool logsRefused_ = false;  ///< a module's log file could not be made (said once)
+  /// Where the launch's events go: options_.events, tee'd to the registry (run()).
+  run::EventStream* events_ = nullptr;
   std::vector<HostDaemon> daemons_;
   int signalFd_ = -1;
   std::optional<run::RunOutcome> failure_;

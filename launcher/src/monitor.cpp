@@ -1,22 +1,15 @@
-#include <dirent.h>
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/stat.h>
+// `vrflow monitor [RUN]`: the live statistics of a registered run (docs/operations.md).
 #include <unistd.h>
 
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
-#include "monitor_files.hpp"
+#include "monitor_table.hpp"
 #include "vrflow/launcher/launch.hpp"
-#include "vrflow/run/run_folders.hpp"
+#include "vrflow/run/registry.hpp"
 
 namespace vrflow::launcher {
 namespace {
@@ -44,6 +37,7 @@ std::string renderLaunch(const json& launch) {
   char line[256];
   out << launch.value("application", "?") << "  (" << launch.value("file", "");
   if (launch.contains("launcher_pid")) out << ", launcher pid " << launch.value("launcher_pid", 0);
+  if (launch.contains("pid")) out << ", pid " << launch.value("pid", 0);
   out << ")\n";
   std::snprintf(line, sizeof line, "%-8s %-16s %10s %6s %-16s %6s %10s\n", "HOST", "MODULE", "IT/S",
                 "WAIT%", "STATE", "CPU%", "RSS MiB");
@@ -119,124 +113,33 @@ std::string renderLaunch(const json& launch) {
   return out.str();
 }
 
-namespace {
-
-// A monitor file larger than this is not a launcher's (they hold a few KiB per host).
-constexpr off_t kMaxMonitorFileBytes = off_t{16} << 20;
-
-// The launcher pid in a monitor file's name ("monitor-PID.json", or a temporary
-// "monitor-PID.json.XXXXXX" of publishMonitorFile()), or 0 if the name is not one.
-pid_t launcherOf(const std::string& name, bool& temporary) {
-  if (name.rfind("monitor-", 0) != 0) return 0;
-  char* end = nullptr;
-  const long pid = std::strtol(name.c_str() + 8, &end, 10);
-  if (pid <= 0 || end == name.c_str() + 8 || std::strncmp(end, ".json", 5) != 0) return 0;
-  temporary = end[5] != '\0';
-  if (temporary && end[5] != '.') return 0;
-  return static_cast<pid_t>(pid);
-}
-
-bool processGone(pid_t pid) {
-  return kill(pid, 0) != 0 && errno == ESRCH;
-}
-
-// A regular file of `dir` (never through a symbolic link), at most kMaxMonitorFileBytes.
-std::string readMonitorFile(int dir, const std::string& name) {
-  const int fd = openat(dir, name.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return {};
-  struct stat info {};
-  std::string text;
-  if (fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_size <= kMaxMonitorFileBytes) {
-    text.resize(static_cast<std::size_t>(info.st_size));
-    const ssize_t n = read(fd, text.data(), text.size());
-    text.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
+int monitor(const std::string& runPrefix, bool once, bool asJson) {
+  auto found = run::findRun(runPrefix, /*all=*/true);
+  if (!found) {
+    std::fprintf(stderr, "vrflow monitor: %s\n", found.error().message.c_str());
+    return 1;
   }
-  close(fd);
-  return text;
-}
-
-// The live launches: their monitor files whose launcher is still running.
-Result<std::vector<json>> liveLaunches() {
-  auto dir = monitorDirectory();
-  if (!dir) return dir.error();
-  removeStaleMonitorFiles(*dir);
-  std::vector<json> launches;
-  DIR* d = opendir(dir->c_str());
-  if (d == nullptr) return launches;
-  while (dirent* e = readdir(d)) {
-    bool temporary = false;
-    const pid_t pid = launcherOf(e->d_name, temporary);
-    if (pid <= 0 || temporary || kill(pid, 0) != 0) continue;
-    auto j = json::parse(readMonitorFile(dirfd(d), e->d_name), nullptr, false);
-    if (!j.is_discarded() && j.is_object() && j.contains("hosts")) launches.push_back(std::move(j));
+  const std::string id = found->identity.id;
+  if (!found->running) {
+    std::fprintf(stderr,
+                 "vrflow monitor: run '%s' has ended (%s); `vrflow logs %s` shows its logs\n",
+                 id.c_str(), found->stateWord().c_str(), id.c_str());
+    return 1;
   }
-  closedir(d);
-  return launches;
-}
-
-}  // namespace
-
-Result<std::string> monitorDirectory() {
-  return run::runtimeDirectory();
-}
-
-void removeStaleMonitorFiles(const std::string& dir) {
-  DIR* d = opendir(dir.c_str());
-  if (d == nullptr) return;
-  while (dirent* e = readdir(d)) {
-    bool temporary = false;
-    const pid_t pid = launcherOf(e->d_name, temporary);
-    if (pid > 0 && processGone(pid)) {
-      unlinkat(dirfd(d), e->d_name, 0);
-    }
-  }
-  closedir(d);
-}
-
-bool publishMonitorFile(const std::string& dir, const std::string& text) {
-  const std::string path = dir + "/monitor-" + std::to_string(getpid()) + ".json";
-  // mkostemp opens with O_CREAT | O_EXCL: a name that exists (a link planted there included)
-  // is never opened, and rename() replaces a link at `path` instead of following it.
-  std::string temp = path + ".XXXXXX";
-  const int fd = mkostemp(temp.data(), O_CLOEXEC);
-  if (fd < 0) return false;
-  bool ok = fchmod(fd, 0600) == 0;
-  for (std::size_t done = 0; ok && done < text.size();) {
-    const ssize_t n = write(fd, text.data() + done, text.size() - done);
-    ok = n > 0;
-    if (ok) done += static_cast<std::size_t>(n);
-  }
-  ok = close(fd) == 0 && ok;
-  if (ok && rename(temp.c_str(), path.c_str()) == 0) return true;
-  unlink(temp.c_str());
-  return false;
-}
-
-void removeMonitorFile(const std::string& dir) {
-  unlink((dir + "/monitor-" + std::to_string(getpid()) + ".json").c_str());
-}
-
-int monitor(bool once, bool asJson) {
-  bool seen = false;
   while (true) {
-    const auto launches = liveLaunches();
-    if (!launches) {
-      std::fprintf(stderr, "vrflow monitor: %s\n", launches.error().message.c_str());
+    // The record moves to the state folder when the run ends: found again by its whole id.
+    auto record = run::findRun(id, /*all=*/true);
+    if (!record) {
+      std::fprintf(stderr, "vrflow monitor: %s\n", record.error().message.c_str());
       return 1;
     }
-    if (launches->empty()) {
-      if (!seen)
-        std::fprintf(stderr, "vrflow monitor: no launch is running (looked in %s)\n",
-                     monitorDirectory()->c_str());
-      return seen ? 0 : 1;
-    }
-    seen = true;
-    std::string text;
-    for (const auto& l : *launches) text += asJson ? l.dump() + "\n" : renderLaunch(l) + "\n";
+    json shown = json::parse(record->state.toJson());
+    shown[record->identity.kind == "launch" ? "launcher_pid" : "pid"] = record->identity.pid;
     if (!once && !asJson && isatty(STDOUT_FILENO)) std::fputs("\033[H\033[2J", stdout);
-    std::fputs(text.c_str(), stdout);
+    std::fputs(((asJson ? shown.dump() : renderLaunch(shown)) + "\n").c_str(), stdout);
+    if (!record->running) std::printf("%s\n", record->state.endLine().c_str());
     std::fflush(stdout);
-    if (once) return 0;
+    if (once || !record->running) return 0;
     std::this_thread::sleep_for(std::chrono::seconds(1));
   }
 }

@@ -66,6 +66,8 @@ vrflow_add_library(run SHARED
     src/run/log.cpp
     src/run/module_logs.cpp
     src/run/module_output.cpp
+    src/run/run_state.cpp
+    src/run/registry.cpp
   PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/run
   PUBLIC_DEPS vrflow::daemon vrflow::app vrflow::module
   PRIVATE_DEPS nlohmann_json::nlohmann_json spdlog::spdlog)

@@ -1,6 +1,6 @@
-// The monitor folder of `vrflow launch` / `vrflow monitor`: a folder that is not private to the
-// user is refused, links planted in it are never followed, and the files of launchers killed
-// with SIGKILL are removed.
+// The runtime folder of the registry of runs (`vrflow launch` / `vrflow monitor`): a folder that
+// is not private to the user is refused, a link planted in it is never followed, and the
+// records of launchers killed with SIGKILL leave it.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -20,18 +20,26 @@ std::string threeHostsFile() {
   return sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml";
 }
 
-// XDG_RUNTIME_DIR set to a folder of this test's own, so its monitor folder is <tmp>/vrflow.
+// XDG_RUNTIME_DIR set to a folder of this test's own, so its runtime folder is <tmp>/vrflow
+// (and XDG_STATE_HOME, for the ended runs).
 class MonitorFolderTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (const char* previous = std::getenv("XDG_RUNTIME_DIR")) saved_ = previous;
+    if (const char* previous = std::getenv("XDG_STATE_HOME")) savedState_ = previous;
     setenv("XDG_RUNTIME_DIR", dir.path().c_str(), 1);
+    setenv("XDG_STATE_HOME", dir.file("state").c_str(), 1);
   }
   void TearDown() override {
     if (saved_) {
       setenv("XDG_RUNTIME_DIR", saved_->c_str(), 1);
     } else {
       unsetenv("XDG_RUNTIME_DIR");
+    }
+    if (savedState_) {
+      setenv("XDG_STATE_HOME", savedState_->c_str(), 1);
+    } else {
+      unsetenv("XDG_STATE_HOME");
     }
     // A killed launcher's daemons die with it and come back to this test (a subreaper) to reap.
     for (const auto& left : leftoverProcesses()) {
@@ -42,16 +50,8 @@ class MonitorFolderTest : public ::testing::Test {
   TempDir dir;
 
  private:
-  std::optional<std::string> saved_;
+  std::optional<std::string> saved_, savedState_;
 };
-
-// The pid of a process that has ended (and was reaped).
-pid_t deadPid() {
-  const pid_t pid = fork();
-  if (pid == 0) _exit(0);
-  waitpid(pid, nullptr, 0);
-  return pid;
-}
 
 TEST_F(MonitorFolderTest, AFolderOthersMayWriteIsRefusedByMonitorAndLaunch) {
   ASSERT_EQ(mkdir(folder().c_str(), 0700), 0);
@@ -82,39 +82,33 @@ TEST_F(MonitorFolderTest, AFolderOfAnotherUserIsRefused) {
       << shown.err;
 }
 
-TEST_F(MonitorFolderTest, LinksPlantedUnderTheLaunchersNamesAreNeverFollowed) {
+TEST_F(MonitorFolderTest, ALinkPlantedAsTheRegistryIsNeverFollowed) {
   ASSERT_EQ(mkdir(folder().c_str(), 0700), 0);
-  const auto victim = dir.write("victim.txt", "precious\n");
-  const auto victimTmp = dir.write("victim-tmp.txt", "precious too\n");
-  // The shell's pid is the launcher's (exec): links under both names the launcher writes.
-  const auto result =
-      runCommand({"/bin/sh", "-c",
-                  "ln -s '" + victim + "' '" + folder() + "'/monitor-$$.json && ln -s '" +
-                      victimTmp + "' '" + folder() + "'/monitor-$$.json.tmp && exec '" + binDir() +
-                      "/vrflow' launch '" + threeHostsFile() + "' -n 20"},
-                 120);
-  EXPECT_EQ(result.exitCode, 0) << result.err;
-  EXPECT_EQ(readFile(victim), "precious\n");
-  EXPECT_EQ(readFile(victimTmp), "precious too\n");
-  // The launcher has ended: what it left (the planted temporary link) goes at the next look.
-  runVrflow({"monitor", "--once"}, 30);
-  EXPECT_EQ(runCommand({"/bin/sh", "-c", "ls -A '" + folder() + "'"}).out, "");
+  ASSERT_EQ(mkdir(dir.file("victim").c_str(), 0700), 0);
+  ASSERT_EQ(symlink(dir.file("victim").c_str(), (folder() + "/runs").c_str()), 0);
+  const auto launched = runVrflow({"launch", threeHostsFile(), "-n", "20"}, 120);
+  EXPECT_EQ(launched.exitCode, 0) << launched.err;
+  EXPECT_NE(launched.err.find("`vrflow monitor` will not show this launch"), std::string::npos)
+      << launched.err;
+  EXPECT_EQ(runCommand({"/bin/sh", "-c", "ls -A '" + dir.file("victim") + "'"}).out, "")
+      << "the launch wrote through the link";
+  const auto listed = runVrflow({"list"}, 30);
+  EXPECT_EQ(listed.exitCode, 1);
+  EXPECT_NE(listed.err.find("is not a folder of yours"), std::string::npos) << listed.err;
 }
 
-TEST_F(MonitorFolderTest, TheFileOfALauncherKilledWithSigkillIsRemovedAtTheNextLook) {
-  // A launcher killed with SIGKILL cannot remove its file.
+TEST_F(MonitorFolderTest, TheRecordOfALauncherKilledWithSigkillLeavesAtTheNextLook) {
+  // A launcher killed with SIGKILL cannot move its record.
   const auto killed = runVrflow({"launch", threeHostsFile(), "--timeout", "60"}, 90, 3, SIGKILL);
   EXPECT_EQ(killed.exitCode, 128 + SIGKILL);
-  const auto left = runCommand({"/bin/sh", "-c", "ls -A '" + folder() + "'"}).out;
-  EXPECT_NE(left.find("monitor-"), std::string::npos) << "the launch published nothing";
-  // And one of a launcher long gone, with a temporary of it.
-  const pid_t dead = deadPid();
-  dir.write("vrflow/monitor-" + std::to_string(dead) + ".json", "{\"hosts\":[]}");
-  dir.write("vrflow/monitor-" + std::to_string(dead) + ".json.Ab12Cd", "{");
+  const auto left = runCommand({"/bin/sh", "-c", "ls -A '" + folder() + "/runs'"}).out;
+  EXPECT_NE(left.find("pipeline-"), std::string::npos) << "the launch registered nothing";
   const auto shown = runVrflow({"monitor", "--once"}, 30);
   EXPECT_EQ(shown.exitCode, 1);
-  EXPECT_NE(shown.err.find("no launch is running"), std::string::npos) << shown.err;
-  EXPECT_EQ(runCommand({"/bin/sh", "-c", "ls -A '" + folder() + "'"}).out, "");
+  EXPECT_NE(shown.err.find("no run is running"), std::string::npos) << shown.err;
+  EXPECT_EQ(runCommand({"/bin/sh", "-c", "ls -A '" + folder() + "/runs'"}).out, "");
+  const auto all = runVrflow({"list", "--all"}, 30);
+  EXPECT_NE(all.out.find("lost"), std::string::npos) << all.out;
 }
 
 }  // namespace

@@ -51,9 +51,15 @@ double EventStream::elapsed() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
+void EventStream::tee(Writer tee) {
+  std::lock_guard lock(mutex_);
+  tee_ = std::move(tee);
+}
+
 void EventStream::write(const std::string& line) {
   std::lock_guard lock(mutex_);
-  writer_(line);
+  if (writer_) writer_(line);
+  if (tee_) tee_(line);
 }
 
 void EventStream::started(const app::Application& application) {

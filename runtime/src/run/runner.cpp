@@ -25,6 +25,7 @@
 #include "vrflow/message/ids.hpp"
 #include "vrflow/run/events.hpp"
 #include "vrflow/run/log.hpp"
+#include "vrflow/run/registry.hpp"
 #include "vrflow/run/trace.hpp"
 
 namespace vrflow::run {
@@ -43,7 +44,25 @@ std::map<std::string, uint64_t, std::less<>> moduleIterations(const app::Applica
 }
 
 RunOutcome runApplication(const app::Application& application, const app::Catalog& catalog,
-                          const RunOptions& options) {
+                          const RunOptions& given) {
+  // The daemon thread must not take the signals meant for the supervisor: block them before
+  // it is created (it inherits this mask); blocked before the run registers, a SIGTERM from
+  // `vrflow stop` always ends it in order.
+  sigset_t signals, previous;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGCHLD);
+  pthread_sigmask(SIG_BLOCK, &signals, &previous);
+  // A run of `vrflow run` (with an id) registers, its events feeding the registry
+  // (docs/operations.md); a daemon's share of a launch does not (the launch registers).
+  std::optional<RegisteredRun> registered;
+  RunOptions options = given;
+  if (!given.runId.empty() && given.hostLink == nullptr) {
+    registered.emplace(identityOf(application, "run", given.runId, given.iterations, given.logDir),
+                       given.events);
+    options.events = registered->events();
+  }
   daemon::DaemonOptions daemonOptions;
   daemonOptions.segmentBytes = options.segmentBytes;
   daemonOptions.iterationLimit = options.iterations;
@@ -57,14 +76,6 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
     }
   }
   if (options.hostLink != nullptr) options.hostLink->configure(daemonOptions);
-  // The daemon thread must not take the signals meant for the supervisor: block them before
-  // it is created (it inherits this mask).
-  sigset_t signals, previous;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGCHLD);
-  pthread_sigmask(SIG_BLOCK, &signals, &previous);
 
   auto daemon = daemon::Daemon::create(application, catalog, daemonOptions);
   if (!daemon) {

@@ -69,15 +69,11 @@ struct LaunchOptions {
 std::string mergeReports(const app::Application& application, const std::vector<std::string>& parts,
                          const run::RunOutcome& outcome, uint64_t iterations, double wallSeconds);
 
-/// Folder (mode 0700) where running launches publish their live state:
-/// $XDG_RUNTIME_DIR/vrflow, or /tmp/vrflow-<uid>; created if missing. An error if it is not a
-/// folder of this user that only they may write (as ssh and tmux refuse theirs).
-Result<std::string> monitorDirectory();
-
-/// `vrflow monitor`: shows the live state of the launches running for this user, per host and
-/// module (iterations/s, wait vs compute, state, CPU, memory), per connection (queue, messages/s,
-/// bytes/s) and per link. Returns 0, or 1 when no launch is running.
-int monitor(bool once, bool json);
+/// `vrflow monitor [RUN]`: shows the live state of a registered run or launch (run::findRun:
+/// any unique start of its id; empty: the only running run), per host and module
+/// (iterations/s, wait vs compute, state, CPU, memory), per connection (queue, messages/s,
+/// bytes/s) and per link, each second until it ends. Returns 0, or 1 when there is no such run.
+int monitor(const std::string& run, bool once, bool json);
 
 /// `vrflow monitor --events FILE|-`: the same table from an event stream (docs/events.md),
 /// redrawn at each statistics event, until its "end" (a file still being written is followed;

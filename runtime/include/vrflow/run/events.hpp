@@ -26,8 +26,9 @@ class EventStream {
   /// Receives each line, without its newline.
   using Writer = std::function<void(const std::string& line)>;
 
-  /// A stream that hands each line to `writer`; `withStats`: false drops the stats events
-  /// (a daemon under the launcher, whose statistics travel on their own control lines).
+  /// A stream that hands each line to `writer` (empty: to none but the tee); `withStats`: false
+  /// drops the stats events (a daemon under the launcher, whose statistics travel on their own
+  /// control lines).
   explicit EventStream(Writer writer, bool withStats = true);
   /// `vrflow run --events TARGET`: "-" is standard output (dup'ed first: the caller may then
   /// point descriptor 1 elsewhere), anything else a file, created or truncated.
@@ -35,6 +36,10 @@ class EventStream {
   ~EventStream();
   EventStream(const EventStream&) = delete;
   EventStream& operator=(const EventStream&) = delete;
+
+  /// Also hands each line to `tee` (the run's registration, docs/operations.md), in order and
+  /// one at a time; set before the first event.
+  void tee(Writer tee);
 
   /// "started": the application, its hosts and modules, before the modules start.
   void started(const app::Application& application);
@@ -58,6 +63,7 @@ class EventStream {
   double elapsed() const;
 
   Writer writer_;
+  Writer tee_;
   bool withStats_ = true;
   int fd_ = -1;  ///< owned by open()'s streams
   std::mutex mutex_;
