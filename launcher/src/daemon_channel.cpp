@@ -61,6 +61,7 @@ void Launcher::onLine(HostDaemon& d, const std::string& line) {
       break;
     case Kind::Stats:
       if (events_ != nullptr) events_->stats(event.text, d.host);
+      d.stats = std::move(event.text);
       break;
     case Kind::Event:
       if (events_ != nullptr) events_->relay(event.text, d.host);

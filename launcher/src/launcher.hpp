@@ -47,6 +47,7 @@ struct HostDaemon {
   bool stopAnswered = false;  ///< it answered "stop"
   int finishedCode = 0;
   std::string finishedStatus, finishedError, report, exitText, trace;
+  std::string stats;  ///< its last "stats" line (the progress line)
   bool clockKnown = false;
   int64_t clockOffsetNs = 0;  ///< the daemon's steady clock minus ours
 
