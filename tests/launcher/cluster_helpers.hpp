@@ -1,6 +1,6 @@
 #pragma once
 
-// What the cluster tests (hostfile_test.cpp, slurm_test.cpp) share.
+// What the launcher tests share (hostfile, slurm, launch and ssh tests).
 
 #include <sys/types.h>
 

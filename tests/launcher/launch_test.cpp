@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "cluster_helpers.hpp"
 #include "process_helpers.hpp"
 
 namespace vrflow::testing {
@@ -26,18 +27,6 @@ std::string pipelineFile() {
 }
 std::string threeHostsFile() {
   return sourceDir() + "/examples/pipeline_3hosts/pipeline_3hosts.xml";
-}
-
-// The report without timings and without what names the file or the hosts.
-nlohmann::json deterministicPart(const std::string& path) {
-  auto report = nlohmann::json::parse(readFile(path));
-  report.erase("timing");
-  report.erase("file");
-  for (auto& m : report["modules"]) {
-    m.erase("timing");
-    m.erase("host");
-  }
-  return report;
 }
 
 std::string cmdline(pid_t pid) {

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -154,14 +155,18 @@ TEST_F(RunsTest, APlainRunIsListedMonitoredShownAndStopped) {
   const std::string logDir = r["log_dir"];
   appendLog(logDir, "springs", "stiffness 400\nsettled\n");
   appendLog(logDir, "recorder", "writing out/trajectory.csv\n");
-  appendLog(logDir, "vrflow", "run started\n");
   const auto springs = runVrflow({"logs", id, "springs"}, 30);
   EXPECT_EQ(springs.exitCode, 0) << springs.err;
   EXPECT_EQ(springs.out, "stiffness 400\nsettled\n");
   const auto all = runVrflow({"logs", id}, 30);
-  EXPECT_EQ(all.out,
-            "[springs] stiffness 400\n[springs] settled\n[recorder] writing "
-            "out/trajectory.csv\n[vrflow] run started\n");
+  // The modules' logs in file order, then the runtime's own (vrflow.log, written by the run).
+  EXPECT_EQ(all.out.rfind("[springs] stiffness 400\n[springs] settled\n[recorder] writing "
+                          "out/trajectory.csv\n[vrflow] ",
+                          0),
+            0u)
+      << all.out;
+  EXPECT_NE(all.out.find("vrflow: run " + id + ", logs in " + logDir + "\n"), std::string::npos)
+      << all.out;
 
   const auto stopped = runVrflow({"stop", id.substr(0, 10)}, 60);
   EXPECT_EQ(stopped.exitCode, 0) << stopped.err;
@@ -343,13 +348,19 @@ TEST_F(RunsTest, LogsFollowPrintsNewLinesAndEndsWithTheRun) {
   follower.join();  // returns only once the run has ended
   EXPECT_EQ(run.result().exitCode, 130) << run.result().err;
   EXPECT_EQ(followed.exitCode, 0) << followed.err;
-  // Each file's lines in order; the files' lines interleave as they were seen.
-  EXPECT_NE(followed.out.find("[relay] first\n[relay] second\n"), std::string::npos)
-      << followed.out;
-  EXPECT_NE(followed.out.find("[chain] last words\n"), std::string::npos) << followed.out;
-  EXPECT_EQ(followed.out.size(),
+  // Each file's lines in order; the files' lines interleave as they were seen. The runtime's
+  // own lines (vrflow.log) come too: the stop is among them.
+  std::string modules, runtime;
+  std::istringstream lines(followed.out);
+  for (std::string line; std::getline(lines, line);) {
+    (line.rfind("[vrflow] ", 0) == 0 ? runtime : modules) += line + "\n";
+  }
+  EXPECT_NE(modules.find("[relay] first\n[relay] second\n"), std::string::npos) << followed.out;
+  EXPECT_NE(modules.find("[chain] last words\n"), std::string::npos) << followed.out;
+  EXPECT_EQ(modules.size(),
             std::string("[relay] first\n[relay] second\n[chain] last words\n").size())
       << followed.out;
+  EXPECT_NE(runtime.find("interrupted by SIGTERM"), std::string::npos) << followed.out;
   // On a run that has ended: prints and exits.
   const auto after = runVrflow({"logs", id, "relay", "--follow"}, 30);
   EXPECT_EQ(after.exitCode, 0);

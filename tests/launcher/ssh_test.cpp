@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "cluster_helpers.hpp"
 #include "process_helpers.hpp"
 
 namespace vrflow::testing {
@@ -116,17 +117,6 @@ class Sshd {
   pid_t pid_ = -1;
   int port_ = 0;
 };
-
-nlohmann::json deterministicPart(const std::string& path) {
-  auto report = nlohmann::json::parse(readFile(path));
-  report.erase("timing");
-  report.erase("file");
-  for (auto& m : report["modules"]) {
-    m.erase("timing");
-    m.erase("host");
-  }
-  return report;
-}
 
 TEST(LaunchSsh, ThreeHostsThroughSshdGiveTheSameDigestsAsOneHost) {
   TempDir dir;
