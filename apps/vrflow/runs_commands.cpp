@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -161,6 +162,13 @@ struct LogTail {
 
 int showLogs(const std::string& prefix, const std::string& module, bool follow) {
   auto found = run::findRun(prefix, /*all=*/true);
+  if (!found && prefix.empty()) {
+    // No run going on: the last one that ran (what a person looks at after a run failed).
+    auto runs = run::listRuns(/*all=*/true);
+    const bool noneRunning =
+        runs && std::none_of(runs->begin(), runs->end(), [](const auto& r) { return r.running; });
+    if (noneRunning && !runs->empty()) found = runs->back();
+  }
   if (!found) {
     std::fprintf(stderr, "vrflow logs: %s\n", found.error().message.c_str());
     return 1;

@@ -183,6 +183,10 @@ TEST_F(RunsTest, APlainRunIsListedMonitoredShownAndStopped) {
   EXPECT_EQ(ended[0]["state"], "interrupted");
   EXPECT_EQ(ended[0]["end"]["exit_code"], 130);
   EXPECT_EQ(runVrflow({"logs", id, "springs"}, 30).out, "stiffness 400\nsettled\n");
+  // With no run going on, `logs` shows the last one that ran.
+  const auto last = runVrflow({"logs"}, 30);
+  EXPECT_EQ(last.exitCode, 0) << last.err;
+  EXPECT_EQ(last.out.rfind("[springs] stiffness 400\n", 0), 0u) << last.out;
   const auto again = runVrflow({"stop", id}, 30);
   EXPECT_EQ(again.exitCode, 1);
   EXPECT_NE(again.err.find("has already ended (interrupted)"), std::string::npos) << again.err;
