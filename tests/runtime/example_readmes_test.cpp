@@ -86,12 +86,32 @@ std::vector<std::vector<std::string>> commandBlocks(const std::string& readme) {
   return blocks;
 }
 
+// A node package that an application file of examples/<example> uses and this build lacks
+// (the sanitizer builds leave the node packages out); empty when it has them all.
+std::string missingNodePackage(const std::string& example) {
+  for (const auto& entry :
+       std::filesystem::directory_iterator(sourceDir() + "/examples/" + example)) {
+    if (entry.path().extension() != ".xml") continue;
+    const std::string text = readFile(entry.path().string());
+    for (const char* package : {"rigid", "massspring", "fluid", "viewer"}) {
+      const bool used = text.find("package=\"" + std::string(package) + "\"") != std::string::npos;
+      if (used && !std::filesystem::exists(binDir() + "/../share/vrflow/packages/" + package)) {
+        return package;
+      }
+    }
+  }
+  return {};
+}
+
 class ExampleReadme : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ExampleReadme, CommandsRunAsWrittenFromTheRepositoryRoot) {
   const std::string example = GetParam();
   const auto blocks = commandBlocks(readFile(sourceDir() + "/examples/" + example + "/README.md"));
   ASSERT_FALSE(blocks.empty()) << "no command in examples/" << example << "/README.md";
+  if (const std::string missing = missingNodePackage(example); !missing.empty()) {
+    GTEST_SKIP() << "this build has no node package '" << missing << "' (VRFLOW_NODES=OFF)";
+  }
   TempDir root;
   std::filesystem::create_directory_symlink(std::filesystem::path(binDir()).parent_path(),
                                             root.file("build"));
