@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 
@@ -42,7 +43,21 @@ TEST(LaunchStall, AStoppedModuleIsNamedWithItsHostNotBlamedOnAnotherHost) {
     springs = descendantNamed("vrflow-core-spr");  // comm keeps 15 characters
   }
   EXPECT_NE(springs, 0) << "no springs module";
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the run get going
+  // Stop it only once the network iterates (a module stopped before it joined its daemon is a
+  // start failure, not a stall): this launch's entry in `vrflow list` counts iterations. A
+  // sanitized module on a loaded machine takes seconds to get there.
+  const pid_t launcher = descendantNamed("vrflow");
+  uint64_t iterations = 0;
+  for (int i = 0; i < 120 && launcher != 0 && iterations < 20; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    const auto listed = runVrflow({"list", "--json"}, 20);
+    const auto runs = nlohmann::json::parse(listed.out, nullptr, false);
+    if (!runs.is_array()) continue;
+    for (const auto& run : runs) {
+      if (run.value("pid", 0) == launcher) iterations = run.value("iterations", uint64_t{0});
+    }
+  }
+  EXPECT_GE(iterations, 20u) << "the launch (pid " << launcher << ") did not get going";
   if (springs != 0) kill(springs, SIGSTOP);
   launch.join();
   EXPECT_EQ(result.exitCode, 1) << result.err;

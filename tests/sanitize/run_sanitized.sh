@@ -15,4 +15,17 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
 cd "$build"
-ctest --output-on-failure -j "$(nproc)" -L 'runtime|message|app|transport|launcher'
+status=0
+ctest --output-on-failure -j "$(nproc)" -L 'runtime|message|app|transport|launcher' || status=$?
+if [ "$status" -ne 0 ] && [ -s Testing/Temporary/LastTestsFailed.log ]; then
+  # The failures' own output again, last, where a log cut to its tail still shows it.
+  echo "=== output of the failed tests (${type}) ==="
+  while IFS=: read -r _ name; do
+    awk -v name="$name" '
+      { t = "Test: " name }
+      !on && length($0) >= length(t) && substr($0, length($0) - length(t) + 1) == t { on = 1 }
+      on { print }
+      on && /^"[^"]*" end time:/ { exit }' Testing/Temporary/LastTest.log | tail -n 80
+  done < Testing/Temporary/LastTestsFailed.log
+fi
+exit "$status"
