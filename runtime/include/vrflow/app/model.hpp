@@ -107,6 +107,30 @@ struct EditorNode {
   SourceLocation loc;
 };
 
+/// A note on the editor's canvas (`<note>` in `<editor>`): text in a box; the runtime ignores it.
+struct EditorNote {
+  std::string id;
+  double x = 0;  ///< top-left corner, scene units
+  double y = 0;
+  double width = 200;
+  double height = 80;
+  std::string text;  ///< plain text, lines separated by '\n'
+  SourceLocation loc;
+};
+
+/// A frame on the editor's canvas (`<frame>` in `<editor>`): a titled, coloured rectangle drawn
+/// behind the nodes it surrounds, for grouping; the runtime ignores it.
+struct EditorFrame {
+  std::string id;
+  std::string title;
+  double x = 0;  ///< top-left corner, scene units
+  double y = 0;
+  double width = 400;
+  double height = 300;
+  std::string color;  ///< "#rrggbb", empty for the default
+  SourceLocation loc;
+};
+
 /// A folder of node packages the file names (`<packages path="..."/>`): searched like a
 /// --packages folder, after the command line's and before $VRFLOW_PACKAGE_PATH and the installed
 /// packages (docs/application-format.md, "Package folders"). `path` is kept as written; a
@@ -127,6 +151,8 @@ struct Application {
   std::vector<Filter> filters;
   std::vector<Connection> connections;
   std::vector<EditorNode> editor;
+  std::vector<EditorNote> notes;    ///< in `<editor>`, after the nodes
+  std::vector<EditorFrame> frames;  ///< in `<editor>`, after the notes
   std::string file;  ///< the file it was loaded from; empty for a model built in code
 };
 
