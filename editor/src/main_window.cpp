@@ -399,8 +399,14 @@ void MainWindow::problemActivated(int row) {
   if (!p.cycle.empty()) connection = p.cycle.front();
   canvas_->selectOnly(nodes, connection);
   // A misspelt parameter with a suggestion: the double-click renames it (one undoable edit).
+  // Queued: the edit refills the list, which must not happen inside its own signal.
   if (const auto fix = parameterSuggestion(p)) {
-    apply(renameParameter(app_, p.node, fix->first, fix->second), false);
+    QMetaObject::invokeMethod(
+        this,
+        [this, node = p.node, from = fix->first, to = fix->second] {
+          apply(renameParameter(app_, node, from, to), false);
+        },
+        Qt::QueuedConnection);
   }
 }
 

@@ -332,6 +332,7 @@ void PropertiesPanel::addParameterRow(QFormLayout* form, const app::ParamSpec& s
   overrideButton->setDefaultAction(overrideAction);
   overrideButton->setText("\u25b6");
   overrideButton->setAutoRaise(true);
+  overrideButton->setFocusPolicy(Qt::NoFocus);  // Tab goes from field to field
   if (declared && spec.type != app::ParamType::Vec3) h->addWidget(overrideButton);
   row.label = new QLabel;
   row.label->setToolTip(editor->toolTip());
@@ -344,6 +345,7 @@ void PropertiesPanel::addParameterRow(QFormLayout* form, const app::ParamSpec& s
   }
   row.reset = new QToolButton;
   row.reset->setText("\u21ba");
+  row.reset->setFocusPolicy(Qt::NoFocus);
   row.reset->setToolTip("Reset to the default (" + qtText(spec.defaultValue) + ")");
   connect(row.reset, &QToolButton::clicked, this,
           [this, node, name] { Q_EMIT parameterEdited(node, name, ""); });

@@ -14,8 +14,8 @@ namespace {
 std::vector<std::string> commentsIn(const std::string& xml) {
   static const std::regex comment("<!--([\\s\\S]*?)-->");
   std::vector<std::string> found;
-  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), comment); it != std::sregex_iterator();
-       ++it) {
+  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), comment);
+       it != std::sregex_iterator(); ++it) {
     found.push_back((*it)[1].str());
   }
   return found;
@@ -174,9 +174,10 @@ TEST(EditorSection, ABadNumberOrSizeOrColourIsReportedAtItsAttribute) {
   EXPECT_ONLY_ERROR_AT(loadProblems("<application>\n  <editor>\n    <frame id=\"a\" width=\"0\"/>\n"
                                     "  </editor>\n</application>\n"),
                        3, 20, "width must be above 0");
-  EXPECT_ONLY_ERROR_AT(loadProblems("<application>\n  <editor>\n    <frame id=\"a\" color=\"red\"/>\n"
-                                    "  </editor>\n</application>\n"),
-                       3, 20, "color 'red' must be written #rrggbb");
+  EXPECT_ONLY_ERROR_AT(
+      loadProblems("<application>\n  <editor>\n    <frame id=\"a\" color=\"red\"/>\n"
+                   "  </editor>\n</application>\n"),
+      3, 20, "color 'red' must be written #rrggbb");
   EXPECT_ONLY_ERROR_AT(loadProblems("<application>\n  <editor>\n    <note id=\"a\"><b/></note>\n"
                                     "  </editor>\n</application>\n"),
                        3, 18, "unknown element <b> in <note>");
