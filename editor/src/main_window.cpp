@@ -13,6 +13,7 @@
 #include <QMenu>
 #include <QMenuBar>
 #include <QPlainTextEdit>
+#include <QRegularExpression>
 #include <QSaveFile>
 #include <QStatusBar>
 #include <QTemporaryDir>
@@ -179,7 +180,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
             if (!apply(setHostAddress(app_, host, address), false)) hosts_->show(app_);
           });
   connect(hosts_, &HostsPanel::importRequested, this, [this] {
-    const QString file = reporter().fileName(this, false, QDir::homePath());
+    const QString file = reporter().hostfileName(this, QDir::homePath());
     if (file.isEmpty()) return;
     QFile in(file);
     if (!in.open(QIODevice::ReadOnly)) {
@@ -353,6 +354,10 @@ void MainWindow::refresh() {
         style()->standardIcon(error ? QStyle::SP_MessageBoxCritical : QStyle::SP_MessageBoxWarning),
         (where.isEmpty() ? QString() : where + ": ") + qtText(p.message));
     item->setToolTip(qtText(p.text));
+    if (const auto fix = parameterSuggestion(p)) {
+      item->setText(item->text() + "  \u2014 double-click to rename it to '" + qtText(fix->second) +
+                    "'");
+    }
     problemList_->addItem(item);
   }
   statusBar()->showMessage(errors + warnings == 0
@@ -370,6 +375,18 @@ void MainWindow::showSelection() {
   properties_->show(app_, *catalog_, selected.size() == 1 ? selected.front() : std::string());
 }
 
+// A parameter the node's type does not declare, and the declared name validation suggests:
+// "... has no parameter 'stifness' (parameters: ...); did you mean 'stiffness'?".
+std::optional<std::pair<std::string, std::string>> MainWindow::parameterSuggestion(
+    const Problem& problem) {
+  static const QRegularExpression pattern(
+      "has no parameter '([^']+)' .*did you mean '([^']+)'\\?$");
+  if (problem.node.empty()) return std::nullopt;
+  const QRegularExpressionMatch match = pattern.match(qtText(problem.message));
+  if (!match.hasMatch()) return std::nullopt;
+  return std::make_pair(stdText(match.captured(1)), stdText(match.captured(2)));
+}
+
 void MainWindow::problemActivated(int row) {
   if (row < 0 || static_cast<std::size_t>(row) >= problems_.size()) return;
   const Problem& p = problems_[static_cast<std::size_t>(row)];
@@ -381,6 +398,16 @@ void MainWindow::problemActivated(int row) {
   std::optional<std::size_t> connection = p.connection;
   if (!p.cycle.empty()) connection = p.cycle.front();
   canvas_->selectOnly(nodes, connection);
+  // A misspelt parameter with a suggestion: the double-click renames it (one undoable edit).
+  // Queued: the edit refills the list, which must not happen inside its own signal.
+  if (const auto fix = parameterSuggestion(p)) {
+    QMetaObject::invokeMethod(
+        this,
+        [this, node = p.node, from = fix->first, to = fix->second] {
+          apply(renameParameter(app_, node, from, to), false);
+        },
+        Qt::QueuedConnection);
+  }
 }
 
 // ---- Edits -------------------------------------------------------------------------------
