@@ -306,6 +306,20 @@ void Canvas::wheelEvent(QWheelEvent* event) {
   event->accept();
 }
 
+bool Canvas::event(QEvent* event) {
+  // Delete with notes or frames selected is the canvas' key, not the Edit menu's shortcut
+  // (which deletes nodes and connections only).
+  if (event->type() == QEvent::ShortcutOverride) {
+    const auto* key = static_cast<QKeyEvent*>(event);
+    if ((key->key() == Qt::Key_Delete || key->key() == Qt::Key_Backspace) &&
+        scene_->focusItem() == nullptr && !selectedNotesAndFrames().empty()) {
+      event->accept();
+      return true;
+    }
+  }
+  return QGraphicsView::event(event);
+}
+
 void Canvas::keyPressEvent(QKeyEvent* event) {
   // Text typed into a note or a frame's title goes there.
   const bool typing = scene_->focusItem() != nullptr &&

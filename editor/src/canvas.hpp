@@ -117,6 +117,7 @@ class Canvas : public QGraphicsView {
   void editRequested(const vrflow::editor::Edit& edit);
 
  protected:
+  bool event(QEvent* event) override;
   void mousePressEvent(QMouseEvent* event) override;
   void mouseMoveEvent(QMouseEvent* event) override;
   void mouseReleaseEvent(QMouseEvent* event) override;

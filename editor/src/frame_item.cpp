@@ -3,12 +3,10 @@
 #include <QGraphicsScene>
 #include <QGraphicsSceneMouseEvent>
 #include <QPainter>
-#include <algorithm>
 
 #include "inplace_text_item.hpp"
 #include "node_item.hpp"
 #include "note_item.hpp"
-#include "resize_handle.hpp"
 
 namespace vrflow::editor::gui {
 
@@ -19,19 +17,16 @@ constexpr double kTitleHeight = 22;
 }  // namespace
 
 FrameItem::FrameItem(std::string id, QSizeF size, QString title, QColor color)
-    : id_(std::move(id)), size_(size), title_(std::move(title)), color_(color) {
+    : ResizableItem(size, QSizeF(80, 50)),
+      id_(std::move(id)),
+      title_(std::move(title)),
+      color_(color) {
   setFlags(ItemIsMovable | ItemIsSelectable | ItemSendsGeometryChanges);
   setZValue(-1);  // behind connections and nodes
 }
 
 QRectF FrameItem::boundingRect() const {
-  return QRectF(QPointF(-2, -2), size_ + QSizeF(4, 4));
-}
-
-void FrameItem::setSize(QSizeF size) {
-  if (size == size_) return;
-  prepareGeometryChange();
-  size_ = size;
+  return QRectF(QPointF(-2, -2), size() + QSizeF(4, 4));
 }
 
 void FrameItem::setTitle(const QString& title) {
@@ -46,7 +41,7 @@ void FrameItem::setColor(QColor color) {
 
 void FrameItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget*) {
   painter->setRenderHint(QPainter::Antialiasing);
-  const QRectF box(QPointF(0, 0), size_);
+  const QRectF box(QPointF(0, 0), size());
   QColor fill = color_;
   fill.setAlpha(40);
   painter->setBrush(fill);
@@ -58,16 +53,16 @@ void FrameItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidge
   QPainterPath clip;
   clip.addRoundedRect(box, 8, 8);
   painter->setClipPath(clip);
-  painter->fillRect(QRectF(0, 0, size_.width(), kTitleHeight), band);
+  painter->fillRect(QRectF(0, 0, size().width(), kTitleHeight), band);
   painter->restore();
   QFont font = painter->font();
   font.setPointSizeF(9.5);
   font.setBold(true);
   painter->setFont(font);
   painter->setPen(Qt::white);
-  painter->drawText(QRectF(10, 0, size_.width() - 20, kTitleHeight),
+  painter->drawText(QRectF(10, 0, size().width() - 20, kTitleHeight),
                     Qt::AlignLeft | Qt::AlignVCenter, title_);
-  drawResizeHandle(painter, size_, color_.darker(130));
+  drawHandle(painter, color_.darker(130));
 }
 
 void FrameItem::editTitle() {
@@ -80,15 +75,10 @@ void FrameItem::editTitle() {
 }
 
 void FrameItem::mousePressEvent(QGraphicsSceneMouseEvent* event) {
-  if (event->button() == Qt::LeftButton && onResizeHandle(event->pos(), size_)) {
-    resizing_ = true;
-    event->accept();
-    return;
-  }
   carried_.clear();
-  if (event->button() == Qt::LeftButton && scene() != nullptr) {
+  if (event->button() == Qt::LeftButton && scene() != nullptr && !onHandle(event->pos())) {
     // What lies inside (by its top-left corner, as moveFrame() decides) moves with the frame.
-    const QRectF area(scenePos(), size_);
+    const QRectF area(scenePos(), size());
     for (QGraphicsItem* item : scene()->items(area)) {
       if (item->isSelected() || item->parentItem() != nullptr) continue;
       if (dynamic_cast<NodeItem*>(item) == nullptr && dynamic_cast<NoteItem*>(item) == nullptr)
@@ -97,20 +87,11 @@ void FrameItem::mousePressEvent(QGraphicsSceneMouseEvent* event) {
     }
   }
   lastPos_ = pos();
-  QGraphicsItem::mousePressEvent(event);
-}
-
-void FrameItem::mouseMoveEvent(QGraphicsSceneMouseEvent* event) {
-  if (resizing_) {
-    setSize(QSizeF(std::max(80.0, event->pos().x()), std::max(50.0, event->pos().y())));
-    return;
-  }
-  QGraphicsItem::mouseMoveEvent(event);
+  ResizableItem::mousePressEvent(event);
 }
 
 void FrameItem::mouseReleaseEvent(QGraphicsSceneMouseEvent* event) {
-  resizing_ = false;
-  QGraphicsItem::mouseReleaseEvent(event);
+  ResizableItem::mouseReleaseEvent(event);
   carried_.clear();
 }
 

@@ -4,24 +4,23 @@
 // nodes and notes inside, its corner handle resizes it, its title is edited in place.
 
 #include <QColor>
-#include <QGraphicsItem>
 #include <QString>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "resizable_item.hpp"
+
 namespace vrflow::editor::gui {
 
 /// A frame (`<frame>` in the file's `<editor>` section).
-class FrameItem : public QGraphicsItem {
+class FrameItem : public ResizableItem {
  public:
   FrameItem(std::string id, QSizeF size, QString title, QColor color);
   QRectF boundingRect() const override;
   void paint(QPainter* painter, const QStyleOptionGraphicsItem* option, QWidget* widget) override;
 
   const std::string& id() const { return id_; }
-  QSizeF size() const { return size_; }
-  void setSize(QSizeF size);
   const QString& title() const { return title_; }
   void setTitle(const QString& title);
   QColor color() const { return color_; }
@@ -33,17 +32,14 @@ class FrameItem : public QGraphicsItem {
 
  protected:
   void mousePressEvent(QGraphicsSceneMouseEvent* event) override;
-  void mouseMoveEvent(QGraphicsSceneMouseEvent* event) override;
   void mouseReleaseEvent(QGraphicsSceneMouseEvent* event) override;
   void mouseDoubleClickEvent(QGraphicsSceneMouseEvent* event) override;
   QVariant itemChange(GraphicsItemChange change, const QVariant& value) override;
 
  private:
   std::string id_;
-  QSizeF size_;
   QString title_;
   QColor color_;
-  bool resizing_ = false;
   /// The unselected nodes and notes inside while the frame is dragged, moved along with it.
   std::vector<QGraphicsItem*> carried_;
   QPointF lastPos_;

@@ -2,28 +2,20 @@
 
 #include <QGraphicsSceneMouseEvent>
 #include <QPainter>
-#include <algorithm>
 
 #include "inplace_text_item.hpp"
-#include "resize_handle.hpp"
 
 namespace vrflow::editor::gui {
 
 NoteItem::NoteItem(std::string id, QSizeF size, QString text)
-    : id_(std::move(id)), size_(size), text_(std::move(text)) {
+    : ResizableItem(size, QSizeF(40, 24)), id_(std::move(id)), text_(std::move(text)) {
   setFlags(ItemIsMovable | ItemIsSelectable);
   setZValue(0.5);  // above connections and frames, below nodes
   setToolTip("Note: double-click to edit; drag the corner to resize");
 }
 
 QRectF NoteItem::boundingRect() const {
-  return QRectF(QPointF(-2, -2), size_ + QSizeF(6, 6));
-}
-
-void NoteItem::setSize(QSizeF size) {
-  if (size == size_) return;
-  prepareGeometryChange();
-  size_ = size;
+  return QRectF(QPointF(-2, -2), size() + QSizeF(6, 6));
 }
 
 void NoteItem::setText(const QString& text) {
@@ -33,7 +25,7 @@ void NoteItem::setText(const QString& text) {
 
 void NoteItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget*) {
   painter->setRenderHint(QPainter::Antialiasing);
-  const QRectF box(QPointF(0, 0), size_);
+  const QRectF box(QPointF(0, 0), size());
   painter->setPen(Qt::NoPen);
   painter->setBrush(QColor(0, 0, 0, 30));
   painter->drawRect(box.translated(3, 3));
@@ -46,35 +38,13 @@ void NoteItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
   painter->setPen(QColor(60, 52, 20));
   painter->drawText(box.adjusted(6, 4, -6, -4), Qt::AlignLeft | Qt::AlignTop | Qt::TextWordWrap,
                     text_);
-  drawResizeHandle(painter, size_, QColor(170, 150, 70));
+  drawHandle(painter, QColor(170, 150, 70));
 }
 
 void NoteItem::editText() {
   new InPlaceTextItem(this, text_, true, [this, id = id_, callback = textEdited](const QString& t) {
     if (callback) callback(id, t);
   });
-}
-
-void NoteItem::mousePressEvent(QGraphicsSceneMouseEvent* event) {
-  if (event->button() == Qt::LeftButton && onResizeHandle(event->pos(), size_)) {
-    resizing_ = true;
-    event->accept();
-    return;
-  }
-  QGraphicsItem::mousePressEvent(event);
-}
-
-void NoteItem::mouseMoveEvent(QGraphicsSceneMouseEvent* event) {
-  if (resizing_) {
-    setSize(QSizeF(std::max(40.0, event->pos().x()), std::max(24.0, event->pos().y())));
-    return;
-  }
-  QGraphicsItem::mouseMoveEvent(event);
-}
-
-void NoteItem::mouseReleaseEvent(QGraphicsSceneMouseEvent* event) {
-  resizing_ = false;
-  QGraphicsItem::mouseReleaseEvent(event);
 }
 
 void NoteItem::mouseDoubleClickEvent(QGraphicsSceneMouseEvent* event) {

@@ -35,6 +35,19 @@ Result<Edit> noSuch(std::string_view what, std::string_view id) {
   return makeError("no " + std::string(what) + " '" + std::string(id) + "'");
 }
 
+// Applies `change` to the element `id` of `list` (a member of a copy of `app`): the edit, or
+// why not ("unchanged" when `change` returns false).
+template <typename T, typename Change>
+Result<Edit> changeOne(const app::Application& app, std::vector<T> app::Application::*list,
+                       std::string_view what, std::string_view id, std::string label,
+                       Change change) {
+  app::Application after = app;
+  T* item = findById(after.*list, id);
+  if (item == nullptr) return noSuch(what, id);
+  if (!change(*item)) return makeError("unchanged");
+  return Edit{std::move(label), app, std::move(after)};
+}
+
 bool inside(double x, double y, const app::EditorFrame& frame) {
   return x >= frame.x && x <= frame.x + frame.width && y >= frame.y && y <= frame.y + frame.height;
 }
@@ -94,12 +107,11 @@ Result<Edit> setNoteArea(const app::Application& app, std::string_view id, Rect 
 }
 
 Result<Edit> setNoteText(const app::Application& app, std::string_view id, std::string text) {
-  app::Application after = app;
-  auto* note = findById(after.notes, id);
-  if (note == nullptr) return noSuch("note", id);
-  if (note->text == text) return makeError("unchanged");
-  note->text = std::move(text);
-  return Edit{"Edit note", app, std::move(after)};
+  return changeOne(app, &app::Application::notes, "note", id, "Edit note", [&](auto& note) {
+    if (note.text == text) return false;
+    note.text = std::move(text);
+    return true;
+  });
 }
 
 Result<Edit> setFrameArea(const app::Application& app, std::string_view id, Rect area) {
@@ -141,21 +153,19 @@ Result<Edit> moveFrame(const app::Application& app, std::string_view id, double 
 }
 
 Result<Edit> setFrameTitle(const app::Application& app, std::string_view id, std::string title) {
-  app::Application after = app;
-  auto* frame = findById(after.frames, id);
-  if (frame == nullptr) return noSuch("frame", id);
-  if (frame->title == title) return makeError("unchanged");
-  frame->title = std::move(title);
-  return Edit{"Rename frame", app, std::move(after)};
+  return changeOne(app, &app::Application::frames, "frame", id, "Rename frame", [&](auto& frame) {
+    if (frame.title == title) return false;
+    frame.title = std::move(title);
+    return true;
+  });
 }
 
 Result<Edit> setFrameColor(const app::Application& app, std::string_view id, std::string color) {
-  app::Application after = app;
-  auto* frame = findById(after.frames, id);
-  if (frame == nullptr) return noSuch("frame", id);
-  if (frame->color == color) return makeError("unchanged");
-  frame->color = std::move(color);
-  return Edit{"Recolour frame", app, std::move(after)};
+  return changeOne(app, &app::Application::frames, "frame", id, "Recolour frame", [&](auto& frame) {
+    if (frame.color == color) return false;
+    frame.color = std::move(color);
+    return true;
+  });
 }
 
 Result<Edit> removeNotesAndFrames(const app::Application& app,
