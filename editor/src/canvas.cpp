@@ -197,6 +197,11 @@ void Canvas::mousePressEvent(QMouseEvent* event) {
     event->accept();
     return;
   }
+  // A right click on empty canvas keeps the selection (its menu may frame it).
+  if (event->button() == Qt::RightButton && itemAt(event->position().toPoint()) == nullptr) {
+    event->accept();
+    return;
+  }
   if (event->button() == Qt::LeftButton) {
     if (PortItem* port = portAt(event->position().toPoint())) {
       dragFrom_ = port;

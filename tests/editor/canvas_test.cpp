@@ -100,6 +100,8 @@ class CanvasWindow : public ::testing::Test {
   // Right-clicks at a scene point and picks `entry` in the menu that pops up.
   void pickFromContextMenu(QPointF scenePos, const QString& entry) {
     const QPoint pos = at(scenePos);
+    mouse(QEvent::MouseButtonPress, pos, Qt::RightButton, Qt::RightButton);
+    mouse(QEvent::MouseButtonRelease, pos, Qt::RightButton, Qt::NoButton);
     QContextMenuEvent event(QContextMenuEvent::Mouse, pos, canvas()->viewport()->mapToGlobal(pos));
     QApplication::sendEvent(canvas()->viewport(), &event);
     QApplication::processEvents();
@@ -198,14 +200,16 @@ TEST_F(CanvasWindow, NotesAreAddedMovedResizedEditedInPlaceAndDeleted) {
   const QPointF corner =
       note->scenePos() + QPointF(note->size().width() - 4, note->size().height() - 4);
   drag(corner, corner + QPointF(120, 60));
-  EXPECT_NEAR(app().notes.front().width, 200 + 120, 4);
-  EXPECT_NEAR(app().notes.front().height, 80 + 60, 4);
+  EXPECT_NEAR(app().notes.front().width, 200 + 120, 6);
+  EXPECT_NEAR(app().notes.front().height, 80 + 60, 6);
   EXPECT_NEAR(app().notes.front().x, 100, 3);  // the corner moved, not the note
   // Its text edited in place: double-click, type, click elsewhere.
-  QTest::mouseDClick(canvas()->viewport(), Qt::LeftButton, {},
-                     at(note->scenePos() + QPointF(40, 40)));
-  QTest::keyClicks(canvas()->viewport(), "Springs are stiff");
+  const QPoint text = at(note->scenePos() + QPointF(40, 40));
+  QTest::mouseDClick(canvas()->viewport(), Qt::LeftButton, {}, text);
+  mouse(QEvent::MouseButtonRelease, text, Qt::LeftButton, Qt::NoButton);  // as a mouse ends it
+  QTest::keyClicks(canvas(), "Springs are stiff");
   QTest::mouseClick(canvas()->viewport(), Qt::LeftButton, {}, at({-120, 150}));
+
   settle();
   EXPECT_EQ(app().notes.front().text, "Springs are stiff");
   EXPECT_EQ(note->text(), "Springs are stiff");
@@ -252,8 +256,8 @@ TEST_F(CanvasWindow, FramesGoBehindNodesCarryThemAndAreRenamedAndRecoloured) {
   // Renamed in place from its menu, recoloured from its menu.
   const QPointF inside = item->scenePos() + QPointF(10, item->size().height() - 20);
   pickFromContextMenu(inside, "Rename frame");
-  QTest::keyClicks(canvas()->viewport(), "Output");
-  QTest::keyClick(canvas()->viewport(), Qt::Key_Return);
+  QTest::keyClicks(canvas(), "Output");
+  QTest::keyClick(canvas(), Qt::Key_Return);
   settle();
   EXPECT_EQ(app().frames.front().title, "Output");
   EXPECT_EQ(item->title(), "Output");
@@ -264,7 +268,7 @@ TEST_F(CanvasWindow, FramesGoBehindNodesCarryThemAndAreRenamedAndRecoloured) {
   const QPointF corner =
       item->scenePos() + QPointF(item->size().width() - 4, item->size().height() - 4);
   drag(corner, corner + QPointF(60, 30));
-  EXPECT_NEAR(app().frames.front().width, frame.width + 60, 4);
+  EXPECT_NEAR(app().frames.front().width, frame.width + 60, 6);
   EXPECT_NEAR(app::findEditorNode(app(), "recorder")->y, 400, 3);
 
   window_->undoStack()->undo();  // resize
@@ -291,7 +295,9 @@ TEST_F(CanvasWindow, FitShowsTheWholeRoutedWallAndNeverZoomsPastNaturalSize) {
   }
   EXPECT_LE(canvas()->transform().m11(), 1.0);
   const QString shot = qEnvironmentVariable("VRFLOW_CANVAS_SCREENSHOT");
-  if (!shot.isEmpty()) EXPECT_TRUE(window_->screenshot(shot));
+  if (!shot.isEmpty()) {
+    EXPECT_TRUE(window_->screenshot(shot));
+  }
 
   // A small network is shown at its natural size, not blown up.
   openText(R"(<application name="one"><modules>
@@ -311,6 +317,10 @@ TEST_F(CanvasWindow, DroppingANodeKeepsTheViewWhereItWas) {
   const QPoint edge = canvas()->viewport()->rect().bottomRight() - QPoint(60, 40);
   QMimeData mime;
   mime.setData(kNodeMime, "module core relay");
+  QDragEnterEvent enter(edge, Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
+  QApplication::sendEvent(canvas()->viewport(), &enter);
+  QDragMoveEvent move(edge, Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
+  QApplication::sendEvent(canvas()->viewport(), &move);
   QDropEvent dropped(QPointF(edge), Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
   QApplication::sendEvent(canvas()->viewport(), &dropped);
   QApplication::processEvents();
