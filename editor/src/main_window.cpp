@@ -123,6 +123,8 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   connect(canvas_, &Canvas::nodesMoved, this, [this](const Positions& positions) {
     if (!apply(moveNodes(app_, positions))) refresh();
   });
+  // Notes and frames edited on the canvas go through the undo stack like every edit.
+  connect(canvas_, &Canvas::editRequested, this, [this](const Edit& edit) { apply(edit); });
   connect(canvas_, &Canvas::addRequested, this,
           [this](const QString& spec, QPointF at) { addNode(spec, at); });
   connect(canvas_, &Canvas::hostDropped, this,
@@ -336,7 +338,7 @@ void MainWindow::refresh() {
   state.catalog = catalog_.get();
   state.problems = problems_;
   state.run = lastRun_;
-  canvas_->rebuild();
+  canvas_->sync();  // only what changed since the scene last showed the application
   hosts_->show(app_);
 
   problemList_->clear();
