@@ -1,6 +1,7 @@
 // The canvas' interactions beyond selecting, moving and connecting: quick-add by typing or by
 // releasing a wire over empty space, dropping a node on a connection to insert it, where pastes
 // land, and composites opened (drill down) or made from a selection.
+#include <QApplication>
 #include <QCursor>
 #include <QGraphicsDropShadowEffect>
 #include <QGraphicsScene>
@@ -81,14 +82,18 @@ bool Canvas::quickAddKey(QKeyEvent* event) {
 }
 
 bool Canvas::focusNextPrevChild(bool next) {
-  // Tab on the canvas opens quick-add, as in node editors, instead of leaving the canvas.
-  if (hasFocus() && state_.app != nullptr && !readOnly_) {
-    const QPoint at = viewport()->mapFromGlobal(QCursor::pos());
-    openQuickAdd(viewport()->rect().contains(at) ? at : viewport()->rect().center());
+  // Tab inside the popup, or the popup hiding (Qt moves the focus on), opens nothing; Tab from an
+  // opened composite goes on as usual.
+  const QWidget* focus = QApplication::focusWidget();
+  if (quickAdd_ != nullptr &&
+      (quickAdd_->isVisible() || focus == quickAdd_ || quickAdd_->isAncestorOf(focus)))
     return true;
-  }
-  if (quickAdd_ != nullptr && quickAdd_->isVisible()) return true;  // Tab inside the popup
-  return QGraphicsView::focusNextPrevChild(next);
+  if (compositeView_ != nullptr || readOnly_ || state_.app == nullptr)
+    return QGraphicsView::focusNextPrevChild(next);
+  // Tab on the canvas opens quick-add, as in node editors, instead of leaving the canvas.
+  const QPoint at = viewport()->mapFromGlobal(QCursor::pos());
+  openQuickAdd(viewport()->rect().contains(at) ? at : viewport()->rect().center());
+  return true;
 }
 
 bool Canvas::offerNodesForWire(const PortItem* from, QPoint at) {

@@ -83,8 +83,12 @@ void QuickAdd::filter(const QString& text) {
   for (int row = 0; row < list_->count(); ++row) {
     QListWidgetItem* item = list_->item(row);
     const QString spec = item->data(Qt::UserRole).toString();
+    // Each word typed starts a word of the spec ("co sp" finds "module core spring").
+    const QStringList specWords = spec.split(' ', Qt::SkipEmptyParts);
     const bool match = std::all_of(needles.begin(), needles.end(), [&](const QString& needle) {
-      return spec.contains(needle, Qt::CaseInsensitive);
+      return std::any_of(specWords.begin(), specWords.end(), [&](const QString& word) {
+        return word.startsWith(needle, Qt::CaseInsensitive);
+      });
     });
     item->setHidden(!match);
     if (match && first == nullptr) first = item;

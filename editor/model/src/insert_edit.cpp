@@ -47,16 +47,14 @@ std::optional<std::pair<double, double>> topLeft(const std::vector<app::EditorNo
 std::optional<std::string> firstCompatiblePort(const app::Application& app,
                                                const app::Catalog& catalog, std::string_view id,
                                                bool input, const app::Endpoint& other) {
-  const auto ports = nodePorts(app, catalog, id);
-  // Data ports first: beginIt/endIt fit almost anything and are rarely what is meant.
-  for (const bool sync : {false, true}) {
-    for (const auto& port : ports) {
-      if (port.isInput != input || isSyncPort(port) != sync) continue;
-      const app::Endpoint mine{std::string(id), port.name};
-      const auto why = input ? connectionRefusal(app, catalog, other, mine)
-                             : connectionRefusal(app, catalog, mine, other);
-      if (!why) return port.name;
-    }
+  // beginIt/endIt take almost anything: they are offered only for a wire from one of them.
+  const bool sync = other.port == app::kBeginItPort || other.port == app::kEndItPort;
+  for (const auto& port : nodePorts(app, catalog, id)) {
+    if (port.isInput != input || isSyncPort(port) != sync) continue;
+    const app::Endpoint mine{std::string(id), port.name};
+    const auto why = input ? connectionRefusal(app, catalog, other, mine)
+                           : connectionRefusal(app, catalog, mine, other);
+    if (!why) return port.name;
   }
   return std::nullopt;
 }

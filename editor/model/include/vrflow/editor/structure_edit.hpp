@@ -18,7 +18,8 @@
 namespace vrflow::editor {
 
 /// The first port of node `id` that a connection to (when `input`) or from `other` would accept,
-/// or nullopt. `other` is an output when `input` is true, an input otherwise.
+/// or nullopt. `other` is an output when `input` is true, an input otherwise. beginIt/endIt are
+/// considered only when `other` is one of them.
 std::optional<std::string> firstCompatiblePort(const app::Application& app,
                                                const app::Catalog& catalog, std::string_view id,
                                                bool input, const app::Endpoint& other);
