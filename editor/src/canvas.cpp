@@ -225,6 +225,7 @@ void Canvas::mouseMoveEvent(QMouseEvent* event) {
     event->accept();
     return;
   }
+  trackDrag(event);
   if (dragFrom_ != nullptr) {
     const QPointF start = dragFrom_->scenePos();
     const QPointF end = mapToScene(event->position().toPoint());
@@ -276,12 +277,15 @@ void Canvas::mouseReleaseEvent(QMouseEvent* event) {
         const PortItem* in = from->spec().isInput ? from : target;
         Q_EMIT connectRequested(out->endpoint(), in->endpoint());
       }
+    } else if (target == nullptr) {
+      offerNodesForWire(from, event->position().toPoint());
     }
     event->accept();
     return;
   }
   QGraphicsView::mouseReleaseEvent(event);
   if (event->button() != Qt::LeftButton || state_.app == nullptr) return;
+  if (dropSelectionOnWire()) return;
   // Nodes dragged to a new place: snap to the grid and report where.
   Positions moved;
   for (const auto& [id, item] : nodes_) {
@@ -337,6 +341,7 @@ void Canvas::keyPressEvent(QKeyEvent* event) {
     event->accept();
     return;
   }
+  if (quickAddKey(event)) return;
   QGraphicsView::keyPressEvent(event);
 }
 
@@ -369,6 +374,8 @@ void Canvas::dragEnterEvent(QDragEnterEvent* event) {
 
 void Canvas::dragMoveEvent(QDragMoveEvent* event) {
   if (event->mimeData()->hasFormat(kNodeMime)) {
+    hoverWireForSpec(QString::fromUtf8(event->mimeData()->data(kNodeMime)),
+                     event->position().toPoint());
     acceptAsCopy(event);
   } else if (event->mimeData()->hasFormat(kHostMime)) {
     if (nodeAt(event->position().toPoint()) != nullptr) {
@@ -381,7 +388,10 @@ void Canvas::dragMoveEvent(QDragMoveEvent* event) {
 
 void Canvas::dropEvent(QDropEvent* event) {
   const QMimeData* mime = event->mimeData();
-  if (mime->hasFormat(kNodeMime)) {
+  if (mime->hasFormat(kNodeMime) &&
+      dropSpecOnWire(QString::fromUtf8(mime->data(kNodeMime)), event->position().toPoint())) {
+    acceptAsCopy(event);
+  } else if (mime->hasFormat(kNodeMime)) {
     const QPointF at = mapToScene(event->position().toPoint());
     Q_EMIT addRequested(QString::fromUtf8(mime->data(kNodeMime)),
                         QPointF(snap(at.x()), snap(at.y())));

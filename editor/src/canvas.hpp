@@ -52,6 +52,9 @@ struct CanvasState {
   std::map<std::string, double> live;
 };
 
+class QuickAdd;
+class CompositeView;
+
 class Canvas : public QGraphicsView {
   Q_OBJECT
 
@@ -148,6 +151,63 @@ class Canvas : public QGraphicsView {
   void addFrameAroundSelection();
   QMenu* frameMenu(FrameItem* frame);
 
+  // ---- Interactions (canvas_interactions.cpp): quick-add, wire drops, insert on a wire, the
+  // paste point, composites opened and collapsed. ----
+ public:
+  /// The cursor's scene position when it is over the view (where a paste lands), else nullopt.
+  std::optional<QPointF> cursorScenePos() const;
+  /// Opens the quick-add popup at view position `at` with `text` typed; with `wireFrom`, it
+  /// lists only the types that connect to that port and connects the one chosen.
+  void openQuickAdd(QPoint at, const QString& text = {}, const PortItem* wireFrom = nullptr);
+  /// The quick-add popup (nullptr before the first use).
+  QuickAdd* quickAdd() const { return quickAdd_; }
+  /// Collapses the selected nodes into a new composite, one undoable edit (editRequested).
+  void collapseSelection();
+  /// Opens (drills down into) composite instance `id` over the canvas; false with the reason in
+  /// lastRefusal() when its inside cannot be read.
+  bool openComposite(const std::string& id);
+  /// The open composite's view, or nullptr when the application is shown.
+  CompositeView* compositeView() const { return compositeView_; }
+  /// A read-only canvas (an opened composite's inside) shows and offers no edit.
+  void setReadOnly(bool readOnly);
+  /// The connection highlighted as the target of a node drop, or nullopt.
+  std::optional<std::size_t> wireUnderDrop() const { return wireHover_; }
+
+ Q_SIGNALS:
+  /// An edit made on the canvas (insert, quick-add with a connection, collapse); `select`: the
+  /// nodes to select once it is applied.
+  void editRequested(const vrflow::editor::Edit& edit, const std::vector<std::string>& select);
+  /// Something to say in the status bar (why a drop or an opening was refused).
+  void messageRequested(const QString& text);
+
+ protected:
+  void mouseDoubleClickEvent(QMouseEvent* event) override;
+  bool focusNextPrevChild(bool next) override;
+
+ private:
+  bool quickAddKey(QKeyEvent* event);
+  void trackDrag(QMouseEvent* event);
+  bool offerNodesForWire(const PortItem* from, QPoint at);
+  bool dropSelectionOnWire();
+  void hoverWireForSpec(const QString& spec, QPoint at);
+  bool dropSpecOnWire(const QString& spec, QPoint at);
+  void closeComposite();
+  void quickAddChosen(const QString& spec);
+  std::optional<std::size_t> wireAt(QPoint viewPos, const std::string& node) const;
+  void setWireHover(std::optional<std::size_t> index, const std::optional<std::string>& refusal,
+                    QPoint at);
+
+  QuickAdd* quickAdd_ = nullptr;
+  CompositeView* compositeView_ = nullptr;
+  std::optional<std::size_t> wireHover_;  ///< a connection the drop would accept
+  std::optional<std::size_t> wireShown_;  ///< the connection drawn highlighted
+  std::optional<app::Endpoint> quickAddWire_;
+  bool quickAddWireIsOutput_ = true;
+  QPointF quickAddAt_;
+  bool readOnly_ = false;
+  // ---- end of interactions ----
+
+ private:
   QGraphicsScene* scene_;
   CanvasState state_;
   /// The application as the scene last showed it (what sync() compares against).

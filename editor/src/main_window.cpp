@@ -22,6 +22,7 @@
 #include <QUndoCommand>
 #include <QUndoStack>
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <set>
 
@@ -30,6 +31,7 @@
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/daemon/plugin.hpp"
+#include "vrflow/editor/structure_edit.hpp"
 #include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 
@@ -55,6 +57,14 @@ class EditCommand : public QUndoCommand {
   MainWindow* window_;
   Edit edit_;
 };
+
+// Where pasted nodes land: at the cursor when it is over the canvas, else (nullopt) beside the
+// copied nodes.
+std::optional<std::pair<double, double>> pasteCorner(const Canvas& canvas) {
+  const auto at = canvas.cursorScenePos();
+  if (!at) return std::nullopt;
+  return std::make_pair(std::round(at->x() / 10) * 10, std::round(at->y() / 10) * 10);
+}
 
 }  // namespace
 
@@ -132,6 +142,12 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
             apply(assignHost(app_, {node}, stdText(host)));
           });
   connect(canvas_, &Canvas::deleteRequested, this, &MainWindow::deleteSelection);
+  connect(canvas_, &Canvas::editRequested, this,
+          [this](const Edit& edit, const std::vector<std::string>& select) {
+            if (apply(edit, false)) canvas_->selectOnly(select);
+          });
+  connect(canvas_, &Canvas::messageRequested, this,
+          [this](const QString& text) { statusBar()->showMessage(text, 8000); });
   connect(canvas_, &Canvas::selectionChangedIds, this, &MainWindow::showSelection);
   connect(canvas_, &Canvas::contextMenuForNodes, this,
           [this](const std::vector<std::string>& ids, QPoint at) {
@@ -143,6 +159,11 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
                                    [this, ids, id] { apply(assignHost(app_, ids, id)); });
             }
             menu.addAction("Duplicate", this, &MainWindow::duplicateSelection);
+            if (ids.size() == 1 && nodeKind(app_, ids.front()) == NodeKind::Instance) {
+              menu.addAction("Open composite", this,
+                             [this, id = ids.front()] { canvas_->openComposite(id); });
+            }
+            menu.addAction("Collapse into composite", canvas_, &Canvas::collapseSelection);
             menu.addAction("Copy", this, &MainWindow::copySelection);
             menu.addAction("Delete", this, &MainWindow::deleteSelection);
             menu.exec(at);
@@ -474,16 +495,18 @@ void MainWindow::copySelection() {
 }
 
 void MainWindow::paste() {
+  const auto corner = pasteCorner(*canvas_);
   std::vector<std::string> ids;
-  if (apply(pasteXml(app_, stdText(QApplication::clipboard()->text()), 40, 40, &ids), false))
+  if (apply(pasteXmlAt(app_, stdText(QApplication::clipboard()->text()), corner, &ids), false))
     canvas_->selectOnly(ids);
 }
 
 void MainWindow::duplicateSelection() {
   const auto nodes = canvas_->selectedNodes();
   if (nodes.empty()) return;
+  const auto corner = pasteCorner(*canvas_);
   std::vector<std::string> ids;
-  auto edit = pasteXml(app_, copyAsXml(app_, nodes), 40, 40, &ids);
+  auto edit = pasteXmlAt(app_, copyAsXml(app_, nodes), corner, &ids);
   if (edit) edit->label = "Duplicate";
   if (apply(std::move(edit), false)) canvas_->selectOnly(ids);
 }
