@@ -271,6 +271,13 @@ TEST_F(CanvasWindow, FramesGoBehindNodesCarryThemAndAreRenamedAndRecoloured) {
   EXPECT_NEAR(app().frames.front().width, frame.width + 60, 6);
   EXPECT_NEAR(app::findEditorNode(app(), "recorder")->y, 400, 3);
 
+  // A picture of the frame behind its nodes, with a note, for the docs (when asked for).
+  if (const QString shot = qEnvironmentVariable("VRFLOW_CANVAS_FRAME_SCREENSHOT");
+      !shot.isEmpty()) {
+    ASSERT_TRUE(window_->apply(addNote(app(), -150, 330, "The recorder writes\nout/demo/")));
+    EXPECT_TRUE(window_->screenshot(shot));
+    window_->undoStack()->undo();
+  }
   window_->undoStack()->undo();  // resize
   window_->undoStack()->undo();  // colour
   window_->undoStack()->undo();  // title
