@@ -374,6 +374,13 @@ TEST_F(CanvasWindow, AConnectionBendsAroundANodeInItsWayAndFeedbackPassesBelow) 
               b));  // the straight curve would
   // The feedback edge keeps passing below both ends.
   EXPECT_GT(back->path().boundingRect().bottom(), canvas()->nodeItem("a")->sceneBody().bottom());
+  // While c is dragged, the connections into it follow it.
+  const QPointF c = canvas()->nodeItem("c")->scenePos();
+  canvas()->selectOnly({"c"});
+  drag(c + QPointF(60, 10), c + QPointF(60, 70), [&] {
+    EXPECT_NE(canvas()->nodeItem("c")->scenePos(), c);
+    EXPECT_EQ(across->path().pointAtPercent(1), canvas()->portScenePos("c", "in"));
+  });
   // Moving b out of the way straightens the curve.
   canvas()->selectOnly({"b"});
   drag(b.topLeft() + QPointF(60, 10), b.topLeft() + QPointF(60, 310));
