@@ -249,6 +249,11 @@ void Canvas::mouseMoveEvent(QMouseEvent* event) {
     return;
   }
   QGraphicsView::mouseMoveEvent(event);
+  // Nodes dragged (or carried by a frame): their connections follow as they go.
+  if (QGraphicsItem* grabber = scene_->mouseGrabberItem();
+      (event->buttons() & Qt::LeftButton) &&
+      (dynamic_cast<NodeItem*>(grabber) != nullptr || dynamic_cast<FrameItem*>(grabber) != nullptr))
+    routeConnections();
 }
 
 void Canvas::mouseReleaseEvent(QMouseEvent* event) {

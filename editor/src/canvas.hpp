@@ -183,6 +183,7 @@ class Canvas : public QGraphicsView {
  protected:
   void mouseDoubleClickEvent(QMouseEvent* event) override;
   bool focusNextPrevChild(bool next) override;
+  void dragLeaveEvent(QDragLeaveEvent* event) override;
 
  private:
   bool quickAddKey(QKeyEvent* event);

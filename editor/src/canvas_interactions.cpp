@@ -3,6 +3,7 @@
 // land, and composites opened (drill down) or made from a selection.
 #include <QApplication>
 #include <QCursor>
+#include <QDragLeaveEvent>
 #include <QGraphicsDropShadowEffect>
 #include <QGraphicsScene>
 #include <QKeyEvent>
@@ -218,6 +219,11 @@ void Canvas::hoverWireForSpec(const QString& spec, QPoint at) {
     if (!edit) refusal = edit.error().message;
   }
   setWireHover(wire, refusal, at);
+}
+
+void Canvas::dragLeaveEvent(QDragLeaveEvent* event) {
+  setWireHover(std::nullopt, std::nullopt, {});  // a palette drag left: no wire stays lit
+  QGraphicsView::dragLeaveEvent(event);
 }
 
 bool Canvas::dropSpecOnWire(const QString& spec, QPoint at) {

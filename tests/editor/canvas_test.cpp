@@ -271,6 +271,13 @@ TEST_F(CanvasWindow, FramesGoBehindNodesCarryThemAndAreRenamedAndRecoloured) {
   EXPECT_NEAR(app().frames.front().width, frame.width + 60, 6);
   EXPECT_NEAR(app::findEditorNode(app(), "recorder")->y, 400, 3);
 
+  // A picture of the frame behind its nodes, with a note, for the docs (when asked for).
+  if (const QString shot = qEnvironmentVariable("VRFLOW_CANVAS_FRAME_SCREENSHOT");
+      !shot.isEmpty()) {
+    ASSERT_TRUE(window_->apply(addNote(app(), -150, 330, "The recorder writes\nout/demo/")));
+    EXPECT_TRUE(window_->screenshot(shot));
+    window_->undoStack()->undo();
+  }
   window_->undoStack()->undo();  // resize
   window_->undoStack()->undo();  // colour
   window_->undoStack()->undo();  // title
@@ -367,6 +374,13 @@ TEST_F(CanvasWindow, AConnectionBendsAroundANodeInItsWayAndFeedbackPassesBelow) 
               b));  // the straight curve would
   // The feedback edge keeps passing below both ends.
   EXPECT_GT(back->path().boundingRect().bottom(), canvas()->nodeItem("a")->sceneBody().bottom());
+  // While c is dragged, the connections into it follow it.
+  const QPointF c = canvas()->nodeItem("c")->scenePos();
+  canvas()->selectOnly({"c"});
+  drag(c + QPointF(60, 10), c + QPointF(60, 70), [&] {
+    EXPECT_NE(canvas()->nodeItem("c")->scenePos(), c);
+    EXPECT_EQ(across->path().pointAtPercent(1), canvas()->portScenePos("c", "in"));
+  });
   // Moving b out of the way straightens the curve.
   canvas()->selectOnly({"b"});
   drag(b.topLeft() + QPointF(60, 10), b.topLeft() + QPointF(60, 310));

@@ -242,6 +242,14 @@ TEST_F(CanvasInteraction, DroppingAPaletteEntryOnAWireInsertsTheNewNode) {
   QDragMoveEvent move(at, Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
   QApplication::sendEvent(viewport, &move);
   EXPECT_EQ(canvas()->wireUnderDrop(), std::optional<std::size_t>(0));
+  // Leaving the canvas puts the wire out; coming back lights it again.
+  QDragLeaveEvent leave;
+  QApplication::sendEvent(viewport, &leave);
+  EXPECT_EQ(canvas()->wireUnderDrop(), std::nullopt);
+  EXPECT_EQ(canvas()->connectionItem(0)->graphicsEffect(), nullptr);
+  QApplication::sendEvent(viewport, &enter);
+  QApplication::sendEvent(viewport, &move);
+  ASSERT_EQ(canvas()->wireUnderDrop(), std::optional<std::size_t>(0));
   QDropEvent dropped(QPointF(at), Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
   QApplication::sendEvent(viewport, &dropped);
   QApplication::processEvents();
