@@ -116,8 +116,6 @@ class Canvas : public QGraphicsView {
   void deleteRequested();
   void selectionChangedIds();
   void contextMenuForNodes(const std::vector<std::string>& ids, QPoint globalPos);
-  /// An edit of notes or frames made on the canvas, to be applied through the undo stack.
-  void editRequested(const vrflow::editor::Edit& edit);
 
  protected:
   bool event(QEvent* event) override;
@@ -174,8 +172,8 @@ class Canvas : public QGraphicsView {
   std::optional<std::size_t> wireUnderDrop() const { return wireHover_; }
 
  Q_SIGNALS:
-  /// An edit made on the canvas (insert, quick-add with a connection, collapse); `select`: the
-  /// nodes to select once it is applied.
+  /// An edit made on the canvas (insert, quick-add with a connection, collapse, notes and
+  /// frames); `select`: the nodes to select once it is applied (none: the selection stays).
   void editRequested(const vrflow::editor::Edit& edit, const std::vector<std::string>& select);
   /// Something to say in the status bar (why a drop or an opening was refused).
   void messageRequested(const QString& text);

@@ -46,7 +46,7 @@ std::vector<std::string> Canvas::selectedNotesAndFrames() const {
 }
 
 void Canvas::requestEdit(Result<Edit> edit) {
-  if (edit) Q_EMIT editRequested(*edit);
+  if (edit) Q_EMIT editRequested(*edit, {});
 }
 
 void Canvas::syncNotesAndFrames() {

@@ -133,8 +133,6 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   connect(canvas_, &Canvas::nodesMoved, this, [this](const Positions& positions) {
     if (!apply(moveNodes(app_, positions))) refresh();
   });
-  // Notes and frames edited on the canvas go through the undo stack like every edit.
-  connect(canvas_, &Canvas::editRequested, this, [this](const Edit& edit) { apply(edit); });
   connect(canvas_, &Canvas::addRequested, this,
           [this](const QString& spec, QPointF at) { addNode(spec, at); });
   connect(canvas_, &Canvas::hostDropped, this,
@@ -144,7 +142,8 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   connect(canvas_, &Canvas::deleteRequested, this, &MainWindow::deleteSelection);
   connect(canvas_, &Canvas::editRequested, this,
           [this](const Edit& edit, const std::vector<std::string>& select) {
-            if (apply(edit, false)) canvas_->selectOnly(select);
+            // Notes and frames edited on the canvas select nothing new.
+            if (apply(edit, select.empty()) && !select.empty()) canvas_->selectOnly(select);
           });
   connect(canvas_, &Canvas::messageRequested, this,
           [this](const QString& text) { statusBar()->showMessage(text, 8000); });
