@@ -306,9 +306,17 @@ TEST_F(EditorDocument, DoubleClickingADidYouMeanProblemRenamesTheParameter) {
   }
   ASSERT_NE(found, nullptr);
   problems->scrollToItem(found);
-  const QPoint at = problems->visualItemRect(found).center();
+  // Near the start of the row: a long message is wider than the list.
+  const QRect rect = problems->visualItemRect(found);
+  const QPoint at(rect.left() + 20, rect.center().y());
+  int activated = 0;
+  QObject::connect(problems, &QListWidget::itemActivated, [&] { ++activated; });
   QTest::mouseDClick(problems->viewport(), Qt::LeftButton, Qt::NoModifier, at);
   QApplication::processEvents();
+  ASSERT_EQ(activated, 1) << rect.x() << "," << rect.y() << " " << rect.width() << "x"
+                          << rect.height() << " viewport " << problems->viewport()->width() << "x"
+                          << problems->viewport()->height() << " visible "
+                          << problems->isVisible();
   const auto& params = app::findModule(app(), "spring")->params;
   EXPECT_EQ(app::findParam(params, "stifness"), nullptr);
   EXPECT_EQ(app::paramString(params, "stiffness", ""), "3");
