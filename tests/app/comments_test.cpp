@@ -170,14 +170,14 @@ TEST(EditorSection, ANoteOrFrameIdUsedTwiceIsOneErrorAtTheSecond) {
 TEST(EditorSection, ABadNumberOrSizeOrColourIsReportedAtItsAttribute) {
   EXPECT_ONLY_ERROR_AT(loadProblems("<application>\n  <editor>\n    <note id=\"a\" x=\"left\"/>\n"
                                     "  </editor>\n</application>\n"),
-                       3, 19, "must be a finite number");
+                       3, 18, "must be a finite number");
   EXPECT_ONLY_ERROR_AT(loadProblems("<application>\n  <editor>\n    <frame id=\"a\" width=\"0\"/>\n"
                                     "  </editor>\n</application>\n"),
-                       3, 20, "width must be above 0");
+                       3, 19, "width must be above 0");
   EXPECT_ONLY_ERROR_AT(
       loadProblems("<application>\n  <editor>\n    <frame id=\"a\" color=\"red\"/>\n"
                    "  </editor>\n</application>\n"),
-      3, 20, "color 'red' must be written #rrggbb");
+      3, 19, "color 'red' must be written #rrggbb");
   EXPECT_ONLY_ERROR_AT(loadProblems("<application>\n  <editor>\n    <note id=\"a\"><b/></note>\n"
                                     "  </editor>\n</application>\n"),
                        3, 18, "unknown element <b> in <note>");

@@ -166,8 +166,10 @@ TEST(SaveApplication, HandWrittenFileBecomesCanonicalThenStaysStable) {
   <connections><connection to='t.in' from='s.out' capacity='0' policy='block'/></connections>
 </application>)");
   const std::string canonical = saveApplication(app);
+  // The comment stays, before the root as written (issue 20: comments survive edits).
   EXPECT_EQ(canonical,
             "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+            "<!-- written by hand -->\n"
             "<application name=\"hand\" version=\"1\">\n"
             "  <hosts>\n"
             "    <host id=\"main\"/>\n"

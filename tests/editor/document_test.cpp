@@ -295,7 +295,7 @@ TEST_F(EditorDocument, TheHostfileDialogShowsHostfilesWhateverTheirNames) {
   dialog->reject();
 }
 
-TEST_F(EditorDocument, DoubleClickingADidYouMeanProblemRenamesTheParameter) {
+TEST_F(EditorDocument, ActivatingADidYouMeanProblemRenamesTheParameter) {
   ASSERT_TRUE(window_->addNode("module core spring", QPointF(0, 0)));
   ASSERT_TRUE(window_->apply(setParameter(app(), "spring", "stifness", "3")));
   QListWidget* problems = window_->problemList();
@@ -306,8 +306,12 @@ TEST_F(EditorDocument, DoubleClickingADidYouMeanProblemRenamesTheParameter) {
   }
   ASSERT_NE(found, nullptr);
   problems->scrollToItem(found);
-  const QPoint at = problems->visualItemRect(found).center();
-  QTest::mouseDClick(problems->viewport(), Qt::LeftButton, Qt::NoModifier, at);
+  // Click the problem, then Enter: the list's activation, as a double-click gives.
+  const QRect rect = problems->visualItemRect(found);
+  QTest::mouseClick(problems->viewport(), Qt::LeftButton, Qt::NoModifier,
+                    QPoint(rect.left() + 20, rect.center().y()));
+  ASSERT_EQ(problems->currentItem(), found);
+  QTest::keyClick(problems, Qt::Key_Return);
   QApplication::processEvents();
   const auto& params = app::findModule(app(), "spring")->params;
   EXPECT_EQ(app::findParam(params, "stifness"), nullptr);

@@ -274,10 +274,11 @@ TEST(EditorModel, ProblemsPointAtTheirNodeOrConnection) {
 
 TEST(EditorModel, ProblemsOfAnUnchangedFileCarryItsOwnLines) {
   const auto catalog = coreCatalog();
-  // A comment shifts every line of the file against the canonical text.
+  // Blank lines (which the canonical writer leaves out, keeping the comment) shift every line
+  // of the file against the canonical text.
   const std::string text =
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"x\" version=\"1\">\n"
-      "  <!-- one -->\n  <!-- two -->\n  <modules>\n"
+      "  <!-- one -->\n\n\n  <modules>\n"
       "    <module id=\"r\" package=\"core\" type=\"recorder\"/>\n  </modules>\n</application>\n";
   auto app = app::loadApplicationString(text, "x.xml");
   ASSERT_TRUE(app.ok());
@@ -285,14 +286,14 @@ TEST(EditorModel, ProblemsOfAnUnchangedFileCarryItsOwnLines) {
   auto problems = findProblems(*app, catalog, {}, &opened);
   ASSERT_EQ(problems.size(), 1u);  // required input 'in' unconnected
   EXPECT_EQ(problems[0].node, "r");
-  EXPECT_EQ(problems[0].text.rfind("x.xml:6:", 0), 0u) << problems[0].text;
-  // Once edited, the canonical text is checked (the module is on line 4 there).
+  EXPECT_EQ(problems[0].text.rfind("x.xml:7:", 0), 0u) << problems[0].text;
+  // Once edited, the canonical text is checked (the module is on line 5 there).
   History history(*app);
   history.push(*setParameter(history.application(), "r", "file", "a.csv"));
   problems = findProblems(history.application(), catalog, {}, &opened);
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems[0].node, "r");
-  EXPECT_EQ(problems[0].text.rfind("x.xml:4:", 0), 0u) << problems[0].text;
+  EXPECT_EQ(problems[0].text.rfind("x.xml:5:", 0), 0u) << problems[0].text;
 }
 
 TEST(EditorModel, AutoLayoutGoesLeftToRight) {
