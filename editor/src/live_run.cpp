@@ -43,6 +43,24 @@ HostLive* LiveRun::host(const std::string& id) {
   return nullptr;
 }
 
+const HostLive* LiveRun::host(const std::string& id) const {
+  return const_cast<LiveRun*>(this)->host(id);
+}
+
+const ConnectionLive* LiveRun::connection(const std::string& from, const std::string& to) const {
+  for (const auto& c : connections) {
+    if (c.from == from && c.to == to) return &c;
+  }
+  return nullptr;
+}
+
+const LinkLive* LiveRun::link(const std::string& from, const std::string& to) const {
+  for (const auto& l : links) {
+    if (l.from == from && l.to == to) return &l;
+  }
+  return nullptr;
+}
+
 std::string LiveRun::summary() const {
   char line[160];
   switch (phase) {
@@ -73,7 +91,140 @@ void LiveRunModel::reset() {
   lastStatsTime_ = -1;
   lastStatsTimeOfHost_.clear();
   previous_.clear();
+  previousTraffic_.clear();
   badLines_ = 0;
+}
+
+void LiveRunModel::readStats(const json& event) {
+  const std::string statsHost = text(event, "host");
+  double& last = statsHost.empty() ? lastStatsTime_ : lastStatsTimeOfHost_[statsHost];
+  const double dt = last >= 0 ? run_.time - last : 0;
+  last = run_.time;
+  const std::size_t keep =
+      static_cast<std::size_t>(kHistorySeconds / std::max(dt > 0 ? dt : 1.0, 0.05));
+  if (event.contains("modules") && event["modules"].is_array()) {
+    for (const auto& m : event["modules"]) {
+      if (!m.is_object()) continue;
+      auto& module = run_.modules[text(m, "id")];
+      if (module.id.empty()) module.id = text(m, "id");
+      if (module.host.empty()) module.host = statsHost;
+      const uint64_t iterations = count(m, "iterations");
+      const Totals now{count(m, "compute_ns"), count(m, "wait_ns"), count(m, "cpu_ns")};
+      const auto before = previous_.find(module.id);
+      if (dt > 0 && before != previous_.end()) {
+        const Totals& was = before->second;
+        module.rate =
+            static_cast<double>(iterations - std::min(iterations, module.iterations)) / dt;
+        const auto delta = [](uint64_t a, uint64_t b) {
+          return static_cast<double>(a - std::min(a, b));
+        };
+        const double compute = delta(now.compute, was.compute), wait = delta(now.wait, was.wait);
+        module.waitShare = compute + wait > 0 ? wait / (compute + wait) : 0;
+        module.cpu = delta(now.cpu, was.cpu) / 1e9 / dt;
+      }
+      previous_[module.id] = now;
+      module.iterations = iterations;
+      module.state = text(m, "state");
+      module.rssMiB = static_cast<double>(count(m, "rss_bytes")) / 1048576.0;
+      // An ended process uses no CPU; its last interval's figure would stay forever.
+      if (module.state == "ended" || module.state == "finished") module.cpu = 0;
+      if (dt > 0) {
+        module.history.push_back(module.rate);
+        while (module.history.size() > keep) module.history.pop_front();
+      }
+    }
+  }
+  readConnections(event);
+  readLinks(event, statsHost);
+  sumHosts();
+}
+
+void LiveRunModel::readConnections(const json& event) {
+  if (!event.contains("connections") || !event["connections"].is_array()) return;
+  for (const auto& c : event["connections"]) {
+    if (!c.is_object()) continue;
+    const std::string from = text(c, "from"), to = text(c, "to");
+    auto it = std::find_if(run_.connections.begin(), run_.connections.end(),
+                           [&](const ConnectionLive& x) { return x.from == from && x.to == to; });
+    if (it == run_.connections.end()) {
+      run_.connections.push_back(ConnectionLive{from, to});
+      it = std::prev(run_.connections.end());
+    }
+    ConnectionLive& connection = *it;
+    connection.length = count(c, "length");
+    connection.capacity = count(c, "capacity");
+    connection.fill = connection.capacity > 0
+                          ? std::min(1.0, static_cast<double>(connection.length) /
+                                              static_cast<double>(connection.capacity))
+                          : 0;
+    connection.messages = count(c, "messages");
+    connection.bytes = count(c, "bytes");
+    connection.dropped = count(c, "dropped");
+    Counters& was = previousTraffic_["c\n" + from + "\n" + to];
+    const double dt = was.time >= 0 ? run_.time - was.time : 0;
+    if (dt > 0) {
+      connection.messagesPerSecond =
+          static_cast<double>(connection.messages - std::min(connection.messages, was.messages)) /
+          dt;
+      connection.mibPerSecond =
+          static_cast<double>(connection.bytes - std::min(connection.bytes, was.bytes)) / dt /
+          1048576.0;
+    }
+    was = Counters{run_.time, connection.messages, connection.bytes};
+  }
+}
+
+void LiveRunModel::readLinks(const json& event, const std::string& host) {
+  if (host.empty() || !event.contains("links") || !event["links"].is_array()) return;
+  for (const auto& l : event["links"]) {
+    if (!l.is_object() || !l.contains("peer") || !l["peer"].is_number_integer()) continue;
+    const int peer = l["peer"].get<int>();
+    if (peer < 0 || static_cast<std::size_t>(peer) >= run_.hosts.size()) continue;
+    const std::string to = run_.hosts[static_cast<std::size_t>(peer)].id;
+    auto it = std::find_if(run_.links.begin(), run_.links.end(),
+                           [&](const LinkLive& x) { return x.from == host && x.to == to; });
+    if (it == run_.links.end()) {
+      run_.links.push_back(LinkLive{host, to});
+      it = std::prev(run_.links.end());
+    }
+    LinkLive& link = *it;
+    link.messages = count(l, "messages_sent");
+    link.bytes = count(l, "bytes_sent");
+    Counters& was = previousTraffic_["l\n" + host + "\n" + to];
+    const double dt = was.time >= 0 ? run_.time - was.time : 0;
+    if (dt > 0) {
+      link.messagesPerSecond =
+          static_cast<double>(link.messages - std::min(link.messages, was.messages)) / dt;
+      link.mibPerSecond =
+          static_cast<double>(link.bytes - std::min(link.bytes, was.bytes)) / dt / 1048576.0;
+    }
+    was = Counters{run_.time, link.messages, link.bytes};
+  }
+}
+
+void LiveRunModel::markHost(const std::string& host, const std::string& cause, bool lost) {
+  HostLive* h = run_.host(host);
+  if (h == nullptr) {
+    run_.hosts.emplace_back().id = host;
+    h = &run_.hosts.back();
+  }
+  if (h->cause.empty()) h->cause = cause;
+  h->lost = h->lost || lost;
+}
+
+void LiveRunModel::sumHosts() {
+  for (auto& h : run_.hosts) {
+    h.cpu = 0;
+    h.rssMiB = 0;
+    h.modules = 0;
+  }
+  for (const auto& [id, module] : run_.modules) {
+    HostLive* h = run_.host(module.host);
+    if (h == nullptr) continue;
+    h->cpu += module.cpu;
+    h->rssMiB += module.rssMiB;
+    ++h->modules;
+  }
 }
 
 void LiveRunModel::handleLine(const QByteArray& line) {
@@ -83,6 +234,7 @@ void LiveRunModel::handleLine(const QByteArray& line) {
     return;
   }
   const std::string kind = event["event"].get<std::string>();
+  if (kind == "started" && run_.phase == LiveRun::Phase::Ended) reset();  // the next run
   if (event.contains("time") && event["time"].is_number()) run_.time = event["time"].get<double>();
 
   if (kind == "started") {
@@ -110,44 +262,13 @@ void LiveRunModel::handleLine(const QByteArray& line) {
     }
   } else if (kind == "stats") {
     if (run_.phase == LiveRun::Phase::None) run_.phase = LiveRun::Phase::Running;
-    const std::string statsHost = text(event, "host");
-    double& last = statsHost.empty() ? lastStatsTime_ : lastStatsTimeOfHost_[statsHost];
-    const double dt = last >= 0 ? run_.time - last : 0;
-    last = run_.time;
-    const std::size_t keep =
-        static_cast<std::size_t>(kHistorySeconds / std::max(dt > 0 ? dt : 1.0, 0.05));
-    if (event.contains("modules") && event["modules"].is_array()) {
-      for (const auto& m : event["modules"]) {
-        if (!m.is_object()) continue;
-        auto& module = run_.modules[text(m, "id")];
-        if (module.id.empty()) module.id = text(m, "id");
-        if (module.host.empty()) module.host = statsHost;
-        const uint64_t iterations = count(m, "iterations");
-        const Totals now{count(m, "compute_ns"), count(m, "wait_ns"), count(m, "cpu_ns")};
-        const auto before = previous_.find(module.id);
-        if (dt > 0 && before != previous_.end()) {
-          const Totals& was = before->second;
-          module.rate =
-              static_cast<double>(iterations - std::min(iterations, module.iterations)) / dt;
-          const auto delta = [](uint64_t a, uint64_t b) {
-            return static_cast<double>(a - std::min(a, b));
-          };
-          const double compute = delta(now.compute, was.compute), wait = delta(now.wait, was.wait);
-          module.waitShare = compute + wait > 0 ? wait / (compute + wait) : 0;
-          module.cpu = delta(now.cpu, was.cpu) / 1e9 / dt;
-        }
-        previous_[module.id] = now;
-        module.iterations = iterations;
-        module.state = text(m, "state");
-        module.rssMiB = static_cast<double>(count(m, "rss_bytes")) / 1048576.0;
-        if (dt > 0) {
-          module.history.push_back(module.rate);
-          while (module.history.size() > keep) module.history.pop_front();
-        }
-      }
-    }
+    readStats(event);
   } else if (kind == "warning") {
     run_.warnings.push_back(text(event, "text"));
+    // A daemon that reports a lost peer: the peer is the lost one (the warning names it).
+    const std::string named = hostNamedIn(run_.warnings.back());
+    if (!named.empty() && run_.warnings.back().find("lost") != std::string::npos)
+      markHost(named, run_.warnings.back(), true);
   } else if (kind == "module_exit") {
     auto& module = run_.modules[text(event, "module")];
     if (module.id.empty()) module.id = text(event, "module");
@@ -156,6 +277,7 @@ void LiveRunModel::handleLine(const QByteArray& line) {
     module.exit = text(event, "exit");
     const std::string cause = text(event, "cause");
     if (!cause.empty()) module.failure = cause;
+    sumHosts();
   } else if (kind == "end") {
     run_.phase = LiveRun::Phase::Ended;
     run_.exitCode = event.contains("exit_code") && event["exit_code"].is_number_integer()
@@ -166,11 +288,10 @@ void LiveRunModel::handleLine(const QByteArray& line) {
     if (!run_.error.empty()) {
       const std::string failed = moduleNamedIn(run_.error);
       if (!failed.empty() && run_.modules.count(failed)) run_.modules[failed].failure = run_.error;
-      if (HostLive* h = run_.host(hostNamedIn(run_.error))) {
-        h->cause = run_.error;
-        h->lost = run_.error.find("lost") != std::string::npos;
-      }
+      const std::string host = hostNamedIn(run_.error);
+      if (!host.empty()) markHost(host, run_.error, run_.error.find("lost") != std::string::npos);
     }
+    sumHosts();
     Q_EMIT changed();
     Q_EMIT ended();
     return;
