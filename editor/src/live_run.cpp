@@ -24,14 +24,24 @@ std::string text(const json& object, const char* key) {
   return it != object.end() && it->is_string() ? it->get<std::string>() : std::string();
 }
 
-// The host a line "host 'b': ..." names, or empty.
-std::string hostNamedIn(const std::string& line) {
-  const std::string prefix = "host '";
+// The host a line names after `prefix` ("host 'b'"), or empty.
+std::string hostNamedIn(const std::string& line, const std::string& prefix = "host '") {
   const auto at = line.find(prefix);
   if (at == std::string::npos) return {};
   const auto end = line.find('\'', at + prefix.size());
   return end == std::string::npos ? std::string()
                                   : line.substr(at + prefix.size(), end - at - prefix.size());
+}
+
+// The host a line says was lost: the peer of "lost the link to host 'c'" (what a daemon says
+// of a peer gone silent), or the host whose daemon died; empty when none.
+std::string lostHostIn(const std::string& line) {
+  const std::string peer = hostNamedIn(line, "lost the link to host '");
+  if (!peer.empty()) return peer;
+  if (line.find("closed its control channel") != std::string::npos ||
+      line.find("lost") != std::string::npos)
+    return hostNamedIn(line);
+  return {};
 }
 
 }  // namespace
@@ -265,10 +275,8 @@ void LiveRunModel::handleLine(const QByteArray& line) {
     readStats(event);
   } else if (kind == "warning") {
     run_.warnings.push_back(text(event, "text"));
-    // A daemon that reports a lost peer: the peer is the lost one (the warning names it).
-    const std::string named = hostNamedIn(run_.warnings.back());
-    if (!named.empty() && run_.warnings.back().find("lost") != std::string::npos)
-      markHost(named, run_.warnings.back(), true);
+    const std::string lost = lostHostIn(run_.warnings.back());
+    if (!lost.empty()) markHost(lost, run_.warnings.back(), true);
   } else if (kind == "module_exit") {
     auto& module = run_.modules[text(event, "module")];
     if (module.id.empty()) module.id = text(event, "module");
@@ -288,8 +296,12 @@ void LiveRunModel::handleLine(const QByteArray& line) {
     if (!run_.error.empty()) {
       const std::string failed = moduleNamedIn(run_.error);
       if (!failed.empty() && run_.modules.count(failed)) run_.modules[failed].failure = run_.error;
-      const std::string host = hostNamedIn(run_.error);
-      if (!host.empty()) markHost(host, run_.error, run_.error.find("lost") != std::string::npos);
+      const std::string lost = lostHostIn(run_.error);
+      if (!lost.empty()) {
+        markHost(lost, run_.error, true);
+      } else if (const std::string host = hostNamedIn(run_.error); !host.empty()) {
+        markHost(host, run_.error, false);
+      }
     }
     sumHosts();
     Q_EMIT changed();

@@ -50,7 +50,7 @@ std::string name(const json& e) {
 TimelineView::TimelineView(QWidget* parent) : QGraphicsView(parent) {
   setScene(new QGraphicsScene(this));
   setDragMode(QGraphicsView::ScrollHandDrag);
-  setTransformationAnchor(QGraphicsView::AnchorUnderMouse);
+  setTransformationAnchor(QGraphicsView::NoAnchor);  // the wheel keeps the cursor's time itself
   setRenderHint(QPainter::Antialiasing, false);
   setViewportUpdateMode(QGraphicsView::FullViewportUpdate);  // the labels follow the view
   setBackgroundBrush(Qt::white);
@@ -188,7 +188,12 @@ void TimelineView::wheelEvent(QWheelEvent* event) {
   const double lowest =
       (viewport()->width() - kLabelWidth) / std::max(durationMs_ * 1.04, 1e-3) / 2;
   const double wanted = std::clamp(now * factor, std::min(lowest, now), 1e6);
+  const QPoint cursor = event->position().toPoint();
+  const double before = mapToScene(cursor).x();
   if (wanted != now) scale(wanted / now, 1);
+  QScrollBar* bar = horizontalScrollBar();
+  bar->setValue(bar->value() +
+                static_cast<int>(std::lround((before - mapToScene(cursor).x()) * wanted)));
   fitted_ = false;
   event->accept();
 }

@@ -175,7 +175,7 @@ TEST_F(LiveView, FailedModuleLostHostUnboundedQueueAndBadLinesAreShownWithTheirC
   EXPECT_EQ(link->lines().at(0), "a \u2192 b: 100 msg/s \u00b7 100.0 MiB/s");
   EXPECT_FALSE(link->lost());
 
-  // The springs die of the memory limit; then host c is lost.
+  // The springs die of the memory limit; then host b loses host c.
   feed(R"({"event":"module_exit","time":2.5,"module":"springs","host":"b","exit":"signal 9",)"
        R"js("cause":"killed at its memory limit (64 MiB)"})js");
   ModuleBadgeItem* springs = overlay().badge("springs");
@@ -183,8 +183,9 @@ TEST_F(LiveView, FailedModuleLostHostUnboundedQueueAndBadLinesAreShownWithTheirC
   EXPECT_TRUE(springs->failed());
   EXPECT_EQ(springs->lines().back(), "failed: killed at its memory limit (64 MiB)");
   EXPECT_TRUE(springs->toolTip().contains("memory limit"));
-  feed(R"({"event":"end","time":3.0,"exit_code":1,"status":"failed",)"
-       R"js("error":"host 'c': lost the link to its daemon (no heartbeat for 3 s)"})js");
+  feed(
+      R"({"event":"end","time":3.0,"exit_code":1,"status":"failed",)"
+      R"js("error":"host 'b': lost the link to host 'c' (127.0.0.3:4100): no heartbeat for 3 s"})js");
   EXPECT_EQ(run.phase, LiveRun::Phase::Ended);
   ASSERT_NE(run.host("c"), nullptr);
   EXPECT_TRUE(run.host("c")->lost);
@@ -204,7 +205,9 @@ TEST_F(LiveView, FailedModuleLostHostUnboundedQueueAndBadLinesAreShownWithTheirC
   EXPECT_TRUE(c->toolTip().contains("no heartbeat")) << c->toolTip().toStdString();
   EXPECT_TRUE(loadOf(0).contains("cores"));
   EXPECT_EQ(QString::fromStdString(run.summary()),
-            "Failed: host 'c': lost the link to its daemon (no heartbeat for 3 s) [exit 1]");
+            "Failed: host 'b': lost the link to host 'c' (127.0.0.3:4100): no heartbeat for 3 s "
+            "[exit 1]");
+  EXPECT_FALSE(run.host("b")->lost);  // b said so; c is the lost one
 
   // A new `started` begins the next run: the failures are forgotten.
   feed(

@@ -29,6 +29,14 @@ class Timeline : public LiveWindow {
     QApplication::processEvents();
   }
 
+  void mouse(TimelineView* view, QEvent::Type type, QPoint at, Qt::MouseButton button,
+             Qt::MouseButtons buttons) {
+    QMouseEvent event(type, QPointF(at), view->viewport()->mapToGlobal(QPointF(at)), button,
+                      buttons, Qt::NoModifier);
+    QApplication::sendEvent(view->viewport(), &event);
+    QApplication::processEvents();
+  }
+
   // The Run menu's action named `text`.
   QAction* runMenuAction(const QString& text) {
     for (QAction* menu : window_->menuBar()->actions()) {
@@ -86,10 +94,10 @@ TEST_F(Timeline, TheWheelZoomsTheTimeAxisAroundTheCursorAndADragPans) {
   // Zoomed in, a drag to the left shows later times.
   for (int i = 0; i < 8; ++i) wheel(view, at, 120);
   const double left = view->mapToScene(QPoint(300, 60)).x();
-  QTest::mousePress(view->viewport(), Qt::LeftButton, {}, QPoint(500, 60));
-  QTest::mouseMove(view->viewport(), QPoint(400, 60));
-  QTest::mouseMove(view->viewport(), QPoint(300, 60));
-  QTest::mouseRelease(view->viewport(), Qt::LeftButton, {}, QPoint(300, 60));
+  mouse(view, QEvent::MouseButtonPress, QPoint(500, 60), Qt::LeftButton, Qt::LeftButton);
+  mouse(view, QEvent::MouseMove, QPoint(400, 60), Qt::NoButton, Qt::LeftButton);
+  mouse(view, QEvent::MouseMove, QPoint(300, 60), Qt::NoButton, Qt::LeftButton);
+  mouse(view, QEvent::MouseButtonRelease, QPoint(300, 60), Qt::LeftButton, Qt::NoButton);
   EXPECT_GT(view->mapToScene(QPoint(300, 60)).x(), left);
 }
 
