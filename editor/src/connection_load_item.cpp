@@ -6,15 +6,11 @@
 
 namespace vrflow::editor::gui {
 
-namespace {
-
-QFont labelFont() {
+QFont overlayFont(double pointSize) {
   QFont font;
-  font.setPointSizeF(7);
+  font.setPointSizeF(pointSize);
   return font;
 }
-
-}  // namespace
 
 QColor colorOfFill(double fill) {
   if (fill < 0) return QColor(150, 156, 166);  // unbounded: no fill to show
@@ -44,7 +40,7 @@ void ConnectionLoadItem::setLoad(double fill, const QString& label, const QStrin
 
 QRectF ConnectionLoadItem::labelRect() const {
   if (label_.isEmpty()) return {};
-  const double width = QFontMetricsF(labelFont()).horizontalAdvance(label_) + 8;
+  const double width = QFontMetricsF(overlayFont()).horizontalAdvance(label_) + 8;
   // Just below the curve's middle, so that the curve stays visible.
   return QRectF(middle_.x() - width / 2, middle_.y() + 6, width, 13);
 }
@@ -65,7 +61,7 @@ void ConnectionLoadItem::paint(QPainter* painter, const QStyleOptionGraphicsItem
   painter->setPen(QPen(color_, 1));
   painter->setBrush(QColor(255, 255, 255, 230));
   painter->drawRoundedRect(r, 3, 3);
-  painter->setFont(labelFont());
+  painter->setFont(overlayFont());
   painter->setPen(QColor(30, 40, 55));
   painter->drawText(r, Qt::AlignCenter, label_);
 }

@@ -5,11 +5,14 @@
 // messages/s and MiB/s at the curve's middle, away from the ports.
 
 #include <QColor>
+#include <QFont>
 #include <QGraphicsObject>
 #include <QPainterPath>
 
 namespace vrflow::editor::gui {
 
+/// The small font of the live view's labels on the canvas.
+QFont overlayFont(double pointSize = 7);
 /// The colour of a queue `fill` (0..1): green when empty, amber half full, red full.
 QColor colorOfFill(double fill);
 

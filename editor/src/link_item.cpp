@@ -5,15 +5,11 @@
 #include <QPainter>
 #include <algorithm>
 
+#include "connection_load_item.hpp"
+
 namespace vrflow::editor::gui {
 
 namespace {
-
-QFont labelFont() {
-  QFont font;
-  font.setPointSizeF(7.5);
-  return font;
-}
 
 // Where the segment from the centre of `r` towards `towards` leaves `r`.
 QPointF edgeOf(const QRectF& r, QPointF towards) {
@@ -50,7 +46,7 @@ void LinkItem::setRates(const QStringList& lines, bool lost) {
 }
 
 QRectF LinkItem::labelRect() const {
-  const QFontMetricsF metrics(labelFont());
+  const QFontMetricsF metrics(overlayFont(7.5));
   double width = 0;
   for (const auto& line : lines_) width = std::max(width, metrics.horizontalAdvance(line));
   const double height = metrics.height() * static_cast<double>(lines_.size()) + 4;
@@ -82,7 +78,7 @@ void LinkItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
   painter->setPen(QPen(lost_ ? QColor(210, 30, 30) : QColor(120, 126, 136), 1));
   painter->setBrush(QColor(255, 255, 255, 235));
   painter->drawRoundedRect(r, 3, 3);
-  painter->setFont(labelFont());
+  painter->setFont(overlayFont(7.5));
   painter->setPen(QColor(30, 40, 55));
   painter->drawText(r, Qt::AlignCenter, lines_.join("\n"));
 }

@@ -28,6 +28,16 @@ QString rateText(double messagesPerSecond, double mibPerSecond) {
   return QString("%1 msg/s \u00b7 %2/s").arg(messagesPerSecond, 0, 'f', 0).arg(mib(mibPerSecond));
 }
 
+// Deletes the items of `items` whose key `keep` no longer has.
+template <typename Map, typename Keep>
+void dropMissing(Map& items, const Keep& keep) {
+  std::erase_if(items, [&](auto& entry) {
+    if (keep.count(entry.first) != 0) return false;
+    delete entry.second.data();
+    return true;
+  });
+}
+
 }  // namespace
 
 std::string canvasNodeOf(const Canvas& canvas, const std::string& module) {
@@ -131,14 +141,7 @@ void LiveOverlay::refreshModules(const LiveRun& run) {
     if (!failure.isEmpty() && f.failure.isEmpty())
       f.failure = f.modules > 1 || id != node ? qtText(id) + ": " + failure : failure;
   }
-  for (auto it = badges_.begin(); it != badges_.end();) {
-    if (figures.count(it->first) == 0) {
-      delete it->second.data();
-      it = badges_.erase(it);
-    } else {
-      ++it;
-    }
-  }
+  dropMissing(badges_, figures);
   for (auto& [node, f] : figures) {
     const auto& s = states[node];
     f.state = s.size() == 1 ? qtText(*s.begin()) : QString("%1 states").arg(s.size());
@@ -234,14 +237,7 @@ void LiveOverlay::refreshLinks(const LiveRun& run) {
                           .arg(mib(static_cast<double>(link.bytes) / 1048576.0));
     lines[{key.first, key.second}] << text;
   }
-  for (auto it = links_.begin(); it != links_.end();) {
-    if (lines.count(it->first) == 0) {
-      delete it->second.data();
-      it = links_.erase(it);
-    } else {
-      ++it;
-    }
-  }
+  dropMissing(links_, lines);
   const auto colorOf = [&](const std::string& host) {
     for (std::size_t i = 0; i < app.hosts.size(); ++i) {
       if (app.hosts[i].id == host) return colorOfHost(i);

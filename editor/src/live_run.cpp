@@ -44,6 +44,18 @@ std::string lostHostIn(const std::string& line) {
   return {};
 }
 
+// The entry of `list` from `from` to `to`, added when there is none.
+template <typename T>
+T& entryOf(std::vector<T>& list, const std::string& from, const std::string& to) {
+  for (auto& x : list) {
+    if (x.from == from && x.to == to) return x;
+  }
+  T& added = list.emplace_back();
+  added.from = from;
+  added.to = to;
+  return added;
+}
+
 }  // namespace
 
 HostLive* LiveRun::host(const std::string& id) {
@@ -154,13 +166,7 @@ void LiveRunModel::readConnections(const json& event) {
   for (const auto& c : event["connections"]) {
     if (!c.is_object()) continue;
     const std::string from = text(c, "from"), to = text(c, "to");
-    auto it = std::find_if(run_.connections.begin(), run_.connections.end(),
-                           [&](const ConnectionLive& x) { return x.from == from && x.to == to; });
-    if (it == run_.connections.end()) {
-      run_.connections.push_back(ConnectionLive{from, to});
-      it = std::prev(run_.connections.end());
-    }
-    ConnectionLive& connection = *it;
+    ConnectionLive& connection = entryOf(run_.connections, from, to);
     connection.length = count(c, "length");
     connection.capacity = count(c, "capacity");
     connection.fill = connection.capacity > 0
@@ -170,17 +176,7 @@ void LiveRunModel::readConnections(const json& event) {
     connection.messages = count(c, "messages");
     connection.bytes = count(c, "bytes");
     connection.dropped = count(c, "dropped");
-    Counters& was = previousTraffic_["c\n" + from + "\n" + to];
-    const double dt = was.time >= 0 ? run_.time - was.time : 0;
-    if (dt > 0) {
-      connection.messagesPerSecond =
-          static_cast<double>(connection.messages - std::min(connection.messages, was.messages)) /
-          dt;
-      connection.mibPerSecond =
-          static_cast<double>(connection.bytes - std::min(connection.bytes, was.bytes)) / dt /
-          1048576.0;
-    }
-    was = Counters{run_.time, connection.messages, connection.bytes};
+    traffic("c\n" + from + "\n" + to, connection);
   }
 }
 
@@ -191,25 +187,24 @@ void LiveRunModel::readLinks(const json& event, const std::string& host) {
     const int peer = l["peer"].get<int>();
     if (peer < 0 || static_cast<std::size_t>(peer) >= run_.hosts.size()) continue;
     const std::string to = run_.hosts[static_cast<std::size_t>(peer)].id;
-    auto it = std::find_if(run_.links.begin(), run_.links.end(),
-                           [&](const LinkLive& x) { return x.from == host && x.to == to; });
-    if (it == run_.links.end()) {
-      run_.links.push_back(LinkLive{host, to});
-      it = std::prev(run_.links.end());
-    }
-    LinkLive& link = *it;
+    LinkLive& link = entryOf(run_.links, host, to);
     link.messages = count(l, "messages_sent");
     link.bytes = count(l, "bytes_sent");
-    Counters& was = previousTraffic_["l\n" + host + "\n" + to];
-    const double dt = was.time >= 0 ? run_.time - was.time : 0;
-    if (dt > 0) {
-      link.messagesPerSecond =
-          static_cast<double>(link.messages - std::min(link.messages, was.messages)) / dt;
-      link.mibPerSecond =
-          static_cast<double>(link.bytes - std::min(link.bytes, was.bytes)) / dt / 1048576.0;
-    }
-    was = Counters{run_.time, link.messages, link.bytes};
+    traffic("l\n" + host + "\n" + to, link);
   }
+}
+
+template <typename T>
+void LiveRunModel::traffic(const std::string& key, T& counted) {
+  Counters& was = previousTraffic_[key];
+  const double dt = was.time >= 0 ? run_.time - was.time : 0;
+  if (dt > 0) {
+    counted.messagesPerSecond =
+        static_cast<double>(counted.messages - std::min(counted.messages, was.messages)) / dt;
+    counted.mibPerSecond =
+        static_cast<double>(counted.bytes - std::min(counted.bytes, was.bytes)) / dt / 1048576.0;
+  }
+  was = Counters{run_.time, counted.messages, counted.bytes};
 }
 
 void LiveRunModel::markHost(const std::string& host, const std::string& cause, bool lost) {

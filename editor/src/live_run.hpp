@@ -136,6 +136,9 @@ class LiveRunModel : public QObject {
   void readStats(const nlohmann::json& event);
   void readConnections(const nlohmann::json& event);
   void readLinks(const nlohmann::json& event, const std::string& host);
+  /// Sets `counted`'s rates from its totals and those at its previous `stats` (under `key`).
+  template <typename T>
+  void traffic(const std::string& key, T& counted);
   void markHost(const std::string& host, const std::string& cause, bool lost);
   void sumHosts();
 };

@@ -62,6 +62,19 @@ Cell number(double value, int decimals = 0) {
 
 constexpr double kMiB = 1048576.0;
 
+// The links' rows: their rates now, or their averages over `wall` seconds when it is positive.
+std::vector<std::vector<Cell>> linkRows(const LiveRun& run, double wall) {
+  std::vector<std::vector<Cell>> rows;
+  for (const auto& l : run.links) {
+    const double messages = static_cast<double>(l.messages),
+                 mib = static_cast<double>(l.bytes) / kMiB;
+    rows.push_back(
+        {qtText(l.from), qtText(l.to), number(wall > 0 ? messages / wall : l.messagesPerSecond),
+         number(wall > 0 ? mib / wall : l.mibPerSecond, 2), number(messages), number(mib, 2)});
+  }
+  return rows;
+}
+
 }  // namespace
 
 RunTable::RunTable(QWidget* parent)
@@ -101,13 +114,7 @@ void RunTable::showLive(const LiveRun& run) {
                     number(static_cast<double>(c.dropped))});
   }
   fill(connections_, rows);
-  rows.clear();
-  for (const auto& l : run.links) {
-    rows.push_back({qtText(l.from), qtText(l.to), number(l.messagesPerSecond),
-                    number(l.mibPerSecond, 2), number(static_cast<double>(l.messages)),
-                    number(static_cast<double>(l.bytes) / kMiB, 2)});
-  }
-  fill(links_, rows);
+  fill(links_, linkRows(run, 0));
 }
 
 void RunTable::showReport(const RunReport& report, const LiveRun& run) {
@@ -138,14 +145,7 @@ void RunTable::showReport(const RunReport& report, const LiveRun& run) {
                     number(static_cast<double>(c.dropped))});
   }
   fill(connections_, rows);
-  rows.clear();
-  for (const auto& l : run.links) {
-    rows.push_back({qtText(l.from), qtText(l.to), number(average(static_cast<double>(l.messages))),
-                    number(average(static_cast<double>(l.bytes)) / kMiB, 2),
-                    number(static_cast<double>(l.messages)),
-                    number(static_cast<double>(l.bytes) / kMiB, 2)});
-  }
-  fill(links_, rows);
+  fill(links_, linkRows(run, wall));
 }
 
 }  // namespace vrflow::editor::gui
