@@ -5,6 +5,7 @@
 #include <QMenuBar>
 #include <QTest>
 #include <QWheelEvent>
+#include <cmath>
 
 #include "live_fixture.hpp"
 
@@ -81,15 +82,20 @@ TEST_F(Timeline, TheWheelZoomsTheTimeAxisAroundTheCursorAndADragPans) {
   const double fitted = view->pixelsPerMs();
   ASSERT_GT(fitted, 0.0);
   const QPoint at(600, 60);
+  wheel(view, at, 120);
+  EXPECT_NEAR(view->pixelsPerMs(), fitted * 1.25, fitted * 1e-6);
+  EXPECT_DOUBLE_EQ(view->transform().m22(), 1.0);  // rows keep their height
+  wheel(view, at, 240);
+  // Once the trace is wider than the view, the time under the cursor stays under it.
+  const double zoomed = view->pixelsPerMs();
+  EXPECT_NEAR(zoomed, fitted * std::pow(1.25, 3), fitted * 1e-6);
   const QPointF before = view->mapToScene(at);
   wheel(view, at, 120);
   wheel(view, at, 120);
-  EXPECT_NEAR(view->pixelsPerMs(), fitted * 1.25 * 1.25, fitted * 1e-6);
-  EXPECT_DOUBLE_EQ(view->transform().m22(), 1.0);  // rows keep their height
-  // The time under the cursor stays under it.
+  EXPECT_NEAR(view->pixelsPerMs(), zoomed * 1.25 * 1.25, zoomed * 1e-6);
   EXPECT_NEAR(view->mapToScene(at).x(), before.x(), 2 / view->pixelsPerMs());
   wheel(view, at, -240);
-  EXPECT_NEAR(view->pixelsPerMs(), fitted, fitted * 1e-6);
+  EXPECT_NEAR(view->pixelsPerMs(), zoomed, zoomed * 1e-6);
 
   // Zoomed in, a drag to the left shows later times.
   for (int i = 0; i < 8; ++i) wheel(view, at, 120);
