@@ -38,6 +38,16 @@ void ConnectionLoadItem::setLoad(double fill, const QString& label, const QStrin
   update();
 }
 
+void ConnectionLoadItem::hoverEnterEvent(QGraphicsSceneHoverEvent*) {
+  hovered_ = true;
+  update();
+}
+
+void ConnectionLoadItem::hoverLeaveEvent(QGraphicsSceneHoverEvent*) {
+  hovered_ = false;
+  update();
+}
+
 QRectF ConnectionLoadItem::labelRect() const {
   if (label_.isEmpty()) return {};
   const double width = QFontMetricsF(overlayFont()).horizontalAdvance(label_) + 8;
@@ -56,7 +66,7 @@ void ConnectionLoadItem::paint(QPainter* painter, const QStyleOptionGraphicsItem
   painter->setPen(Qt::NoPen);
   painter->setBrush(band);
   painter->drawPath(curve_);
-  if (label_.isEmpty()) return;
+  if (!labelShown()) return;
   const QRectF r = labelRect();
   painter->setPen(QPen(color_, 1));
   painter->setBrush(QColor(255, 255, 255, 230));

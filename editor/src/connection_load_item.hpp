@@ -1,8 +1,9 @@
 #pragma once
 
 // A connection's live load on the canvas: a band behind its curve coloured by the queue's fill
-// against its capacity (green, amber, red; grey when unbounded), and a small label with its
-// messages/s and MiB/s at the curve's middle, away from the ports.
+// against its capacity (green, amber, red; grey when unbounded), and, while the pointer is over
+// the curve, a small label with its messages/s and MiB/s at the curve's middle (never on the
+// ports, never piled with its neighbours').
 
 #include <QColor>
 #include <QFont>
@@ -27,10 +28,16 @@ class ConnectionLoadItem : public QGraphicsObject {
   void setLoad(double fill, const QString& label, const QString& tooltip);
   QColor color() const { return color_; }
   const QString& label() const { return label_; }
+  /// Whether the label is drawn now (the pointer is over the curve).
+  bool labelShown() const { return hovered_ && !label_.isEmpty(); }
 
   QRectF boundingRect() const override;
   QPainterPath shape() const override { return curve_; }
   void paint(QPainter* painter, const QStyleOptionGraphicsItem* option, QWidget* widget) override;
+
+ protected:
+  void hoverEnterEvent(QGraphicsSceneHoverEvent* event) override;
+  void hoverLeaveEvent(QGraphicsSceneHoverEvent* event) override;
 
  private:
   QRectF labelRect() const;
@@ -39,6 +46,7 @@ class ConnectionLoadItem : public QGraphicsObject {
   QPointF middle_;
   QColor color_;
   QString label_;
+  bool hovered_ = false;
 };
 
 }  // namespace vrflow::editor::gui

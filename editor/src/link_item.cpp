@@ -24,7 +24,7 @@ QPointF edgeOf(const QRectF& r, QPointF towards) {
 }  // namespace
 
 LinkItem::LinkItem(QString a, QString b) : a_(std::move(a)), b_(std::move(b)) {
-  setZValue(-2);  // behind the connections and the nodes
+  setZValue(2);  // over the nodes: groups of hosts overlap on a canvas laid out by data flow
   setAcceptHoverEvents(true);
 }
 
@@ -67,8 +67,8 @@ void LinkItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
   const QPointF side = (normal.p2() - normal.p1()) * 4;
   for (int lane = 0; lane < 2; ++lane) {
     QColor color = lost_ ? QColor(210, 30, 30) : (lane == 0 ? colorA_ : colorB_);
-    color.setAlpha(170);
-    QPen pen(color, 6, Qt::DashLine, Qt::FlatCap);
+    color.setAlpha(120);
+    QPen pen(color, 5, Qt::DashLine, Qt::FlatCap);
     painter->setPen(pen);
     const QPointF shift = lane == 0 ? side : -side;
     painter->drawLine(QLineF(from_ + shift, to_ + shift));

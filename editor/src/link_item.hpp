@@ -9,7 +9,7 @@
 
 namespace vrflow::editor::gui {
 
-/// One pair of hosts, drawn behind the nodes.
+/// One pair of hosts, drawn translucent over the nodes.
 class LinkItem : public QGraphicsObject {
   Q_OBJECT
 

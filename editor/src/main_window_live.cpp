@@ -30,11 +30,15 @@ void MainWindow::setUpLiveView(QMenu* runMenu) {
   timelineDock_->setObjectName("Timeline");
   timelineDock_->setWidget(timeline_);
   addDockWidget(Qt::BottomDockWidgetArea, timelineDock_);
-  for (QDockWidget* dock : findChildren<QDockWidget*>()) {
+  const auto docks = findChildren<QDockWidget*>();
+  for (QDockWidget* dock : docks) {
     if (dock->objectName() == "Run log") {
       tabifyDockWidget(dock, runTableDock_);
       tabifyDockWidget(dock, timelineDock_);
     }
+  }
+  for (QDockWidget* dock : docks) {
+    if (dock->objectName() == "Problems") dock->raise();  // the first tab stays in front
   }
   runMenu->addSeparator();
   runMenu->addAction("Open &trace\u2026", this, [this] {
