@@ -1,5 +1,6 @@
 // The timeline dock: the trace of a real run of examples/pipeline (`vrflow run --trace`) drawn
 // per module, with its message arrows, zoomed by real wheel events and opened from the Run menu.
+#include <QDir>
 #include <QDockWidget>
 #include <QGraphicsItem>
 #include <QMenuBar>
@@ -71,6 +72,15 @@ TEST_F(Timeline, ShowsEachModulesWaitAndComputeSpansAndTheMessagesBetweenThem) {
     if (item->toolTip().startsWith("compute \u00b7 relay \u00b7 iteration ")) ++tipped;
   }
   EXPECT_EQ(tipped, 30);
+
+  // The dock as a person sees it, zoomed on the first iterations.
+  view->resize(1000, 200);
+  view->fitAll();
+  const QPoint left(200, 60);
+  for (int i = 0; i < 10; ++i) wheel(view, left, 120);
+  const QString shots = QCoreApplication::applicationDirPath() + "/../test-screenshots";
+  QDir().mkpath(shots);
+  EXPECT_TRUE(view->grab().save(shots + "/timeline_pipeline.png"));
 }
 
 TEST_F(Timeline, TheWheelZoomsTheTimeAxisAroundTheCursorAndADragPans) {
