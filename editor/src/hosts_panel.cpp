@@ -22,6 +22,7 @@
 #include <sstream>
 
 #include "canvas.hpp"
+#include "live_run.hpp"
 #include "panels.hpp"
 #include "qt_text.hpp"
 #include "vrflow/editor/edit.hpp"
@@ -51,12 +52,12 @@ class HostTable : public QTableWidget {
 // ---- Hosts -------------------------------------------------------------------------------
 
 HostsPanel::HostsPanel(QWidget* parent) : QWidget(parent) {
-  auto* table = new HostTable(0, 3);
+  auto* table = new HostTable(0, 4);
   table->ids = &ids_;
   table_ = table;
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(4, 4, 4, 4);
-  table_->setHorizontalHeaderLabels({"", "Host", "Address"});
+  table_->setHorizontalHeaderLabels({"", "Host", "Address", "Load"});
   table_->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Fixed);
   table_->setColumnWidth(0, 22);
   table_->horizontalHeader()->setStretchLastSection(true);
@@ -124,6 +125,49 @@ void HostsPanel::show(const app::Application& app) {
   }
   if (current >= 0 && current < table_->rowCount()) table_->setCurrentCell(current, 1);
   filling_ = false;
+  fillLoad();
+}
+
+void HostsPanel::showLoad(const LiveRun& run) {
+  load_.clear();
+  for (const auto& host : run.hosts) {
+    Load load;
+    load.failed = host.lost || !host.cause.empty();
+    if (host.lost) {
+      load.text = "lost";
+    } else if (!host.cause.empty()) {
+      load.text = "failed";
+    } else {
+      load.text =
+          QString("%1 cores \u00b7 %2 MiB").arg(host.cpu, 0, 'f', 2).arg(host.rssMiB, 0, 'f', 0);
+    }
+    load.tooltip = QString("%1 module(s): %2 cores of CPU, %3 MiB resident")
+                       .arg(host.modules)
+                       .arg(host.cpu, 0, 'f', 2)
+                       .arg(host.rssMiB, 0, 'f', 1);
+    if (!host.cause.empty()) load.tooltip += "\n" + qtText(host.cause);
+    load_[host.id] = load;
+  }
+  fillLoad();
+}
+
+void HostsPanel::fillLoad() {
+  const bool filling = filling_;
+  filling_ = true;
+  for (std::size_t i = 0; i < ids_.size(); ++i) {
+    const auto it = load_.find(ids_[i]);
+    auto* item = new QTableWidgetItem(it == load_.end() ? QString() : it->second.text);
+    item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable);
+    if (it != load_.end()) {
+      item->setToolTip(it->second.tooltip);
+      if (it->second.failed) {
+        item->setForeground(QColor(200, 20, 20));
+        item->setBackground(QColor(255, 225, 225));
+      }
+    }
+    table_->setItem(static_cast<int>(i), 3, item);
+  }
+  filling_ = filling;
 }
 
 }  // namespace vrflow::editor::gui

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,7 @@ struct HostLive {
   double rssMiB = 0;  ///< its modules' resident memory
   bool lost = false;  ///< its daemon or connection was lost
   std::string cause;  ///< why it failed or was lost (empty when fine)
+  int modules = 0;    ///< how many modules of the run it holds
 };
 
 /// Everything known of one run.
@@ -86,6 +88,11 @@ struct LiveRun {
   /// "Failed (stalled): <error>", ...
   std::string summary() const;
   HostLive* host(const std::string& id);
+  const HostLive* host(const std::string& id) const;
+  /// The connection from `from` to `to` ("node.port" of the expanded network), or nullptr.
+  const ConnectionLive* connection(const std::string& from, const std::string& to) const;
+  /// The link from host `from` to host `to`, or nullptr.
+  const LinkLive* link(const std::string& from, const std::string& to) const;
 };
 
 /// Reads event lines into a LiveRun.
@@ -118,7 +125,22 @@ class LiveRunModel : public QObject {
     uint64_t compute = 0, wait = 0, cpu = 0;
   };
   std::map<std::string, Totals> previous_;
+  /// A connection's or link's counters at its previous `stats` (by "from\nto").
+  struct Counters {
+    double time = -1;
+    uint64_t messages = 0, bytes = 0;
+  };
+  std::map<std::string, Counters> previousTraffic_;
   int badLines_ = 0;
+
+  void readStats(const nlohmann::json& event);
+  void readConnections(const nlohmann::json& event);
+  void readLinks(const nlohmann::json& event, const std::string& host);
+  /// Sets `counted`'s rates from its totals and those at its previous `stats` (under `key`).
+  template <typename T>
+  void traffic(const std::string& key, T& counted);
+  void markHost(const std::string& host, const std::string& cause, bool lost);
+  void sumHosts();
 };
 
 }  // namespace vrflow::editor::gui

@@ -301,6 +301,8 @@ void MainWindow::buildMenus() {
   tools->addSeparator();
   tools->addAction(runAction_);
   tools->addAction(stopAction_);
+  setUpLiveView(
+      runMenu);  // helper B: the live overlay, run table and timeline (main_window_live.cpp)
 }
 
 // ---- State -------------------------------------------------------------------------------

@@ -11,8 +11,12 @@
 #include <vector>
 
 #include "canvas.hpp"
+#include "live_overlay.hpp"
+#include "live_run.hpp"
 #include "panels.hpp"
 #include "run_console.hpp"
+#include "run_table.hpp"
+#include "timeline.hpp"
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/model.hpp"
 #include "vrflow/editor/analysis.hpp"
@@ -109,6 +113,17 @@ class MainWindow : public QMainWindow {
   /// Iterations/s per module from the running `vrflow`'s event stream (empty when none).
   const std::map<std::string, double>& liveRates() const { return liveRates_; }
 
+  // ---- Live view (helper B, issue 20 items 2-3; main_window_live.cpp). Until A's run
+  // controller owns the LiveRunModel (`live()`), the window keeps one here. ----
+  /// What the editor knows of the run going on or last ended, from its event stream.
+  LiveRunModel* liveModel() const { return liveModel_; }
+  LiveOverlay* liveOverlay() const { return liveOverlay_; }
+  RunTable* runTable() const { return runTable_; }
+  TimelineView* timeline() const { return timeline_; }
+  /// Opens a trace in the timeline dock and shows it; reports why it cannot (false).
+  bool openTrace(const QString& path);
+  // ---- end of the live view block ----
+
   /// Applies an edit through the undo stack; reports why when it cannot be made.
   bool apply(Result<Edit> edit, bool quietWhenUnchanged = true);
   /// Called by undo commands after the application changed.
@@ -173,6 +188,16 @@ class MainWindow : public QMainWindow {
   std::optional<RunReport> lastRun_;
   QString runError_;
   std::map<std::string, double> liveRates_;
+
+  // ---- Live view (helper B; main_window_live.cpp) ----
+  void setUpLiveView(QMenu* runMenu);
+  LiveRunModel* liveModel_ = nullptr;
+  LiveOverlay* liveOverlay_ = nullptr;
+  RunTable* runTable_ = nullptr;
+  TimelineView* timeline_ = nullptr;
+  QDockWidget* runTableDock_ = nullptr;
+  QDockWidget* timelineDock_ = nullptr;
+  // ---- end of the live view block ----
 };
 
 }  // namespace vrflow::editor::gui

@@ -107,14 +107,19 @@ class PropertiesPanel : public QWidget {
   QWidget* body_ = nullptr;
 };
 
-/// The hosts: id, address, colour; add, remove, rename, import a hostfile, assign the
-/// selection. A host's row drags onto a node to assign it.
+struct LiveRun;
+
+/// The hosts: id, address, colour, load while a run goes; add, remove, rename, import a
+/// hostfile, assign the selection. A host's row drags onto a node to assign it.
 class HostsPanel : public QWidget {
   Q_OBJECT
 
  public:
   explicit HostsPanel(QWidget* parent = nullptr);
   void show(const app::Application& app);
+  /// Shows each host's load in the run (its modules' CPU in cores and memory; lost or failed
+  /// with the cause); an empty run (no hosts) clears the column.
+  void showLoad(const LiveRun& run);
   QTableWidget* table() const { return table_; }
   /// The host of the current row, or empty.
   std::string currentHost() const;
@@ -131,6 +136,13 @@ class HostsPanel : public QWidget {
   QTableWidget* table_;
   std::vector<std::string> ids_;
   bool filling_ = false;
+  /// The load column's text, tooltip and whether the host failed, by host id.
+  struct Load {
+    QString text, tooltip;
+    bool failed = false;
+  };
+  std::map<std::string, Load> load_;
+  void fillLoad();
 };
 
 }  // namespace vrflow::editor::gui

@@ -76,6 +76,7 @@ void RunConsole::readLog() {
 }
 
 void RunConsole::handleEvent(const QByteArray& line) {
+  Q_EMIT eventLine(line);
   const QJsonObject event = QJsonDocument::fromJson(line).object();
   if (event.value("event").toString() != "stats") return;
   // Rates from two successive snapshots of the modules' iteration counters.

@@ -45,6 +45,8 @@ class RunConsole : public QObject {
   void logLine(const QString& line);
   /// liveRates() changed.
   void liveRatesUpdated();
+  /// One line of the run's event stream (helper B: fed to the window's LiveRunModel).
+  void eventLine(const QByteArray& line);
   /// The run is over; report() holds its report. -1: it could not start.
   void finished(int exitCode);
 
