@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "vrflow/camera/synthetic_scene.hpp"
 
 namespace vrflow::camera {

@@ -87,7 +87,7 @@ TEST(SyntheticUser, OccupancyIsTheSignOfTheAnalyticDistance) {
     }
 }
 
-TEST(SyntheticUser, SilhouetteContainsTheProjectionOfEveryInnerPointAndNoOuterOne) {
+TEST(SyntheticUser, SilhouetteContainsTheProjectionOfEveryInnerPoint) {
   const SyntheticUser user(standingPose());
   CameraCalibration camera = cameraRing(5)[1];
   camera.distortion = (cv::Mat_<double>(1, 5) << -0.05, 0.01, 0, 0, 0);
@@ -95,7 +95,7 @@ TEST(SyntheticUser, SilhouetteContainsTheProjectionOfEveryInnerPointAndNoOuterOn
   cv::RNG rng(7);
   std::vector<cv::Point3d> points;
   std::vector<bool> inside;
-  while (points.size() < 4000) {
+  while (points.size() < 40000) {
     const cv::Vec3d p(rng.uniform(-0.7, 0.7), rng.uniform(0.45, 1.85), rng.uniform(-0.5, 0.9));
     const double d = user.signedDistance(p);
     if (std::abs(d) < 0.01) continue;  // away from the surface: pixels are ~5 mm there
@@ -117,8 +117,8 @@ TEST(SyntheticUser, SilhouetteContainsTheProjectionOfEveryInnerPointAndNoOuterOn
       ++checked;
     }
   }
-  EXPECT_GT(checked, 100);
-  // Every mask pixel's ray meets the body: its pixel is near the projection of some inside point.
+  EXPECT_GT(checked, 500);
+  // The body covers a plausible part of the view (about 1.1 m tall at 2.5 m).
   EXPECT_GT(cv::countNonZero(mask), 5000);
   EXPECT_LT(cv::countNonZero(mask), mask.size().area() / 4);
 }

@@ -36,13 +36,17 @@ void addNoise(cv::Mat& image, double noise, std::uint64_t noiseSeed) {
 
 }  // namespace
 
+// Heights (m) of the ring's cameras in turn: low ones see under the arms and the torso, high
+// ones over them.
+constexpr double kHeights[] = {1.4, 3.4, 0.5, 3.0, 0.8};
+
 std::vector<CameraCalibration> cameraRing(int count, cv::Size size) {
   std::vector<CameraCalibration> cameras;
-  const double focal = 550.0 * size.width / 640.0;
+  const double focal = 650.0 * size.width / 640.0;
   const cv::Vec3d target(0, 1.25, 0.15);
   for (int n = 0; n < count; ++n) {
     const double angle = 2 * CV_PI * n / count;
-    const cv::Vec3d eye(2.5 * std::sin(angle), n % 2 == 0 ? 1.6 : 2.6, 2.5 * std::cos(angle));
+    const cv::Vec3d eye(2.0 * std::sin(angle), kHeights[n % 5], 2.0 * std::cos(angle));
     cameras.push_back(lookAtCamera(size, focal, eye, target));
   }
   return cameras;
