@@ -41,6 +41,37 @@ TEST(DistanceField, SquaredDistancesEqualBruteForceOnRandomGrids) {
   }
 }
 
+TEST(DistanceField, SignedFieldEqualsBruteForceOnRandomGrids) {
+  cv::RNG rng(22);
+  for (int trial = 0; trial < 40; ++trial) {
+    const GridSpec s{{0, 0, 0}, 0.5, rng.uniform(1, 10), rng.uniform(1, 10), rng.uniform(1, 10)};
+    VoxelGrid grid(s);
+    // A blob away from the border or anywhere: both the bounding box and the border cases.
+    const double density = rng.uniform(0.05, 0.6);
+    const bool blob = trial % 2 == 0;
+    for (int k = 0; k < s.nz; ++k)
+      for (int j = 0; j < s.ny; ++j)
+        for (int i = 0; i < s.nx; ++i) {
+          const bool interior =
+              i > 1 && j > 1 && k > 1 && i < s.nx - 2 && j < s.ny - 2 && k < s.nz - 2;
+          grid.occupied[s.index(i, j, k)] = (!blob || interior) && rng.uniform(0.0, 1.0) < density;
+        }
+    const std::vector<float> toInside = bruteForce(grid, 1), toOutside = bruteForce(grid, 0);
+    std::vector<float> expected(s.count());
+    for (int k = 0; k < s.nz; ++k)
+      for (int j = 0; j < s.ny; ++j)
+        for (int i = 0; i < s.nx; ++i) {
+          const std::size_t n = s.index(i, j, k);
+          const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
+          expected[n] =
+              grid.occupied[n]
+                  ? -(std::min(std::sqrt(toOutside[n]), static_cast<float>(border)) - 0.5f) * 0.5f
+                  : (toInside[n] >= kNoVoxel ? kNoVoxel : (std::sqrt(toInside[n]) - 0.5f) * 0.5f);
+        }
+    EXPECT_EQ(signedDistanceField(grid), expected) << "trial " << trial;
+  }
+}
+
 // The largest |sdf - exact| over the grid, in voxels, for a solid of analytic signed distance.
 template <typename Distance>
 double worstErrorInVoxels(const GridSpec& spec, Distance exact) {

@@ -88,25 +88,45 @@ std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target)
 }
 
 std::vector<float> signedDistanceField(const VoxelGrid& grid) {
-  const std::vector<float> toInside = squaredDistanceTo(grid, 1);
-  std::vector<float> toOutside = squaredDistanceTo(grid, 0);
   const GridSpec& s = grid.spec;
-  const auto h = static_cast<float>(s.voxelSize);
-  // Outside the grid counts as outside: an inside voxel is at most its distance to the border
-  // plus one from an outside centre.
+  const std::vector<float> toInside = squaredDistanceTo(grid, 1);
+  // Only inside voxels need their distance to the outside, and each has a nearest outside voxel
+  // in the occupied bounding box grown by one voxel (clamping any other onto that box's border
+  // layer, which is outside, brings it no farther): the transform runs on that box alone.
+  cv::Vec3i lo(s.nx, s.ny, s.nz), hi(0, 0, 0);
   for (int k = 0; k < s.nz; ++k)
     for (int j = 0; j < s.ny; ++j)
-      for (int i = 0; i < s.nx; ++i) {
-        const std::size_t n = s.index(i, j, k);
-        if (grid.occupied[n]) {
-          const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
-          const float outside = std::min(std::sqrt(toOutside[n]), static_cast<float>(border));
-          toOutside[n] = -(outside - 0.5f) * h;
-        } else {
-          toOutside[n] = toInside[n] >= kNoVoxel ? kNoVoxel : (std::sqrt(toInside[n]) - 0.5f) * h;
+      for (int i = 0; i < s.nx; ++i)
+        if (grid.occupied[s.index(i, j, k)]) {
+          lo = {std::min(lo[0], i), std::min(lo[1], j), std::min(lo[2], k)};
+          hi = {std::max(hi[0], i + 1), std::max(hi[1], j + 1), std::max(hi[2], k + 1)};
         }
+  const auto h = static_cast<float>(s.voxelSize);
+  std::vector<float> field(s.count());
+  for (std::size_t n = 0; n < field.size(); ++n)
+    field[n] = toInside[n] >= kNoVoxel ? kNoVoxel : (std::sqrt(toInside[n]) - 0.5f) * h;
+  if (hi[0] == 0) return field;  // nothing inside
+  lo = {std::max(lo[0] - 1, 0), std::max(lo[1] - 1, 0), std::max(lo[2] - 1, 0)};
+  hi = {std::min(hi[0] + 1, s.nx), std::min(hi[1] + 1, s.ny), std::min(hi[2] + 1, s.nz)};
+  VoxelGrid box(GridSpec{s.origin, s.voxelSize, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  for (int k = lo[2]; k < hi[2]; ++k)
+    for (int j = lo[1]; j < hi[1]; ++j)
+      for (int i = lo[0]; i < hi[0]; ++i)
+        box.occupied[box.spec.index(i - lo[0], j - lo[1], k - lo[2])] =
+            grid.occupied[s.index(i, j, k)];
+  const std::vector<float> toOutside = squaredDistanceTo(box, 0);
+  // Beyond the grid counts as outside: an inside voxel is at most its distance to the border
+  // plus one from an outside centre.
+  for (int k = lo[2]; k < hi[2]; ++k)
+    for (int j = lo[1]; j < hi[1]; ++j)
+      for (int i = lo[0]; i < hi[0]; ++i) {
+        const std::size_t n = s.index(i, j, k);
+        if (!grid.occupied[n]) continue;
+        const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
+        const float squared = toOutside[box.spec.index(i - lo[0], j - lo[1], k - lo[2])];
+        field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
       }
-  return toOutside;
+  return field;
 }
 
 }  // namespace vrflow::camera
