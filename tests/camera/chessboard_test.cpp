@@ -133,13 +133,18 @@ TEST(Chessboard, ViewsOfDifferentSizesAreAnError) {
             "its size");
 }
 
-TEST(CalibrateTool, WritesACalibrationFileFromImageFiles) {
-  TempDir dir;
-  const CameraCalibration truth = truePosedCamera();
+// The calibration views as PNG files view_N.png in `dir`.
+void writeCalibrationViews(const TempDir& dir, const CameraCalibration& truth) {
   int n = 0;
   for (const Pose& pose : calibrationPoses())
     ASSERT_TRUE(cv::imwrite(dir.file("view_" + std::to_string(n++) + ".png"),
                             renderChessboard(truth, board(), pose.rotation, pose.translation)));
+}
+
+TEST(CalibrateTool, WritesACalibrationFileFromImageFiles) {
+  TempDir dir;
+  const CameraCalibration truth = truePosedCamera();
+  writeCalibrationViews(dir, truth);
   ASSERT_TRUE(cv::imwrite(dir.file("world.png"), worldBoardImage(truth)));
   cv::Vec3d boardRotation;
   cv::Rodrigues(kWorldBoardRotation, boardRotation);
@@ -161,10 +166,7 @@ TEST(CalibrateTool, WritesACalibrationFileFromImageFiles) {
 TEST(CalibrateTool, AWorldImageOfTheWrongSizeIsOneClearError) {
   TempDir dir;
   const CameraCalibration truth = truePosedCamera();
-  int n = 0;
-  for (const Pose& pose : calibrationPoses())
-    ASSERT_TRUE(cv::imwrite(dir.file("view_" + std::to_string(n++) + ".png"),
-                            renderChessboard(truth, board(), pose.rotation, pose.translation)));
+  writeCalibrationViews(dir, truth);
   ASSERT_TRUE(cv::imwrite(dir.file("world.png"), cv::Mat(240, 320, CV_8UC1, cv::Scalar(90))));
   const auto result = vrflow::testing::runCommand(
       {vrflow::testing::binDir() + "/vrflow-camera-calibrate", "--board", "9x6", "--square", "0.04",
