@@ -1,0 +1,26 @@
+#pragma once
+// The signed distance field of a voxel model: an exact Euclidean distance transform, separable
+// and linear in the voxel count (Felzenszwalb and Huttenlocher, "Distance transforms of sampled
+// functions", 2012: the lower envelope of parabolas along each axis in turn).
+
+#include <cstdint>
+#include <vector>
+
+#include "vrflow/camera/voxel_grid.hpp"
+
+namespace vrflow::camera {
+
+/// Squared distance (in voxels^2) from every voxel centre to the nearest centre of a voxel whose
+/// occupancy equals `target`; kNoVoxel where the grid has none.
+std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target);
+
+/// The value squaredDistanceTo gives when no voxel has the target occupancy.
+inline constexpr float kNoVoxel = 1e20f;
+
+/// Signed distance (metres) of every voxel centre to the model's surface, negative inside: for a
+/// voxel outside, the distance to the nearest inside centre less half a voxel; inside, minus the
+/// distance to the nearest outside centre less half a voxel (the surface lies half-way between
+/// an inside and an outside centre). Voxels beyond the grid count as outside.
+std::vector<float> signedDistanceField(const VoxelGrid& grid);
+
+}  // namespace vrflow::camera
