@@ -12,7 +12,7 @@
 
 #include "canvas.hpp"
 #include "panels.hpp"
-#include "run_console.hpp"
+#include "run_controller.hpp"
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/model.hpp"
 #include "vrflow/editor/analysis.hpp"
@@ -24,8 +24,11 @@ class QPlainTextEdit;
 class QMenu;
 class QDockWidget;
 class QAction;
+class QLabel;
 
 namespace vrflow::editor::gui {
+
+class LogView;
 
 /// Where the window's messages go: dialogs by default; tests record them instead.
 class Reporter {
@@ -78,10 +81,28 @@ class MainWindow : public QMainWindow {
   void autoLayout();
   void assignSelectionToHost(const std::string& host);
 
-  // Run.
+  // Run (main_window_run.cpp).
+  /// Runs the application on this machine (`vrflow run`, N iterations; 0: until it ends).
   void runApplication(int iterations = 0);
+  /// Starts `request` (its application is the saved file); false when it cannot start (errors
+  /// in the application, not saved, a run going on).
+  bool startRun(RunRequest request);
+  /// Opens the Run/Launch dialog (window-modal, not blocking); accepting it starts the run.
+  void showRunDialog(bool launch);
+  /// Opens the list of this user's running runs; accepting follows the chosen one.
+  void showAttachDialog();
+  /// Follows the registered run `id` (any unique start of it) on the canvas.
+  bool attachRun(const QString& id);
+  /// Shows the log of `module` of the current or last run in the "Module log" dock.
+  void showModuleLog(const std::string& module);
   void stopRun();
   bool running() const;
+  /// The choices last made for the current file in the Run/Launch dialog.
+  RunRequest rememberedRunRequest(bool launch) const;
+  RunController* runController() const { return runs_; }
+  /// The status bar's run line: LiveRun::summary() of the current or last run.
+  QLabel* runStatus() const { return runStatus_; }
+  LogView* moduleLog() const { return moduleLog_; }
 
   /// Renders the window to a PNG file.
   bool screenshot(const QString& path);
@@ -126,6 +147,8 @@ class MainWindow : public QMainWindow {
   void rebuildRecentMenu();
   void showSelection();
   void problemActivated(int row);
+  /// The Run menu and the run controller's signals (main_window_run.cpp).
+  void setUpRuns();
   void finishRun(int exitCode);
   void showLiveRates();
   void setDocument(app::Application app, OpenedText opened, const QString& path);
@@ -158,8 +181,14 @@ class MainWindow : public QMainWindow {
   QAction* runAction_ = nullptr;
   QAction* stopAction_ = nullptr;
 
-  RunConsole* console_;  ///< the run started from the Run menu
-  QTimer* ticker_;       ///< the status bar's seconds while a run goes on
+  QAction* launchAction_ = nullptr;
+  QAction* attachAction_ = nullptr;
+  QAction* logAction_ = nullptr;
+
+  RunController* runs_;  ///< the run started or attached from the Run menu
+  QLabel* runStatus_;    ///< the run's summary, kept after its end
+  LogView* moduleLog_;
+  QDockWidget* moduleLogDock_ = nullptr;
   std::optional<RunReport> lastRun_;
   QString runError_;
   std::map<std::string, double> liveRates_;

@@ -77,6 +77,9 @@ class PropertiesPanel : public QWidget {
   void initialMessagesEdited(const std::string& node, const std::string& port, int count);
   void hostChosen(const std::string& node, const std::string& host);
   void renameRequested(const std::string& node, const std::string& newId);
+  /// "Override for this run": the next run sets `node.name=value` (`--set`), the file unchanged.
+  void overrideForRunRequested(const std::string& node, const std::string& name,
+                               const std::string& value);
 
  private:
   QWidget* editorFor(const app::ParamSpec& spec, const std::string& value, bool set);
