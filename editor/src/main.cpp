@@ -75,11 +75,10 @@ int main(int argc, char** argv) {
   int exitCode = 0;
   if (parser.isSet(runFirst) || parser.isSet(launchFirst)) {
     QEventLoop loop;
-    QObject::connect(&window, &vrflow::editor::gui::MainWindow::runFinished, &loop,
-                     [&](int code) {
-                       exitCode = code;
-                       loop.quit();
-                     });
+    QObject::connect(&window, &vrflow::editor::gui::MainWindow::runFinished, &loop, [&](int code) {
+      exitCode = code;
+      loop.quit();
+    });
     if (parser.isSet(launchFirst)) {
       // As the Run/Launch dialog would start it, with the command line's choices only (not
       // the user's remembered ones: a script gives the same run anywhere).

@@ -15,8 +15,6 @@
 #include <QPlainTextEdit>
 #include <QSaveFile>
 #include <QStatusBar>
-#include <QTemporaryDir>
-#include <QTimer>
 #include <QToolBar>
 #include <QUndoCommand>
 #include <QUndoStack>

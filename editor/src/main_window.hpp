@@ -3,7 +3,6 @@
 #include <QMainWindow>
 #include <QSettings>
 #include <QStringList>
-#include <QTimer>
 #include <map>
 #include <memory>
 #include <optional>
@@ -149,6 +148,7 @@ class MainWindow : public QMainWindow {
   void problemActivated(int row);
   /// The Run menu and the run controller's signals (main_window_run.cpp).
   void setUpRuns();
+  void setRunActions(bool runGoesOn);
   void finishRun(int exitCode);
   void showLiveRates();
   void setDocument(app::Application app, OpenedText opened, const QString& path);
@@ -181,6 +181,7 @@ class MainWindow : public QMainWindow {
   QAction* runAction_ = nullptr;
   QAction* stopAction_ = nullptr;
 
+  QAction* runDialogAction_ = nullptr;
   QAction* launchAction_ = nullptr;
   QAction* attachAction_ = nullptr;
   QAction* logAction_ = nullptr;

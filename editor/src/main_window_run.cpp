@@ -28,9 +28,10 @@ void MainWindow::setUpRuns() {
   QMenu* runMenu = menuBar()->addMenu("&Run");
   runAction_ = runMenu->addAction("&Run on this machine", QKeySequence(Qt::Key_F5), this,
                                   [this] { runApplication(); });
-  runMenu->addAction("Run\u2026", QKeySequence(Qt::CTRL | Qt::Key_R), this,
-                     [this] { showRunDialog(false); });
-  launchAction_ = runMenu->addAction("&Launch on hosts\u2026", this, [this] { showRunDialog(true); });
+  runDialogAction_ = runMenu->addAction("Run\u2026", QKeySequence(Qt::CTRL | Qt::Key_R), this,
+                                        [this] { showRunDialog(false); });
+  launchAction_ =
+      runMenu->addAction("&Launch on hosts\u2026", this, [this] { showRunDialog(true); });
   attachAction_ = runMenu->addAction("&Attach to a run\u2026", this, &MainWindow::showAttachDialog);
   stopAction_ =
       runMenu->addAction("&Stop", QKeySequence(Qt::SHIFT | Qt::Key_F5), this, &MainWindow::stopRun);
@@ -49,8 +50,8 @@ void MainWindow::setUpRuns() {
             RunRequest request = rememberedRunRequest(false);
             request.overrides.emplace_back(qtText(node + "." + name), qtText(value));
             saveRunChoices(*settings_, request);
-            statusBar()->showMessage(
-                qtText("The next run sets " + node + "." + name + "=" + value), 8000);
+            statusBar()->showMessage(qtText("The next run sets " + node + "." + name + "=" + value),
+                                     8000);
           });
 }
 
@@ -91,14 +92,9 @@ bool MainWindow::startRun(RunRequest request) {
   canvas_->state().live.clear();
   runError_.clear();
   refresh();
-  if (!runs_->start(request)) {
-    finishRun(-1);
-    return false;
-  }
-  runAction_->setEnabled(false);
-  launchAction_->setEnabled(false);
-  attachAction_->setEnabled(false);
-  stopAction_->setEnabled(true);
+  // A process that cannot start ends through finished(-1) (finishRun); the log says why.
+  if (!runs_->start(request)) return false;
+  setRunActions(true);
   runStatus_->setText(qtText(runs_->live()->run().summary()));
   return true;
 }
@@ -108,14 +104,9 @@ bool MainWindow::attachRun(const QString& id) {
   lastRun_.reset();
   liveRates_.clear();
   canvas_->state().live.clear();
-  if (!runs_->attach(id)) {
-    finishRun(-1);
-    return false;
-  }
-  runAction_->setEnabled(false);
-  launchAction_->setEnabled(false);
-  attachAction_->setEnabled(false);
-  stopAction_->setEnabled(true);
+  if (!runs_->attach(id)) return false;
+  setRunActions(true);
+  runStatus_->setText(qtText(runs_->live()->run().summary()));
   return true;
 }
 
@@ -133,8 +124,7 @@ void MainWindow::showRunDialog(bool launch) {
 void MainWindow::showAttachDialog() {
   auto* dialog = new AttachDialog(runs_->listRuns(false), this);
   dialog->setAttribute(Qt::WA_DeleteOnClose);
-  connect(dialog, &QDialog::accepted, this,
-          [this, dialog] { attachRun(dialog->chosenRun()); });
+  connect(dialog, &QDialog::accepted, this, [this, dialog] { attachRun(dialog->chosenRun()); });
   dialog->open();
 }
 
@@ -166,11 +156,14 @@ void MainWindow::showLiveRates() {
   Q_EMIT liveRatesUpdated();
 }
 
+void MainWindow::setRunActions(bool runGoesOn) {
+  for (QAction* action : {runAction_, runDialogAction_, launchAction_, attachAction_})
+    action->setEnabled(!runGoesOn);
+  stopAction_->setEnabled(runGoesOn);
+}
+
 void MainWindow::finishRun(int exitCode) {
-  runAction_->setEnabled(true);
-  launchAction_->setEnabled(true);
-  attachAction_->setEnabled(true);
-  stopAction_->setEnabled(false);
+  setRunActions(false);
   lastRun_ = runs_->report();
   canvas_->state().live.clear();  // the report's figures replace the live ones
   QString summary;

@@ -6,8 +6,19 @@
 #include <QJsonArray>
 #include <QJsonDocument>
 #include <QJsonObject>
+#include <QRegularExpression>
 
 namespace vrflow::editor::gui {
+
+QString shellCommandLine(const QStringList& words) {
+  static const QRegularExpression plain("^[A-Za-z0-9_./=:,+@%-]+$");
+  QStringList quoted;
+  for (QString word : words) {
+    if (!plain.match(word).hasMatch()) word = "'" + word.replace("'", "'\\''") + "'";
+    quoted << word;
+  }
+  return quoted.join(' ');
+}
 
 QString RunRequest::workingDirectory() const {
   return outputDir.isEmpty() ? QFileInfo(application).absolutePath()
@@ -16,8 +27,8 @@ QString RunRequest::workingDirectory() const {
 
 QString RunRequest::traceFile() const {
   if (!trace) return {};
-  return QDir(workingDirectory()).filePath(QFileInfo(application).completeBaseName() +
-                                           ".trace.json");
+  return QDir(workingDirectory())
+      .filePath(QFileInfo(application).completeBaseName() + ".trace.json");
 }
 
 QString RunRequest::reportFile() const {
@@ -35,7 +46,8 @@ QStringList RunRequest::arguments() const {
   for (const auto& [name, value] : overrides) args << "--set" << name + "=" + value;
   for (const QString& dir : packageDirs) args << "--packages" << dir;
   if (trace) args << "--trace" << traceFile();
-  args << "--report" << reportFile() << "--events" << "-";
+  args << "--report" << reportFile() << "--events"
+       << "-";
   return args;
 }
 
@@ -113,10 +125,12 @@ bool RunController::startProcess(const QStringList& args, const QString& working
   });
   pendingEvents_.clear();
   pendingLog_.clear();
+  idLookups_ = 0;
   live_->reset();
   ended_ = false;
-  commandLine_ = QProcess::joinArgs(QStringList{program_} + args);
-  Q_EMIT logLine("$ " + commandLine_ + (attached_ ? QString() : "   (in " + workingDirectory + ")"));
+  commandLine_ = shellCommandLine(QStringList{program_} + args);
+  Q_EMIT logLine("$ " + commandLine_ +
+                 (attached_ ? QString() : "   (in " + workingDirectory + ")"));
   process_->start(program_, args);
   if (!process_->waitForStarted(10000)) return false;
   Q_EMIT started();
@@ -163,7 +177,10 @@ void RunController::readEvents() {
     const QByteArray line = pendingEvents_.left(at);
     pendingEvents_.remove(0, at + 1);
     // The registration exists once the run writes events: its id can be read now.
-    if (runId_.isEmpty() && !attached_) learnRunId();
+    if (runId_.isEmpty() && !attached_ && idLookups_ < 3) {
+      ++idLookups_;
+      learnRunId();
+    }
     live_->handleLine(line);
   }
 }

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <QJsonObject>
+#include <QList>
 #include <QObject>
 #include <QProcess>
 #include <QString>
@@ -16,15 +18,15 @@ namespace vrflow::editor::gui {
 /// What to start: `vrflow run` or `vrflow launch` of one application file, with the choices of
 /// the Run/Launch dialog. arguments() is the exact command line.
 struct RunRequest {
-  QString application;  ///< the application file
-  bool launch = false;  ///< `vrflow launch` on the file's hosts; false: `vrflow run` here
+  QString application;        ///< the application file
+  bool launch = false;        ///< `vrflow launch` on the file's hosts; false: `vrflow run` here
   QString backend = "local";  ///< launch only: local, ssh, mpirun, slurm
   QString hostfile;           ///< launch only: `--hosts FILE`; empty: the file's own hosts
   int iterations = 0;         ///< `--iterations N`; 0: until the application ends
   /// `--set NODE.PARAM=VALUE` each, in order.
   std::vector<std::pair<QString, QString>> overrides;
-  QString outputDir;  ///< the run's working folder; empty: the application file's folder
-  bool trace = false;  ///< `--trace <outputDir>/<application>.trace.json`
+  QString outputDir;        ///< the run's working folder; empty: the application file's folder
+  bool trace = false;       ///< `--trace <outputDir>/<application>.trace.json`
   QStringList packageDirs;  ///< `--packages DIR` each
 
   /// The working folder the run starts in.
@@ -36,6 +38,9 @@ struct RunRequest {
   /// The arguments after the program, ending with `--report REPORT --events -`.
   QStringList arguments() const;
 };
+
+/// `words` as one shell command line (each quoted when it needs it), for people to read and copy.
+QString shellCommandLine(const QStringList& words);
 
 /// One run the editor follows: started by it (a QProcess of `vrflow run|launch ... --events -`)
 /// or attached to (`vrflow monitor RUN --follow-events`). Either way each line of the child's
@@ -96,6 +101,7 @@ class RunController : public QObject {
   QString commandLine_, runId_, traceFile_, reportFile_, logDir_;
   QByteArray pendingEvents_, pendingLog_;
   std::optional<RunReport> report_;
+  int idLookups_ = 0;  ///< `vrflow list` calls made to find the run's id
   bool attached_ = false;
   bool ended_ = true;
 };

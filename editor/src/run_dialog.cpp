@@ -11,7 +11,6 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QPlainTextEdit>
-#include <QProcess>
 #include <QPushButton>
 #include <QRadioButton>
 #include <QSpinBox>
@@ -146,13 +145,13 @@ RunDialog::RunDialog(QString program, const app::Application& application,
 
   connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
   connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
-  connect(here_, &QRadioButton::toggled, this, &RunDialog::update);
-  connect(backend_, &QComboBox::currentTextChanged, this, &RunDialog::update);
-  connect(hostfile_, &QLineEdit::textChanged, this, &RunDialog::update);
-  connect(iterations_, &QSpinBox::valueChanged, this, &RunDialog::update);
-  connect(overrides_, &QTableWidget::cellChanged, this, &RunDialog::update);
-  connect(output_, &QLineEdit::textChanged, this, &RunDialog::update);
-  connect(trace_, &QCheckBox::toggled, this, &RunDialog::update);
+  connect(here_, &QRadioButton::toggled, this, &RunDialog::showCommandLine);
+  connect(backend_, &QComboBox::currentTextChanged, this, &RunDialog::showCommandLine);
+  connect(hostfile_, &QLineEdit::textChanged, this, &RunDialog::showCommandLine);
+  connect(iterations_, &QSpinBox::valueChanged, this, &RunDialog::showCommandLine);
+  connect(overrides_, &QTableWidget::cellChanged, this, &RunDialog::showCommandLine);
+  connect(output_, &QLineEdit::textChanged, this, &RunDialog::showCommandLine);
+  connect(trace_, &QCheckBox::toggled, this, &RunDialog::showCommandLine);
   connect(addButton, &QPushButton::clicked, this, [this] {
     addOverride({}, {});
     overrides_->setCurrentCell(overrides_->rowCount() - 1, 0);
@@ -160,7 +159,7 @@ RunDialog::RunDialog(QString program, const app::Application& application,
   });
   connect(removeButton, &QPushButton::clicked, this, [this] {
     if (overrides_->currentRow() >= 0) overrides_->removeRow(overrides_->currentRow());
-    update();
+    showCommandLine();
   });
   connect(chooseHostfile, &QPushButton::clicked, this, [this] {
     const QString file = QFileDialog::getOpenFileName(this, "Hostfile", hostfile_->text());
@@ -170,7 +169,7 @@ RunDialog::RunDialog(QString program, const app::Application& application,
     const QString dir = QFileDialog::getExistingDirectory(this, "Output folder", output_->text());
     if (!dir.isEmpty()) output_->setText(dir);
   });
-  update();
+  showCommandLine();
 }
 
 void RunDialog::addOverride(const QString& name, const QString& value) {
@@ -202,11 +201,11 @@ RunRequest RunDialog::request() const {
 
 QString RunDialog::commandLine() const {
   const RunRequest now = request();
-  return "cd " + QProcess::joinArgs({now.workingDirectory()}) + " && " +
-         QProcess::joinArgs(QStringList{program_} + now.arguments());
+  return "cd " + shellCommandLine({now.workingDirectory()}) + " && " +
+         shellCommandLine(QStringList{program_} + now.arguments());
 }
 
-void RunDialog::update() {
+void RunDialog::showCommandLine() {
   const bool launch = hosts_->isChecked();
   backend_->setEnabled(launch);
   hostfile_->setEnabled(launch);

@@ -49,7 +49,7 @@ class RunDialog : public QDialog {
 
  private:
   void addOverride(const QString& name, const QString& value);
-  void update();
+  void showCommandLine();
 
   QString program_;
   RunRequest base_;

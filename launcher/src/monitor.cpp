@@ -164,10 +164,10 @@ int followEvents(const std::string& runPrefix) {
     std::fflush(stdout);
   };
   // The registration knows the hosts and module ids, not their types or placement.
-  json started = {{"event", "started"},       {"time", 0.0},
-                  {"application", identity.application}, {"file", identity.file},
-                  {"run", identity.id},       {"hosts", json::array()},
-                  {"modules", json::array()}};
+  json started = {
+      {"event", "started"},      {"time", 0.0},        {"application", identity.application},
+      {"file", identity.file},   {"run", identity.id}, {"hosts", json::array()},
+      {"modules", json::array()}};
   for (const auto& host : identity.hosts) started["hosts"].push_back({{"id", host}});
   for (const auto& module : identity.modules) started["modules"].push_back({{"id", module}});
   print(started);
