@@ -68,15 +68,22 @@ bool RunController::running() const {
   return process_ != nullptr && process_->state() != QProcess::NotRunning;
 }
 
-bool RunController::start(const RunRequest& request) {
+bool RunController::forgetLastRun(bool attaching) {
   if (running()) {
     Q_EMIT logLine("A run is going on: stop it first");
     return false;
   }
-  attached_ = false;
+  attached_ = attaching;
   runId_.clear();
   logDir_.clear();
+  traceFile_.clear();
+  reportFile_.clear();
   report_.reset();
+  return true;
+}
+
+bool RunController::start(const RunRequest& request) {
+  if (!forgetLastRun(false)) return false;
   traceFile_ = request.traceFile();
   reportFile_ = request.reportFile();
   QFile::remove(reportFile_);  // a report read at the end is this run's
@@ -89,16 +96,8 @@ bool RunController::start(const RunRequest& request) {
 }
 
 bool RunController::attach(const QString& runId) {
-  if (running()) {
-    Q_EMIT logLine("A run is going on: stop it first");
-    return false;
-  }
-  attached_ = true;
-  reportFile_.clear();
+  if (!forgetLastRun(true)) return false;
   runId_ = runId;
-  logDir_.clear();
-  traceFile_.clear();
-  report_.reset();
   for (const QJsonObject& run : listRuns(false)) {
     if (run.value("id").toString().startsWith(runId)) {
       runId_ = run.value("id").toString();

@@ -89,6 +89,8 @@ class RunController : public QObject {
   void finished(int exitCode);
 
  private:
+  /// Clears what is known of the last run; false while one is followed.
+  bool forgetLastRun(bool attaching);
   bool startProcess(const QStringList& args, const QString& workingDirectory);
   void readEvents();
   void readLog();

@@ -26,6 +26,7 @@
 #include <QRadioButton>
 #include <QSignalSpy>
 #include <QSpinBox>
+#include <QStatusBar>
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
@@ -234,6 +235,11 @@ TEST_F(EditorRuns, TheRunDialogStartsARunFollowedLiveToItsEndAndTheReasonStays) 
   EXPECT_TRUE(status().startsWith("Finished: 120 iterations")) << status().toStdString();
   QTest::qWait(1500);
   EXPECT_TRUE(status().startsWith("Finished: 120 iterations")) << status().toStdString();
+  // An edit after the run writes its own message; the run's line stays beside it.
+  window_->autoLayout();
+  EXPECT_TRUE(window_->statusBar()->currentMessage().startsWith("Valid")) << log();
+  EXPECT_TRUE(status().startsWith("Finished: 120 iterations")) << status().toStdString();
+  EXPECT_TRUE(window_->runStatus()->isVisible());
   const LiveRun& run = window_->runController()->live()->run();
   EXPECT_EQ(run.modules.size(), 5u);
   EXPECT_EQ(run.modules.at("relay").iterations, 120u);
