@@ -3,7 +3,9 @@
 #include <QContextMenuEvent>
 #include <QGraphicsPathItem>
 #include <QGraphicsScene>
+#include <QGraphicsTextItem>
 #include <QKeyEvent>
+#include <QMenu>
 #include <QMimeData>
 #include <QMouseEvent>
 #include <QPainter>
@@ -14,6 +16,7 @@
 #include <cmath>
 
 #include "qt_text.hpp"
+#include "vrflow/editor/notes.hpp"
 
 namespace vrflow::editor::gui {
 
@@ -74,11 +77,16 @@ void Canvas::selectOnly(const std::vector<std::string>& ids,
       if (auto* item = connectionItem(*connection)) item->setSelected(true);
     }
   }
+  // Scroll only to what is out of sight: the view does not move under the user otherwise.
+  const QRectF visible = mapToScene(viewport()->rect()).boundingRect();
+  QGraphicsItem* shown = nullptr;
   if (!ids.empty()) {
-    if (auto* item = nodeItem(ids.front())) ensureVisible(item, 80, 80);
+    shown = nodeItem(ids.front());
   } else if (connection) {
-    if (auto* item = connectionItem(*connection)) ensureVisible(item, 80, 80);
+    shown = connectionItem(*connection);
   }
+  if (shown != nullptr && !visible.intersects(shown->sceneBoundingRect()))
+    ensureVisible(shown, 80, 80);
   Q_EMIT selectionChangedIds();
 }
 
@@ -111,20 +119,20 @@ QPointF Canvas::portScenePos(const std::string& node, const std::string& port) c
 void Canvas::fitAll() {
   QRectF bounds;
   for (const auto& [id, item] : nodes_) bounds = bounds.united(item->sceneBoundingRect());
-  for (const auto* item : connections_) bounds = bounds.united(item->sceneBoundingRect());
+  for (const auto* item : connections_) bounds = bounds.united(item->path().boundingRect());
+  for (const auto& [id, item] : notes_) bounds = bounds.united(item->sceneBoundingRect());
+  for (const auto& [id, item] : frames_) bounds = bounds.united(item->sceneBoundingRect());
   if (bounds.isEmpty()) {
     resetTransform();
     centerOn(0, 0);
     return;
   }
-  fitInView(bounds.adjusted(-30, -30, 30, 30), Qt::KeepAspectRatio);
-  // Do not blow small networks up beyond their natural size, nor shrink big ones until their
-  // text cannot be read (scroll instead).
-  if (transform().m11() > 1.0 || transform().m11() < 0.5) {
-    const double scale = transform().m11() > 1.0 ? 1.0 : 0.5;
-    setTransform(QTransform::fromScale(scale, scale));
-    centerOn(bounds.center());
-  }
+  bounds = bounds.adjusted(-30, -30, 30, 30);
+  // As far out as the graph needs, but never blown up beyond its natural size.
+  const double scale =
+      std::min({1.0, viewport()->width() / bounds.width(), viewport()->height() / bounds.height()});
+  setTransform(QTransform::fromScale(scale, scale));
+  centerOn(bounds.center());
 }
 
 Positions Canvas::nodeSizes() const {
@@ -189,6 +197,11 @@ void Canvas::mousePressEvent(QMouseEvent* event) {
     event->accept();
     return;
   }
+  // A right click on empty canvas keeps the selection (its menu may frame it).
+  if (event->button() == Qt::RightButton && itemAt(event->position().toPoint()) == nullptr) {
+    event->accept();
+    return;
+  }
   if (event->button() == Qt::LeftButton) {
     if (PortItem* port = portAt(event->position().toPoint())) {
       dragFrom_ = port;
@@ -212,6 +225,7 @@ void Canvas::mouseMoveEvent(QMouseEvent* event) {
     event->accept();
     return;
   }
+  trackDrag(event);
   if (dragFrom_ != nullptr) {
     const QPointF start = dragFrom_->scenePos();
     const QPointF end = mapToScene(event->position().toPoint());
@@ -263,12 +277,15 @@ void Canvas::mouseReleaseEvent(QMouseEvent* event) {
         const PortItem* in = from->spec().isInput ? from : target;
         Q_EMIT connectRequested(out->endpoint(), in->endpoint());
       }
+    } else if (target == nullptr) {
+      offerNodesForWire(from, event->position().toPoint());
     }
     event->accept();
     return;
   }
   QGraphicsView::mouseReleaseEvent(event);
   if (event->button() != Qt::LeftButton || state_.app == nullptr) return;
+  if (dropSelectionOnWire()) return;
   // Nodes dragged to a new place: snap to the grid and report where.
   Positions moved;
   for (const auto& [id, item] : nodes_) {
@@ -287,6 +304,7 @@ void Canvas::mouseReleaseEvent(QMouseEvent* event) {
     }
   }
   if (!moved.empty()) Q_EMIT nodesMoved(moved);
+  reportNoteAndFrameChanges();
 }
 
 void Canvas::wheelEvent(QWheelEvent* event) {
@@ -297,20 +315,47 @@ void Canvas::wheelEvent(QWheelEvent* event) {
   event->accept();
 }
 
+bool Canvas::event(QEvent* event) {
+  // Delete with notes or frames selected is the canvas' key, not the Edit menu's shortcut
+  // (which deletes nodes and connections only).
+  if (event->type() == QEvent::ShortcutOverride) {
+    const auto* key = static_cast<QKeyEvent*>(event);
+    if ((key->key() == Qt::Key_Delete || key->key() == Qt::Key_Backspace) &&
+        scene_->focusItem() == nullptr && !selectedNotesAndFrames().empty()) {
+      event->accept();
+      return true;
+    }
+  }
+  return QGraphicsView::event(event);
+}
+
 void Canvas::keyPressEvent(QKeyEvent* event) {
-  if (event->key() == Qt::Key_Delete || event->key() == Qt::Key_Backspace) {
+  // Text typed into a note or a frame's title goes there.
+  const bool typing = scene_->focusItem() != nullptr &&
+                      (scene_->focusItem()->flags() & QGraphicsItem::ItemIsFocusable) != 0 &&
+                      dynamic_cast<QGraphicsTextItem*>(scene_->focusItem()) != nullptr;
+  if (!typing && (event->key() == Qt::Key_Delete || event->key() == Qt::Key_Backspace)) {
+    const auto annotations = selectedNotesAndFrames();
+    if (!annotations.empty()) requestEdit(removeNotesAndFrames(*state_.app, annotations));
     Q_EMIT deleteRequested();
     event->accept();
     return;
   }
+  if (quickAddKey(event)) return;
   QGraphicsView::keyPressEvent(event);
 }
 
 void Canvas::contextMenuEvent(QContextMenuEvent* event) {
-  NodeItem* node = nodeAt(event->pos());
-  if (node == nullptr) return;
-  if (!node->isSelected()) selectOnly({node->id()});
-  Q_EMIT contextMenuForNodes(selectedNodes(), event->globalPos());
+  if (NodeItem* node = nodeAt(event->pos())) {
+    if (!node->isSelected()) selectOnly({node->id()});
+    Q_EMIT contextMenuForNodes(selectedNodes(), event->globalPos());
+    return;
+  }
+  // A frame's menu, a note's, or the canvas' own (add a note, a frame).
+  if (QMenu* menu = contextMenuAt(event->pos())) {
+    menu->setAttribute(Qt::WA_DeleteOnClose);
+    menu->popup(event->globalPos());
+  }
 }
 
 namespace {
@@ -329,6 +374,8 @@ void Canvas::dragEnterEvent(QDragEnterEvent* event) {
 
 void Canvas::dragMoveEvent(QDragMoveEvent* event) {
   if (event->mimeData()->hasFormat(kNodeMime)) {
+    hoverWireForSpec(QString::fromUtf8(event->mimeData()->data(kNodeMime)),
+                     event->position().toPoint());
     acceptAsCopy(event);
   } else if (event->mimeData()->hasFormat(kHostMime)) {
     if (nodeAt(event->position().toPoint()) != nullptr) {
@@ -341,7 +388,10 @@ void Canvas::dragMoveEvent(QDragMoveEvent* event) {
 
 void Canvas::dropEvent(QDropEvent* event) {
   const QMimeData* mime = event->mimeData();
-  if (mime->hasFormat(kNodeMime)) {
+  if (mime->hasFormat(kNodeMime) &&
+      dropSpecOnWire(QString::fromUtf8(mime->data(kNodeMime)), event->position().toPoint())) {
+    acceptAsCopy(event);
+  } else if (mime->hasFormat(kNodeMime)) {
     const QPointF at = mapToScene(event->position().toPoint());
     Q_EMIT addRequested(QString::fromUtf8(mime->data(kNodeMime)),
                         QPointF(snap(at.x()), snap(at.y())));

@@ -13,13 +13,22 @@
 #include <string>
 #include <vector>
 
+#include "canvas_style.hpp"
+#include "connection_item.hpp"
+#include "frame_item.hpp"
+#include "node_item.hpp"
+#include "note_item.hpp"
+#include "port_item.hpp"
+#include "routing.hpp"
 #include "vrflow/app/catalog.hpp"
 #include "vrflow/app/model.hpp"
 #include "vrflow/editor/analysis.hpp"
+#include "vrflow/editor/changes.hpp"
 #include "vrflow/editor/edit.hpp"
 
 class QGraphicsScene;
 class QGraphicsPathItem;
+class QMenu;
 
 namespace vrflow::editor::gui {
 
@@ -30,14 +39,6 @@ using Positions = std::map<std::string, std::pair<double, double>>;
 inline constexpr const char* kNodeMime = "application/x-vrflow-node";
 /// Mime type of a host dragged from the hosts panel: its id.
 inline constexpr const char* kHostMime = "application/x-vrflow-host";
-
-/// The colour of a message data type ("objects", "events", ..., "any").
-QColor colorOfData(const std::string& data);
-/// The colour of the host at `index` in the application's host list.
-QColor colorOfHost(std::size_t index);
-/// The curve of a connection from an output at `from` to an input at `to` (around, below both
-/// ends, when it goes back).
-QPainterPath connectionCurve(QPointF from, QPointF to);
 
 /// What the canvas draws, besides the application.
 struct CanvasState {
@@ -51,9 +52,8 @@ struct CanvasState {
   std::map<std::string, double> live;
 };
 
-class NodeItem;
-class PortItem;
-class ConnectionItem;
+class QuickAdd;
+class CompositeView;
 
 class Canvas : public QGraphicsView {
   Q_OBJECT
@@ -65,6 +65,11 @@ class Canvas : public QGraphicsView {
   CanvasState& state() { return state_; }
   /// Recreates every item from state(); keeps the selection (by id) and the view.
   void rebuild();
+  /// Brings the scene up to date with state() by what changed since the last rebuild() or
+  /// sync() (editor::diff()): only the items of added, removed or changed nodes, connections,
+  /// notes and frames are created or deleted; the others stay (with their selection, a drag in
+  /// progress and the view), moved or redrawn in place.
+  void sync();
 
   /// The selected nodes' ids (in model order).
   std::vector<std::string> selectedNodes() const;
@@ -78,11 +83,21 @@ class Canvas : public QGraphicsView {
   PortItem* portItem(const std::string& node, const std::string& port) const;
   /// The item of connection `index`, or nullptr.
   ConnectionItem* connectionItem(std::size_t index) const;
+  /// The item of a note, or nullptr.
+  NoteItem* noteItem(const std::string& id) const;
+  /// The item of a frame, or nullptr.
+  FrameItem* frameItem(const std::string& id) const;
+  /// The selected notes' and frames' ids.
+  std::vector<std::string> selectedNotesAndFrames() const;
+  /// The menu a right-click at `viewPos` opens on a frame or on empty canvas (add a note, a
+  /// frame, a frame around the selection; rename, recolour, delete a frame), or nullptr over
+  /// a node (contextMenuForNodes() is emitted then). The caller owns it.
+  QMenu* contextMenuAt(QPoint viewPos);
   /// Scene position of a port's connection point.
   QPointF portScenePos(const std::string& node, const std::string& port) const;
   /// Shows live iterations/s on the nodes, in place (no rebuild: a drag in progress goes on).
   void setLiveRates(const std::map<std::string, double>& rates);
-  /// Shows every node.
+  /// Shows every node, note and frame: zooms out as far as they need, in no further than 1x.
   void fitAll();
   /// Sizes of the node items (for the automatic layout).
   Positions nodeSizes() const;
@@ -101,8 +116,11 @@ class Canvas : public QGraphicsView {
   void deleteRequested();
   void selectionChangedIds();
   void contextMenuForNodes(const std::vector<std::string>& ids, QPoint globalPos);
+  /// An edit of notes or frames made on the canvas, to be applied through the undo stack.
+  void editRequested(const vrflow::editor::Edit& edit);
 
  protected:
+  bool event(QEvent* event) override;
   void mousePressEvent(QMouseEvent* event) override;
   void mouseMoveEvent(QMouseEvent* event) override;
   void mouseReleaseEvent(QMouseEvent* event) override;
@@ -117,106 +135,95 @@ class Canvas : public QGraphicsView {
  private:
   PortItem* portAt(QPoint viewPos) const;
   NodeItem* nodeAt(QPoint viewPos) const;
+  FrameItem* frameAt(QPoint viewPos) const;
 
+  // canvas_scene.cpp: nodes and connections.
+  NodeItem* makeNode(const std::string& id);
+  void placeNode(NodeItem* item);
+  void removeNode(const std::string& id);
+  void syncConnections();
+  void routeConnections();
+  void decorate();
+  // canvas_notes.cpp: notes and frames.
+  void syncNotesAndFrames();
+  void reportNoteAndFrameChanges();
+  void requestEdit(Result<Edit> edit);
+  void addFrameAroundSelection();
+  QMenu* frameMenu(FrameItem* frame);
+
+  // ---- Interactions (canvas_interactions.cpp): quick-add, wire drops, insert on a wire, the
+  // paste point, composites opened and collapsed. ----
+ public:
+  /// The cursor's scene position when it is over the view (where a paste lands), else nullopt.
+  std::optional<QPointF> cursorScenePos() const;
+  /// Opens the quick-add popup at view position `at` with `text` typed; with `wireFrom`, it
+  /// lists only the types that connect to that port and connects the one chosen.
+  void openQuickAdd(QPoint at, const QString& text = {}, const PortItem* wireFrom = nullptr);
+  /// The quick-add popup (nullptr before the first use).
+  QuickAdd* quickAdd() const { return quickAdd_; }
+  /// Collapses the selected nodes into a new composite, one undoable edit (editRequested).
+  void collapseSelection();
+  /// Opens (drills down into) composite instance `id` over the canvas; false with the reason in
+  /// lastRefusal() when its inside cannot be read.
+  bool openComposite(const std::string& id);
+  /// The open composite's view, or nullptr when the application is shown.
+  CompositeView* compositeView() const { return compositeView_; }
+  /// A read-only canvas (an opened composite's inside) shows and offers no edit.
+  void setReadOnly(bool readOnly);
+  /// The connection highlighted as the target of a node drop, or nullopt.
+  std::optional<std::size_t> wireUnderDrop() const { return wireHover_; }
+
+ Q_SIGNALS:
+  /// An edit made on the canvas (insert, quick-add with a connection, collapse); `select`: the
+  /// nodes to select once it is applied.
+  void editRequested(const vrflow::editor::Edit& edit, const std::vector<std::string>& select);
+  /// Something to say in the status bar (why a drop or an opening was refused).
+  void messageRequested(const QString& text);
+
+ protected:
+  void mouseDoubleClickEvent(QMouseEvent* event) override;
+  bool focusNextPrevChild(bool next) override;
+
+ private:
+  bool quickAddKey(QKeyEvent* event);
+  void trackDrag(QMouseEvent* event);
+  bool offerNodesForWire(const PortItem* from, QPoint at);
+  bool dropSelectionOnWire();
+  void hoverWireForSpec(const QString& spec, QPoint at);
+  bool dropSpecOnWire(const QString& spec, QPoint at);
+  void closeComposite();
+  void quickAddChosen(const QString& spec);
+  std::optional<std::size_t> wireAt(QPoint viewPos, const std::string& node) const;
+  void setWireHover(std::optional<std::size_t> index, const std::optional<std::string>& refusal,
+                    QPoint at);
+
+  QuickAdd* quickAdd_ = nullptr;
+  CompositeView* compositeView_ = nullptr;
+  std::optional<std::size_t> wireHover_;  ///< a connection the drop would accept
+  std::optional<std::size_t> wireShown_;  ///< the connection drawn highlighted
+  std::optional<app::Endpoint> quickAddWire_;
+  bool quickAddWireIsOutput_ = true;
+  QPointF quickAddAt_;
+  bool readOnly_ = false;
+  // ---- end of interactions ----
+
+ private:
   QGraphicsScene* scene_;
   CanvasState state_;
+  /// The application as the scene last showed it (what sync() compares against).
+  std::optional<app::Application> shown_;
   std::map<std::string, NodeItem*> nodes_;
+  /// What each node item was made from (title, ports, host): remade when that differs.
+  std::map<std::string, QString> looks_;
   std::vector<ConnectionItem*> connections_;
+  std::map<std::string, NoteItem*> notes_;
+  std::map<std::string, FrameItem*> frames_;
   std::vector<QGraphicsItem*> decorations_;
   PortItem* dragFrom_ = nullptr;
   QGraphicsPathItem* dragLine_ = nullptr;
   bool panning_ = false;
   QPoint panLast_;
   QString lastRefusal_;
-};
-
-/// A port: a small circle on its node's edge with its name beside it.
-class PortItem : public QGraphicsItem {
- public:
-  PortItem(QGraphicsItem* parent, std::string node, app::PortSpec spec);
-  QRectF boundingRect() const override;
-  void paint(QPainter* painter, const QStyleOptionGraphicsItem* option, QWidget* widget) override;
-
-  const std::string& node() const { return node_; }
-  const app::PortSpec& spec() const { return spec_; }
-  app::Endpoint endpoint() const { return {node_, spec_.name}; }
-  void setHighlight(int highlight) {  // 0 none, 1 accepts, -1 refuses
-    highlight_ = highlight;
-    update();
-  }
-  void setLabelSide(bool left) { labelLeft_ = left; }
-
- private:
-  std::string node_;
-  app::PortSpec spec_;
-  int highlight_ = 0;
-  bool labelLeft_ = false;
-};
-
-/// A module (box), filter (rhombus) or composite instance (dashed box).
-class NodeItem : public QGraphicsItem {
- public:
-  NodeItem(std::string id, NodeKind kind, QString title, QString subtitle, QColor hostColor,
-           QString hostName, const std::vector<app::PortSpec>& ports);
-  QRectF boundingRect() const override;
-  QPainterPath shape() const override;
-  void paint(QPainter* painter, const QStyleOptionGraphicsItem* option, QWidget* widget) override;
-
-  const std::string& id() const { return id_; }
-  NodeKind kind() const { return kind_; }
-  QSizeF size() const { return size_; }
-  std::vector<PortItem*> ports() const { return ports_; }
-  /// Problems on this node: 0 none, 1 warning, 2 error; the tooltip lists them.
-  void setProblems(int level, const QString& text);
-  /// Text under the node (run statistics) and whether the run failed here.
-  void setRunInfo(const QString& text, bool failed);
-  /// Text on the node's badge ("x5 on a, b" for instances), empty for none.
-  void setBadge(const QString& text) { badge_ = text; }
-  int problemLevel() const { return problemLevel_; }
-
- private:
-  std::string id_;
-  NodeKind kind_;
-  QString title_;
-  QString subtitle_;
-  QColor hostColor_;
-  QString hostName_;
-  QSizeF size_;
-  std::vector<PortItem*> ports_;
-  int problemLevel_ = 0;
-  QString runInfo_;
-  QString badge_;
-  bool failed_ = false;
-};
-
-/// A connection: a cubic curve from an output port to an input port.
-class ConnectionItem : public QGraphicsItem {
- public:
-  ConnectionItem(std::size_t index, QPointF from, QPointF to, QColor color, bool stampsOnly);
-  QRectF boundingRect() const override;
-  QPainterPath shape() const override;
-  void paint(QPainter* painter, const QStyleOptionGraphicsItem* option, QWidget* widget) override;
-
-  std::size_t index() const { return index_; }
-  QColor color() const { return color_; }
-  /// 0 fine, 1 warning, 2 error, 3 part of a deadlock cycle.
-  void setProblem(int level) {
-    problem_ = level;
-    update();
-  }
-  int problem() const { return problem_; }
-  void setLabel(const QString& text) { label_ = text; }
-  const QString& label() const { return label_; }
-  QPointF midPoint() const { return mid_; }
-
- private:
-  std::size_t index_;
-  QPainterPath path_;
-  QColor color_;
-  bool stampsOnly_;
-  int problem_ = 0;
-  QString label_;
-  QPointF mid_;
 };
 
 }  // namespace vrflow::editor::gui

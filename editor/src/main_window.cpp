@@ -13,12 +13,14 @@
 #include <QMenu>
 #include <QMenuBar>
 #include <QPlainTextEdit>
+#include <QRegularExpression>
 #include <QSaveFile>
 #include <QStatusBar>
 #include <QToolBar>
 #include <QUndoCommand>
 #include <QUndoStack>
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <set>
 
@@ -28,6 +30,7 @@
 #include "vrflow/app/writer.hpp"
 #include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/daemon/plugin.hpp"
+#include "vrflow/editor/structure_edit.hpp"
 #include "vrflow/run/prepare.hpp"
 #include "vrflow/run/runner.hpp"
 
@@ -53,6 +56,14 @@ class EditCommand : public QUndoCommand {
   MainWindow* window_;
   Edit edit_;
 };
+
+// Where pasted nodes land: at the cursor when it is over the canvas, else (nullopt) beside the
+// copied nodes.
+std::optional<std::pair<double, double>> pasteCorner(const Canvas& canvas) {
+  const auto at = canvas.cursorScenePos();
+  if (!at) return std::nullopt;
+  return std::make_pair(std::round(at->x() / 10) * 10, std::round(at->y() / 10) * 10);
+}
 
 }  // namespace
 
@@ -121,6 +132,9 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   connect(canvas_, &Canvas::nodesMoved, this, [this](const Positions& positions) {
     if (!apply(moveNodes(app_, positions))) refresh();
   });
+  // Notes and frames edited on the canvas go through the undo stack like every edit.
+  connect(canvas_, qOverload<const Edit&>(&Canvas::editRequested), this,
+          [this](const Edit& edit) { apply(edit); });
   connect(canvas_, &Canvas::addRequested, this,
           [this](const QString& spec, QPointF at) { addNode(spec, at); });
   connect(canvas_, &Canvas::hostDropped, this,
@@ -128,6 +142,12 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
             apply(assignHost(app_, {node}, stdText(host)));
           });
   connect(canvas_, &Canvas::deleteRequested, this, &MainWindow::deleteSelection);
+  connect(canvas_, qOverload<const Edit&, const std::vector<std::string>&>(&Canvas::editRequested),
+          this, [this](const Edit& edit, const std::vector<std::string>& select) {
+            if (apply(edit, false)) canvas_->selectOnly(select);
+          });
+  connect(canvas_, &Canvas::messageRequested, this,
+          [this](const QString& text) { statusBar()->showMessage(text, 8000); });
   connect(canvas_, &Canvas::selectionChangedIds, this, &MainWindow::showSelection);
   connect(canvas_, &Canvas::contextMenuForNodes, this,
           [this](const std::vector<std::string>& ids, QPoint at) {
@@ -144,6 +164,11 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
                   ->setEnabled(!runs_->runId().isEmpty());
             }
             menu.addAction("Duplicate", this, &MainWindow::duplicateSelection);
+            if (ids.size() == 1 && nodeKind(app_, ids.front()) == NodeKind::Instance) {
+              menu.addAction("Open composite", this,
+                             [this, id = ids.front()] { canvas_->openComposite(id); });
+            }
+            menu.addAction("Collapse into composite", canvas_, &Canvas::collapseSelection);
             menu.addAction("Copy", this, &MainWindow::copySelection);
             menu.addAction("Delete", this, &MainWindow::deleteSelection);
             menu.exec(at);
@@ -183,7 +208,7 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
             if (!apply(setHostAddress(app_, host, address), false)) hosts_->show(app_);
           });
   connect(hosts_, &HostsPanel::importRequested, this, [this] {
-    const QString file = reporter().fileName(this, false, QDir::homePath());
+    const QString file = reporter().hostfileName(this, QDir::homePath());
     if (file.isEmpty()) return;
     QFile in(file);
     if (!in.open(QIODevice::ReadOnly)) {
@@ -336,7 +361,7 @@ void MainWindow::refresh() {
   state.catalog = catalog_.get();
   state.problems = problems_;
   state.run = lastRun_;
-  canvas_->rebuild();
+  canvas_->sync();  // only what changed since the scene last showed the application
   hosts_->show(app_);
 
   problemList_->clear();
@@ -354,6 +379,10 @@ void MainWindow::refresh() {
         style()->standardIcon(error ? QStyle::SP_MessageBoxCritical : QStyle::SP_MessageBoxWarning),
         (where.isEmpty() ? QString() : where + ": ") + qtText(p.message));
     item->setToolTip(qtText(p.text));
+    if (const auto fix = parameterSuggestion(p)) {
+      item->setText(item->text() + "  \u2014 double-click to rename it to '" + qtText(fix->second) +
+                    "'");
+    }
     problemList_->addItem(item);
   }
   statusBar()->showMessage(errors + warnings == 0
@@ -371,6 +400,18 @@ void MainWindow::showSelection() {
   properties_->show(app_, *catalog_, selected.size() == 1 ? selected.front() : std::string());
 }
 
+// A parameter the node's type does not declare, and the declared name validation suggests:
+// "... has no parameter 'stifness' (parameters: ...); did you mean 'stiffness'?".
+std::optional<std::pair<std::string, std::string>> MainWindow::parameterSuggestion(
+    const Problem& problem) {
+  static const QRegularExpression pattern(
+      "has no parameter '([^']+)' .*did you mean '([^']+)'\\?$");
+  if (problem.node.empty()) return std::nullopt;
+  const QRegularExpressionMatch match = pattern.match(qtText(problem.message));
+  if (!match.hasMatch()) return std::nullopt;
+  return std::make_pair(stdText(match.captured(1)), stdText(match.captured(2)));
+}
+
 void MainWindow::problemActivated(int row) {
   if (row < 0 || static_cast<std::size_t>(row) >= problems_.size()) return;
   const Problem& p = problems_[static_cast<std::size_t>(row)];
@@ -382,6 +423,16 @@ void MainWindow::problemActivated(int row) {
   std::optional<std::size_t> connection = p.connection;
   if (!p.cycle.empty()) connection = p.cycle.front();
   canvas_->selectOnly(nodes, connection);
+  // A misspelt parameter with a suggestion: the double-click renames it (one undoable edit).
+  // Queued: the edit refills the list, which must not happen inside its own signal.
+  if (const auto fix = parameterSuggestion(p)) {
+    QMetaObject::invokeMethod(
+        this,
+        [this, node = p.node, from = fix->first, to = fix->second] {
+          apply(renameParameter(app_, node, from, to), false);
+        },
+        Qt::QueuedConnection);
+  }
 }
 
 // ---- Edits -------------------------------------------------------------------------------
@@ -446,16 +497,18 @@ void MainWindow::copySelection() {
 }
 
 void MainWindow::paste() {
+  const auto corner = pasteCorner(*canvas_);
   std::vector<std::string> ids;
-  if (apply(pasteXml(app_, stdText(QApplication::clipboard()->text()), 40, 40, &ids), false))
+  if (apply(pasteXmlAt(app_, stdText(QApplication::clipboard()->text()), corner, &ids), false))
     canvas_->selectOnly(ids);
 }
 
 void MainWindow::duplicateSelection() {
   const auto nodes = canvas_->selectedNodes();
   if (nodes.empty()) return;
+  const auto corner = pasteCorner(*canvas_);
   std::vector<std::string> ids;
-  auto edit = pasteXml(app_, copyAsXml(app_, nodes), 40, 40, &ids);
+  auto edit = pasteXmlAt(app_, copyAsXml(app_, nodes), corner, &ids);
   if (edit) edit->label = "Duplicate";
   if (apply(std::move(edit), false)) canvas_->selectOnly(ids);
 }

@@ -18,6 +18,7 @@
 #include "vrflow/editor/edit.hpp"
 
 class QUndoStack;
+class QFileDialog;
 class QListWidget;
 class QPlainTextEdit;
 class QMenu;
@@ -42,7 +43,13 @@ class Reporter {
   virtual QString fileName(QWidget* parent, bool forSaving, const QString& suggestion);
   /// A host id and address for a new host; false to cancel.
   virtual bool newHost(QWidget* parent, QString& id, QString& address);
+  /// A hostfile to import (makeHostfileDialog()), starting in `folder`; empty to cancel.
+  virtual QString hostfileName(QWidget* parent, const QString& folder);
 };
+
+/// The dialog that picks a hostfile to import: every file shown by default (hostfiles are
+/// often named `hosts`, `hostfile` or `nodes`, without a suffix), and a "Hostfiles" filter.
+std::unique_ptr<QFileDialog> makeHostfileDialog(QWidget* parent, const QString& folder);
 
 struct EditorOptions {
   std::vector<std::string> packageDirs;  ///< extra package folders, before the search path
@@ -149,6 +156,9 @@ class MainWindow : public QMainWindow {
   /// The Run menu and the run controller's signals (main_window_run.cpp).
   void setUpRuns();
   void setRunActions(bool runGoesOn);
+  /// The (misspelt, suggested) parameter names of a "did you mean" problem, or nullopt.
+  static std::optional<std::pair<std::string, std::string>> parameterSuggestion(
+      const Problem& problem);
   void finishRun(int exitCode);
   void showLiveRates();
   void setDocument(app::Application app, OpenedText opened, const QString& path);

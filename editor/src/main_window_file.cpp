@@ -35,10 +35,9 @@ void MainWindow::setDocument(app::Application app, OpenedText opened, const QStr
   opened_ = std::move(opened);
   path_ = path;
   lastRun_.reset();
-  {
-    const QSignalBlocker block(undo_);
-    undo_->clear();
-  }
+  // Not blocked: the Undo and Redo actions follow the stack's signals, and must forget the
+  // previous document's edits.
+  undo_->clear();
   undo_->setClean();
   computeFallbackLayout();
   refresh();

@@ -47,6 +47,8 @@ QString kindGroup(app::ModuleKind kind) {
 }
 
 constexpr int kSpecRole = Qt::UserRole + 1;
+// A group's name without its count.
+constexpr int kGroupRole = Qt::UserRole + 2;
 
 }  // namespace
 
@@ -82,6 +84,7 @@ void Palette::setCatalog(const app::Catalog& catalog) {
     QFont font = group->font(0);
     font.setBold(true);
     group->setFont(0, font);
+    group->setData(0, kGroupRole, name);
     groups[name] = group;
   }
   for (const app::ModuleType* type : catalog.moduleTypes()) {
@@ -100,11 +103,7 @@ void Palette::setCatalog(const app::Catalog& catalog) {
     item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsDragEnabled);
   }
   for (auto& [name, group] : groups) {
-    if (group->childCount() == 0) {
-      delete group;
-    } else {
-      group->setText(0, name + QString(" (%1)").arg(group->childCount()));
-    }
+    if (group->childCount() == 0) delete group;
   }
   tree_->expandAll();
   setFilterText(search_->text());
@@ -122,6 +121,11 @@ void Palette::setFilterText(const QString& text) {
       shown += match ? 1 : 0;
     }
     group->setHidden(shown == 0);
+    // The count is of the entries shown: "(3)", or "(1 of 3)" while a search hides some.
+    const int total = group->childCount();
+    const QString name = group->data(0, kGroupRole).toString();
+    group->setText(0, shown == total ? QString("%1 (%2)").arg(name).arg(total)
+                                     : QString("%1 (%2 of %3)").arg(name).arg(shown).arg(total));
   }
 }
 

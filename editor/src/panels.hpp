@@ -5,6 +5,8 @@
 
 #include <QTreeWidget>
 #include <QWidget>
+#include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@ class QTableWidget;
 class QFormLayout;
 class QLabel;
 class QVBoxLayout;
+class QToolButton;
 
 namespace vrflow::editor::gui {
 
@@ -77,15 +80,29 @@ class PropertiesPanel : public QWidget {
   void initialMessagesEdited(const std::string& node, const std::string& port, int count);
   void hostChosen(const std::string& node, const std::string& host);
   void renameRequested(const std::string& node, const std::string& newId);
-  /// "Override for this run": the next run sets `node.name=value` (`--set`), the file unchanged.
+  /// "Override for this run" on a parameter: pass `node.name=value` to the next run only.
   void overrideForRunRequested(const std::string& node, const std::string& name,
                                const std::string& value);
 
  private:
-  QWidget* editorFor(const app::ParamSpec& spec, const std::string& value, bool set);
+  /// The widgets of one parameter and the value they show.
+  struct ParamRow {
+    std::string shown;  ///< the value set in the file, or the default
+    bool set = false;
+    std::function<void(const std::string&)> display;  ///< shows a value without emitting
+    QLabel* label = nullptr;
+    QToolButton* reset = nullptr;
+  };
+
+  QWidget* editorFor(const app::ParamSpec& spec, ParamRow& row);
+  void addParameterRow(QFormLayout* form, const app::ParamSpec& spec, ParamRow& row, bool declared);
+  void build(const app::Application& app, const app::Catalog& catalog);
+  void updateInPlace(const app::Application& app, const app::Catalog& catalog);
   void clear();
 
   std::string node_;
+  std::string structure_;  ///< what the widgets were built for; see structureOf()
+  std::map<std::string, ParamRow> rows_;
   QVBoxLayout* layout_;
   QWidget* body_ = nullptr;
 };

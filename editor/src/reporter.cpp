@@ -56,4 +56,21 @@ bool Reporter::newHost(QWidget* parent, QString& id, QString& address) {
   return true;
 }
 
+std::unique_ptr<QFileDialog> makeHostfileDialog(QWidget* parent, const QString& folder) {
+  auto dialog = std::make_unique<QFileDialog>(parent, "Import hostfile", folder);
+  dialog->setFileMode(QFileDialog::ExistingFile);
+  dialog->setAcceptMode(QFileDialog::AcceptOpen);
+  dialog->setNameFilters({"All files (*)",
+                          "Hostfiles (hosts hostfile* *.hostfile *.hosts nodes* "
+                          "machinefile* *.txt)"});
+  dialog->selectNameFilter("All files (*)");
+  return dialog;
+}
+
+QString Reporter::hostfileName(QWidget* parent, const QString& folder) {
+  const std::unique_ptr<QFileDialog> dialog = makeHostfileDialog(parent, folder);
+  if (dialog->exec() != QDialog::Accepted || dialog->selectedFiles().isEmpty()) return {};
+  return dialog->selectedFiles().front();
+}
+
 }  // namespace vrflow::editor::gui

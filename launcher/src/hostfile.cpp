@@ -33,6 +33,45 @@ int slotCount(const std::string& value) {
   return n >= 1 && n <= 1'000'000 ? n : -1;
 }
 
+// A key of vrflow's format: its name and what it sets (the error text, empty when the value is
+// good). The table is the one list of keys: the parser and the "allowed:" message read it.
+struct HostKey {
+  const char* name;
+  std::string (*set)(HostEntry& entry, const std::string& value);
+};
+
+std::string needsAssignment(const char* key, const char* what, const std::string& value) {
+  return value.find('=') == std::string::npos
+             ? std::string(key) + " needs " + what + ", got '" + value + "'"
+             : std::string();
+}
+
+constexpr HostKey kHostKeys[] = {
+    {"address", [](HostEntry& e, const std::string& v) { return e.address = v, std::string(); }},
+    {"node", [](HostEntry& e, const std::string& v) { return e.node = v, std::string(); }},
+    {"user", [](HostEntry& e, const std::string& v) { return e.user = v, std::string(); }},
+    {"ssh-port",
+     [](HostEntry& e, const std::string& v) {
+       const bool digits =
+           !v.empty() && v.size() <= 5 && v.find_first_not_of("0123456789") == v.npos;
+       e.sshPort = digits ? std::stoi(v) : -1;
+       return e.sshPort <= 0 || e.sshPort > 65535 ? "bad ssh-port '" + v + "'" : std::string();
+     }},
+    {"identity", [](HostEntry& e, const std::string& v) { return e.identity = v, std::string(); }},
+    {"ssh-option",
+     [](HostEntry& e, const std::string& v) {
+       e.sshOptions.push_back(v);
+       return needsAssignment("ssh-option", "KEY=VALUE", v);
+     }},
+    {"dir", [](HostEntry& e, const std::string& v) { return e.directory = v, std::string(); }},
+    {"daemon", [](HostEntry& e, const std::string& v) { return e.daemon = v, std::string(); }},
+    {"env",
+     [](HostEntry& e, const std::string& v) {
+       e.environment.push_back(v);
+       return needsAssignment("env", "NAME=VALUE", v);
+     }},
+};
+
 Result<HostEntry> vrflowLine(const Line& line, const std::string& path) {
   auto fail = [&](const std::string& why) {
     return makeError(path + ":" + std::to_string(line.number) + ": error: " + why);
@@ -45,38 +84,14 @@ Result<HostEntry> vrflowLine(const Line& line, const std::string& path) {
     const auto eq = word.find('=');
     if (eq == std::string::npos) return fail("expected KEY=VALUE, got '" + word + "'");
     const std::string key = word.substr(0, eq), value = word.substr(eq + 1);
-    if (key == "address") {
-      entry.address = value;
-    } else if (key == "node") {
-      entry.node = value;
-    } else if (key == "user") {
-      entry.user = value;
-    } else if (key == "ssh-port") {
-      try {
-        entry.sshPort = std::stoi(value);
-      } catch (...) {
-        entry.sshPort = -1;
-      }
-      if (entry.sshPort <= 0 || entry.sshPort > 65535) return fail("bad ssh-port '" + value + "'");
-    } else if (key == "identity") {
-      entry.identity = value;
-    } else if (key == "ssh-option") {
-      if (value.find('=') == std::string::npos)
-        return fail("ssh-option needs KEY=VALUE, got '" + value + "'");
-      entry.sshOptions.push_back(value);
-    } else if (key == "dir") {
-      entry.directory = value;
-    } else if (key == "daemon") {
-      entry.daemon = value;
-    } else if (key == "env") {
-      if (value.find('=') == std::string::npos)
-        return fail("env needs NAME=VALUE, got '" + value + "'");
-      entry.environment.push_back(value);
-    } else {
-      return fail("unknown key '" + key +
-                  "' (allowed: address, node, user, ssh-port, identity, ssh-option, dir, daemon, "
-                  "env)");
+    const HostKey* found = nullptr;
+    std::string allowed;
+    for (const HostKey& k : kHostKeys) {
+      if (key == k.name) found = &k;
+      allowed += (allowed.empty() ? "" : ", ") + std::string(k.name);
     }
+    if (found == nullptr) return fail("unknown key '" + key + "' (allowed: " + allowed + ")");
+    if (const std::string error = found->set(entry, value); !error.empty()) return fail(error);
   }
   return entry;
 }

@@ -215,6 +215,7 @@ run::RunOutcome Launcher::run() {
   }
   sigprocmask(SIG_SETMASK, &previous, nullptr);
   if (events_ != nullptr) events_->end(outcome);
+  events_ = nullptr;  // the registry's stream ends with `registered`, here
   return outcome;
 }
 

@@ -5,6 +5,7 @@ vrflow_add_library(app SHARED
   PRIVATE_INCLUDE ${CMAKE_CURRENT_SOURCE_DIR}/src/app
   SOURCES
     src/app/application_reader.cpp
+    src/app/editor_reader.cpp
     src/app/application_writer.cpp
     src/app/catalog.cpp
     src/app/composite.cpp

@@ -1,11 +1,8 @@
 // vrflow-daemon under `--control`, stopped before the launcher's "go": by the end of its control
 // input, by "stop", and by a link that fails while the hosts connect. Each must end with a
 // clean exit status, one line saying why, its report to the launcher, and nothing left behind.
-#include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -113,15 +110,8 @@ TEST(DaemonStopBeforeGo, StopEndsItCleanly) {
 TEST(DaemonStopBeforeGo, ALinkThatFailsWhileHostsConnectEndsItCleanly) {
   const auto shm = vrflowShmEntries();
   // A port of 127.0.0.2 where nobody listens (bound, then closed): host b refuses the link.
-  const int probe = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  inet_pton(AF_INET, "127.0.0.2", &addr.sin_addr);
-  ASSERT_EQ(bind(probe, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
-  socklen_t len = sizeof addr;
-  getsockname(probe, reinterpret_cast<sockaddr*>(&addr), &len);
-  const std::string port = std::to_string(ntohs(addr.sin_port));
-  close(probe);
+  const std::string port = std::to_string(unusedPort("127.0.0.2"));
+  ASSERT_NE(port, "0");
   const auto run =
       runDaemon("peer 1 127.0.0.2 " + port + "\npeer 2 127.0.0.3 " + port + "\nconnect\n");
   expectCleanStop(run, "cannot link to the other hosts: cannot reach host 'b'", shm);

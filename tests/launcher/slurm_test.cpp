@@ -1,13 +1,10 @@
 // The slurm backend against a real Slurm that this test starts: munged with its own key and
 // socket, slurmctld and three slurmd (nodes n1-n3, each on its own port and its own loopback
 // address 127.0.0.1-3), all in a temporary folder with their own state, spool and pid files.
-#include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
 #include <signal.h>
 #include <sys/prctl.h>
-#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -26,18 +23,6 @@ namespace vrflow::testing {
 namespace {
 
 // A TCP port of 127.0.0.1 free now.
-int freePort() {
-  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
-
 const char* const kPrograms[] = {"/usr/sbin/munged",  "/usr/sbin/slurmctld", "/usr/sbin/slurmd",
                                  "/usr/bin/salloc",   "/usr/bin/sbatch",     "/usr/bin/srun",
                                  "/usr/bin/scontrol", "/usr/bin/squeue",     "/usr/bin/scancel",
@@ -81,7 +66,7 @@ class LocalSlurm {
       const std::string id = std::to_string(n);
       mkdir((d + "/spool-n" + id).c_str(), 0755);
       nodes += "NodeName=n" + id + " NodeHostname=" + host + " NodeAddr=127.0.0." + id +
-               " Port=" + std::to_string(freePort()) + " CPUs=1\n";
+               " Port=" + std::to_string(unusedPort()) + " CPUs=1\n";
     }
     conf_ = dir_.write("slurm.conf",
                        "ClusterName=vrflowtest\n"
@@ -89,7 +74,7 @@ class LocalSlurm {
                            host +
                            "(127.0.0.1)\n"
                            "SlurmctldPort=" +
-                           std::to_string(freePort()) +
+                           std::to_string(unusedPort()) +
                            "\n"
                            "SlurmUser=root\nSlurmdUser=root\n"
                            "AuthType=auth/munge\nCredType=cred/munge\n"

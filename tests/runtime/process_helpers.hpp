@@ -26,6 +26,9 @@ CommandResult runVrflow(std::vector<std::string> args, double timeoutSeconds = 6
 /// child subreaper), killed and reaped; their command lines are returned.
 std::vector<std::string> leftoverProcesses();
 
+/// A TCP port of `address` (IPv4) where nobody listens now: bound to port 0, read, closed.
+int unusedPort(const std::string& address = "127.0.0.1");
+
 /// One process as /proc/PID/stat shows it.
 struct ProcessInfo {
   pid_t pid = 0;

@@ -302,6 +302,24 @@ Result<Edit> setParameter(const app::Application& app, std::string_view node, st
   return makeEdit("Set " + std::string(node) + "." + std::string(name), app, std::move(after));
 }
 
+Result<Edit> renameParameter(const app::Application& app, std::string_view node,
+                             std::string_view name, std::string_view newName) {
+  app::Application after = app;
+  auto* params = paramsOf(after, node);
+  if (params == nullptr) return makeError("no node '" + std::string(node) + "'");
+  if (app::findParam(*params, newName) != nullptr) {
+    return makeError("parameter '" + std::string(newName) + "' is already set on " +
+                     std::string(node));
+  }
+  const auto it = std::find_if(params->begin(), params->end(),
+                               [&](const app::Param& p) { return p.name == name; });
+  if (it == params->end()) return makeError("parameter '" + std::string(name) + "' is not set");
+  it->name = newName;
+  return makeEdit(
+      "Rename " + std::string(node) + "." + std::string(name) + " to " + std::string(newName), app,
+      std::move(after));
+}
+
 Result<Edit> setInitialMessages(const app::Application& app, std::string_view module,
                                 std::string_view port, int count) {
   if (count < 0) return makeError("initial messages must not be negative");

@@ -36,6 +36,7 @@ Param detail::readParam(const ReadContext& context, const pugi::xml_node& node) 
   }
   param.value = reader.text("value");
   param.loc = reader.loc();
+  param.comments = detail::commentsBefore(node);
   expectEmpty(context, node);
   return param;
 }
@@ -48,6 +49,7 @@ Host readHost(const ReadContext& context, const pugi::xml_node& node) {
   host.id = reader.required("id");
   host.address = reader.text("address", kDefaultHostAddress);
   host.loc = reader.loc();
+  host.comments = detail::commentsBefore(node);
   expectEmpty(context, node);
   return host;
 }
@@ -59,6 +61,7 @@ InputConfig readInput(const ReadContext& context, const pugi::xml_node& node) {
   input.initialMessages = reader.integer("initial-messages", 0);
   input.mode = reader.keyword("mode", InputMode::Fifo, parseInputMode, "fifo, latest");
   input.loc = reader.loc();
+  input.comments = detail::commentsBefore(node);
   expectEmpty(context, node);
   return input;
 }
@@ -73,6 +76,8 @@ Module readModule(const ReadContext& context, const pugi::xml_node& node) {
   module.endIt = reader.keyword("endit", EndItTiming::AfterIteration, parseEndItTiming,
                                 "after-iteration, after-wait");
   module.loc = reader.loc();
+  module.comments = detail::commentsBefore(node);
+  module.endComments = detail::trailingComments(node);
   detail::forEachChild(context, node, {"param", "input"}, [&](const pugi::xml_node& child) {
     if (std::string_view(child.name()) == "param") {
       module.params.push_back(readParam(context, child));
@@ -91,6 +96,8 @@ Filter readFilter(const ReadContext& context, const pugi::xml_node& node) {
   filter.host = reader.text("host");
   filter.plugin = reader.text("plugin");
   filter.loc = reader.loc();
+  filter.comments = detail::commentsBefore(node);
+  filter.endComments = detail::trailingComments(node);
   detail::forEachChild(context, node, {"param"}, [&](const pugi::xml_node& child) {
     filter.params.push_back(readParam(context, child));
   });
@@ -116,19 +123,9 @@ Connection readConnection(const ReadContext& context, const pugi::xml_node& node
   connection.policy = reader.keyword("policy", QueuePolicy::Block, parseQueuePolicy,
                                      "block, drop-oldest, drop-newest");
   connection.loc = reader.loc();
+  connection.comments = detail::commentsBefore(node);
   expectEmpty(context, node);
   return connection;
-}
-
-EditorNode readEditorNode(const ReadContext& context, const pugi::xml_node& node) {
-  const ElementReader reader(context, node, {"ref", "x", "y"});
-  EditorNode editorNode;
-  editorNode.ref = reader.required("ref");
-  editorNode.x = reader.number("x", 0);
-  editorNode.y = reader.number("y", 0);
-  editorNode.loc = reader.loc();
-  expectEmpty(context, node);
-  return editorNode;
 }
 
 PackageFolder readPackageFolder(const ReadContext& context, const pugi::xml_node& node) {
@@ -136,6 +133,7 @@ PackageFolder readPackageFolder(const ReadContext& context, const pugi::xml_node
   PackageFolder folder;
   folder.path = reader.required("path");
   folder.loc = reader.loc();
+  folder.comments = detail::commentsBefore(node);
   expectEmpty(context, node);
   return folder;
 }
@@ -147,6 +145,11 @@ void readSection(const ReadContext& context, const pugi::xml_node& section, Appl
     return;
   }
   const ElementReader reader(context, section, {});
+  SectionComments comments{std::string(name), detail::commentsBefore(section),
+                           detail::trailingComments(section)};
+  if (!comments.before.empty() || !comments.end.empty()) {
+    app.sectionComments.push_back(std::move(comments));
+  }
   if (name == "hosts") {
     detail::forEachChild(context, section, {"host"}, [&](const pugi::xml_node& child) {
       app.hosts.push_back(readHost(context, child));
@@ -168,15 +171,16 @@ void readSection(const ReadContext& context, const pugi::xml_node& section, Appl
       app.connections.push_back(readConnection(context, child));
     });
   } else {
-    detail::forEachChild(context, section, {"node"}, [&](const pugi::xml_node& child) {
-      app.editor.push_back(readEditorNode(context, child));
-    });
+    detail::readEditorSection(context, section, app);
   }
 }
 
 void readRoot(const ReadContext& context, const pugi::xml_node& root, Application& app) {
   const ElementReader reader(context, root, {"name", "version"});
   app.name = reader.text("name");
+  app.comments = detail::commentsBefore(root);
+  app.endComments = detail::trailingComments(root);
+  app.afterComments = detail::commentsAfter(root);
   if (reader.has("version") && reader.text("version") != "1") {
     reader.errorAt("version", "unsupported format version '" + reader.text("version") +
                                   "' (this vrflow reads version 1)");

@@ -19,4 +19,8 @@ std::optional<Application> readApplication(std::string_view xml, const std::stri
 /// Reads a <param name="..." value="..."/> element.
 Param readParam(const ReadContext& context, const pugi::xml_node& node);
 
+/// Reads the <editor> section: node positions, notes and frames (ids of notes and frames must
+/// be distinct; sizes above 0; colours #rrggbb).
+void readEditorSection(const ReadContext& context, const pugi::xml_node& section, Application& app);
+
 }  // namespace vrflow::app::detail

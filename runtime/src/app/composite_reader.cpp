@@ -261,6 +261,7 @@ Instance readInstance(const ReadContext& context, const pugi::xml_node& node) {
   instance.composite = reader.required("composite");
   instance.host = reader.text("host");
   instance.loc = reader.loc();
+  instance.comments = commentsBefore(node);
   forEachChild(context, node, {"param"}, [&](const pugi::xml_node& child) {
     instance.params.push_back(readParam(context, child));
   });

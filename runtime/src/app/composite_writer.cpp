@@ -79,16 +79,17 @@ void writeComposite(std::string& out, int depth, const Composite& composite, boo
 
 void writeComposites(std::string& out, const Application& app) {
   if (app.composites.empty()) return;
-  Tag(out, 1, "composites").open();
+  openSection(out, app, "composites");
   for (const Composite& composite : app.composites) writeComposite(out, 2, composite, false);
-  closeTag(out, 1, "composites");
+  closeSection(out, app, "composites");
 }
 
 void writeInstances(std::string& out, const Application& app) {
   if (app.instances.empty()) return;
   const std::string firstHost = app.hosts.empty() ? std::string() : app.hosts.front().id;
-  Tag(out, 1, "instances").open();
+  openSection(out, app, "instances");
   for (const Instance& instance : app.instances) {
+    writeComments(out, 2, instance.comments);
     Tag tag(out, 2, "instance");
     tag.attribute("id", instance.id).attribute("composite", instance.composite);
     if (!instance.host.empty()) tag.attributeUnless("host", instance.host, firstHost);
@@ -97,12 +98,10 @@ void writeInstances(std::string& out, const Application& app) {
       continue;
     }
     tag.open();
-    for (const Param& param : instance.params) {
-      Tag(out, 3, "param").attribute("name", param.name).attribute("value", param.value).close();
-    }
+    writeParams(out, 3, instance.params);
     closeTag(out, 2, "instance");
   }
-  closeTag(out, 1, "instances");
+  closeSection(out, app, "instances");
 }
 
 }  // namespace detail

@@ -167,6 +167,32 @@ void forEachChild(const ReadContext& context, const pugi::xml_node& parent,
   }
 }
 
+std::vector<std::string> commentsBefore(const pugi::xml_node& node) {
+  std::vector<std::string> comments;
+  for (pugi::xml_node at = node.previous_sibling(); at.type() == pugi::node_comment;
+       at = at.previous_sibling()) {
+    comments.insert(comments.begin(), at.value());
+  }
+  return comments;
+}
+
+std::vector<std::string> trailingComments(const pugi::xml_node& parent) {
+  const pugi::xml_node last = parent.last_child();
+  if (last.type() != pugi::node_comment) return {};
+  std::vector<std::string> comments = commentsBefore(last);
+  comments.push_back(last.value());
+  return comments;
+}
+
+std::vector<std::string> commentsAfter(const pugi::xml_node& node) {
+  std::vector<std::string> comments;
+  for (pugi::xml_node at = node.next_sibling(); at.type() == pugi::node_comment;
+       at = at.next_sibling()) {
+    comments.push_back(at.value());
+  }
+  return comments;
+}
+
 std::string readTextElement(const ReadContext& context, const pugi::xml_node& node) {
   std::string text;
   for (const pugi::xml_node& child : node.children()) {
@@ -196,8 +222,8 @@ bool readDocument(const SourceText& source, std::string_view rootName,
   }
   const std::string_view xml = source.text();
   pugi::xml_document document;
-  const pugi::xml_parse_result parsed =
-      document.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+  const pugi::xml_parse_result parsed = document.load_buffer(
+      xml.data(), xml.size(), pugi::parse_default | pugi::parse_comments, pugi::encoding_utf8);
   if (!parsed) {
     problems.push_back(parseFailure(source, parsed));
     return false;

@@ -85,6 +85,13 @@ void forEachChild(const ReadContext& context, const pugi::xml_node& parent,
                   const std::vector<std::string_view>& allowed,
                   const std::function<void(const pugi::xml_node&)>& read);
 
+/// The comments written just before `node`, after the element or text before it, in order.
+std::vector<std::string> commentsBefore(const pugi::xml_node& node);
+/// The comments written after the last element or text inside `parent`, in order.
+std::vector<std::string> trailingComments(const pugi::xml_node& parent);
+/// The comments written after `node`, up to the next element or text, in order.
+std::vector<std::string> commentsAfter(const pugi::xml_node& node);
+
 /// The text content of an element that holds only text (e.g. <doc>); reports child elements.
 std::string readTextElement(const ReadContext& context, const pugi::xml_node& node);
 

@@ -49,6 +49,13 @@ const EditorNode* findEditorNode(const Application& app, std::string_view ref) {
   return it == app.editor.end() ? nullptr : &*it;
 }
 
+const SectionComments* findSectionComments(const Application& app, std::string_view section) {
+  const auto it =
+      std::find_if(app.sectionComments.begin(), app.sectionComments.end(),
+                   [&](const SectionComments& comments) { return comments.section == section; });
+  return it == app.sectionComments.end() ? nullptr : &*it;
+}
+
 const InputConfig* findInputConfig(const Module& module, std::string_view port) {
   const auto it = std::find_if(module.inputs.begin(), module.inputs.end(),
                                [&](const InputConfig& input) { return input.port == port; });

@@ -2,6 +2,9 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include "vrflow/app/model.hpp"
 
 namespace vrflow::app::detail {
 
@@ -19,6 +22,8 @@ class Tag {
     return *this;
   }
   void close() { out_ += "/>\n"; }
+  /// Ends the start tag and appends `content` as escaped character data (no end tag).
+  void text(std::string_view content);
   void open() { out_ += ">\n"; }
 
  private:
@@ -27,5 +32,16 @@ class Tag {
 
 /// Appends `</name>` at `depth` (2 spaces per level) and a newline.
 void closeTag(std::string& out, int depth, std::string_view name);
+
+/// Appends each comment as `<!--text-->` on its own line at `depth`.
+void writeComments(std::string& out, int depth, const std::vector<std::string>& comments);
+
+/// Appends one `<param>` line per parameter at `depth`, each after its comments.
+void writeParams(std::string& out, int depth, const std::vector<Param>& params);
+
+/// Appends the comments before section `name` of `app` and its start tag, at depth 1.
+void openSection(std::string& out, const Application& app, std::string_view name);
+/// Appends the comments at the end of section `name` of `app` and its end tag, at depth 1.
+void closeSection(std::string& out, const Application& app, std::string_view name);
 
 }  // namespace vrflow::app::detail

@@ -11,11 +11,16 @@
 
 namespace vrflow::app {
 
+/// The XML comments written just before an element (or at the end of a section), each the text
+/// between `<!--` and `-->` as written; the canonical writer puts them back in the same place.
+using Comments = std::vector<std::string>;
+
 /// A `name = value` setting of a module or filter; the value is parsed by its declared type.
 struct Param {
   std::string name;
   std::string value;
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
 };
 
 /// A machine that runs modules and filters.
@@ -23,6 +28,7 @@ struct Host {
   std::string id;
   std::string address = "127.0.0.1";
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
 };
 
 /// What a connection does when its bounded queue is full.
@@ -38,6 +44,7 @@ struct InputConfig {
   int initialMessages = 0;
   InputMode mode = InputMode::Fifo;
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
 };
 
 /// When a module sends its `endIt` signal: as it calls wait() again, at the end of the
@@ -56,6 +63,8 @@ struct Module {
   std::vector<Param> params;
   std::vector<InputConfig> inputs;
   SourceLocation loc;
+  Comments comments = {};     ///< written just before the element
+  Comments endComments = {};  ///< written after its last child, before its end tag
 };
 
 /// A filter instance, run by the daemon of `host`.
@@ -67,6 +76,8 @@ struct Filter {
   std::string plugin;
   std::vector<Param> params;
   SourceLocation loc;
+  Comments comments = {};     ///< written just before the element
+  Comments endComments = {};  ///< written after its last child, before its end tag
 };
 
 /// One end of a connection: a port of a module or filter, written "node.port" in XML.
@@ -82,6 +93,7 @@ struct Connection {
   int capacity = 0;  ///< messages; 0 = the runtime's default
   QueuePolicy policy = QueuePolicy::Block;
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
 };
 
 /// A use of a composite: its modules, filters and connections, with ids prefixed by "id:".
@@ -92,6 +104,7 @@ struct Instance {
   std::string host;  ///< where its nodes without a host run; resolved to the first host on load
   std::vector<Param> params;
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
 };
 
 /// Where the editor draws a module or filter; the runtime ignores it.
@@ -105,6 +118,7 @@ struct EditorNode {
   double x = 0;
   double y = 0;
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
 };
 
 /// A note on the editor's canvas (`<note>` in `<editor>`): text in a box; the runtime ignores it.
@@ -116,6 +130,7 @@ struct EditorNote {
   double height = 80;
   std::string text;  ///< plain text, lines separated by '\n'
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
 };
 
 /// A frame on the editor's canvas (`<frame>` in `<editor>`): a titled, coloured rectangle drawn
@@ -129,6 +144,7 @@ struct EditorFrame {
   double height = 300;
   std::string color;  ///< "#rrggbb", empty for the default
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
 };
 
 /// A folder of node packages the file names (`<packages path="..."/>`): searched like a
@@ -138,6 +154,14 @@ struct EditorFrame {
 struct PackageFolder {
   std::string path;
   SourceLocation loc;
+  Comments comments = {};  ///< written just before the element
+};
+
+/// The comments of one section of an application file (`<modules>`, `<editor>`, ...).
+struct SectionComments {
+  std::string section;  ///< the section's element name
+  Comments before;      ///< before its start tag
+  Comments end;         ///< after its last element, before its end tag
 };
 
 /// A whole application file. Every vector keeps the order of the file.
@@ -153,7 +177,11 @@ struct Application {
   std::vector<EditorNode> editor;
   std::vector<EditorNote> notes;    ///< in `<editor>`, after the nodes
   std::vector<EditorFrame> frames;  ///< in `<editor>`, after the notes
-  std::string file;  ///< the file it was loaded from; empty for a model built in code
+  std::string file;             ///< the file it was loaded from; empty for a model built in code
+  Comments comments = {};       ///< before `<application>`
+  Comments endComments = {};    ///< before `</application>`
+  Comments afterComments = {};  ///< after `</application>`
+  std::vector<SectionComments> sectionComments = {};  ///< sections with comments, in file order
 };
 
 /// The host the loader adds to a file that declares none.
@@ -177,6 +205,8 @@ const Composite* findComposite(const Application& app, std::string_view name);
 const Host* findHost(const Application& app, std::string_view id);
 /// The editor position of this module or filter, or nullptr.
 const EditorNode* findEditorNode(const Application& app, std::string_view ref);
+/// The comments of section `section` (e.g. "modules"), or nullptr when it has none.
+const SectionComments* findSectionComments(const Application& app, std::string_view section);
 /// The `<input>` settings of one input port of a module, or nullptr when it has none.
 const InputConfig* findInputConfig(const Module& module, std::string_view port);
 /// The `<input>` settings of one port, or the defaults (no initial message, Fifo).

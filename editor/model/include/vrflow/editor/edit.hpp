@@ -91,6 +91,9 @@ Result<Edit> disconnect(const app::Application& app, std::vector<std::size_t> in
 /// Sets a parameter of a module, filter or instance; an empty value removes it (the default).
 Result<Edit> setParameter(const app::Application& app, std::string_view node, std::string_view name,
                           std::string value);
+/// Renames a parameter set on a node (a misspelt one), keeping its value, place and comments.
+Result<Edit> renameParameter(const app::Application& app, std::string_view node,
+                             std::string_view name, std::string_view newName);
 /// Sets the initial message count of a module's input port (0 removes the setting when the
 /// mode is the default).
 Result<Edit> setInitialMessages(const app::Application& app, std::string_view module,

@@ -1,14 +1,9 @@
-// The canvas' items: ports, nodes (modules, filters, composite instances) and connections, and
-// the colours of data types and hosts they are drawn in.
+#include "node_item.hpp"
+
 #include <QFontMetricsF>
 #include <QPainter>
-#include <QPainterPathStroker>
-#include <QPolygonF>
 #include <algorithm>
 #include <cmath>
-
-#include "canvas.hpp"
-#include "qt_text.hpp"
 
 namespace vrflow::editor::gui {
 
@@ -18,67 +13,8 @@ constexpr double kModuleWidth = 190;
 constexpr double kHeader = 42;
 constexpr double kRow = 18;
 constexpr double kFilterWidth = 130;
-constexpr double kPortRadius = 5;
 
 }  // namespace
-
-QPainterPath connectionCurve(QPointF from, QPointF to) {
-  QPainterPath path(from);
-  if (to.x() < from.x() + 30) {
-    // A connection going back (a feedback loop): around, below both ends, not through nodes.
-    const double below = std::max(from.y(), to.y()) + 60;
-    const double midX = (from.x() + to.x()) / 2;
-    path.cubicTo(from + QPointF(70, 0), QPointF(from.x() + 70, below), QPointF(midX, below));
-    path.cubicTo(QPointF(to.x() - 70, below), to - QPointF(70, 0), to);
-    return path;
-  }
-  const double dx = std::max(40.0, std::abs(to.x() - from.x()) * 0.5);
-  path.cubicTo(from + QPointF(dx, 0), to - QPointF(dx, 0), to);
-  return path;
-}
-
-QColor colorOfData(const std::string& data) {
-  if (data == "any" || data.empty()) return QColor(120, 120, 130);
-  if (data == "objects") return QColor(52, 120, 246);
-  if (data == "events") return QColor(236, 130, 30);
-  if (data == "resources") return QColor(40, 170, 90);
-  std::size_t hash = std::hash<std::string>{}(data);
-  return QColor::fromHsv(static_cast<int>(hash % 360), 170, 210);
-}
-
-QColor colorOfHost(std::size_t index) {
-  static const QColor colors[] = {QColor(96, 125, 139), QColor(0, 150, 136), QColor(156, 39, 176),
-                                  QColor(233, 30, 99),  QColor(63, 81, 181), QColor(205, 140, 0),
-                                  QColor(121, 85, 72),  QColor(76, 175, 80)};
-  return colors[index % (sizeof colors / sizeof colors[0])];
-}
-
-PortItem::PortItem(QGraphicsItem* parent, std::string node, app::PortSpec spec)
-    : QGraphicsItem(parent), node_(std::move(node)), spec_(std::move(spec)) {
-  setAcceptHoverEvents(true);
-  QString tip = qtText(spec_.name) + (spec_.isInput ? " (input)" : " (output)") +
-                "\ndata: " + qtText(spec_.data);
-  if (spec_.stampsOnly) tip += ", stamps only";
-  if (spec_.required) tip += "\nrequired";
-  if (!spec_.doc.empty()) tip += "\n" + qtText(spec_.doc);
-  setToolTip(tip);
-}
-
-QRectF PortItem::boundingRect() const {
-  const double r = kPortRadius + 3;
-  return {-r, -r, 2 * r, 2 * r};
-}
-
-void PortItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget*) {
-  painter->setRenderHint(QPainter::Antialiasing);
-  QColor fill = spec_.stampsOnly ? QColor(200, 200, 200) : colorOfData(spec_.data);
-  QPen pen(Qt::white, 1.5);
-  if (highlight_ > 0) pen = QPen(QColor(30, 200, 60), 3);
-  if (highlight_ < 0) pen = QPen(QColor(220, 30, 30), 3);
-  painter->setPen(pen);
-  painter->setBrush(fill);
-  painter->drawEllipse(QPointF(0, 0), kPortRadius, kPortRadius);
-}
 
 NodeItem::NodeItem(std::string id, NodeKind kind, QString title, QString subtitle, QColor hostColor,
                    QString hostName, const std::vector<app::PortSpec>& ports)
@@ -262,54 +198,6 @@ void NodeItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
     painter->drawText(QRectF(-40, h + 4, w + 80, 30),
                       Qt::AlignHCenter | Qt::AlignTop | Qt::TextWordWrap, runInfo_);
   }
-}
-
-ConnectionItem::ConnectionItem(std::size_t index, QPointF from, QPointF to, QColor color,
-                               bool stampsOnly)
-    : index_(index), path_(connectionCurve(from, to)), color_(color), stampsOnly_(stampsOnly) {
-  setFlags(ItemIsSelectable);
-  setZValue(0);
-  mid_ = path_.pointAtPercent(0.5);
-}
-
-QRectF ConnectionItem::boundingRect() const {
-  return path_.boundingRect()
-      .adjusted(-8, -8, 8, 8)
-      .united(QRectF(mid_ - QPointF(90, 22), QSizeF(180, 44)));
-}
-
-QPainterPath ConnectionItem::shape() const {
-  QPainterPathStroker stroker;
-  stroker.setWidth(10);
-  return stroker.createStroke(path_);
-}
-
-void ConnectionItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget*) {
-  painter->setRenderHint(QPainter::Antialiasing);
-  QPen pen(color_, stampsOnly_ ? 1.5 : 2.5);
-  if (stampsOnly_) pen.setStyle(Qt::DashLine);
-  if (problem_ == 1) pen.setColor(QColor(240, 170, 0));
-  if (problem_ >= 2) {
-    pen.setColor(QColor(220, 30, 30));
-    pen.setWidthF(3.5);
-  }
-  if (problem_ == 3) pen.setStyle(Qt::DashDotLine);
-  if (isSelected()) {
-    QPen glow(QColor(255, 200, 0, 160), pen.widthF() + 5);
-    painter->setPen(glow);
-    painter->drawPath(path_);
-  }
-  painter->setPen(pen);
-  painter->setBrush(Qt::NoBrush);
-  painter->drawPath(path_);
-  // Arrow head at the input.
-  const QPointF end = path_.pointAtPercent(1);
-  painter->setBrush(pen.color());
-  painter->setPen(Qt::NoPen);
-  QPolygonF head;
-  head << end << end + QPointF(-9, -4.5) << end + QPointF(-9, 4.5);
-  painter->drawPolygon(head);
-  // Labels (run figures, "deadlock") are items of their own, above the nodes.
 }
 
 }  // namespace vrflow::editor::gui
