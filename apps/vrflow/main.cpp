@@ -286,6 +286,10 @@ int main(int argc, char** argv) {
                              "Run id, or any unique start of it (default: the only running run)");
   monitorCommand->add_flag("--once", monitorOnce, "Print one snapshot and exit");
   monitorCommand->add_flag("--json", monitorJson, "Print the raw snapshots (JSON lines)");
+  bool monitorFollowEvents = false;
+  monitorCommand->add_flag("--follow-events", monitorFollowEvents,
+                           "Print the run's events as JSON lines as they come, until it ends "
+                           "(docs/events.md)");
   std::string monitorSource;
   monitorCommand->add_option("--events", monitorSource,
                              "Show an event stream (FILE, or '-' for stdin) instead of the "
@@ -303,6 +307,7 @@ int main(int argc, char** argv) {
 
   if (const auto code = vrflow::cli::runRunsCommand(runsCommands)) return *code;
   if (monitorCommand->parsed()) {
+    if (monitorFollowEvents) return vrflow::launcher::followEvents(monitorRun);
     return monitorSource.empty()
                ? vrflow::launcher::monitor(monitorRun, monitorOnce, monitorJson)
                : vrflow::launcher::monitorEvents(monitorSource, monitorOnce, monitorJson);

@@ -1,4 +1,5 @@
-// vrflow-editor [APP.xml] [--screenshot OUT.png [--run N] [--select ID]] [--packages DIR]...
+// vrflow-editor [APP.xml] [--screenshot OUT.png [--run N | --launch BACKEND [--hosts FILE]
+//               [--iterations N]] [--select ID]] [--packages DIR]...
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QEventLoop>
@@ -29,7 +30,18 @@ int main(int argc, char** argv) {
   parser.addOption(screenshot);
   QCommandLineOption select(
       "select", "With --screenshot: select this node first (its properties show)", "ID");
+  QCommandLineOption launchFirst(
+      "launch",
+      "With --screenshot: launch on the file's hosts first (vrflow launch --backend BACKEND: "
+      "local, ssh, mpirun, slurm), wait for the end, and exit with the launch's exit status",
+      "BACKEND");
+  QCommandLineOption hostfile("hosts", "With --launch: the hostfile (vrflow launch --hosts)",
+                              "FILE");
+  QCommandLineOption iterations("iterations", "With --launch: stop after N iterations", "N");
   parser.addOption(runFirst);
+  parser.addOption(launchFirst);
+  parser.addOption(hostfile);
+  parser.addOption(iterations);
   parser.addOption(select);
   parser.addOption(packages);
   parser.process(application);
@@ -60,11 +72,26 @@ int main(int argc, char** argv) {
   if (!files.isEmpty()) opened = window.openFile(files.front());
   if (!shooting) return application.exec();
   if (!opened) return 1;
-  if (parser.isSet(runFirst)) {
+  int exitCode = 0;
+  if (parser.isSet(runFirst) || parser.isSet(launchFirst)) {
     QEventLoop loop;
-    QObject::connect(&window, &vrflow::editor::gui::MainWindow::runFinished, &loop,
-                     &QEventLoop::quit);
-    window.runApplication(parser.value(runFirst).toInt());
+    QObject::connect(&window, &vrflow::editor::gui::MainWindow::runFinished, &loop, [&](int code) {
+      exitCode = code;
+      loop.quit();
+    });
+    if (parser.isSet(launchFirst)) {
+      // As the Run/Launch dialog would start it, with the command line's choices only (not
+      // the user's remembered ones: a script gives the same run anywhere).
+      vrflow::editor::gui::RunRequest request;
+      request.launch = true;
+      request.packageDirs = parser.values(packages);
+      request.backend = parser.value(launchFirst);
+      request.hostfile = parser.value(hostfile);
+      request.iterations = parser.value(iterations).toInt();
+      if (!window.startRun(request)) return 1;
+    } else {
+      window.runApplication(parser.value(runFirst).toInt());
+    }
     if (window.running()) loop.exec();
   }
   if (parser.isSet(select)) window.canvas()->selectOnly({parser.value(select).toStdString()});
@@ -74,5 +101,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "vrflow-editor: cannot write %s\n", qPrintable(parser.value(screenshot)));
     return 1;
   }
-  return 0;
+  // --launch exits as the launch did; --run keeps its old meaning (the picture was written).
+  return parser.isSet(launchFirst) ? exitCode : 0;
 }

@@ -16,8 +16,6 @@
 #include <QRegularExpression>
 #include <QSaveFile>
 #include <QStatusBar>
-#include <QTemporaryDir>
-#include <QTimer>
 #include <QToolBar>
 #include <QUndoCommand>
 #include <QUndoStack>
@@ -26,6 +24,7 @@
 #include <cstdlib>
 #include <set>
 
+#include "log_view.hpp"
 #include "qt_text.hpp"
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/writer.hpp"
@@ -81,14 +80,12 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
       hosts_(new HostsPanel),
       problemList_(new QListWidget),
       log_(new QPlainTextEdit),
-      console_(new RunConsole(this)),
-      ticker_(new QTimer(this)) {
-  connect(console_, &RunConsole::logLine, log_, &QPlainTextEdit::appendPlainText);
-  connect(console_, &RunConsole::liveRatesUpdated, this, &MainWindow::showLiveRates);
-  connect(console_, &RunConsole::finished, this, &MainWindow::finishRun);
-  connect(ticker_, &QTimer::timeout, this, [this] {
-    statusBar()->showMessage(QString("Running\u2026 %1 s").arg(console_->elapsedSeconds()));
-  });
+      runs_(new RunController(options_.vrflowProgram.isEmpty()
+                                  ? QCoreApplication::applicationDirPath() + "/vrflow"
+                                  : options_.vrflowProgram,
+                              this)),
+      runStatus_(new QLabel),
+      moduleLog_(new LogView) {
   if (reporter_ == nullptr) {
     ownReporter_ = std::make_unique<Reporter>();
     reporter_ = ownReporter_.get();
@@ -119,6 +116,8 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
   auto* problemsDock = dock("Problems", problemList_, Qt::BottomDockWidgetArea);
   auto* logDock = dock("Run log", log_, Qt::BottomDockWidgetArea);
   tabifyDockWidget(problemsDock, logDock);
+  moduleLogDock_ = dock("Module log", moduleLog_, Qt::BottomDockWidgetArea);
+  tabifyDockWidget(logDock, moduleLogDock_);
   problemsDock->raise();
   resizeDocks({problemsDock}, {150}, Qt::Vertical);
   log_->setReadOnly(true);
@@ -156,6 +155,11 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
               const std::string id = h.id;
               hostsMenu->addAction(qtText(id), this,
                                    [this, ids, id] { apply(assignHost(app_, ids, id)); });
+            }
+            if (ids.size() == 1) {
+              const std::string id = ids.front();
+              menu.addAction("Show log", this, [this, id] { showModuleLog(id); })
+                  ->setEnabled(!runs_->runId().isEmpty());
             }
             menu.addAction("Duplicate", this, &MainWindow::duplicateSelection);
             if (ids.size() == 1 && nodeKind(app_, ids.front()) == NodeKind::Instance) {
@@ -230,7 +234,8 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
 }
 
 MainWindow::~MainWindow() {
-  console_->disconnect(this);
+  runs_->disconnect(this);
+  runs_->live()->disconnect(this);
   // The panels outlive this object's members (Qt deletes children last): no more signals here.
   for (QObject* child : std::initializer_list<QObject*>{canvas_, palette_, properties_, hosts_,
                                                         problemList_, undo_}) {
@@ -284,12 +289,7 @@ void MainWindow::buildMenus() {
   view->addAction("Zoom &out", QKeySequence::ZoomOut, this,
                   [this] { canvas_->scale(1 / 1.2, 1 / 1.2); });
 
-  QMenu* runMenu = menuBar()->addMenu("&Run");
-  runAction_ = runMenu->addAction("&Run on this machine", QKeySequence(Qt::Key_F5), this,
-                                  [this] { runApplication(); });
-  stopAction_ =
-      runMenu->addAction("&Stop", QKeySequence(Qt::SHIFT | Qt::Key_F5), this, &MainWindow::stopRun);
-  stopAction_->setEnabled(false);
+  setUpRuns();
 
   QToolBar* tools = addToolBar("Main");
   tools->setObjectName("Main");
@@ -300,9 +300,9 @@ void MainWindow::buildMenus() {
   tools->addAction("Fit", canvas_, &Canvas::fitAll);
   tools->addSeparator();
   tools->addAction(runAction_);
+  tools->addAction(launchAction_);
   tools->addAction(stopAction_);
-  setUpLiveView(
-      runMenu);  // helper B: the live overlay, run table and timeline (main_window_live.cpp)
+  setUpLiveView(runMenu);  // the live overlay, run table and timeline (main_window_live.cpp)
 }
 
 // ---- State -------------------------------------------------------------------------------
@@ -526,77 +526,6 @@ void MainWindow::assignSelectionToHost(const std::string& host) {
     return;
   }
   apply(assignHost(app_, nodes, host));
-}
-
-// ---- Run ---------------------------------------------------------------------------------
-
-bool MainWindow::running() const {
-  return console_->running();
-}
-
-void MainWindow::runApplication(int iterations) {
-  if (running()) return;
-  if (app::hasErrors([this] {
-        std::vector<app::Diagnostic> d;
-        for (const auto& p : problems_) d.push_back({{}, p.severity, p.message});
-        return d;
-      }())) {
-    reporter().error(this, "Cannot run", "The application has errors; see the Problems list.");
-    return;
-  }
-  if ((path_.isEmpty() || modified()) && !save()) return;
-  QString program = options_.vrflowProgram;
-  if (program.isEmpty()) program = QCoreApplication::applicationDirPath() + "/vrflow";
-  QStringList extra;
-  if (iterations > 0) extra << "--iterations" << QString::number(iterations);
-  for (const auto& dir : options_.packageDirs) extra << "--packages" << qtText(dir);
-  lastRun_.reset();
-  liveRates_.clear();
-  canvas_->state().live.clear();
-  runError_.clear();
-  runAction_->setEnabled(false);
-  stopAction_->setEnabled(true);
-  refresh();
-  console_->start(program, path_, extra);
-  log_->appendPlainText("$ " + console_->commandLine());
-  ticker_->start(1000);
-}
-
-void MainWindow::stopRun() {
-  if (!running()) return;
-  log_->appendPlainText("Stopping the run (SIGTERM)");
-  console_->stop();
-}
-
-void MainWindow::showLiveRates() {
-  liveRates_ = console_->liveRates();
-  canvas_->setLiveRates(liveRates_);
-  Q_EMIT liveRatesUpdated();
-}
-
-void MainWindow::finishRun(int exitCode) {
-  ticker_->stop();
-  runAction_->setEnabled(true);
-  stopAction_->setEnabled(false);
-  lastRun_ = console_->report();
-  canvas_->state().live.clear();  // the report's figures replace the live ones
-  QString summary;
-  if (exitCode == 0) {
-    summary = "Run finished";
-  } else if (exitCode == run::kExitInterrupted) {
-    summary = "Run stopped";
-  } else {
-    summary = QString("Run failed (exit %1)").arg(exitCode);
-    if (lastRun_ && !lastRun_->error.empty()) summary += ": " + qtText(lastRun_->error);
-  }
-  if (lastRun_ && lastRun_->wallSeconds > 0)
-    summary += QString(" after %1 s").arg(lastRun_->wallSeconds, 0, 'f', 2);
-  log_->appendPlainText(summary);
-  runError_ = exitCode == 0 ? QString() : summary;
-  refresh();
-  if (lastRun_ && !lastRun_->failedModule.empty()) canvas_->selectOnly({lastRun_->failedModule});
-  statusBar()->showMessage(summary, 15000);
-  Q_EMIT runFinished(exitCode);
 }
 
 bool MainWindow::screenshot(const QString& path) {

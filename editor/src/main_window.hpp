@@ -3,7 +3,6 @@
 #include <QMainWindow>
 #include <QSettings>
 #include <QStringList>
-#include <QTimer>
 #include <map>
 #include <memory>
 #include <optional>
@@ -14,7 +13,7 @@
 #include "live_overlay.hpp"
 #include "live_run.hpp"
 #include "panels.hpp"
-#include "run_console.hpp"
+#include "run_controller.hpp"
 #include "run_table.hpp"
 #include "timeline.hpp"
 #include "vrflow/app/catalog.hpp"
@@ -29,8 +28,11 @@ class QPlainTextEdit;
 class QMenu;
 class QDockWidget;
 class QAction;
+class QLabel;
 
 namespace vrflow::editor::gui {
+
+class LogView;
 
 /// Where the window's messages go: dialogs by default; tests record them instead.
 class Reporter {
@@ -89,10 +91,28 @@ class MainWindow : public QMainWindow {
   void autoLayout();
   void assignSelectionToHost(const std::string& host);
 
-  // Run.
+  // Run (main_window_run.cpp).
+  /// Runs the application on this machine (`vrflow run`, N iterations; 0: until it ends).
   void runApplication(int iterations = 0);
+  /// Starts `request` (its application is the saved file); false when it cannot start (errors
+  /// in the application, not saved, a run going on).
+  bool startRun(RunRequest request);
+  /// Opens the Run/Launch dialog (window-modal, not blocking); accepting it starts the run.
+  void showRunDialog(bool launch);
+  /// Opens the list of this user's running runs; accepting follows the chosen one.
+  void showAttachDialog();
+  /// Follows the registered run `id` (any unique start of it) on the canvas.
+  bool attachRun(const QString& id);
+  /// Shows the log of `module` of the current or last run in the "Module log" dock.
+  void showModuleLog(const std::string& module);
   void stopRun();
   bool running() const;
+  /// The choices last made for the current file in the Run/Launch dialog.
+  RunRequest rememberedRunRequest(bool launch) const;
+  RunController* runController() const { return runs_; }
+  /// The status bar's run line: LiveRun::summary() of the current or last run.
+  QLabel* runStatus() const { return runStatus_; }
+  LogView* moduleLog() const { return moduleLog_; }
 
   /// Renders the window to a PNG file.
   bool screenshot(const QString& path);
@@ -113,9 +133,9 @@ class MainWindow : public QMainWindow {
   /// Iterations/s per module from the running `vrflow`'s event stream (empty when none).
   const std::map<std::string, double>& liveRates() const { return liveRates_; }
 
-  // ---- Live view (helper B, issue 20 items 2-3; main_window_live.cpp). Until A's run
-  // controller owns the LiveRunModel (`live()`), the window keeps one here. ----
-  /// What the editor knows of the run going on or last ended, from its event stream.
+  // ---- Live view (main_window_live.cpp) ----
+  /// What the editor knows of the run going on or last ended, from its event stream (the run
+  /// controller's model).
   LiveRunModel* liveModel() const { return liveModel_; }
   LiveOverlay* liveOverlay() const { return liveOverlay_; }
   RunTable* runTable() const { return runTable_; }
@@ -148,6 +168,9 @@ class MainWindow : public QMainWindow {
   void rebuildRecentMenu();
   void showSelection();
   void problemActivated(int row);
+  /// The Run menu and the run controller's signals (main_window_run.cpp).
+  void setUpRuns();
+  void setRunActions(bool runGoesOn);
   /// The (misspelt, suggested) parameter names of a "did you mean" problem, or nullopt.
   static std::optional<std::pair<std::string, std::string>> parameterSuggestion(
       const Problem& problem);
@@ -183,13 +206,20 @@ class MainWindow : public QMainWindow {
   QAction* runAction_ = nullptr;
   QAction* stopAction_ = nullptr;
 
-  RunConsole* console_;  ///< the run started from the Run menu
-  QTimer* ticker_;       ///< the status bar's seconds while a run goes on
+  QAction* runDialogAction_ = nullptr;
+  QAction* launchAction_ = nullptr;
+  QAction* attachAction_ = nullptr;
+  QAction* logAction_ = nullptr;
+
+  RunController* runs_;  ///< the run started or attached from the Run menu
+  QLabel* runStatus_;    ///< the run's summary, kept after its end
+  LogView* moduleLog_;
+  QDockWidget* moduleLogDock_ = nullptr;
   std::optional<RunReport> lastRun_;
   QString runError_;
   std::map<std::string, double> liveRates_;
 
-  // ---- Live view (helper B; main_window_live.cpp) ----
+  // ---- Live view (main_window_live.cpp) ----
   void setUpLiveView(QMenu* runMenu);
   LiveRunModel* liveModel_ = nullptr;
   LiveOverlay* liveOverlay_ = nullptr;

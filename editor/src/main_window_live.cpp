@@ -1,6 +1,7 @@
 // The window's live view of a run (issue 20 items 2 and 3): the LiveRunModel fed by the run's
 // event stream, the overlay on the canvas, the hosts' load, the run table and the timeline docks.
 #include <QDockWidget>
+#include <QFileInfo>
 #include <QMenu>
 
 #include "main_window.hpp"
@@ -8,18 +9,19 @@
 namespace vrflow::editor::gui {
 
 void MainWindow::setUpLiveView(QMenu* runMenu) {
-  liveModel_ = new LiveRunModel(this);
+  liveModel_ = runs_->live();  // the run controller's model: started and attached runs alike
   liveOverlay_ = new LiveOverlay(canvas_, liveModel_, this);
   runTable_ = new RunTable;
   timeline_ = new TimelineView;
-  // The run started from the Run menu (A's run controller takes this over when merged).
-  connect(console_, &RunConsole::eventLine, liveModel_, &LiveRunModel::handleLine);
   connect(liveModel_, &LiveRunModel::changed, this, [this] {
     hosts_->showLoad(liveModel_->run());
     runTable_->showLive(liveModel_->run());
   });
   connect(this, &MainWindow::runFinished, this, [this] {
     if (lastRun_) runTable_->showReport(*lastRun_, liveModel_->run());
+    // A run that wrote a trace opens it in the timeline (its dock stays where it is).
+    const QString trace = runs_->traceFile();
+    if (!trace.isEmpty() && QFileInfo::exists(trace)) timeline_->open(trace);
   });
 
   runTableDock_ = new QDockWidget("Run table", this);

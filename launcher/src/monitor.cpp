@@ -1,8 +1,10 @@
 // `vrflow monitor [RUN]`: the live statistics of a registered run (docs/operations.md).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -141,6 +143,85 @@ int monitor(const std::string& runPrefix, bool once, bool asJson) {
     std::fflush(stdout);
     if (once || !record->running) return 0;
     std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+}
+
+int followEvents(const std::string& runPrefix) {
+  auto found = run::findRun(runPrefix, /*all=*/true);
+  if (!found) {
+    std::fprintf(stderr, "vrflow monitor: %s\n", found.error().message.c_str());
+    return 1;
+  }
+  const run::RunIdentity identity = found->identity;
+  if (!found->running) {
+    std::fprintf(stderr,
+                 "vrflow monitor: run '%s' has ended (%s); `vrflow logs %s` shows its logs\n",
+                 identity.id.c_str(), found->stateWord().c_str(), identity.id.c_str());
+    return 1;
+  }
+  auto print = [](const json& event) {
+    std::fputs((event.dump() + "\n").c_str(), stdout);
+    std::fflush(stdout);
+  };
+  // The registration knows the hosts and module ids, not their types or placement.
+  json started = {
+      {"event", "started"},      {"time", 0.0},        {"application", identity.application},
+      {"file", identity.file},   {"run", identity.id}, {"hosts", json::array()},
+      {"modules", json::array()}};
+  for (const auto& host : identity.hosts) started["hosts"].push_back({{"id", host}});
+  for (const auto& module : identity.modules) started["modules"].push_back({{"id", module}});
+  print(started);
+  double time = 0;
+  std::map<std::string, int64_t> printedStats;  // host -> t_ns of the last stats printed
+  json printedWarnings = json::array();
+  while (true) {
+    // The record moves to the state folder when the run ends: found again by its whole id.
+    auto record = run::findRun(identity.id, /*all=*/true);
+    if (!record) {
+      std::fprintf(stderr, "vrflow monitor: %s\n", record.error().message.c_str());
+      return 1;
+    }
+    const json state = json::parse(record->state.toJson());
+    for (const auto& host : state["hosts"]) {
+      const json& now = host["now"];
+      if (!now.is_object()) continue;
+      const std::string name = host.value("host", "");
+      const int64_t at = now.value("t_ns", int64_t{0});
+      const bool seen = printedStats.count(name) != 0;
+      if (seen && printedStats[name] == at) continue;
+      printedStats[name] = at;
+      // A host seen for the first time: its previous snapshot too, so that rates follow at once.
+      for (const json* snapshot : {seen ? nullptr : &host["before"], &now}) {
+        if (snapshot == nullptr || !snapshot->is_object()) continue;
+        json stats = *snapshot;
+        time = std::max(time, stats.value("time", 0.0));
+        stats["time"] = time;
+        if (identity.kind == "launch" && !stats.contains("host")) stats["host"] = name;
+        print(stats);
+      }
+    }
+    // The warnings kept are the last ones: the new ones follow the overlap with those printed.
+    const json& warnings = state["warnings"];
+    std::size_t overlap = std::min(printedWarnings.size(), warnings.size());
+    while (overlap > 0 &&
+           !std::equal(warnings.begin(), warnings.begin() + static_cast<std::ptrdiff_t>(overlap),
+                       printedWarnings.end() - static_cast<std::ptrdiff_t>(overlap))) {
+      --overlap;
+    }
+    for (std::size_t i = overlap; i < warnings.size(); ++i) {
+      print({{"event", "warning"}, {"time", time}, {"text", warnings[i]}});
+    }
+    printedWarnings = warnings;
+    if (!record->running) {
+      const json end = state["end"].is_object() ? state["end"] : json::object();
+      print({{"event", "end"},
+             {"time", time},
+             {"exit_code", end.value("exit_code", -1)},
+             {"status", end.value("status", "lost")},
+             {"error", end.value("error", "")}});
+      return 0;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
 }
 

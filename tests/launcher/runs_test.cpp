@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -227,6 +228,48 @@ TEST_F(RunsTest, AThreeHostLaunchIsListedMonitoredShownAndStopped) {
   ASSERT_EQ(ended.size(), 1u);
   EXPECT_EQ(ended[0]["state"], "interrupted");
   EXPECT_EQ(runVrflow({"logs", id.substr(0, 14), "gravity"}, 30).out, "g = 9.81\n");
+}
+
+TEST_F(RunsTest, AFollowerPrintsALaunchsEventsAsTheyComeUntilItsEnd) {
+  Background launch({"launch", threeHostsFile(), "--timeout", "60"});
+  const json running = waitForRunning(1);
+  ASSERT_EQ(running.size(), 1u);
+  const std::string id = running[0]["id"];
+  Background follower({"monitor", id.substr(0, 12), "--follow-events"});
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // statistics of every host
+  EXPECT_EQ(runVrflow({"stop", id}, 60).exitCode, 0);
+  const auto& followed = follower.result();
+  EXPECT_EQ(followed.exitCode, 0) << followed.err;
+  EXPECT_EQ(launch.result().exitCode, 130);
+
+  // The same event lines as `--events` (docs/events.md): started, each host's stats, the end.
+  std::vector<json> events;
+  std::istringstream lines(followed.out);
+  for (std::string line; std::getline(lines, line);) events.push_back(json::parse(line));
+  ASSERT_GE(events.size(), 5u) << followed.out;
+  EXPECT_EQ(events.front()["event"], "started");
+  EXPECT_EQ(events.front()["run"], id);
+  EXPECT_EQ(events.front()["hosts"].size(), 3u);
+  EXPECT_EQ(events.front()["modules"].size(), 5u);
+  std::set<std::string> statsHosts;
+  double time = 0;
+  for (const auto& event : events) {
+    EXPECT_GE(event["time"].get<double>(), time) << event.dump();
+    time = event["time"].get<double>();
+    if (event["event"] == "stats") {
+      statsHosts.insert(event.value("host", ""));
+      EXPECT_TRUE(event["modules"].is_array());
+    }
+  }
+  EXPECT_EQ(statsHosts, (std::set<std::string>{"a", "b", "c"})) << followed.out;
+  EXPECT_EQ(events.back()["event"], "end");
+  EXPECT_EQ(events.back()["exit_code"], 130);
+  EXPECT_EQ(events.back()["status"], "interrupted");
+
+  // An ended run has no events to follow.
+  const auto ended = runVrflow({"monitor", id, "--follow-events"}, 30);
+  EXPECT_EQ(ended.exitCode, 1);
+  EXPECT_NE(ended.err.find("has ended"), std::string::npos) << ended.err;
 }
 
 TEST_F(RunsTest, ARunStuckInAModuleIsStoppedAllTheSame) {

@@ -75,6 +75,12 @@ std::string mergeReports(const app::Application& application, const std::vector<
 /// bytes/s) and per link, each second until it ends. Returns 0, or 1 when there is no such run.
 int monitor(const std::string& run, bool once, bool json);
 
+/// `vrflow monitor [RUN] --follow-events`: the registered run's events as JSON lines
+/// (docs/events.md) as they come, for a program that did not start it (the editor's "Attach"):
+/// a `started` from its registration, each host's new `stats`, new warnings, and its `end`;
+/// then returns 0. 1 when there is no such run or it has ended.
+int followEvents(const std::string& run);
+
 /// `vrflow monitor --events FILE|-`: the same table from an event stream (docs/events.md),
 /// redrawn at each statistics event, until its "end" (a file still being written is followed;
 /// `-` reads standard input to its end). `once`: the state at the end of what is there now.
