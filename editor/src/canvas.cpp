@@ -346,7 +346,7 @@ void Canvas::keyPressEvent(QKeyEvent* event) {
     event->accept();
     return;
   }
-  if (quickAddKey(event)) return;
+  if (!typing && quickAddKey(event)) return;
   QGraphicsView::keyPressEvent(event);
 }
 

@@ -289,7 +289,7 @@ void MainWindow::buildMenus() {
   view->addAction("Zoom &out", QKeySequence::ZoomOut, this,
                   [this] { canvas_->scale(1 / 1.2, 1 / 1.2); });
 
-  setUpRuns();
+  QMenu* runMenu = setUpRuns();
 
   QToolBar* tools = addToolBar("Main");
   tools->setObjectName("Main");

@@ -169,7 +169,8 @@ class MainWindow : public QMainWindow {
   void showSelection();
   void problemActivated(int row);
   /// The Run menu and the run controller's signals (main_window_run.cpp).
-  void setUpRuns();
+  /// The Run menu and the run controller's connections (main_window_run.cpp).
+  QMenu* setUpRuns();
   void setRunActions(bool runGoesOn);
   /// The (misspelt, suggested) parameter names of a "did you mean" problem, or nullopt.
   static std::optional<std::pair<std::string, std::string>> parameterSuggestion(

@@ -18,7 +18,7 @@
 
 namespace vrflow::editor::gui {
 
-void MainWindow::setUpRuns() {
+QMenu* MainWindow::setUpRuns() {
   connect(runs_, &RunController::logLine, log_, &QPlainTextEdit::appendPlainText);
   connect(runs_, &RunController::finished, this, &MainWindow::finishRun);
   connect(runs_->live(), &LiveRunModel::changed, this, &MainWindow::showLiveRates);
@@ -53,6 +53,7 @@ void MainWindow::setUpRuns() {
             statusBar()->showMessage(qtText("The next run sets " + node + "." + name + "=" + value),
                                      8000);
           });
+  return runMenu;
 }
 
 bool MainWindow::running() const {
