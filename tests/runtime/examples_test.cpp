@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -33,6 +34,23 @@ TEST(Examples, PipelineDemoIsDeterministicAndRecordsEveryIteration) {
   EXPECT_EQ(digests[0], digests[1]);
   const auto lines = readLines(dir.file("out/demo/trajectory.csv"));
   EXPECT_EQ(lines.size(), 1u + 50u * 8u);  // header + 8 points per iteration
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+// An output file parameter stays relative to the run's working folder even when a file of that
+// name lies beside the application (an earlier run's output there must not draw this run's).
+TEST(Examples, AnOutputBesideTheApplicationDoesNotDrawTheRunsOutputThere) {
+  TempDir app, work;
+  const std::string file =
+      app.write("pipeline.xml", readFile(sourceDir() + "/examples/pipeline/pipeline.xml"));
+  std::filesystem::create_directories(app.file("out/demo"));
+  const std::string stale = app.write("out/demo/trajectory.csv", "stale\n");
+  const auto result =
+      runCommand({"/bin/sh", "-c",
+                  "cd " + work.path() + " && " + binDir() + "/vrflow run " + file + " -n 20"});
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(readFile(stale), "stale\n");
+  EXPECT_EQ(readLines(work.file("out/demo/trajectory.csv")).size(), 1u + 20u * 8u);
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 

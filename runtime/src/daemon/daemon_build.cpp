@@ -95,13 +95,18 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         app::parameterSet(type->params, module.params,
                           "module '" + module.id + "' (" + type->package + "/" + type->type + ")");
     if (!moduleParams) return moduleParams.error();
-    // A relative path in a file parameter names a file beside the application when one exists
-    // there (input data shipped with it); otherwise it stays relative to the working directory
-    // (outputs). The same rule as a manifest's executable.
+    // A relative path in a file parameter that is not an output names a file beside the
+    // application when one exists there (input data shipped with it); otherwise, and always for
+    // an output, it stays relative to the working directory (a file left beside the application
+    // never draws a run's output into the application's folder). The same rule as a manifest's
+    // executable, and as validation's (package_files.cpp).
     if (!application.file.empty()) {
       const auto base = std::filesystem::path(application.file).parent_path();
       for (const auto& [name, entry] : std::map(moduleParams->entries())) {
         if (entry.type != app::ParamType::File || !entry.value) continue;
+        const auto spec = std::find_if(type->params.begin(), type->params.end(),
+                                       [&](const app::ParamSpec& p) { return p.name == name; });
+        if (spec != type->params.end() && spec->access == app::FileAccess::Output) continue;
         const std::filesystem::path path(std::get<std::string>(*entry.value));
         std::error_code error;
         if (!path.empty() && path.is_relative() &&
