@@ -161,13 +161,10 @@ void Canvas::decorate() {
                       .arg(static_cast<double>(stats.messages) / wall, 0, 'f', 0)
                       .arg(humanBytes(static_cast<double>(stats.bytes) / wall));
         }
+        // Under the pointer (the tooltip) and in the run table, never piled on the ports.
         item->setLabel(total);
         item->setToolTip(item->toolTip() + "\nlast run: " + total +
                          (wall > 0 ? "\naverage: " + shown : QString()));
-        auto* back = makeLabel(shown, item->midPoint(), item->color(), QColor(30, 60, 120));
-        back->setToolTip(item->toolTip());
-        scene_->addItem(back);
-        decorations_.push_back(back);
       }
     }
   }

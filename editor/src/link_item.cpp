@@ -45,6 +45,22 @@ void LinkItem::setRates(const QStringList& lines, bool lost) {
   update();
 }
 
+void LinkItem::setLabelOnHover(bool onHover) {
+  labelOnHover_ = onHover;
+  setAcceptHoverEvents(true);
+  update();
+}
+
+void LinkItem::hoverEnterEvent(QGraphicsSceneHoverEvent*) {
+  hovered_ = true;
+  update();
+}
+
+void LinkItem::hoverLeaveEvent(QGraphicsSceneHoverEvent*) {
+  hovered_ = false;
+  update();
+}
+
 QRectF LinkItem::labelRect() const {
   const QFontMetricsF metrics(overlayFont(7.5));
   double width = 0;
@@ -73,7 +89,7 @@ void LinkItem::paint(QPainter* painter, const QStyleOptionGraphicsItem*, QWidget
     const QPointF shift = lane == 0 ? side : -side;
     painter->drawLine(QLineF(from_ + shift, to_ + shift));
   }
-  if (lines_.isEmpty()) return;
+  if (!labelShown()) return;
   const QRectF r = labelRect();
   painter->setPen(QPen(lost_ ? QColor(210, 30, 30) : QColor(120, 126, 136), 1));
   painter->setBrush(QColor(255, 255, 255, 235));

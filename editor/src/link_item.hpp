@@ -23,9 +23,16 @@ class LinkItem : public QGraphicsObject {
   const QString& hostB() const { return b_; }
   const QStringList& lines() const { return lines_; }
   bool lost() const { return lost_; }
+  /// After a run its label (the totals) shows only under the pointer; the tooltip always has it.
+  void setLabelOnHover(bool onHover);
+  bool labelShown() const { return !lines_.isEmpty() && (!labelOnHover_ || hovered_); }
 
   QRectF boundingRect() const override;
   void paint(QPainter* painter, const QStyleOptionGraphicsItem* option, QWidget* widget) override;
+
+ protected:
+  void hoverEnterEvent(QGraphicsSceneHoverEvent* event) override;
+  void hoverLeaveEvent(QGraphicsSceneHoverEvent* event) override;
 
  private:
   QRectF labelRect() const;
@@ -35,6 +42,8 @@ class LinkItem : public QGraphicsObject {
   QColor colorA_, colorB_;
   QStringList lines_;
   bool lost_ = false;
+  bool labelOnHover_ = false;
+  bool hovered_ = false;
 };
 
 }  // namespace vrflow::editor::gui

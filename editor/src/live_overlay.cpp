@@ -256,6 +256,8 @@ void LiveOverlay::refreshLinks(const LiveRun& run) {
     const HostLive* a = run.host(pair.first);
     const HostLive* b = run.host(pair.second);
     item->setRates(text, (a != nullptr && a->lost) || (b != nullptr && b->lost));
+    // The totals after the run show under the pointer, never piled on the nodes.
+    item->setLabelOnHover(run.phase == LiveRun::Phase::Ended);
   }
 }
 

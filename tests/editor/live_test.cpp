@@ -314,6 +314,8 @@ TEST_F(LiveView, AThreeHostLaunchIsFollowedLiveWithItsLinksAndHostsLoad) {
   while (next < lines.size()) feed(lines[next++]);
   EXPECT_EQ(run.status, "ok");
   EXPECT_TRUE(overlay().links().front()->lines().front().contains("messages"));
+  // After the run the links' totals show under the pointer only, never piled on the nodes.
+  for (const LinkItem* link : overlay().links()) EXPECT_FALSE(link->labelShown());
 }
 
 }  // namespace
