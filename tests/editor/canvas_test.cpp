@@ -16,6 +16,7 @@
 #include <memory>
 
 #include "main_window.hpp"
+#include "offscreen_app.hpp"
 #include "vrflow/editor/notes.hpp"
 
 namespace vrflow::editor::gui {
@@ -25,13 +26,7 @@ namespace fs = std::filesystem;
 
 class CanvasWindow : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    if (qEnvironmentVariableIsEmpty("QT_QPA_PLATFORM")) qputenv("QT_QPA_PLATFORM", "offscreen");
-    static int argc = 1;
-    static char name[] = "vrflow_editor_canvas_tests";
-    static char* argv[] = {name, nullptr};
-    if (QApplication::instance() == nullptr) new QApplication(argc, argv);
-  }
+  static void SetUpTestSuite() { startOffscreenApplication("vrflow_editor_canvas_tests"); }
 
   void SetUp() override {
     ASSERT_TRUE(dir_.isValid());

@@ -21,6 +21,7 @@
 #include <regex>
 
 #include "main_window.hpp"
+#include "offscreen_app.hpp"
 
 namespace vrflow::editor::gui {
 namespace {
@@ -65,13 +66,7 @@ QString example(const char* path) {
 
 class EditorDocument : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    if (qEnvironmentVariableIsEmpty("QT_QPA_PLATFORM")) qputenv("QT_QPA_PLATFORM", "offscreen");
-    static int argc = 1;
-    static char name[] = "vrflow_editor_document_tests";
-    static char* argv[] = {name, nullptr};
-    if (QApplication::instance() == nullptr) new QApplication(argc, argv);
-  }
+  static void SetUpTestSuite() { startOffscreenApplication("vrflow_editor_document_tests"); }
 
   void SetUp() override {
     ASSERT_TRUE(dir_.isValid());

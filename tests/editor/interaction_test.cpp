@@ -26,6 +26,7 @@
 
 #include "composite_view.hpp"
 #include "main_window.hpp"
+#include "offscreen_app.hpp"
 #include "quick_add.hpp"
 
 namespace vrflow::editor::gui {
@@ -35,13 +36,7 @@ const QString kSource = VRFLOW_TEST_SOURCE_DIR;
 
 class CanvasInteraction : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    if (qEnvironmentVariableIsEmpty("QT_QPA_PLATFORM")) qputenv("QT_QPA_PLATFORM", "offscreen");
-    static int argc = 1;
-    static char name[] = "vrflow_editor_interaction_tests";
-    static char* argv[] = {name, nullptr};
-    if (QApplication::instance() == nullptr) new QApplication(argc, argv);
-  }
+  static void SetUpTestSuite() { startOffscreenApplication("vrflow_editor_interaction_tests"); }
 
   void SetUp() override {
     ASSERT_TRUE(dir_.isValid());

@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "main_window.hpp"
+#include "offscreen_app.hpp"
 
 namespace vrflow::editor::gui::testing {
 
@@ -32,13 +33,7 @@ class AnsweringReporter : public Reporter {
 
 class LiveWindow : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    if (qEnvironmentVariableIsEmpty("QT_QPA_PLATFORM")) qputenv("QT_QPA_PLATFORM", "offscreen");
-    static int argc = 1;
-    static char name[] = "vrflow_editor_live_tests";
-    static char* argv[] = {name, nullptr};
-    if (QApplication::instance() == nullptr) new QApplication(argc, argv);
-  }
+  static void SetUpTestSuite() { startOffscreenApplication("vrflow_editor_live_tests"); }
 
   void SetUp() override {
     ASSERT_TRUE(dir_.isValid());

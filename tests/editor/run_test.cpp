@@ -37,6 +37,7 @@
 #include "attach_dialog.hpp"
 #include "log_view.hpp"
 #include "main_window.hpp"
+#include "offscreen_app.hpp"
 #include "run_dialog.hpp"
 
 namespace vrflow::editor::gui {
@@ -94,13 +95,7 @@ const char* kFailingHostApp = R"(<?xml version="1.0" encoding="UTF-8"?>
 
 class EditorRuns : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    if (qEnvironmentVariableIsEmpty("QT_QPA_PLATFORM")) qputenv("QT_QPA_PLATFORM", "offscreen");
-    static int argc = 1;
-    static char name[] = "vrflow_editor_run_tests";
-    static char* argv[] = {name, nullptr};
-    if (QApplication::instance() == nullptr) new QApplication(argc, argv);
-  }
+  static void SetUpTestSuite() { startOffscreenApplication("vrflow_editor_run_tests"); }
 
   void SetUp() override {
     ASSERT_TRUE(dir_.isValid());

@@ -25,6 +25,7 @@
 #include <memory>
 
 #include "main_window.hpp"
+#include "offscreen_app.hpp"
 #include "vrflow/app/writer.hpp"
 
 namespace vrflow::editor::gui {
@@ -62,13 +63,7 @@ class RecordingReporter : public Reporter {
 
 class EditorWindow : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    if (qEnvironmentVariableIsEmpty("QT_QPA_PLATFORM")) qputenv("QT_QPA_PLATFORM", "offscreen");
-    static int argc = 1;
-    static char name[] = "vrflow_editor_window_tests";
-    static char* argv[] = {name, nullptr};
-    if (QApplication::instance() == nullptr) new QApplication(argc, argv);
-  }
+  static void SetUpTestSuite() { startOffscreenApplication("vrflow_editor_window_tests"); }
 
   void SetUp() override {
     ASSERT_TRUE(dir_.isValid());
