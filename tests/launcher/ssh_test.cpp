@@ -1,7 +1,10 @@
 // The ssh backend against a real sshd that this test starts on loopback, with keys it makes.
+#include <arpa/inet.h>
 #include <dirent.h>
+#include <netinet/in.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -59,38 +62,17 @@ class Sshd {
     }
     dir_.write("authorized_keys", readFile(dir_.file("user_key.pub")));
     chmod(dir_.file("authorized_keys").c_str(), 0600);
-    port_ = 20000 + static_cast<int>(getpid() % 20000);
-    dir_.write("sshd_config", "Port " + std::to_string(port_) +
-                                  "\nListenAddress 127.0.0.1\nListenAddress 127.0.0.2\n"
-                                  "ListenAddress 127.0.0.3\nHostKey " +
-                                  dir_.file("host_key") + "\nAuthorizedKeysFile " +
-                                  dir_.file("authorized_keys") + "\nPidFile " +
-                                  dir_.file("sshd.pid") +
-                                  "\nUsePAM no\nStrictModes no\nPasswordAuthentication no\n"
-                                  "KbdInteractiveAuthentication no\nPubkeyAuthentication yes\n"
-                                  "PermitRootLogin prohibit-password\nLogLevel ERROR\n");
-    pid_ = fork();
-    if (pid_ == 0) {
-      execl("/usr/sbin/sshd", "/usr/sbin/sshd", "-D", "-f", dir_.file("sshd_config").c_str(), "-E",
-            dir_.file("sshd.log").c_str(), static_cast<char*>(nullptr));
-      _exit(127);
+    // A port below the kernel's ephemeral range (32768 and up here), free on all three
+    // addresses: a port in that range may be taken on 127.0.0.1 alone by some client's
+    // connection, and sshd then listens on .2 and .3 only.
+    std::string why;
+    for (int attempt = 0; attempt < 8; ++attempt) {
+      port_ = freeOnEveryAddress(20000 + static_cast<int>((getpid() * 7 + attempt * 997) % 12000));
+      if (port_ == 0) continue;
+      why = launch();
+      if (why.empty()) return {};
     }
-    // Ready when a login works.
-    for (int i = 0; i < 50; ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      const auto probe =
-          runCommand({"/usr/bin/ssh", "-T", "-o", "BatchMode=yes", "-o", "StrictHostKeyChecking=no",
-                      "-o", "UserKnownHostsFile=/dev/null", "-o", "LogLevel=ERROR", "-i",
-                      dir_.file("user_key"), "-p", std::to_string(port_), "127.0.0.2", "true"},
-                     20);
-      if (probe.exitCode == 0) return {};
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        return "sshd did not start: " + readFile(dir_.file("sshd.log"));
-      }
-    }
-    return "no login through sshd within 5 s: " + readFile(dir_.file("sshd.log"));
+    return why;
   }
   void stop() {
     if (pid_ > 0) {
@@ -113,6 +95,64 @@ class Sshd {
   }
 
  private:
+  // `port` when nothing is bound to it on 127.0.0.1-3, else 0.
+  static int freeOnEveryAddress(int port) {
+    for (const char* address : {"127.0.0.1", "127.0.0.2", "127.0.0.3"}) {
+      const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+      sockaddr_in addr{};
+      addr.sin_family = AF_INET;
+      addr.sin_port = htons(static_cast<uint16_t>(port));
+      inet_pton(AF_INET, address, &addr.sin_addr);
+      const bool free = fd >= 0 && bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0;
+      if (fd >= 0) close(fd);
+      if (!free) return 0;
+    }
+    return port;
+  }
+  // Starts sshd on port_; empty once a login works through every one of its addresses.
+  std::string launch() {
+    dir_.write("sshd_config", "Port " + std::to_string(port_) +
+                                  "\nListenAddress 127.0.0.1\nListenAddress 127.0.0.2\n"
+                                  "ListenAddress 127.0.0.3\nHostKey " +
+                                  dir_.file("host_key") + "\nAuthorizedKeysFile " +
+                                  dir_.file("authorized_keys") + "\nPidFile " +
+                                  dir_.file("sshd.pid") +
+                                  "\nUsePAM no\nStrictModes no\nPasswordAuthentication no\n"
+                                  "KbdInteractiveAuthentication no\nPubkeyAuthentication yes\n"
+                                  "PermitRootLogin prohibit-password\nLogLevel ERROR\n");
+    pid_ = fork();
+    if (pid_ == 0) {
+      execl("/usr/sbin/sshd", "/usr/sbin/sshd", "-D", "-f", dir_.file("sshd_config").c_str(), "-E",
+            dir_.file("sshd.log").c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    const auto login = [&](const char* address) {
+      return runCommand({"/usr/bin/ssh", "-T", "-o", "BatchMode=yes", "-o",
+                         "StrictHostKeyChecking=no", "-o", "UserKnownHostsFile=/dev/null", "-o",
+                         "LogLevel=ERROR", "-i", dir_.file("user_key"), "-p",
+                         std::to_string(port_), address, "true"},
+                        20)
+                 .exitCode == 0;
+    };
+    // Ready when a login works through each address the hostfile will name.
+    for (int i = 0; i < 50; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      if (login("127.0.0.1") && login("127.0.0.2") && login("127.0.0.3")) return {};
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return "sshd did not start: " + readFile(dir_.file("sshd.log"));
+      }
+    }
+    const std::string why = "no login through sshd on port " + std::to_string(port_) +
+                            " within 5 s: " + readFile(dir_.file("sshd.log"));
+    kill(pid_, SIGTERM);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    pid_ = -1;
+    return why;
+  }
+
   const TempDir& dir_;
   pid_t pid_ = -1;
   int port_ = 0;
