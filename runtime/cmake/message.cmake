@@ -12,6 +12,7 @@ set(vrflow_message_sources
     src/message/digest.cpp
     src/message/empty_message.cpp
     src/message/ids.cpp
+    src/message/input_events.cpp
     src/message/object_type.cpp
     src/message/object_writer.cpp
     src/message/parse.cpp
