@@ -38,6 +38,26 @@ void tangents(const Eigen::Vector3d& n, Eigen::Vector3d& t1, Eigen::Vector3d& t2
   }
 }
 
+// The relative normal velocity after a bounce (the target of the normal row), for a contact
+// whose gap `gap` (negative when they overlap) closes at relative normal velocity `vn` < 0 (this
+// step's gravity included), under a relative normal acceleration `a` pulling the bodies together
+// (gravity on one of them), with restitution `e`. The bounce gives back e^2 of the normal kinetic
+// energy the pair has when it touches, measured with the quantity the integrator conserves in free
+// flight (semi-implicit Euler keeps v^2/2 + a x - a v dt/2 exactly, x the gap, v its rate before
+// the step): so the rebound reaches e^2 of the drop height whatever the step, where the plain -e vn
+// bounced from where the last step left the body (up to |vn| dt above the surface) and rose that
+// much higher (+15 % at dt = 0.01 for e = 0.5).
+// With a = 0 it is -e vn.
+double reboundVelocity(double e, double vn, double gap, double a, double dt) {
+  const double before = vn + a * dt;  // the rate at the start of the step
+  const double energy = 0.5 * before * before + a * gap - 0.5 * a * before * dt;
+  // After the step the gap is gap + v dt: v^2/2 + a (gap + v dt) - a v dt / 2 = e^2 energy.
+  const double c = a * gap - e * e * std::max(energy, 0.0);
+  const double discriminant = 0.25 * a * a * dt * dt - 2.0 * c;
+  if (discriminant <= 0) return 0.0;
+  return std::max(-0.5 * a * dt + std::sqrt(discriminant), 0.0);
+}
+
 }  // namespace
 
 struct RigidContactSolver::Impl {
@@ -300,12 +320,20 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       const double distance = pt.getDistance();
       const double vn = velocityAlong(c, 0);
       const bool bounce = vn < -p.restitutionThreshold;
+      // Gravity's pull along the normal, bringing the pair together (a dynamic body falls).
+      const Eigen::Vector3d g = asEigen(p.gravity);
+      const double pull = -((ea->body.kinematic ? Eigen::Vector3d::Zero() : g) -
+                            (eb->body.kinematic ? Eigen::Vector3d::Zero() : g))
+                               .dot(normal);
+      const auto rebound = [&](double gap) {
+        return reboundVelocity(p.restitution, vn, gap, std::max(pull, 0.0), dt);
+      };
       if (distance > 0) {
         // Speculative: approach allowed up to the gap; a bounce when the gap closes this step.
         c.target = -distance / dt;
-        if (bounce && vn * dt < -distance) c.target = std::max(c.target, -p.restitution * vn);
+        if (bounce && vn * dt < -distance) c.target = std::max(c.target, rebound(distance));
       } else {
-        c.target = std::max(bounce ? -p.restitution * vn : 0.0,
+        c.target = std::max(bounce ? rebound(distance) : 0.0,
                             p.baumgarte / dt * std::max(-distance - p.slop, 0.0));
       }
       if (p.warmStart) {
