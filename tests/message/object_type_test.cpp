@@ -14,7 +14,9 @@ TEST(ObjectType, IdIsFnv1aOfTheName) {
 TEST(ObjectType, BuiltinParameterIndicesMatchTheirConstants) {
   EXPECT_EQ(rigidType().indexOf("position"), RigidParam::kPosition);
   EXPECT_EQ(rigidType().indexOf("sdf"), RigidParam::kSdf);
-  EXPECT_EQ(rigidType().paramCount(), 9u);
+  EXPECT_EQ(rigidType().indexOf("friction"), RigidParam::kFriction);
+  EXPECT_EQ(rigidType().indexOf("restitution"), RigidParam::kRestitution);
+  EXPECT_EQ(rigidType().paramCount(), 11u);
   EXPECT_EQ(rigidType().param(RigidParam::kInertia).kind, ParamKind::Mat3);
   EXPECT_EQ(massSpringType().indexOf("bounds"), MassSpringParam::kBounds);
   EXPECT_EQ(massSpringType().param(MassSpringParam::kPinned).kind, ParamKind::Bytes);

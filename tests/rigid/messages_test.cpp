@@ -56,6 +56,30 @@ TEST(RigidMessages, AddThenUpdateRoundTripsThroughTheCopy) {
   EXPECT_EQ(copy.entries().at(moved.id).body.position, moved.position);
 }
 
+TEST(RigidMessages, MaterialsTravelOnlyWhenABodyHasItsOwn) {
+  Body plain = makeBody(1, msg::Shape::sphere(0.1), 1.0, {0, 0, 0});
+  Body rubber = makeBody(2, msg::Shape::sphere(0.1), 1.0, {1, 0, 0});
+  rubber.friction = 0.9;
+  rubber.restitution = 0.8;
+  msg::VectorSink sink;
+  msg::MessageBuilder builder(sink);
+  writeAdd(builder, plain, 11);
+  writeAdd(builder, rubber, 12);
+  const auto size = builder.finish();
+  auto view = msg::MessageView::parse(std::span(sink.buffer()).first(size));
+  ASSERT_TRUE(view) << view.error().message;
+  for (const auto chunk : *view) {
+    const auto object = chunk.asObject();
+    if (!object) continue;
+    EXPECT_EQ(object->scalar(msg::RigidParam::kFriction).has_value(), object->id() == 2);
+  }
+  RigidObjectCopy copy;
+  ASSERT_TRUE(copy.apply(*view));
+  EXPECT_LT(copy.entries().at(1).body.friction, 0.0);
+  EXPECT_EQ(copy.entries().at(2).body.friction, 0.9);
+  EXPECT_EQ(copy.entries().at(2).body.restitution, 0.8);
+}
+
 TEST(RigidMessages, ObjectNamingAMissingShapeIsAnError) {
   msg::VectorSink sink;
   msg::MessageBuilder builder(sink);

@@ -1,6 +1,7 @@
 // The rigid solvers against analytic answers and invariants, stepped in one process.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <set>
@@ -82,6 +83,63 @@ TEST(RigidPhysics, BouncingSphereReboundsToRestitutionSquaredWhateverTheStep) {
         EXPECT_NEAR(ratio, e * e, 0.01 * e * e + 9.81 * dt * dt / 8 / height)
             << "e = " << e << ", dt = " << dt;
       }
+    }
+  }
+}
+
+TEST(RigidPhysics, EachPairBouncesAndSlidesWithItsOwnMaterials) {
+  // Restitution: the larger of the pair's. Two spheres dropped 1 m side by side onto a ground with
+  // no material of its own (the solver's 0.3): the rubber one (0.8) rebounds to 0.64 m, the putty
+  // one (0.1) to 0.3^2 = 0.09 m.
+  {
+    ContactParams params;
+    params.restitution = 0.3;
+    params.restitutionThreshold = 0.1;
+    RigidWorld world(gravityField(), params);
+    Body rubber = makeBody(2, msg::Shape::sphere(0.1), 1.0, {-1, 1.1, 0});
+    rubber.restitution = 0.8;
+    Body putty = makeBody(3, msg::Shape::sphere(0.1), 1.0, {1, 1.1, 0});
+    putty.restitution = 0.1;
+    ASSERT_TRUE(world.add({ground(), rubber, putty}));
+    std::array<double, 2> peak{}, rising{};
+    for (int i = 0; i < 400; ++i) {
+      world.step(kDt);
+      for (int k = 0; k < 2; ++k) {
+        const Body& b = *world.state().find(static_cast<std::uint64_t>(2 + k));
+        if (b.linearVelocity[1] > 0 && peak[k] == 0) rising[k] = 1;
+        if (rising[k] == 1) {
+          peak[k] = std::max(peak[k], b.position[1] - 0.1);
+          if (b.linearVelocity[1] < 0) rising[k] = 2;
+        }
+      }
+    }
+    std::printf("[materials] rebound %.4f (0.8 on 0.3) and %.4f (0.1 on 0.3)\n", peak[0], peak[1]);
+    EXPECT_NEAR(peak[0], 0.64, 0.01);
+    EXPECT_NEAR(peak[1], 0.09, 0.005);
+  }
+  // Friction: the geometric mean. Boxes launched at 2 m/s along a ground with the solver's 0.6
+  // stop after v^2 / (2 mu g): mu = sqrt(0.1 * 0.6) slides 0.83 m, sqrt(0.9 * 0.6) 0.28 m, less
+  // v dt / 2 with semi-implicit Euler (each step moves with the velocity after its friction).
+  {
+    ContactParams params;
+    params.friction = 0.6;
+    RigidWorld world(gravityField(), params);
+    world.state().setSleep({.enabled = false});
+    const double h = 0.1;
+    Body ice = makeBody(2, msg::Shape::box({h, h, h}), 1.0, {-2, h, -1});
+    ice.friction = 0.1;
+    Body rubber = makeBody(3, msg::Shape::box({h, h, h}), 1.0, {-2, h, 1});
+    rubber.friction = 0.9;
+    ice.linearVelocity = rubber.linearVelocity = {2, 0, 0};
+    ASSERT_TRUE(world.add({ground(), ice, rubber}));
+    for (int i = 0; i < 200; ++i) world.step(kDt);
+    const double slid[2] = {world.state().find(2)->position[0] + 2,
+                            world.state().find(3)->position[0] + 2};
+    for (int k = 0; k < 2; ++k) {
+      const double mu = std::sqrt((k == 0 ? 0.1 : 0.9) * 0.6);
+      const double expected = 4.0 / (2 * mu * 9.81) - 2.0 * kDt / 2;
+      std::printf("[materials] slid %.4f m, v^2/(2 mu g) - v dt/2 = %.4f m\n", slid[k], expected);
+      EXPECT_NEAR(slid[k], expected, 0.01 * expected);
     }
   }
 }

@@ -47,6 +47,19 @@ TEST(RigidScene, LoadsEveryShapeKindWithMassOrDensity) {
   EXPECT_TRUE(found) << "the point (0.2, 0, 0) of the file is not at position + (0.2, 0, 0)";
 }
 
+TEST(RigidScene, BodiesMayCarryTheirOwnMaterial) {
+  auto scene = parseScene(
+      R"({"bodies": [{"shape": {"type": "sphere", "radius": 1}, "mass": 1, "friction": 0.1,
+                      "restitution": 0.9},
+                     {"shape": {"type": "sphere", "radius": 1}, "mass": 1}]})",
+      "materials.json");
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ((*scene)[0].friction, 0.1);
+  EXPECT_EQ((*scene)[0].restitution, 0.9);
+  EXPECT_LT((*scene)[1].friction, 0.0);  // none of its own: the interactor's
+  EXPECT_LT((*scene)[1].restitution, 0.0);
+}
+
 TEST(RigidScene, BadFilesGiveErrorsNamingFileAndLine) {
   const std::string origin = "scenes/bad.json";
   auto syntax = parseScene(
@@ -76,7 +89,10 @@ TEST(RigidScene, BadFilesGiveErrorsNamingFileAndLine) {
        R"({"shape": {"type": "sphere", "radius": 1}, "kinematic": true, "mass": 1})",
        R"({"shape": {"type": "convexHull", "points": [[0,0,0],[1,0,0],[0,1,0],[1,1,0]]}, "mass": 1})",
        R"({"shape": {"type": "triangleMesh", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,3]]}, "kinematic": true})",
-       R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "orientation": [0, 0, 0, 0]})"}) {
+       R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "orientation": [0, 0, 0, 0]})",
+       R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "friction": -0.5})",
+       R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "restitution": 1.5})",
+       R"({"shape": {"type": "sphere", "radius": 1}, "mass": 1, "restitution": "high"})"}) {
     auto result = parseScene(std::string("{\"bodies\": [") + body + "]}", origin);
     ASSERT_FALSE(result) << body;
     EXPECT_EQ(result.error().message.rfind("scenes/bad.json:1: body 0: ", 0), 0u)

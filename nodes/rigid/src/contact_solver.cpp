@@ -60,6 +60,14 @@ double reboundVelocity(double e, double vn, double gap, double a, double dt) {
 
 }  // namespace
 
+double combinedFriction(double a, double b, double fallback) {
+  return std::sqrt((a < 0 ? fallback : a) * (b < 0 ? fallback : b));
+}
+
+double combinedRestitution(double a, double b, double fallback) {
+  return std::max(a < 0 ? fallback : a, b < 0 ? fallback : b);
+}
+
 struct RigidContactSolver::Impl {
   struct Entry {
     Body body;
@@ -241,6 +249,7 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     std::array<Eigen::Vector3d, 3> dir, raxd, rbxd, ia, ib;
     std::array<double, 3> mass, acc;
     double target;
+    double friction;  // the pair's coefficient
     Eigen::Vector3d accRoll;
     RowMatrix3d rollMass;  // inverse of (Ia^-1 + Ib^-1)
     bool rolls;            // a sphere or capsule is involved
@@ -317,6 +326,7 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       if (c.rolls) {
         c.rollMass = inverse(invInertia[c.a] + invInertia[c.b]);
       }
+      c.friction = combinedFriction(ea->body.friction, eb->body.friction, p.friction);
       const double distance = pt.getDistance();
       const double vn = velocityAlong(c, 0);
       const bool bounce = vn < -p.restitutionThreshold;
@@ -326,7 +336,9 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
                             (eb->body.kinematic ? Eigen::Vector3d::Zero() : g))
                                .dot(normal);
       const auto rebound = [&](double gap) {
-        return reboundVelocity(p.restitution, vn, gap, std::max(pull, 0.0), dt);
+        const double e =
+            combinedRestitution(ea->body.restitution, eb->body.restitution, p.restitution);
+        return reboundVelocity(e, vn, gap, std::max(pull, 0.0), dt);
       };
       if (distance > 0) {
         // Speculative: approach allowed up to the gap; a bounce when the gap closes this step.
@@ -352,7 +364,7 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   for (int iteration = 0; iteration < p.iterations; ++iteration) {
     for (Constraint& c : constraints) {
       // Friction within the cone of the current normal impulse (box approximation).
-      const double limit = p.friction * c.acc[0];
+      const double limit = c.friction * c.acc[0];
       for (int axis = 1; axis < 3; ++axis) {
         const double next =
             std::clamp(c.acc[axis] - c.mass[axis] * velocityAlong(c, axis), -limit, limit);

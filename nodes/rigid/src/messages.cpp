@@ -13,8 +13,8 @@ using P = msg::RigidParam;
 void writeAdd(msg::MessageBuilder& builder, const Body& body, std::uint64_t shapeId) {
   const auto bytes = msg::encodeShape(body.shape);
   builder.addRawResource(shapeId, false, bytes);
-  builder.addObject(body.id, msg::rigidType(), msg::ObjectOp::Add)
-      .set(P::kPosition, body.position)
+  auto object = builder.addObject(body.id, msg::rigidType(), msg::ObjectOp::Add);
+  object.set(P::kPosition, body.position)
       .set(P::kOrientation, body.orientation)
       .set(P::kLinearVelocity, body.linearVelocity)
       .set(P::kAngularVelocity, body.angularVelocity)
@@ -22,6 +22,9 @@ void writeAdd(msg::MessageBuilder& builder, const Body& body, std::uint64_t shap
       .set(P::kInertia, body.kinematic ? Mat3{} : body.inertia)
       .set(P::kBounds, msg::worldBounds(body.shape, body.position, body.orientation))
       .set(P::kShape, shapeId);
+  // Materials travel only when the body has its own, so scenes without them send what they sent.
+  if (body.friction >= 0) object.set(P::kFriction, body.friction);
+  if (body.restitution >= 0) object.set(P::kRestitution, body.restitution);
 }
 
 void writeUpdate(msg::MessageBuilder& builder, const Body& body, const Change& change) {
@@ -73,6 +76,8 @@ Status RigidObjectCopy::apply(const msg::MessageView& message,
       e.body.mass = e.body.kinematic ? kInfiniteMass : *v;
     }
     if (auto v = object->mat3(P::kInertia); v && !e.body.kinematic) e.body.inertia = *v;
+    if (auto v = object->scalar(P::kFriction)) e.body.friction = *v;
+    if (auto v = object->scalar(P::kRestitution)) e.body.restitution = *v;
     if (auto v = object->idParam(P::kShape); v && *v != e.shapeId) {
       e.shapeId = *v;
       const auto s = shapes_.find(*v);

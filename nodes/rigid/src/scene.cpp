@@ -114,7 +114,7 @@ Body parseBody(const json& j, std::uint64_t id) {
   if (!j.is_object()) throw BodyError{"a body must be an object"};
   onlyKeys(j,
            {"name", "shape", "mass", "density", "kinematic", "position", "orientation",
-            "linearVelocity", "angularVelocity"},
+            "linearVelocity", "angularVelocity", "friction", "restitution"},
            "");
   if (!j.contains("shape")) throw BodyError{"missing 'shape'"};
   Vec3 offset{};
@@ -150,6 +150,16 @@ Body parseBody(const json& j, std::uint64_t id) {
     body.linearVelocity = vector<3>(j["linearVelocity"], "linearVelocity");
   if (j.contains("angularVelocity"))
     body.angularVelocity = vector<3>(j["angularVelocity"], "angularVelocity");
+  if (j.contains("friction")) {
+    body.friction = number(j["friction"], "friction");
+    if (!(body.friction >= 0 && body.friction <= 10))
+      throw BodyError{"'friction' must be between 0 and 10"};
+  }
+  if (j.contains("restitution")) {
+    body.restitution = number(j["restitution"], "restitution");
+    if (!(body.restitution >= 0 && body.restitution <= 1))
+      throw BodyError{"'restitution' must be between 0 and 1"};
+  }
   return body;
 }
 

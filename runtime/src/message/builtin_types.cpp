@@ -26,6 +26,8 @@ const ObjectType& rigidType() {
                                                           {"bounds", ParamKind::Aabb},
                                                           {"shape", ParamKind::Id},
                                                           {"sdf", ParamKind::Id},
+                                                          {"friction", ParamKind::Scalar},
+                                                          {"restitution", ParamKind::Scalar},
                                                       });
   return type;
 }

@@ -23,7 +23,9 @@ struct RigidParam {
     kInertia,          ///< Mat3
     kBounds,           ///< Aabb
     kShape,            ///< Id of a mesh resource
-    kSdf               ///< Id of a signed-distance-field resource
+    kSdf,              ///< Id of a signed-distance-field resource
+    kFriction,         ///< Scalar, the surface's friction coefficient (absent: the interactor's)
+    kRestitution       ///< Scalar, the surface's restitution (absent: the interactor's)
   };
 };
 

@@ -30,6 +30,11 @@ struct Body {
   Vec3 angularVelocity{};
   /// Infinite mass: forces never move it; it moves only with its own (constant) velocities.
   bool kinematic = false;
+  /// The surface's material; negative: none of its own (the interactor's `friction` and
+  /// `restitution` apply). A pair combines its two bodies' values (combinedFriction,
+  /// combinedRestitution in contact_solver.hpp).
+  double friction = -1.0;
+  double restitution = -1.0;
 
   double inverseMass() const { return kinematic ? 0.0 : 1.0 / mass; }
 };

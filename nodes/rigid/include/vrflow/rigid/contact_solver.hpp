@@ -29,9 +29,10 @@ struct ContactParams {
   /// gravity): the solver predicts v + g dt before solving, so resting contact holds.
   Vec3 gravity{manifest_defaults::kGravityX, manifest_defaults::kGravityY,
                manifest_defaults::kGravityZ};
-  /// coefficient of restitution (one value for every pair)
+  /// Coefficient of restitution and Coulomb friction of a body that has none of its own
+  /// (Body::restitution, Body::friction negative).
   double restitution = manifest_defaults::kRestitution;
-  double friction = manifest_defaults::kFriction;  ///< Coulomb friction coefficient
+  double friction = manifest_defaults::kFriction;
   /// closing speeds (m/s) below this do not bounce
   double restitutionThreshold = manifest_defaults::kRestitutionThreshold;
   int iterations = manifest_defaults::kIterations;  ///< sequential impulse iterations
@@ -48,6 +49,13 @@ struct ContactParams {
   double speculativeDistance = 0.04;
   bool warmStart = true;
 };
+
+/// The friction of a pair: the geometric mean sqrt(fa fb) of its bodies' (Box2D's and Bullet's
+/// rule: ice on anything slides), a negative value standing for `fallback`.
+double combinedFriction(double a, double b, double fallback);
+/// The restitution of a pair: the larger of its bodies' (Box2D's rule: a rubber ball bounces on
+/// any floor), a negative value standing for `fallback`.
+double combinedRestitution(double a, double b, double fallback);
 
 /// One contact point found in the last solve (for tests and diagnostics).
 struct ContactInfo {
