@@ -1,8 +1,8 @@
 // The ssh backend against a real sshd that this test starts on loopback, with keys it makes.
 #include <arpa/inet.h>
 #include <dirent.h>
-#include <netinet/in.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -127,11 +127,11 @@ class Sshd {
       _exit(127);
     }
     const auto login = [&](const char* address) {
-      return runCommand({"/usr/bin/ssh", "-T", "-o", "BatchMode=yes", "-o",
-                         "StrictHostKeyChecking=no", "-o", "UserKnownHostsFile=/dev/null", "-o",
-                         "LogLevel=ERROR", "-i", dir_.file("user_key"), "-p",
-                         std::to_string(port_), address, "true"},
-                        20)
+      return runCommand(
+                 {"/usr/bin/ssh", "-T", "-o", "BatchMode=yes", "-o", "StrictHostKeyChecking=no",
+                  "-o", "UserKnownHostsFile=/dev/null", "-o", "LogLevel=ERROR", "-i",
+                  dir_.file("user_key"), "-p", std::to_string(port_), address, "true"},
+                 20)
                  .exitCode == 0;
     };
     // Ready when a login works through each address the hostfile will name.
