@@ -1,0 +1,51 @@
+// openModuleDevice and feedPointerEvents: the input modules' shared start.
+#include "vrflow/input/module_device.hpp"
+
+#include <cstdio>
+
+namespace vrflow::input {
+
+std::unique_ptr<Device> openModuleDevice(const Module& module, const std::string& program,
+                                         bool haptic) {
+  const auto& params = module.params();
+  auto fail = [&](const char* name, const std::string& why) {
+    std::fprintf(stderr, "%s: parameter '%s' of module '%s': %s\n", program.c_str(), name,
+                 module.id().c_str(), why.c_str());
+    return std::unique_ptr<Device>();
+  };
+  DeviceOptions options;
+  options.scale = params.getFloat("scale");
+  options.origin = params.getVec3("origin");
+  options.hotplug = params.getBool("hotplug");
+  const std::string unplug = params.getString("on-unplug");
+  if (unplug != "keep" && unplug != "stop")
+    return fail("on-unplug", "'" + unplug + "' is neither keep nor stop");
+  options.stopOnUnplug = unplug == "stop";
+  if (haptic) {
+    options.armMass = params.getFloat("arm-mass");
+    options.armDamping = params.getFloat("arm-damping");
+    options.armStiffness = params.getFloat("arm-stiffness");
+  }
+  const std::string spec = params.getString("device");
+  auto device = openDevice(spec, options);
+  if (!device) return fail("device", device.error().message);
+  if (haptic && !(*device)->haptic())
+    return fail("device", "'" + spec + "' renders no force: give arm:FILE or plugin:LIBRARY.so");
+  return std::move(*device);
+}
+
+int feedPointerEvents(Device& device, const Message& message) {
+  if (!message.valid()) return 0;
+  int count = 0;
+  for (const auto chunk : message.view()) {
+    const auto event = chunk.asEvent();
+    if (!event || event->kind() != msg::kPointerEventKind) continue;
+    if (const auto pointer = msg::pointerEvent(*event)) {
+      device.feed(*pointer);
+      ++count;
+    }
+  }
+  return count;
+}
+
+}  // namespace vrflow::input
