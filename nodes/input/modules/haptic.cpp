@@ -29,6 +29,7 @@ int main() {
   coupling.toolMass = params.getFloat("tool-mass");
   coupling.period = params.getFloat("dt");
   coupling.physicsPeriod = params.getFloat("physics-dt");
+  coupling.gravity = params.getVec3("gravity");
   if (auto status = input::checkCoupling(coupling); !status) {
     std::fprintf(stderr, "%s: parameter 'stiffness' of module '%s': %s\n", program.c_str(),
                  module.id().c_str(), status.error().message.c_str());
