@@ -6,6 +6,8 @@
 // The physics runs slower: put a `decimate` filter on `objects` and a `repeat` filter on
 // `events` (nodes/input/README.md). Every `objects` message is self-contained (the tool's shape
 // resource and add chunk), so that a decimate filter in between loses nothing.
+#include <time.h>
+
 #include <cstdio>
 #include <memory>
 
@@ -60,7 +62,25 @@ int main() {
       rigid::makeBody(module.newId(), msg::Shape::sphere(params.getFloat("tool-radius")),
                       coupling.toolMass, first->position);
   const std::uint64_t shapeId = module.newId();
-  while (module.wait()) {
+  // Real time: tick i waits for its inputs no earlier than start + i dt on the monotonic clock
+  // (a real device's servo rate); otherwise the loop runs as fast as its inputs allow.
+  const bool realtime = params.getBool("realtime");
+  timespec start{};
+  clock_gettime(CLOCK_MONOTONIC, &start);
+  for (std::uint64_t tick = 0;; ++tick) {
+    if (realtime) {
+      const double due = static_cast<double>(tick) * dt;
+      timespec at = start;
+      const auto whole = static_cast<time_t>(due);
+      at.tv_sec += whole;
+      at.tv_nsec += static_cast<long>((due - static_cast<double>(whole)) * 1e9);
+      if (at.tv_nsec >= 1000000000L) {
+        at.tv_nsec -= 1000000000L;
+        ++at.tv_sec;
+      }
+      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &at, nullptr);
+    }
+    if (!module.wait()) break;
     msg::Vec3 contact{};
     if (const Message& received = module.get(events); received.valid()) {
       for (const auto chunk : received.view()) {
