@@ -117,3 +117,25 @@ TEST(Picking, GrabForceIsASpringDamperClampedToItsMaximum) {
 
 }  // namespace
 }  // namespace vrflow::input
+
+namespace vrflow::input {
+namespace {
+
+// The plugin backend loads a real shared library (the test plugin), drives it through the
+// Device interface, and reports the plugin's own error for bad arguments.
+TEST(Devices, PluginLibraryIsLoadedAndDrivenThroughTheDeviceInterface) {
+  auto device = openDevice(std::string("plugin:") + VRFLOW_TEST_DEVICE_PLUGIN + ":1 2 3");
+  ASSERT_TRUE(device) << device.error().message;
+  EXPECT_TRUE((*device)->haptic());
+  (*device)->render({2, 0, 0}, 0.5);
+  auto sample = (*device)->sample(0.5);
+  ASSERT_TRUE(sample);
+  EXPECT_EQ(sample->position, (msg::Vec3{1.5, 2, 3}));
+  auto bad = openDevice(std::string("plugin:") + VRFLOW_TEST_DEVICE_PLUGIN + ":one two");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message, std::string("plugin:") + VRFLOW_TEST_DEVICE_PLUGIN +
+                                     ": arguments 'one two' are not X Y Z");
+}
+
+}  // namespace
+}  // namespace vrflow::input
