@@ -213,6 +213,52 @@ TEST(InputNetwork, HeadModuleSendsTheTrackedPositionAsAPointObject) {
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 
+// The package's examples, as their README tells a user to run them (outputs moved into a
+// temporary folder with --set).
+TEST(InputExamples, GrabStackCarriesTheTopBoxAsideAndSetsItDown) {
+  TempDir dir;
+  const auto result =
+      runCommand({binDir() + "/vrflow", "run", sourceDir() + "/nodes/input/examples/grab_stack.xml",
+                  "-n", "400", "--set", "bodies.state-file=" + dir.file("state.json")},
+                 60);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto top = body(dir.file("state.json"), 3);
+  EXPECT_NEAR(coordinate(top, 0), 1.0, 0.03);
+  EXPECT_NEAR(coordinate(top, 1), 0.25, 0.01);
+  EXPECT_NEAR(coordinate(top, 2), 0.0, 0.03);
+  for (std::size_t i : {1u, 2u}) {  // the two boxes left in the stack did not move
+    EXPECT_NEAR(coordinate(body(dir.file("state.json"), i), 0), 0.0, 0.01);
+    EXPECT_NEAR(coordinate(body(dir.file("state.json"), i), 1), 0.5 * static_cast<double>(i) - 0.25,
+                0.01);
+  }
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
+// The haptic probe: while the tool presses on the box, the hand feels the contact force less
+// the tool's weight (its gravity is on), and the stroke's friction; the 5 kg box stays put.
+TEST(InputExamples, HapticProbeRendersTheBoxsContactLessTheToolsWeight) {
+  TempDir dir;
+  const auto result = runCommand(
+      {binDir() + "/vrflow", "run", sourceDir() + "/nodes/input/examples/haptic_probe.xml", "-n",
+       "300", "--set", "bodies.state-file=" + dir.file("state.json"), "--set",
+       "tool.log=" + dir.file("haptic.csv")},
+      60);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto rows = readCsvRows(dir.file("haptic.csv"));
+  ASSERT_EQ(rows.size(), 3000u);
+  double contact = 0, feedback = 0;
+  for (std::size_t i = 1400; i < 1600; ++i) {  // 1.4 s to 1.6 s: pressing
+    contact += std::stod(rows[i][8]) / 200;
+    feedback += std::stod(rows[i][11]) / 200;
+  }
+  EXPECT_GT(contact, 5.0);
+  EXPECT_NEAR(feedback, contact - 0.2 * 9.81, 0.02 * contact);
+  const auto box = body(dir.file("state.json"), 1);
+  EXPECT_NEAR(coordinate(box, 0), 0.0, 0.005);
+  EXPECT_NEAR(coordinate(box, 1), 0.2, 0.005);
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
 /// Runs `app` and returns its stderr and stdout; expects a failure.
 std::string failure(const std::string& app) {
   const auto result = runCommand({binDir() + "/vrflow", "run", app, "-n", "20"}, 60);
@@ -243,6 +289,9 @@ TEST(InputNetwork, BadDeviceAndParametersFailTheRunWithOneErrorNamingThem) {
       {param("device", "evdev:/dev/input/event-vrflow-missing") + param("hotplug", "false"),
        "parameter 'device' of module 'pointer': evdev:/dev/input/event-vrflow-missing: cannot "
        "open the input device node (No such file or directory; set hotplug to wait for it)"},
+      {param("device", "script"),
+       "parameter 'keyframes' of module 'pointer': device 'script' needs a keyframe file: set "
+       "keyframes"},
       {param("device", "joystick"),
        "parameter 'device' of module 'pointer': device 'joystick': give script:FILE"},
       {param("device", "script:" + data("push.keys")) + param("radius", "-1"), "radius"},

@@ -26,7 +26,15 @@ std::unique_ptr<Device> openModuleDevice(const Module& module, const std::string
     options.armDamping = params.getFloat("arm-damping");
     options.armStiffness = params.getFloat("arm-stiffness");
   }
-  const std::string spec = params.getString("device");
+  std::string spec = params.getString("device");
+  // `script` and `arm` alone take their file from `keyframes` (a file parameter: resolved
+  // beside the application file and checked before the run starts).
+  if (spec == "script" || spec == "arm") {
+    const std::string keyframes = params.getString("keyframes");
+    if (keyframes.empty())
+      return fail("keyframes", "device '" + spec + "' needs a keyframe file: set keyframes");
+    spec += ":" + keyframes;
+  }
   auto device = openDevice(spec, options);
   if (!device) return fail("device", device.error().message);
   if (haptic && !(*device)->haptic())

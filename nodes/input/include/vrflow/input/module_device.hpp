@@ -11,7 +11,8 @@
 
 namespace vrflow::input {
 
-/// Opens the device the module's parameters name (`device`, `scale`, `origin`, `hotplug`,
+/// Opens the device the module's parameters name (`device`, `keyframes` for `script` and `arm`
+/// given alone, `scale`, `origin`, `hotplug`,
 /// `on-unplug` and, where declared, `arm-mass`, `arm-damping`, `arm-stiffness`). On error prints
 /// "PROGRAM: parameter 'NAME' of module 'ID': why" and returns null (exit with status 2).
 std::unique_ptr<Device> openModuleDevice(const Module& module, const std::string& program,
