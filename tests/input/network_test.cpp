@@ -125,6 +125,39 @@ TEST(InputNetwork, GrabLiftsABodyAndLetsItFall) {
   EXPECT_TRUE(vrflowShmEntries().empty());
 }
 
+// The window backend: the grab's `device` port receives a window's pointer events (a scripted
+// window standing for the on-screen viewer). A press with the ray on the box picks its front
+// face; dragging the ray up lifts the box by that point, releasing drops it.
+TEST(InputNetwork, WindowPointerEventsClickAndDragABox) {
+  TempDir dir;
+  const std::string modules = R"(    <module id="window" package="input-testing" type="clicks">
+      <param name="keyframes" value=")" +
+                              data("drag.keys") + R"("/>
+    </module>
+    <module id="grab" package="input" type="grab">
+      <param name="device" value="window"/>
+    </module>
+)";
+  const std::string connections = R"(    <connection from="bodies.objects" to="grab.objects"/>
+    <connection from="window.events" to="grab.device"/>
+    <connection from="grab.forces" to="bodies.events"/>
+)";
+  const auto app = dir.write(
+      "drag.xml", rigidApp(data("push.json"), dir.file("state.json"), modules, connections));
+  auto held = runVrflow({"run", app, "-n", "151"}, 60);
+  ASSERT_EQ(held.exitCode, 0) << held.err;
+  const auto lifted = body(dir.file("state.json"), 1);
+  // Hanging by its front face's centre, pulled to y = 1.2 (less the sag, 9.81 / 200 m): the
+  // box's top is near that point, its centre about a half side below.
+  EXPECT_GT(lifted["boundsMax"][1].get<double>(), 1.2 - 9.81 / 200.0 - 0.05);
+  EXPECT_GT(coordinate(lifted, 1), 0.8);
+  auto dropped = runVrflow({"run", app, "-n", "400"}, 60);
+  ASSERT_EQ(dropped.exitCode, 0) << dropped.err;
+  EXPECT_LT(body(dir.file("state.json"), 1)["boundsMin"][1].get<double>(), 0.01);
+  EXPECT_TRUE(leftoverProcesses().empty());
+  EXPECT_TRUE(vrflowShmEntries().empty());
+}
+
 std::string hapticModule(const std::string& device, const std::string& log,
                          const std::string& extra = "") {
   return R"(    <module id="tool" package="input" type="haptic">
