@@ -1,6 +1,6 @@
 // vrflow-bench-input: latency from a device event to the force it causes reaching the module
-// that applies it, measured in real runs (`vrflow run --trace`) from the trace's spans and
-// message flows. One JSON object per line:
+// that applies it, measured in real runs (`vrflow run --trace` on bench/haptic_latency.xml and
+// bench/grab_latency.xml) from the trace's spans and message flows. One JSON object per line:
 //   haptic-arm: the haptic module at 1 kHz (real time) with the simulated arm; from the tick's
 //     device sample (its compute span's start) to the feedback force's arrival in the module
 //     that renders it (a recorder standing for the device driver);
@@ -25,76 +25,6 @@
 namespace {
 
 namespace fs = std::filesystem;
-
-const char* kGround =
-    R"({"bodies": [{"shape": {"type": "box", "halfExtents": [2, 0.5, 2]}, "kinematic": true, "position": [0, -0.5, 0]},
- {"shape": {"type": "box", "halfExtents": [0.2, 0.2, 0.2]}, "mass": 1, "position": [1, 0.2, 0]}]})";
-const char* kPress = "0 0 0.3 0\n1 0 -0.05 0\n2 0.5 -0.05 0\n3 0 0.3 0\n";
-const char* kLift = "0 1 0.2 0 0\n0.1 1 0.2 0 1\n1 1 1.2 0 1\n2 1 1.2 0 1\n";
-
-std::string hapticApp(const fs::path& dir) {
-  return R"(<?xml version="1.0" encoding="UTF-8"?>
-<application name="bench-input-haptic" version="1">
-  <modules>
-    <module id="bodies" package="rigid" type="animator">
-      <param name="scene" value=")" +
-         (dir / "scene.json").string() + R"("/>
-      <input port="events" initial-messages="1"/>
-    </module>
-    <module id="contacts" package="rigid" type="interactor"><param name="gravity" value="0 0 0"/></module>
-    <module id="tool" package="input" type="haptic">
-      <param name="device" value="arm:)" +
-         (dir / "press.keys").string() + R"("/>
-      <param name="realtime" value="true"/>
-      <input port="events" initial-messages="10"/>
-    </module>
-    <module id="hand" package="core" type="recorder"><param name="file" value=")" +
-         (dir / "feedback.csv").string() + R"("/></module>
-  </modules>
-  <filters>
-    <filter id="physics_rate" type="decimate"><param name="count" value="10"/></filter>
-    <filter id="haptic_rate" type="repeat"><param name="count" value="10"/></filter>
-  </filters>
-  <connections>
-    <connection from="bodies.objects" to="contacts.objects"/>
-    <connection from="contacts.forces" to="bodies.events"/>
-    <connection from="tool.objects" to="physics_rate.in"/>
-    <connection from="physics_rate.out" to="contacts.objects"/>
-    <connection from="contacts.forces" to="haptic_rate.in"/>
-    <connection from="haptic_rate.out" to="tool.events"/>
-    <connection from="tool.feedback" to="hand.in"/>
-  </connections>
-</application>
-)";
-}
-
-std::string grabApp(const fs::path& dir) {
-  return R"(<?xml version="1.0" encoding="UTF-8"?>
-<application name="bench-input-grab" version="1">
-  <modules>
-    <module id="bodies" package="rigid" type="animator">
-      <param name="scene" value=")" +
-         (dir / "scene.json").string() + R"("/>
-      <input port="events" initial-messages="1"/>
-    </module>
-    <module id="contacts" package="rigid" type="interactor"/>
-    <module id="field" package="rigid" type="forcefield"/>
-    <module id="grab" package="input" type="grab">
-      <param name="device" value="script:)" +
-         (dir / "lift.keys").string() + R"("/>
-    </module>
-  </modules>
-  <connections>
-    <connection from="bodies.objects" to="field.objects"/>
-    <connection from="bodies.objects" to="contacts.objects"/>
-    <connection from="bodies.objects" to="grab.objects"/>
-    <connection from="field.forces" to="bodies.events"/>
-    <connection from="contacts.forces" to="bodies.events"/>
-    <connection from="grab.forces" to="bodies.events"/>
-  </connections>
-</application>
-)";
-}
 
 /// One module's compute spans (start, end) in µs, in order.
 using Spans = std::vector<std::pair<double, double>>;
@@ -183,11 +113,13 @@ void report(const Trace& trace, const std::string& device, const std::string& fl
   std::fflush(stdout);
 }
 
-int run(const fs::path& bin, const fs::path& app, const fs::path& trace, int iterations) {
-  const std::string command = "'" + (bin / "vrflow").string() + "' run '" + app.string() +
-                              "' --no-progress -n " + std::to_string(iterations) + " --trace '" +
-                              trace.string() + "' --log-dir '" +
-                              (app.parent_path() / "logs").string() + "' >/dev/null";
+/// Runs `app` (bench/ in the source tree) in `dir`, where its outputs and logs go.
+int run(const fs::path& bin, const fs::path& app, const fs::path& dir, const fs::path& trace,
+        int iterations) {
+  const std::string command = "cd '" + dir.string() + "' && '" + (bin / "vrflow").string() +
+                              "' run '" + app.string() + "' --no-progress -n " +
+                              std::to_string(iterations) + " --trace '" + trace.string() +
+                              "' --log-dir '" + (dir / "logs").string() + "' >/dev/null";
   return std::system(command.c_str());
 }
 
@@ -203,17 +135,13 @@ int main(int argc, char** argv) {
   char pattern[] = "/tmp/vrflow-bench-input-XXXXXX";
   if (!mkdtemp(pattern)) return 1;
   const fs::path dir = pattern;
-  std::ofstream(dir / "scene.json") << kGround;
-  std::ofstream(dir / "press.keys") << kPress;
-  std::ofstream(dir / "lift.keys") << kLift;
-  std::ofstream(dir / "haptic.xml") << hapticApp(dir);
-  std::ofstream(dir / "grab.xml") << grabApp(dir);
+  const fs::path apps = VRFLOW_INPUT_BENCH_DIR;
   utsname name{};
   uname(&name);
   const std::string host = name.nodename;
 
   // The haptic loop: `seconds` of real time at 1 kHz, 100 physics steps a second.
-  if (run(bin, dir / "haptic.xml", dir / "haptic.json", 100 * seconds) != 0) {
+  if (run(bin, apps / "haptic_latency.xml", dir, dir / "haptic.json", 100 * seconds) != 0) {
     std::fprintf(stderr, "vrflow-bench-input: the haptic run failed (logs in %s)\n", dir.c_str());
     return 1;
   }
@@ -221,7 +149,7 @@ int main(int argc, char** argv) {
   const double ticks = static_cast<double>(haptic.compute.at("tool").size());
   report(haptic, "haptic-arm", "tool -> hand", "tool", ticks / haptic.wall, host);
 
-  if (run(bin, dir / "grab.xml", dir / "grab.json", 200 * seconds) != 0) {
+  if (run(bin, apps / "grab_latency.xml", dir, dir / "grab.json", 200 * seconds) != 0) {
     std::fprintf(stderr, "vrflow-bench-input: the grab run failed (logs in %s)\n", dir.c_str());
     return 1;
   }

@@ -41,15 +41,11 @@ int main() {
         return 1;
       }
     }
-    input::feedPointerEvents(*device, module.get(events));
     const double dt = module.timeStep() > 0 ? module.timeStep() : fallbackDt;
     const double time =
         module.timeStep() > 0 ? module.simTime() : static_cast<double>(module.iteration()) * dt;
-    auto sample = device->sample(time);
-    if (!sample) {
-      std::fprintf(stderr, "%s: %s\n", program.c_str(), sample.error().message.c_str());
-      return 1;
-    }
+    const auto sample = input::nextSample(module, &events, *device, program, time);
+    if (!sample) return 1;
     const bool pressed = sample->present && (sample->buttons & (1u << button)) != 0;
     if (!pressed) held.reset();
     if (pressed && !held) {

@@ -52,11 +52,8 @@ int main() {
                  "contact_x,contact_y,contact_z,feedback_x,feedback_y,feedback_z\n");
   }
   const double dt = coupling.period;
-  const auto first = device->sample(0.0);
-  if (!first) {
-    std::fprintf(stderr, "%s: %s\n", program.c_str(), first.error().message.c_str());
-    return 1;
-  }
+  const auto first = input::nextSample(module, nullptr, *device, program, 0.0);
+  if (!first) return 1;
   input::HapticTool tool(coupling, first->position);
   rigid::Body body =
       rigid::makeBody(module.newId(), msg::Shape::sphere(params.getFloat("tool-radius")),
@@ -91,11 +88,8 @@ int main() {
       }
     }
     const double time = static_cast<double>(module.iteration()) * dt;
-    auto sample = device->sample(time);
-    if (!sample) {
-      std::fprintf(stderr, "%s: %s\n", program.c_str(), sample.error().message.c_str());
-      return 1;
-    }
+    const auto sample = input::nextSample(module, nullptr, *device, program, time);
+    if (!sample) return 1;
     const msg::Vec3 force = tool.step(*sample, contact);
     device->render(force, dt);
     body.position = tool.position();

@@ -1,7 +1,5 @@
 // input/pointer: a kinematic rigid sphere at the device's tip, an animator without event input
 // (the paper's section 3.7): the rigid interactor collides it with the bodies, so it pushes them.
-#include <cstdio>
-
 #include "vrflow/input/module_device.hpp"
 #include "vrflow/module/start.hpp"
 #include "vrflow/rigid/messages.hpp"
@@ -10,23 +8,17 @@ int main() {
   using namespace vrflow;
   const std::string program = "vrflow-input-pointer";
   Module module;
-  const InputPort& events = module.addInput("device");
-  const OutputPort& objects = module.addOutput("objects");
-  if (!initOrReport(module, program)) return 2;
-  auto device = input::openModuleDevice(module, program);
-  if (!device) return 2;
+  auto started = input::startDeviceModule(module, program);
+  if (!started) return 2;
   const double dt = module.params().getFloat("dt");
   const double radius = module.params().getFloat("radius");
   rigid::Body body = rigid::makeKinematic(module.newId(), msg::Shape::sphere(radius), {0, 0, 0});
   const std::uint64_t shapeId = module.newId();
   while (module.wait()) {
-    input::feedPointerEvents(*device, module.get(events));
     const double time = static_cast<double>(module.iteration()) * dt;
-    auto sample = device->sample(time);
-    if (!sample) {
-      std::fprintf(stderr, "%s: %s\n", program.c_str(), sample.error().message.c_str());
-      return 1;
-    }
+    const auto sample =
+        input::nextSample(module, &started->events, *started->device, program, time);
+    if (!sample) return 1;
     body.position = sample->position;
     body.orientation = sample->orientation;
     body.linearVelocity = sample->velocity;
@@ -37,7 +29,7 @@ int main() {
       rigid::writeAdd(out.builder(), body, shapeId);
     else
       rigid::writeUpdate(out.builder(), body, {body.id, true, true});
-    if (!module.put(objects, std::move(out))) break;
+    if (!module.put(started->objects, std::move(out))) break;
   }
   return module.exitStatus();
 }

@@ -3,6 +3,8 @@
 
 #include <cstdio>
 
+#include "vrflow/module/start.hpp"
+
 namespace vrflow::input {
 
 std::unique_ptr<Device> openModuleDevice(const Module& module, const std::string& program,
@@ -54,6 +56,26 @@ int feedPointerEvents(Device& device, const Message& message) {
     }
   }
   return count;
+}
+
+std::optional<DeviceModule> startDeviceModule(Module& module, const std::string& program) {
+  const InputPort& events = module.addInput("device");
+  const OutputPort& objects = module.addOutput("objects");
+  if (!initOrReport(module, program)) return std::nullopt;
+  auto device = openModuleDevice(module, program);
+  if (!device) return std::nullopt;
+  return DeviceModule{events, objects, std::move(device)};
+}
+
+std::optional<DeviceSample> nextSample(const Module& module, const InputPort* events,
+                                       Device& device, const std::string& program, double time) {
+  if (events) feedPointerEvents(device, module.get(*events));
+  auto sample = device.sample(time);
+  if (!sample) {
+    std::fprintf(stderr, "%s: %s\n", program.c_str(), sample.error().message.c_str());
+    return std::nullopt;
+  }
+  return *sample;
 }
 
 }  // namespace vrflow::input

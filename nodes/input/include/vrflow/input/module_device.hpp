@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "vrflow/input/device.hpp"
@@ -20,5 +21,22 @@ std::unique_ptr<Device> openModuleDevice(const Module& module, const std::string
 
 /// Feeds the pointer events of `message` (if valid) to the device; returns how many.
 int feedPointerEvents(Device& device, const Message& message);
+
+/// The ports and the device of a module that only publishes a device (pointer, head): a
+/// `device` input for window events, an `objects` output.
+struct DeviceModule {
+  const InputPort& events;
+  const OutputPort& objects;
+  std::unique_ptr<Device> device;
+};
+
+/// Declares the ports, joins the run and opens the device; nullopt (after printing why) when it
+/// cannot: exit with status 2.
+std::optional<DeviceModule> startDeviceModule(Module& module, const std::string& program);
+
+/// Feeds this iteration's window events from `events` (when given) and samples the device at
+/// `time`; nullopt after printing "PROGRAM: why" when the device fails: exit with status 1.
+std::optional<DeviceSample> nextSample(const Module& module, const InputPort* events,
+                                       Device& device, const std::string& program, double time);
 
 }  // namespace vrflow::input
