@@ -119,6 +119,10 @@ std::optional<int> Background::wait(double seconds) {
   return status;
 }
 
+void Background::signal(int signal) {
+  if (pid_ > 0) kill(pid_, signal);
+}
+
 int xdotool(const std::string& display, const std::vector<std::string>& args) {
   std::vector<std::string> argv{"/usr/bin/env", "DISPLAY=" + display, "xdotool"};
   argv.insert(argv.end(), args.begin(), args.end());

@@ -41,6 +41,9 @@ class Background {
   ~Background();
   /// Its exit status (128 + signal when killed), or nullopt when it still runs after `seconds`.
   std::optional<int> wait(double seconds);
+  /// Sends `signal` to it (if it still runs).
+  void signal(int signal);
+  pid_t pid() const { return pid_; }
 
  private:
   pid_t pid_ = 0;
