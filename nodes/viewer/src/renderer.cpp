@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "edge_blend.hpp"
 #include "vrflow/message/eigen.hpp"
 #include "vrflow/message/shape.hpp"
 
@@ -336,6 +337,11 @@ Status checkSettings(const RenderSettings& settings) {
     return makeError("supersample must be 1..4 and keep the drawn size within 8192 pixels, got " +
                      std::to_string(settings.supersample));
   }
+  if (!settings.blendMask.empty() &&
+      settings.blendMask.size() != static_cast<std::size_t>(settings.width) * settings.height) {
+    return makeError("the blend mask has " + std::to_string(settings.blendMask.size()) +
+                     " bytes, not one per pixel of the image");
+  }
   const Tile& t = settings.tile;
   if (t.cols < 1 || t.rows < 1 || t.col < 0 || t.row < 0 || t.col >= t.cols || t.row >= t.rows) {
     return makeError("tile " + std::to_string(t.col) + " " + std::to_string(t.row) + " of " +
@@ -433,6 +439,7 @@ Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera,
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_BLEND);
   }
+  if (!s.blendMask.empty()) applyBlendMask(s.blendMask, s.width, s.height, s.supersample);
   glFinish();
   if (r.window) {
     // The back buffer, before the caller swaps it to the front (rows from the bottom).

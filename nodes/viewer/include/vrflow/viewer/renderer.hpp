@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "vrflow/base/result.hpp"
 #include "vrflow/viewer/camera.hpp"
@@ -35,6 +36,9 @@ struct RenderSettings {
   double pointRadius = 0.08;  ///< spheres drawn for `point` objects
   float particleSize = 3.0f;  ///< fluid particles, pixels
   std::array<float, 3> particleColour{0.15f, 0.40f, 0.85f};
+  /// Edge blending of a wall tile (wall.hpp's blendMask): width x height bytes, rows from the
+  /// top, the frame multiplied by mask / 255; empty: none.
+  std::vector<std::uint8_t> blendMask;
 };
 
 /// The fixed lights: white, directional (world directions towards the lights), no specular. A lit
