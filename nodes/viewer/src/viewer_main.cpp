@@ -18,6 +18,7 @@
 #include "vrflow/viewer/frame_writer.hpp"
 #include "vrflow/viewer/renderer.hpp"
 #include "vrflow/viewer/view_volume.hpp"
+#include "vrflow/viewer/wall.hpp"
 #include "vrflow/viewer/window.hpp"
 
 namespace {
@@ -62,6 +63,7 @@ int main() {
   auto& events = module.addOutput("events");
   auto& ready = module.addOutput("ready");
   auto& release = module.addInput("swap");
+  auto& head = module.addInput("head");
   if (!initOrReport(module, "vrflow-viewer")) return 2;
   ParamProblems params(module);
   const Parameters& values = module.params();
@@ -126,10 +128,46 @@ int main() {
       path = std::move(*loaded);
     }
   }
+  // A tile of a wall file: its pixels, blend mask and head-coupled view replace the viewer's own
+  // size, tile and camera; `window` 'wall' takes its display and window from the file.
+  std::optional<viewer::Wall> wall;
+  const viewer::WallTile* wallTile = nullptr;
+  std::string place = values.getString("window");
+  std::string display = values.getString("display");
+  if (const auto file = values.getString("wall"); !file.empty()) {
+    auto loaded = viewer::loadWall(file);
+    if (!loaded) {
+      params.fail("wall", loaded.error().message);
+    } else {
+      wall = std::move(*loaded);
+      wallTile = wall->find(values.getString("wall-tile"));
+      if (!wallTile) {
+        params.fail("wall-tile", "names no tile of wall file '" + file + "': '" +
+                                     values.getString("wall-tile") + "'");
+      }
+    }
+    if (values.getString("tile") != "0 0 1 1") params.fail("tile", "conflicts with 'wall'");
+    if (!values.getString("camera-path").empty()) {
+      params.fail("camera-path", "conflicts with 'wall' (the wall's eye or 'head' moves it)");
+    }
+  } else if (!values.getString("wall-tile").empty()) {
+    params.fail("wall-tile", "needs 'wall'");
+  }
+  if (wallTile) {
+    render.width = output.width = wall->pixelsX;
+    render.height = output.height = wall->pixelsY;
+    render.blendMask = viewer::blendMask(*wall, wallTile->col, wallTile->row);
+    if (place == "wall") {
+      place = wallTile->window;
+      if (display.empty()) display = wallTile->display;
+    }
+  } else if (place == "wall") {
+    params.fail("window", "is 'wall' but no 'wall' file is given");
+  }
   std::optional<viewer::WindowSettings> onScreen;
-  if (const auto place = values.getString("window"); !place.empty()) {
+  if (!place.empty()) {
     onScreen = viewer::WindowSettings{};
-    onScreen->display = values.getString("display");
+    onScreen->display = display;
     onScreen->width = render.width;
     onScreen->height = render.height;
     onScreen->title = "vrflow " + module.id();
@@ -142,7 +180,7 @@ int main() {
                                 place + "'");
     }
     if (render.supersample != 1) params.fail("supersample", "must be 1 on screen ('window' set)");
-  } else if (!values.getString("display").empty()) {
+  } else if (!display.empty()) {
     params.fail("display", "needs 'window' ('fullscreen' or 'X Y') to open a window on it");
   }
   if (release.connected() != ready.connected()) {
@@ -180,9 +218,10 @@ int main() {
   if (!swapLog) return fail(swapLog.error());
   const auto& t = render.tile;
   const std::string tileText =
-      t == viewer::Tile{} ? std::string()
-                          : ", tile " + std::to_string(t.col) + " " + std::to_string(t.row) +
-                                " of " + std::to_string(t.cols) + "x" + std::to_string(t.rows);
+      wallTile ? ", tile '" + wallTile->id + "' of wall '" + values.getString("wall") + "'"
+      : t == viewer::Tile{} ? std::string()
+                            : ", tile " + std::to_string(t.col) + " " + std::to_string(t.row) +
+                                  " of " + std::to_string(t.cols) + "x" + std::to_string(t.rows);
   const std::string where =
       window ? "a window on " + std::string(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "?") +
                    (writer ? " and " + writer->description() : std::string())
@@ -202,6 +241,10 @@ int main() {
   msg::Aabb within{{inf, inf, inf}, {-inf, -inf, -inf}};
   int status = 0;
   const std::uint64_t eventSource = module.newId();
+  // The head: the first point object (by id) of the `head` input, as last seen.
+  viewer::SceneCache heads(4, [](const std::string&) {});
+  std::optional<viewer::TileView> wallView;
+  bool headRefused = false;
   std::optional<std::uint64_t> readied;  // the iteration whose `ready` went out last
   bool drawn = false;                    // that iteration's frame waits in the back buffer
   std::uint64_t shown = 0;
@@ -225,8 +268,33 @@ int main() {
         drawn = false;
       }
     }
-    const auto cam = path->at(module.iteration());
-    const auto frustum = viewer::tileFrustum(cam, render.tile, render.width, render.height);
+    if (head.connected() && module.get(head).valid()) heads.apply(module.get(head).view());
+    if (wallTile) {
+      msg::Vec3 eye = wall->eye;
+      for (const auto& [id, object] : heads.objects()) {
+        if (object.kind != viewer::ObjectKind::Point) continue;
+        eye = object.position;
+        break;
+      }
+      auto view = viewer::tileView(*wall, wallTile->col, wallTile->row, eye);
+      if (view) {
+        wallView = *view;
+        headRefused = false;
+      } else if (!headRefused) {
+        // Logged once per stretch: the tile keeps the last view it could make.
+        std::fprintf(stderr, "%shead position refused (%s)%s\n", prefix.c_str(),
+                     view.error().message.c_str(), wallView ? ": keeping the last view" : "");
+        headRefused = true;
+      }
+      if (!wallView) {
+        status = fail(view.error());
+        break;
+      }
+    }
+    const auto cam = wallView ? wallView->camera : path->at(module.iteration());
+    const auto frustum = wallView
+                             ? wallView->frustum
+                             : viewer::tileFrustum(cam, render.tile, render.width, render.height);
     if (window) {
       // The window's events, each pointer event with its world ray through this tile's view.
       auto happened = window->poll();
