@@ -107,6 +107,49 @@ TEST(DisplayWall, TheRecordedMosaicOfTheSwapLockedWallEqualsOneViewOfTheWholeWal
   EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
 }
 
+// The 4 x 4 example over four loopback hosts (vrflow launch, tiles of 60 x 34 pixels): every
+// tile on every host shows frames 0, 1, ... in step, and the recorder joins all 16.
+TEST(DisplayWall, TheFourByFourWallOverFourLoopbackHostsShowsEveryFrameInStep) {
+  TempDir dir;
+  std::string wall = vrflow::testing::readFile(exampleDir() + "/wall_4x4.wall");
+  replaceAll(wall, "pixels 240 135", "pixels 60 34");
+  dir.write("wall.wall", wall);
+  std::string app = vrflow::testing::readFile(exampleDir() + "/display_wall_4x4.xml");
+  replaceAll(app, "\"../paper_scene/scene.json\"",
+             "\"" + vrflow::testing::sourceDir() + "/examples/paper_scene/scene.json\"");
+  replaceAll(app, "value=\"wall_4x4.wall\"", "value=\"" + dir.file("wall.wall") + "\"");
+  const auto file = dir.write("display_wall_4x4.xml", app);
+  fs::create_directories(dir.file("display-wall-4x4"));
+  constexpr int kFrames = 8;
+  const auto result = vrflow::testing::runCommand(
+      {"/bin/sh", "-c",
+       "cd '" + dir.path() + "' && exec '" + vrflow::testing::binDir() + "/vrflow' launch '" +
+           file + "' --composites '" + exampleDir() + "' -n " + std::to_string(kFrames) +
+           " --no-progress --report report.json"},
+      180);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto report = vrflow::testing::readFile(dir.file("report.json"));
+  EXPECT_NE(report.find("\"hosts\": 4"), std::string::npos) << report;
+  for (int t = 0; t < 16; ++t) {
+    const auto lines =
+        vrflow::testing::readLines(dir.file("display-wall-4x4/t" + std::to_string(t) + ".swaps"));
+    ASSERT_EQ(lines.size(), static_cast<std::size_t>(kFrames - 1)) << "tile " << t;
+    for (int k = 0; k + 1 < kFrames; ++k) {
+      EXPECT_EQ(lines[k].substr(0, lines[k].find(' ')), std::to_string(k)) << "tile " << t;
+    }
+  }
+  const auto mosaic = vrflow::testing::runCommand(
+      {vrflow::testing::binDir() + "/vrflow-wall-mosaic", dir.file("wall.wall"),
+       dir.file("display-wall-4x4"), "--out", dir.file("mosaic")},
+      60);
+  ASSERT_EQ(mosaic.exitCode, 0) << mosaic.err;
+  const auto last = readPng(dir.file("mosaic/wall_000007.png"));
+  ASSERT_TRUE(last.ok());
+  EXPECT_EQ(last->width, 4 * 60 + 3 * 1);  // 1.5 cm mullions at 60 px per 0.8 m: 1 pixel
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+  EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
+}
+
 TEST(DisplayWall, TheRecorderRefusesAMissingTileFrameNamingIt) {
   TempDir dir;
   fs::create_directories(dir.file("frames"));
