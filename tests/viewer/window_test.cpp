@@ -128,6 +128,23 @@ TEST_F(OnScreen, PointerAndKeysOfTheWindowComeOutAsEventsInWindowPixels) {
   EXPECT_EQ(keys[1].action, msg::KeyAction::Release);
 }
 
+// Full screen on screen 0 (320 x 240): the window covers the screen and the renderer draws it.
+TEST_F(OnScreen, AFullScreenWindowCoversItsScreen) {
+  auto window = Window::open({server_->display(0), 320, 240, true, 0, 0, "full"});
+  ASSERT_TRUE(window.ok()) << window.error().message;
+  EXPECT_EQ(window->width(), 320);
+  EXPECT_EQ(window->height(), 240);
+  RenderSettings settings;
+  settings.width = 320;
+  settings.height = 240;
+  settings.supersample = 1;
+  auto renderer = Renderer::create(settings, *window);
+  ASSERT_TRUE(renderer.ok()) << renderer.error().message;
+  const auto image = renderer->render(testing::wallScene(), testing::wallCamera());
+  ASSERT_TRUE(image.ok());
+  EXPECT_EQ(image->width, 320);
+}
+
 TEST(Window, ADisplayThatDoesNotAnswerIsAnErrorNamingIt) {
   auto window = Window::open({":39.5", 64, 64, false, 0, 0, "nowhere"});
   ASSERT_FALSE(window.ok());
