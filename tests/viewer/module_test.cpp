@@ -257,5 +257,77 @@ TEST(ViewerModule, WritesAnMp4WhenFfmpegIsPresent) {
   EXPECT_NE(result.err.find("MP4"), std::string::npos) << result.err;
 }
 
+// A wall tile fed a tracked head draws exactly what a tile whose wall file puts the fixed eye
+// there draws, and not what the file's own eye shows.
+TEST(ViewerModule, AWallTileLooksFromTheHeadItReceives) {
+  TempDir dir;
+  const std::string wall =
+      "grid 1 1\npixels 160 90\nsize 1.6 0.9\ncentre 0 1.2 2\ntile w 0 0 h :0 0 0\n";
+  dir.write("far.wall", wall + "eye 0 1.5 6\n");
+  dir.write("head.wall", wall + "eye 0.8 2 5\n");
+  const auto viewer = [&](const std::string& id, const std::string& file) {
+    return "<module id=\"" + id + "\" package=\"viewer\" type=\"viewer\" host=\"local\">" +
+           param("wall", dir.file(file)) + param("wall-tile", "w") +
+           param("output-dir", dir.file("frames")) + param("prefix", id) + param("format", "png") +
+           param("supersample", "1") + "</module>";
+  };
+  const std::string app = R"(<?xml version="1.0" encoding="UTF-8"?>
+<application name="head-test" version="1">
+  <hosts><host id="local" address="127.0.0.1"/></hosts>
+  <modules>
+    <module id="bodies" package="viewer-testing" type="bodies" host="local"/>
+    <module id="tracker" package="viewer-testing" type="head" host="local">)" +
+                          param("position", "0.8 2 5") + "</module>" +
+                          viewer("tracked", "far.wall") + viewer("placed", "head.wall") +
+                          viewer("fixed", "far.wall") + R"(
+  </modules>
+  <connections>
+    <connection from="bodies.objects" to="tracked.objects"/>
+    <connection from="bodies.objects" to="placed.objects"/>
+    <connection from="bodies.objects" to="fixed.objects"/>
+    <connection from="tracker.objects" to="tracked.head"/>
+  </connections>
+</application>
+)";
+  const auto result = run(dir, app);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_NE(result.err.find("tile 'w' of wall"), std::string::npos) << result.err;
+  for (int k = 0; k < 5; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "_%06d.png", k);
+    const auto tracked = readPng(dir.file("frames/tracked") + name);
+    const auto placed = readPng(dir.file("frames/placed") + name);
+    const auto fixed = readPng(dir.file("frames/fixed") + name);
+    ASSERT_TRUE(tracked.ok() && placed.ok() && fixed.ok()) << k;
+    EXPECT_EQ(tracked->width, 160);
+    EXPECT_EQ(tracked->rgb, placed->rgb) << "frame " << k;
+    EXPECT_NE(tracked->rgb, fixed->rgb) << "frame " << k;
+  }
+}
+
+TEST(ViewerModule, BadWallParametersStopTheRunNamingThem) {
+  TempDir dir;
+  dir.write("w.wall", "grid 1 1\ntile w 0 0 h :0 0 0\n");
+  dir.write("broken.wall", "grid 1 1\nsize 1\ntile w 0 0 h :0 0 0\n");
+  const auto out = dir.file("frames");
+  const auto unknownTile = run(dir, application(common(out) + param("wall", dir.file("w.wall")) +
+                                                param("wall-tile", "nope")));
+  EXPECT_NE(unknownTile.exitCode, 0);
+  EXPECT_NE(unknownTile.err.find("parameter 'wall-tile' names no tile"), std::string::npos)
+      << unknownTile.err;
+  const auto conflict = run(dir, application(common(out) + param("wall", dir.file("w.wall")) +
+                                             param("wall-tile", "w") + param("tile", "0 0 2 2")));
+  EXPECT_NE(conflict.err.find("parameter 'tile' conflicts with 'wall'"), std::string::npos)
+      << conflict.err;
+  const auto broken = run(dir, application(common(out) + param("wall", dir.file("broken.wall")) +
+                                           param("wall-tile", "w")));
+  EXPECT_NE(broken.exitCode, 0);
+  EXPECT_NE(broken.err.find("broken.wall:2: 'size' expects"), std::string::npos) << broken.err;
+  const auto lonely = run(dir, application(common(out) + param("wall-tile", "w")));
+  EXPECT_NE(lonely.err.find("parameter 'wall-tile' needs 'wall'"), std::string::npos) << lonely.err;
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+  EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
+}
+
 }  // namespace
 }  // namespace vrflow::viewer

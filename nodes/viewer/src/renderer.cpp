@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "edge_blend.hpp"
 #include "vrflow/message/eigen.hpp"
 #include "vrflow/message/shape.hpp"
 
@@ -136,9 +137,10 @@ std::array<float, 3> objectColour(std::uint64_t id) {
 
 struct Renderer::Impl {
   RenderSettings settings;
-  OSMesaContext context = nullptr;
-  std::vector<std::uint8_t> rgba;  // the OSMesa colour buffer, rows from the bottom
-  int bufferWidth = 0;             // settings' size times the supersampling factor
+  OSMesaContext context = nullptr;  // headless, or
+  Window* window = nullptr;         // on screen
+  std::vector<std::uint8_t> rgba;   // the OSMesa colour buffer, rows from the bottom
+  int bufferWidth = 0;              // settings' size times the supersampling factor
   int bufferHeight = 0;
   DrawMesh unitSphere;      // point objects
   std::string description;  // GL_RENDERER and GL_VERSION
@@ -147,12 +149,21 @@ struct Renderer::Impl {
     if (context) OSMesaDestroyContext(context);
   }
 
-  void setUpFrame(const Camera& camera) const;
+  bool bind();
+  void setUpFrame(const Camera& camera, const Frustum& f) const;
   void drawGround() const;
   void drawObjects(const SceneCache& scene, bool shadowPass, const msg::Aabb* within) const;
 };
 
-void Renderer::Impl::setUpFrame(const Camera& camera) const {
+bool Renderer::Impl::bind() {
+  if (window) {
+    window->makeCurrent();
+    return true;
+  }
+  return OSMesaMakeCurrent(context, rgba.data(), GL_UNSIGNED_BYTE, bufferWidth, bufferHeight);
+}
+
+void Renderer::Impl::setUpFrame(const Camera& camera, const Frustum& f) const {
   const auto& s = settings;
   glViewport(0, 0, bufferWidth, bufferHeight);
   glClearColor(s.background[0], s.background[1], s.background[2], 1.0f);
@@ -160,8 +171,6 @@ void Renderer::Impl::setUpFrame(const Camera& camera) const {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
   glMatrixMode(GL_PROJECTION);
   glLoadIdentity();
-  // The tile's share of the whole view's window (the whole window for the default tile).
-  const Frustum f = tileFrustum(camera, s.tile, s.width, s.height);
   glFrustum(f.left, f.right, f.bottom, f.top, f.nearPlane, f.farPlane);
   glMatrixMode(GL_MODELVIEW);
   const Matrix view = lookAt(camera);
@@ -302,7 +311,6 @@ void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass,
   }
 }
 
-Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 Renderer::~Renderer() = default;
@@ -315,7 +323,9 @@ const std::string& Renderer::description() const {
   return impl_->description;
 }
 
-Result<Renderer> Renderer::create(const RenderSettings& settings) {
+namespace {
+
+Status checkSettings(const RenderSettings& settings) {
   if (settings.width < 1 || settings.height < 1 || settings.width > 8192 ||
       settings.height > 8192) {
     return makeError("image size must be 1..8192 pixels each way, got " +
@@ -327,11 +337,23 @@ Result<Renderer> Renderer::create(const RenderSettings& settings) {
     return makeError("supersample must be 1..4 and keep the drawn size within 8192 pixels, got " +
                      std::to_string(settings.supersample));
   }
+  if (!settings.blendMask.empty() &&
+      settings.blendMask.size() != static_cast<std::size_t>(settings.width) * settings.height) {
+    return makeError("the blend mask has " + std::to_string(settings.blendMask.size()) +
+                     " bytes, not one per pixel of the image");
+  }
   const Tile& t = settings.tile;
   if (t.cols < 1 || t.rows < 1 || t.col < 0 || t.row < 0 || t.col >= t.cols || t.row >= t.rows) {
     return makeError("tile " + std::to_string(t.col) + " " + std::to_string(t.row) + " of " +
                      std::to_string(t.cols) + " x " + std::to_string(t.rows) + " is not a tile");
   }
+  return {};
+}
+
+}  // namespace
+
+Result<Renderer> Renderer::create(const RenderSettings& settings) {
+  if (auto valid = checkSettings(settings); !valid) return valid.error();
   auto impl = std::make_unique<Impl>();
   impl->settings = settings;
   impl->context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
@@ -344,28 +366,56 @@ Result<Renderer> Renderer::create(const RenderSettings& settings) {
     return makeError("OSMesa could not bind a " + std::to_string(impl->bufferWidth) + "x" +
                      std::to_string(impl->bufferHeight) + " frame buffer");
   }
+  return Renderer(std::move(impl));
+}
+
+Result<Renderer> Renderer::create(const RenderSettings& settings, Window& window) {
+  if (auto valid = checkSettings(settings); !valid) return valid.error();
+  if (settings.supersample != 1) {
+    return makeError("supersample must be 1 on screen, got " +
+                     std::to_string(settings.supersample));
+  }
+  if (window.width() != settings.width || window.height() != settings.height) {
+    return makeError("the window is " + std::to_string(window.width()) + "x" +
+                     std::to_string(window.height()) + " pixels, not " +
+                     std::to_string(settings.width) + "x" + std::to_string(settings.height));
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->settings = settings;
+  impl->window = &window;
+  impl->bufferWidth = settings.width;
+  impl->bufferHeight = settings.height;
+  impl->rgba.resize(static_cast<std::size_t>(impl->bufferWidth) * impl->bufferHeight * 4);
+  impl->bind();
+  return Renderer(std::move(impl));
+}
+
+Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {
   const auto glString = [](GLenum name) {
     const auto* text = reinterpret_cast<const char*>(glGetString(name));
     return std::string(text ? text : "?");
   };
-  impl->description = glString(GL_RENDERER) + ", OpenGL " + glString(GL_VERSION);
+  impl_->description = glString(GL_RENDERER) + ", OpenGL " + glString(GL_VERSION);
   const auto sphere = msg::renderMesh(msg::Shape::sphere(1.0), 16);
-  impl->unitSphere = buildDrawMesh(sphere.xyz, sphere.indices);
-  return Renderer(std::move(impl));
+  impl_->unitSphere = buildDrawMesh(sphere.xyz, sphere.indices);
 }
 
 Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera,
                                const msg::Aabb* within) {
+  // The tile's share of the whole view's window (the whole window for the default tile).
+  const auto& s = impl_->settings;
+  return render(scene, camera, tileFrustum(camera, s.tile, s.width, s.height), within);
+}
+
+Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera,
+                               const Frustum& frustum, const msg::Aabb* within) {
   Impl& r = *impl_;
   const auto& s = r.settings;
-  if (!OSMesaMakeCurrent(r.context, r.rgba.data(), GL_UNSIGNED_BYTE, r.bufferWidth,
-                         r.bufferHeight)) {
-    return makeError("OSMesa could not bind the frame buffer");
-  }
+  if (!r.bind()) return makeError("OSMesa could not bind the frame buffer");
   if (!finite(camera.eye) || !finite(camera.target) || camera.eye == camera.target) {
     return makeError("camera eye and target must be finite and distinct");
   }
-  r.setUpFrame(camera);
+  r.setUpFrame(camera, frustum);
   if (s.ground) r.drawGround();
   r.drawObjects(scene, false, within);
   if (s.ground && s.shadows) {
@@ -389,7 +439,14 @@ Result<Image> Renderer::render(const SceneCache& scene, const Camera& camera,
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_BLEND);
   }
+  if (!s.blendMask.empty()) applyBlendMask(s.blendMask, s.width, s.height, s.supersample);
   glFinish();
+  if (r.window) {
+    // The back buffer, before the caller swaps it to the front (rows from the bottom).
+    glReadBuffer(GL_BACK);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, r.bufferWidth, r.bufferHeight, GL_RGBA, GL_UNSIGNED_BYTE, r.rgba.data());
+  }
   if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
     return makeError("OpenGL error " + std::to_string(error) + " while rendering");
   }

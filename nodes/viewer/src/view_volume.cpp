@@ -84,6 +84,16 @@ Frustum tileFrustum(const Camera& camera, const Tile& tile, int width, int heigh
   return f;
 }
 
+Ray pointerRay(const Camera& camera, const Frustum& frustum, int width, int height, double x,
+               double y) {
+  const ViewBasis b = viewBasis(camera);
+  const double wx = frustum.left + (frustum.right - frustum.left) * x / width;
+  const double wy = frustum.top - (frustum.top - frustum.bottom) * y / height;
+  const Eigen::Vector3d offset =
+      asEigen(b.forward) * frustum.nearPlane + asEigen(b.side) * wx + asEigen(b.up) * wy;
+  return Ray{msg::toVec3(asEigen(camera.eye) + offset), msg::toVec3(offset.normalized())};
+}
+
 Result<msg::Aabb> parseBox(std::string_view text) {
   std::string copy(text);
   std::replace(copy.begin(), copy.end(), ',', ' ');

@@ -1,7 +1,8 @@
-// viewer/viewer: renders the objects it receives with OSMesa into PNG frames or an MP4, the whole
-// view or one tile of a wall. It only reads: its outputs are the implicit endIt and `interest`
-// (its volume of interest, for a `route` filter), so it cannot change what the simulation
-// computes.
+// viewer/viewer: renders the objects it receives with OSMesa (or into a window on an X display)
+// into PNG frames or an MP4, the whole view or one tile of a wall. It only reads: its outputs
+// are the implicit endIt, `interest` (its volume of interest, for a `route` filter), `events`
+// (its window's pointer and keys) and `ready` (the swap-lock), so it cannot change what the
+// simulation computes.
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -11,11 +12,14 @@
 #include <sstream>
 #include <string>
 
+#include "swap_lock.hpp"
 #include "vrflow/module/module.hpp"
 #include "vrflow/module/start.hpp"
 #include "vrflow/viewer/frame_writer.hpp"
 #include "vrflow/viewer/renderer.hpp"
 #include "vrflow/viewer/view_volume.hpp"
+#include "vrflow/viewer/wall.hpp"
+#include "vrflow/viewer/window.hpp"
 
 namespace {
 
@@ -56,6 +60,10 @@ int main() {
   Module module;
   auto& objects = module.addInput("objects");
   auto& interest = module.addOutput("interest");
+  auto& events = module.addOutput("events");
+  auto& ready = module.addOutput("ready");
+  auto& release = module.addInput("swap");
+  auto& head = module.addInput("head");
   if (!initOrReport(module, "vrflow-viewer")) return 2;
   ParamProblems params(module);
   const Parameters& values = module.params();
@@ -98,7 +106,10 @@ int main() {
   output.width = render.width;
   output.height = render.height;
   output.fps = values.getFloat("fps");
-  if (auto format = viewer::parseFrameFormat(values.getString("format")); format) {
+  const bool writeFrames = values.getString("format") != "none";
+  if (!writeFrames) {
+    output.format = viewer::FrameFormat::Png;  // unused
+  } else if (auto format = viewer::parseFrameFormat(values.getString("format")); format) {
     output.format = *format;
   } else {
     params.fail("format", "expects png, mp4 or auto, got '" + values.getString("format") + "'");
@@ -117,33 +128,107 @@ int main() {
       path = std::move(*loaded);
     }
   }
+  // A tile of a wall file: its pixels, blend mask and head-coupled view replace the viewer's own
+  // size, tile and camera; `window` 'wall' takes its display and window from the file.
+  std::optional<viewer::Wall> wall;
+  const viewer::WallTile* wallTile = nullptr;
+  std::string place = values.getString("window");
+  std::string display = values.getString("display");
+  if (const auto file = values.getString("wall"); !file.empty()) {
+    auto loaded = viewer::loadWall(file);
+    if (!loaded) {
+      params.fail("wall", loaded.error().message);
+    } else {
+      wall = std::move(*loaded);
+      wallTile = wall->find(values.getString("wall-tile"));
+      if (!wallTile) {
+        params.fail("wall-tile", "names no tile of wall file '" + file + "': '" +
+                                     values.getString("wall-tile") + "'");
+      }
+    }
+    if (values.getString("tile") != "0 0 1 1") params.fail("tile", "conflicts with 'wall'");
+    if (!values.getString("camera-path").empty()) {
+      params.fail("camera-path", "conflicts with 'wall' (the wall's eye or 'head' moves it)");
+    }
+  } else if (!values.getString("wall-tile").empty()) {
+    params.fail("wall-tile", "needs 'wall'");
+  }
+  if (wallTile) {
+    render.width = output.width = wall->pixelsX;
+    render.height = output.height = wall->pixelsY;
+    render.blendMask = viewer::blendMask(*wall, wallTile->col, wallTile->row);
+    if (place == "wall") {
+      place = wallTile->window;
+      if (display.empty()) display = wallTile->display;
+    }
+  } else if (place == "wall") {
+    params.fail("window", "is 'wall' but no 'wall' file is given");
+  }
+  std::optional<viewer::WindowSettings> onScreen;
+  if (!place.empty()) {
+    onScreen = viewer::WindowSettings{};
+    onScreen->display = display;
+    onScreen->width = render.width;
+    onScreen->height = render.height;
+    onScreen->title = "vrflow " + module.id();
+    std::istringstream in(place);
+    std::string extra;
+    if (place == "fullscreen") {
+      onScreen->fullScreen = true;
+    } else if (!(in >> onScreen->x >> onScreen->y) || (in >> extra)) {
+      params.fail("window", "expects 'fullscreen' or the top-left corner 'X Y' (pixels), got '" +
+                                place + "'");
+    }
+    if (render.supersample != 1) params.fail("supersample", "must be 1 on screen ('window' set)");
+  } else if (!display.empty()) {
+    params.fail("display", "needs 'window' ('fullscreen' or 'X Y') to open a window on it");
+  }
+  if (release.connected() != ready.connected()) {
+    params.fail("swap-log",
+                "the swap-lock needs both 'ready' and 'swap' connected (through "
+                "merge and broadcast filters), not one of them");
+  }
   if (params.error) {
     std::fprintf(stderr, "vrflow-viewer: %s\n", params.error->message.c_str());
     return 2;
   }
   if (!path) path = viewer::CameraPath(camera);
 
-  auto renderer = viewer::Renderer::create(render);
-  if (!renderer) {
-    std::fprintf(stderr, "vrflow-viewer: module '%s': %s\n", module.id().c_str(),
-                 renderer.error().message.c_str());
-    return 2;
-  }
-  auto writer = viewer::FrameWriter::open(output);
-  if (!writer) {
-    std::fprintf(stderr, "vrflow-viewer: module '%s': %s\n", module.id().c_str(),
-                 writer.error().message.c_str());
-    return 2;
-  }
   const std::string prefix = "vrflow-viewer: module '" + module.id() + "': ";
+  const auto fail = [&prefix](const Error& error) {
+    std::fprintf(stderr, "%s%s\n", prefix.c_str(), error.message.c_str());
+    return 2;
+  };
+  std::optional<viewer::Window> window;
+  if (onScreen) {
+    auto opened = viewer::Window::open(*onScreen);
+    if (!opened) return fail(opened.error());
+    window = std::move(*opened);
+  }
+  auto renderer =
+      window ? viewer::Renderer::create(render, *window) : viewer::Renderer::create(render);
+  if (!renderer) return fail(renderer.error());
+  std::optional<viewer::FrameWriter> writer;
+  if (writeFrames) {
+    auto opened = viewer::FrameWriter::open(output);
+    if (!opened) return fail(opened.error());
+    writer = std::move(*opened);
+  }
+  auto swapLog = viewer::SwapLog::open(values.getString("swap-log"));
+  if (!swapLog) return fail(swapLog.error());
   const auto& t = render.tile;
   const std::string tileText =
-      t == viewer::Tile{} ? std::string()
-                          : ", tile " + std::to_string(t.col) + " " + std::to_string(t.row) +
-                                " of " + std::to_string(t.cols) + "x" + std::to_string(t.rows);
-  std::fprintf(stderr, "%swriting %s, %dx%d%s, every %d iteration(s); drawing with %s\n",
-               prefix.c_str(), writer->description().c_str(), render.width, render.height,
-               tileText.c_str(), every, renderer->description().c_str());
+      wallTile ? ", tile '" + wallTile->id + "' of wall '" + values.getString("wall") + "'"
+      : t == viewer::Tile{} ? std::string()
+                            : ", tile " + std::to_string(t.col) + " " + std::to_string(t.row) +
+                                  " of " + std::to_string(t.cols) + "x" + std::to_string(t.rows);
+  const std::string where =
+      window ? "a window on " + std::string(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "?") +
+                   (writer ? " and " + writer->description() : std::string())
+             : (writer ? writer->description() : std::string("nothing"));
+  std::fprintf(stderr, "%sdrawing into %s, %dx%d%s, every %d iteration(s), with %s%s\n",
+               prefix.c_str(), where.c_str(), render.width, render.height, tileText.c_str(), every,
+               renderer->description().c_str(), release.connected() ? ", swap-locked" : "");
 
   viewer::SceneCache scene(segments, [&prefix](const std::string& line) {
     std::fprintf(stderr, "%s%s\n", prefix.c_str(), line.c_str());
@@ -155,16 +240,90 @@ int main() {
   const double inf = std::numeric_limits<double>::infinity();
   msg::Aabb within{{inf, inf, inf}, {-inf, -inf, -inf}};
   int status = 0;
+  const std::uint64_t eventSource = module.newId();
+  // The head: the first point object (by id) of the `head` input, as last seen.
+  viewer::SceneCache heads(4, [](const std::string&) {});
+  std::optional<viewer::TileView> wallView;
+  bool headRefused = false;
+  std::optional<std::uint64_t> readied;  // the iteration whose `ready` went out last
+  bool drawn = false;                    // that iteration's frame waits in the back buffer
+  std::uint64_t shown = 0;
   while (module.wait()) {
+    if (release.connected()) {
+      // Every tile has drawn the frame this release names: show it now.
+      auto frame = viewer::releasedFrame(module.get(release).view().stamps());
+      if (frame && *frame != readied) {
+        frame = makeError("the swap release names frame " +
+                          (*frame ? std::to_string(**frame) : "none") + " but this tile is at " +
+                          (readied ? std::to_string(*readied) : "none"));
+      }
+      if (!frame) {
+        status = fail(frame.error());
+        break;
+      }
+      if (drawn) {
+        if (window) window->swap();
+        swapLog->shown(*readied);
+        ++shown;
+        drawn = false;
+      }
+    }
+    if (head.connected() && module.get(head).valid()) heads.apply(module.get(head).view());
+    if (wallTile) {
+      msg::Vec3 eye = wall->eye;
+      for (const auto& [id, object] : heads.objects()) {
+        if (object.kind != viewer::ObjectKind::Point) continue;
+        eye = object.position;
+        break;
+      }
+      auto view = viewer::tileView(*wall, wallTile->col, wallTile->row, eye);
+      if (view) {
+        wallView = *view;
+        headRefused = false;
+      } else if (!headRefused) {
+        // Logged once per stretch: the tile keeps the last view it could make.
+        std::fprintf(stderr, "%shead position refused (%s)%s\n", prefix.c_str(),
+                     view.error().message.c_str(), wallView ? ": keeping the last view" : "");
+        headRefused = true;
+      }
+      if (!wallView) {
+        status = fail(view.error());
+        break;
+      }
+    }
+    const auto cam = wallView ? wallView->camera : path->at(module.iteration());
+    const auto frustum = wallView
+                             ? wallView->frustum
+                             : viewer::tileFrustum(cam, render.tile, render.width, render.height);
+    if (window) {
+      // The window's events, each pointer event with its world ray through this tile's view.
+      auto happened = window->poll();
+      if (events.connected() && !happened.empty()) {
+        auto out = module.newMessage(256 + 160 * happened.size());
+        for (auto& event : happened) {
+          if (auto* pointer = std::get_if<msg::PointerEvent>(&event)) {
+            const auto ray = viewer::pointerRay(cam, frustum, render.width, render.height,
+                                                pointer->x, pointer->y);
+            pointer->rayOrigin = ray.origin;
+            pointer->rayDirection = ray.direction;
+            msg::addPointerEvent(out.builder(), eventSource, *pointer);
+          } else {
+            msg::addKeyEvent(out.builder(), eventSource, std::get<msg::KeyEvent>(event));
+          }
+        }
+        if (!module.put(events, std::move(out))) break;
+      }
+      if (window->closeRequested()) {
+        std::fprintf(stderr, "%sthe window was closed: ending\n", prefix.c_str());
+        break;
+      }
+    }
     const Message& message = module.get(objects);
     if (message.valid()) scene.apply(message.view());
     if (interest.connected()) {
       // At iteration 0, then whenever the camera moves the tile's volume: the box around its
       // frustum from the near plane to view-depth, within interest-box ("none" when empty).
-      const auto cam = path->at(module.iteration());
-      const auto volume = viewer::viewVolume(
-          cam, viewer::tileFrustum(cam, render.tile, render.width, render.height), viewDepth,
-          interestBox);
+      const auto volume = viewer::viewVolume(cam, frustum, viewDepth, interestBox);
       const std::string text = volume ? viewer::formatBox(*volume) : "none";
       within = volume ? *volume : msg::Aabb{{inf, inf, inf}, {-inf, -inf, -inf}};
       if (text != published) {
@@ -175,21 +334,39 @@ int main() {
         published = text;
       }
     }
-    if (module.iteration() % static_cast<std::uint64_t>(every) != 0) continue;
-    auto image = renderer->render(scene, path->at(module.iteration()),
-                                  interest.connected() ? &within : nullptr);
-    Status written = image ? writer->write(*image) : Status(image.error());
-    if (!written) {
-      std::fprintf(stderr, "%s%s\n", prefix.c_str(), written.error().message.c_str());
-      status = 1;
-      break;
+    if (module.iteration() % static_cast<std::uint64_t>(every) == 0) {
+      auto image = renderer->render(scene, cam, frustum, interest.connected() ? &within : nullptr);
+      Status written = !image ? Status(image.error()) : writer ? writer->write(*image) : Status();
+      if (!written) {
+        std::fprintf(stderr, "%s%s\n", prefix.c_str(), written.error().message.c_str());
+        status = 1;
+        break;
+      }
+      if (release.connected()) {
+        drawn = true;
+      } else if (window) {
+        window->swap();
+      }
+    }
+    if (ready.connected()) {
+      // Every iteration, drawn or not (`every`), so the barrier never waits on this tile.
+      auto out = module.newMessage();
+      viewer::stampReady(out.builder(), module.iteration());
+      if (!module.put(ready, std::move(out))) break;
+      readied = module.iteration();
     }
   }
-  if (auto closed = writer->close(); !closed) {
-    std::fprintf(stderr, "%s%s\n", prefix.c_str(), closed.error().message.c_str());
-    status = 1;
+  if (writer) {
+    if (auto closed = writer->close(); !closed) {
+      std::fprintf(stderr, "%s%s\n", prefix.c_str(), closed.error().message.c_str());
+      status = 1;
+    }
   }
-  std::fprintf(stderr, "%s%d frame(s) written; %llu shape resource(s) rejected\n", prefix.c_str(),
-               writer->frames(), static_cast<unsigned long long>(scene.stats().rejectedShapes));
+  std::fprintf(stderr,
+               "%s%d frame(s) written, %llu swap-locked frame(s) shown; %llu shape "
+               "resource(s) rejected\n",
+               prefix.c_str(), writer ? writer->frames() : 0,
+               static_cast<unsigned long long>(shown),
+               static_cast<unsigned long long>(scene.stats().rejectedShapes));
   return status != 0 ? status : module.exitStatus();
 }

@@ -4,14 +4,17 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "vrflow/base/result.hpp"
 #include "vrflow/viewer/camera.hpp"
 #include "vrflow/viewer/image.hpp"
 #include "vrflow/viewer/scene_cache.hpp"
 #include "vrflow/viewer/view_volume.hpp"
+#include "vrflow/viewer/window.hpp"
 
-// Draws a SceneCache with OpenGL 1.x through OSMesa (Mesa's software rasteriser, no display).
+// Draws a SceneCache with OpenGL 1.x through OSMesa (Mesa's software rasteriser, no display) or
+// into an on-screen Window: the same drawing code in either context.
 
 namespace vrflow::viewer {
 
@@ -33,6 +36,9 @@ struct RenderSettings {
   double pointRadius = 0.08;  ///< spheres drawn for `point` objects
   float particleSize = 3.0f;  ///< fluid particles, pixels
   std::array<float, 3> particleColour{0.15f, 0.40f, 0.85f};
+  /// Edge blending of a wall tile (wall.hpp's blendMask): width x height bytes, rows from the
+  /// top, the frame multiplied by mask / 255; empty: none.
+  std::vector<std::uint8_t> blendMask;
 };
 
 /// The fixed lights: white, directional (world directions towards the lights), no specular. A lit
@@ -52,11 +58,16 @@ inline constexpr Lighting kLighting{};
 /// the same colour, and neighbouring ids different ones.
 std::array<float, 3> objectColour(std::uint64_t id);
 
-/// An OSMesa context with its colour and depth buffers. One per thread at a time.
+/// An OSMesa context with its colour and depth buffers, or a window's context. One per thread
+/// at a time.
 class Renderer {
  public:
   /// Creates the context (RGBA, 24-bit depth, 8-bit stencil) for settings.width x height.
   static Result<Renderer> create(const RenderSettings& settings);
+  /// Draws into `window`'s back buffer (its size must be settings.width x height, supersample
+  /// 1); render() reads the pixels back before any swap, and the caller swaps. The window must
+  /// outlive the renderer.
+  static Result<Renderer> create(const RenderSettings& settings, Window& window);
   Renderer(Renderer&&) noexcept;
   Renderer& operator=(Renderer&&) noexcept;
   ~Renderer();
@@ -66,6 +77,10 @@ class Renderer {
   /// a routed viewer draws what its volume of interest holds, not objects the route stopped
   /// updating.
   Result<Image> render(const SceneCache& scene, const Camera& camera,
+                       const msg::Aabb* within = nullptr);
+  /// The same through an explicit `frustum` (a wall tile's head-coupled one) instead of the
+  /// settings' tile of the camera's view; `camera` gives the eye and the view's orientation.
+  Result<Image> render(const SceneCache& scene, const Camera& camera, const Frustum& frustum,
                        const msg::Aabb* within = nullptr);
   const RenderSettings& settings() const;
   /// The OpenGL renderer and version strings ("llvmpipe (LLVM 15, 256 bits), 4.5 ..."), for logs.

@@ -45,6 +45,17 @@ struct Frustum {
 /// the tile's window is its share of that view's window at the near plane.
 Frustum tileFrustum(const Camera& camera, const Tile& tile, int width, int height);
 
+/// A half-line in the world.
+struct Ray {
+  msg::Vec3 origin{};     ///< on the near plane
+  msg::Vec3 direction{};  ///< unit
+};
+/// The world ray through window point (`x`, `y`) (pixels from the top-left, continuous: pixel
+/// (i, j) spans [i, i+1) x [j, j+1)) of a `width` x `height` window showing `frustum` seen by
+/// `camera`: it starts on the near plane and leads away from the eye.
+Ray pointerRay(const Camera& camera, const Frustum& frustum, int width, int height, double x,
+               double y);
+
 /// Parses "minx miny minz maxx maxy maxz" (finite, min <= max on every axis).
 Result<msg::Aabb> parseBox(std::string_view text);
 /// "minx miny minz maxx maxy maxz", as the `route` filter reads a volume of interest.

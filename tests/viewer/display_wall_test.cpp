@@ -1,0 +1,191 @@
+// examples/display_wall end to end: the demo scene on a swap-locked 2 x 2 wall (the example's
+// composite), recorded by vrflow-wall-mosaic, against one viewer of the whole wall in the same run.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+
+#include "../runtime/process_helpers.hpp"
+#include "vrflow/viewer/image.hpp"
+#include "wall_scene.hpp"
+
+namespace vrflow::viewer {
+namespace {
+
+namespace fs = std::filesystem;
+using vrflow::testing::TempDir;
+
+constexpr int kIterations = 12;
+
+void replaceAll(std::string& text, const std::string& from, const std::string& to) {
+  for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+}
+
+std::string exampleDir() {
+  return vrflow::testing::sourceDir() + "/examples/display_wall";
+}
+
+// The example with a wall file of `dir` (the example's geometry at 160 x 90 pixels per tile and
+// without mullions, so that the mosaic can equal one view), plus a viewer `whole` drawing a
+// one-tile wall of the same size and place, fed by the same scene.
+std::string application(const TempDir& dir) {
+  std::string wall = vrflow::testing::readFile(exampleDir() + "/wall_2x2.wall");
+  replaceAll(wall, "pixels 480 270", "pixels 160 90");
+  replaceAll(wall, "bezel 0.03 0.03", "bezel 0 0");
+  dir.write("wall.wall", wall);
+  dir.write("whole.wall",
+            "grid 1 1\npixels 320 180\nsize 3.2 1.8\ncentre 0 1.3 3.5\n"
+            "right 1 0 0\nup 0 1 0\neye 0 2.4 7.5\ntile whole 0 0 h0 :0 0 0\n");
+  std::string app = vrflow::testing::readFile(exampleDir() + "/display_wall.xml");
+  replaceAll(app, "\"../paper_scene/scene.json\"",
+             "\"" + vrflow::testing::sourceDir() + "/examples/paper_scene/scene.json\"");
+  replaceAll(app, "value=\"wall_2x2.wall\"", "value=\"" + dir.file("wall.wall") + "\"");
+  replaceAll(app, "  </modules>",
+             "    <module id=\"whole\" package=\"viewer\" type=\"viewer\" host=\"h0\">"
+             "<param name=\"wall\" value=\"" +
+                 dir.file("whole.wall") +
+                 "\"/><param name=\"wall-tile\" value=\"whole\"/><param name=\"supersample\" "
+                 "value=\"1\"/><param name=\"format\" value=\"png\"/><param name=\"output-dir\" "
+                 "value=\"display-wall\"/><param name=\"prefix\" value=\"whole\"/>"
+                 "</module>\n  </modules>");
+  replaceAll(app, "    <connection from=\"scene.out\" to=\"wall.objects\"/>",
+             "    <connection from=\"scene.out\" to=\"wall.objects\"/>\n"
+             "    <connection from=\"scene.out\" to=\"whole.objects\"/>");
+  return app;
+}
+
+TEST(DisplayWall, TheRecordedMosaicOfTheSwapLockedWallEqualsOneViewOfTheWholeWall) {
+  TempDir dir;
+  const auto file = dir.write("display_wall.xml", application(dir));
+  const auto result =
+      vrflow::testing::runCommand({"/bin/sh", "-c",
+                                   "cd '" + dir.path() + "' && exec '" + vrflow::testing::binDir() +
+                                       "/vrflow' run '" + file + "' --composites '" + exampleDir() +
+                                       "' -n " + std::to_string(kIterations) + " --no-progress"},
+                                  180);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto mosaic = vrflow::testing::runCommand(
+      {vrflow::testing::binDir() + "/vrflow-wall-mosaic", dir.file("wall.wall"),
+       dir.file("display-wall"), "--out", dir.file("mosaic")},
+      60);
+  ASSERT_EQ(mosaic.exitCode, 0) << mosaic.err;
+  int worst = 0;
+  for (int k = 0; k < kIterations; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "_%06d.png", k);
+    const auto joined = readPng(dir.file("mosaic/wall") + name);
+    const auto whole = readPng(dir.file("display-wall/whole") + name);
+    ASSERT_TRUE(joined.ok() && whole.ok()) << "frame " << k;
+    ASSERT_EQ(joined->width, 320);
+    ASSERT_EQ(joined->height, 180);
+    int differing = 0, inside = 0;
+    for (int y = 0; y < 180; ++y) {
+      for (int x = 0; x < 320; ++x) {
+        if (joined->at(x, y) == whole->at(x, y)) continue;
+        ++differing;
+        if (!testing::onAnEdge(*whole, x, y)) ++inside;
+      }
+    }
+    EXPECT_EQ(inside, 0) << "frame " << k << ": " << differing << " pixels differ";
+    EXPECT_LE(differing, 320 * 180 / 1000) << "frame " << k;
+    worst = std::max(worst, differing);
+  }
+  RecordProperty("worst_differing_pixels", worst);
+  // Every tile showed frames 0 .. kIterations - 2, in order (the last is drawn, never released).
+  for (int t = 0; t < 4; ++t) {
+    const auto lines =
+        vrflow::testing::readLines(dir.file("display-wall/t" + std::to_string(t) + ".swaps"));
+    ASSERT_EQ(lines.size(), static_cast<std::size_t>(kIterations - 1)) << "tile " << t;
+    for (int k = 0; k + 1 < kIterations; ++k) {
+      EXPECT_EQ(lines[k].substr(0, lines[k].find(' ')), std::to_string(k)) << "tile " << t;
+    }
+  }
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+  EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
+}
+
+// The 4 x 4 example over four loopback hosts (vrflow launch, tiles of 60 x 34 pixels): every
+// tile on every host shows frames 0, 1, ... in step, and the recorder joins all 16.
+TEST(DisplayWall, TheFourByFourWallOverFourLoopbackHostsShowsEveryFrameInStep) {
+  TempDir dir;
+  std::string wall = vrflow::testing::readFile(exampleDir() + "/wall_4x4.wall");
+  replaceAll(wall, "pixels 240 135", "pixels 60 34");
+  dir.write("wall.wall", wall);
+  std::string app = vrflow::testing::readFile(exampleDir() + "/display_wall_4x4.xml");
+  replaceAll(app, "\"../paper_scene/scene.json\"",
+             "\"" + vrflow::testing::sourceDir() + "/examples/paper_scene/scene.json\"");
+  replaceAll(app, "value=\"wall_4x4.wall\"", "value=\"" + dir.file("wall.wall") + "\"");
+  const auto file = dir.write("display_wall_4x4.xml", app);
+  fs::create_directories(dir.file("display-wall-4x4"));
+  constexpr int kFrames = 8;
+  const auto result = vrflow::testing::runCommand(
+      {"/bin/sh", "-c",
+       "cd '" + dir.path() + "' && exec '" + vrflow::testing::binDir() + "/vrflow' launch '" +
+           file + "' --composites '" + exampleDir() + "' -n " + std::to_string(kFrames) +
+           " --no-progress --report report.json"},
+      180);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto report = vrflow::testing::readFile(dir.file("report.json"));
+  EXPECT_NE(report.find("\"hosts\": 4"), std::string::npos) << report;
+  for (int t = 0; t < 16; ++t) {
+    const auto lines =
+        vrflow::testing::readLines(dir.file("display-wall-4x4/t" + std::to_string(t) + ".swaps"));
+    ASSERT_EQ(lines.size(), static_cast<std::size_t>(kFrames - 1)) << "tile " << t;
+    for (int k = 0; k + 1 < kFrames; ++k) {
+      EXPECT_EQ(lines[k].substr(0, lines[k].find(' ')), std::to_string(k)) << "tile " << t;
+    }
+  }
+  const auto mosaic = vrflow::testing::runCommand(
+      {vrflow::testing::binDir() + "/vrflow-wall-mosaic", dir.file("wall.wall"),
+       dir.file("display-wall-4x4"), "--out", dir.file("mosaic")},
+      60);
+  ASSERT_EQ(mosaic.exitCode, 0) << mosaic.err;
+  const auto last = readPng(dir.file("mosaic/wall_000007.png"));
+  ASSERT_TRUE(last.ok());
+  EXPECT_EQ(last->width, 4 * 60 + 3 * 1);  // 1.5 cm mullions at 60 px per 0.8 m: 1 pixel
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+  EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
+}
+
+TEST(DisplayWall, TheRecorderRefusesAMissingTileFrameNamingIt) {
+  TempDir dir;
+  fs::create_directories(dir.file("frames"));
+  Image image;
+  image.width = 160;
+  image.height = 90;
+  image.rgb.assign(160 * 90 * 3, 100);
+  dir.write("wall.wall",
+            "grid 2 1\npixels 160 90\nsize 1.6 0.9\ntile a 0 0 h :0 0 0\n"
+            "tile b 1 0 h :0 0 0\n");
+  ASSERT_TRUE(writePng(dir.file("frames/a_000000.png"), image).ok());
+  ASSERT_TRUE(writePng(dir.file("frames/b_000000.png"), image).ok());
+  ASSERT_TRUE(writePng(dir.file("frames/a_000001.png"), image).ok());
+  const auto missing = vrflow::testing::runCommand(
+      {vrflow::testing::binDir() + "/vrflow-wall-mosaic", dir.file("wall.wall"), dir.file("frames"),
+       "--out", dir.file("mosaic")},
+      30);
+  EXPECT_EQ(missing.exitCode, 2);
+  EXPECT_NE(missing.err.find("frame 1 of tile 'b' is missing"), std::string::npos) << missing.err;
+  const auto badWall =
+      vrflow::testing::runCommand({vrflow::testing::binDir() + "/vrflow-wall-mosaic",
+                                   dir.file("nowall.wall"), dir.file("frames")},
+                                  30);
+  EXPECT_EQ(badWall.exitCode, 2);
+  EXPECT_NE(badWall.err.find("nowall.wall"), std::string::npos) << badWall.err;
+  fs::remove(dir.file("frames/a_000001.png"));
+  dir.write("small.wall",
+            "grid 2 1\npixels 16 16\nsize 1.6 0.9\ntile a 0 0 h :0 0 0\n"
+            "tile b 1 0 h :0 0 0\n");
+  const auto wrongSize = vrflow::testing::runCommand(
+      {vrflow::testing::binDir() + "/vrflow-wall-mosaic", dir.file("small.wall"),
+       dir.file("frames"), "--out", dir.file("mosaic")},
+      30);
+  EXPECT_EQ(wrongSize.exitCode, 2);
+  EXPECT_NE(wrongSize.err.find("160x90"), std::string::npos) << wrongSize.err;
+}
+
+}  // namespace
+}  // namespace vrflow::viewer
