@@ -72,7 +72,7 @@ endfunction()
 # vrflow_add_test(NAME SOURCES ... DEPS ... LABELS ...): one GoogleTest executable, registered
 # with CTest test by test, with the given labels.
 function(vrflow_add_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT;PREFIX" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;PREFIX;RESOURCE_LOCK" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE vrflow_warnings ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   if(NOT ARG_TIMEOUT)
@@ -83,10 +83,16 @@ function(vrflow_add_test name)
   # PREFIX names a second build of the same tests apart from the first ("PREFIX.Suite.Test").
   # The runs the tests start keep their records and logs in the build, not in the user's home
   # (docs/operations.md).
+  # RESOURCE_LOCK names something tests share (an X display number): ctest -j never runs two
+  # tests holding the same lock at once.
+  set(lock "")
+  if(ARG_RESOURCE_LOCK)
+    set(lock RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+  endif()
   gtest_discover_tests(${name}
     TEST_PREFIX "${ARG_PREFIX}"
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
-      ENVIRONMENT "XDG_STATE_HOME=${PROJECT_BINARY_DIR}/test-state"
+      ENVIRONMENT "XDG_STATE_HOME=${PROJECT_BINARY_DIR}/test-state" ${lock}
     DISCOVERY_TIMEOUT 60)
 endfunction()
 
