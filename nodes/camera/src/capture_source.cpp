@@ -1,5 +1,6 @@
 #include "vrflow/camera/capture_source.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
