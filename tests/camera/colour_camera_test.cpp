@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "process_helpers.hpp"
 #include "vrflow/camera/capture_source.hpp"
@@ -105,6 +106,33 @@ TEST(CaptureSource, ImageSequencesDeliverTheirFramesThenStopWithAnError) {
   auto frame = (*wrong)->next();
   ASSERT_FALSE(frame.ok());
   EXPECT_EQ(frame.error().message, "frame 0 is 64x48, the calibration says 640x480");
+}
+
+TEST(CaptureSource, AVideoFileDeliversItsFramesThenStopsWithAnError) {
+  TempDir dir;
+  const auto path = dir.file("clip.avi");
+  {
+    // OpenCV's own Motion-JPEG writer: no codec library needed.
+    cv::VideoWriter writer(path, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                           10, {64, 48});
+    ASSERT_TRUE(writer.isOpened());
+    for (int n = 0; n < 4; ++n) writer.write(renderBackground({64, 48}, n, 0, 0));
+  }
+  auto source = openCaptureSource(sequenceSettings(path, {64, 48}));
+  ASSERT_TRUE(source.ok()) << source.error().message;
+  for (int n = 0; n < 4; ++n) {
+    auto frame = (*source)->next();
+    ASSERT_TRUE(frame.ok()) << frame.error().message;
+    // JPEG is lossy: the frame is near the image written, and nearer it than to the others.
+    const cv::Mat written = renderBackground({64, 48}, n, 0, 0);
+    const cv::Mat other = renderBackground({64, 48}, n + 1, 0, 0);
+    EXPECT_LT(cv::norm(frame->image, written, cv::NORM_L1),
+              0.5 * cv::norm(frame->image, other, cv::NORM_L1));
+  }
+  auto end = (*source)->next();
+  ASSERT_FALSE(end.ok());
+  EXPECT_EQ(end.error().message.rfind("stopped delivering: no frame 4 (it gave 4 frames", 0), 0u)
+      << end.error().message;
 }
 
 TEST(CaptureSource, UnknownSourcesAreRefusedNamingTheForms) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "process_helpers.hpp"
+#include "user_keys.hpp"
 #include "vrflow/camera/calibration.hpp"
 #include "vrflow/camera/synthetic_scene.hpp"
 #include "vrflow/camera/synthetic_user.hpp"
@@ -26,14 +27,6 @@ constexpr int kCameras = 5;
 constexpr int kCells = 96;
 constexpr int kEmptyFrames = 4;
 constexpr double kFps = 10;
-
-std::string keyText(double t, const UserPose& pose) {
-  std::ostringstream out;
-  for (std::size_t i = 0; i < pose.size(); ++i)
-    out << t << ' ' << kUserJoints[i] << ' ' << pose[i][0] << ' ' << pose[i][1] << ' ' << pose[i][2]
-        << '\n';
-  return out.str();
-}
 
 // The user waves: the right hand goes up by 30 cm over 2 s.
 std::string waveKeyframes() {

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "module_error.hpp"
 #include "vrflow/camera/capture_source.hpp"
 #include "vrflow/camera/image_message.hpp"
 #include "vrflow/module/module.hpp"
@@ -20,8 +21,7 @@ int main() {
   if (!initOrReport(module, kProgram)) return 2;
   const auto& params = module.params();
   const auto fail = [&](const std::string& why) {
-    std::fprintf(stderr, "%s: module '%s': %s\n", kProgram, module.id().c_str(), why.c_str());
-    return 1;
+    return camera::moduleError(module, kProgram, why);
   };
   camera::CaptureSettings settings;
   settings.source = params.getString("source");

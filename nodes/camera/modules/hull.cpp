@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "module_error.hpp"
 #include "vrflow/camera/calibration.hpp"
 #include "vrflow/camera/hull_message.hpp"
 #include "vrflow/camera/image_message.hpp"
@@ -27,8 +28,7 @@ int main() {
   if (!initOrReport(module, kProgram)) return 2;
   const auto& params = module.params();
   const auto fail = [&](const std::string& why) {
-    std::fprintf(stderr, "%s: module '%s': %s\n", kProgram, module.id().c_str(), why.c_str());
-    return 1;
+    return camera::moduleError(module, kProgram, why);
   };
   std::vector<camera::CameraCalibration> cameras;
   std::istringstream files(params.getString("calibrations"));

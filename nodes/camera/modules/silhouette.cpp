@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <string>
 
+#include "module_error.hpp"
 #include "vrflow/camera/calibration.hpp"
 #include "vrflow/camera/contour_message.hpp"
 #include "vrflow/camera/image_message.hpp"
@@ -25,8 +26,7 @@ int main() {
   if (!initOrReport(module, kProgram)) return 2;
   const auto& params = module.params();
   const auto fail = [&](const std::string& why) {
-    std::fprintf(stderr, "%s: module '%s': %s\n", kProgram, module.id().c_str(), why.c_str());
-    return 1;
+    return camera::moduleError(module, kProgram, why);
   };
   auto calibration = camera::loadCalibration(params.getString("calibration"));
   if (!calibration) return fail("parameter 'calibration': " + calibration.error().message);
