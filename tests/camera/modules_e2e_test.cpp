@@ -81,7 +81,8 @@ std::string connection(const std::string& from, const std::string& to) {
 }
 
 // The whole chain: captures, silhouettes, a merge, the hull in `slabs` slabs, the recorder.
-std::string chain(const Rig& rig, int slabs, const std::string& recording) {
+std::string chain(const Rig& rig, int slabs, const std::string& recording,
+                  const std::string& model = "static") {
   std::string modules, connections;
   for (int n = 0; n < kCameras; ++n) {
     const std::string i = std::to_string(n);
@@ -92,7 +93,8 @@ std::string chain(const Rig& rig, int slabs, const std::string& recording) {
                    param("empty-frames", std::to_string(kEmptyFrames)) + param("room-seed", i));
     modules += module("sil" + i, "silhouette",
                       param("calibration", rig.calibrations[n]) +
-                          param("background-frames", std::to_string(kEmptyFrames)));
+                          param("background-frames", std::to_string(kEmptyFrames)) +
+                          param("model", model));
     connections += connection("cam" + i + ".image", "sil" + i + ".image");
     connections += connection("sil" + i + ".mask", "masks.in" + i);
   }
@@ -146,9 +148,10 @@ std::vector<Frame> readRecording(const std::string& path) {
   return frames;
 }
 
-CommandResult runChain(const Rig& rig, int slabs, const std::string& recording, int iterations) {
+CommandResult runChain(const Rig& rig, int slabs, const std::string& recording, int iterations,
+                       const std::string& model = "static") {
   const auto app =
-      rig.dir.write("chain" + std::to_string(slabs) + ".xml", chain(rig, slabs, recording));
+      rig.dir.write("chain" + std::to_string(slabs) + ".xml", chain(rig, slabs, recording, model));
   return vrflow::testing::runVrflow(
       {"run", app, "--iterations", std::to_string(iterations), "--no-progress"}, 240);
 }
@@ -201,6 +204,27 @@ TEST(CameraModules, FiveCamerasGiveTheHullOfTheCapsulesInOneSlabOrTwoBitForBit) 
     const double iou = intersectionOverUnion(hull, truth);
     std::printf("frame %zu (t = %.1f s): hull IoU %.4f against the capsules' voxelisation\n", f,
                 frame.simTime, iou);
+    EXPECT_GE(iou, 0.85) << "frame " << f;
+  }
+}
+
+TEST(CameraModules, Mog2SilhouettesGiveTheHullToo) {
+  Rig rig;
+  const int iterations = kEmptyFrames + 2;
+  const auto run = runChain(rig, 1, rig.dir.file("mog2.bin"), iterations, "mog2");
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  expectNothingLeft();
+  const auto frames = readRecording(rig.dir.file("mog2.bin"));
+  ASSERT_EQ(frames.size(), static_cast<std::size_t>(iterations));
+  auto track = KeyframeTrack::load(rig.keyframes);
+  ASSERT_TRUE(track.ok());
+  const GridSpec spec = userVolume(kCells);
+  for (std::size_t f = kEmptyFrames; f < frames.size(); ++f) {
+    VoxelGrid hull(spec);
+    hull.occupied = frames[f].occupied;
+    const double iou =
+        intersectionOverUnion(hull, SyntheticUser(track->poseAt(frames[f].simTime)).voxelize(spec));
+    std::printf("mog2, frame %zu: hull IoU %.4f\n", f, iou);
     EXPECT_GE(iou, 0.85) << "frame " << f;
   }
 }
