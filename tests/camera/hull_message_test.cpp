@@ -55,8 +55,7 @@ TEST(HullMessage, MalformedSlabsAreRefusedWithTheirCause) {
   ASSERT_TRUE(body(bytes).ok());
   // Find the body (its magic) and spoil the version, then the slab range.
   std::size_t at = 0;
-  while (at + 4 <= bytes.size() &&
-         !(bytes[at] == std::byte{'V'} && bytes[at + 1] == std::byte{'X'}))
+  while (at + 4 <= bytes.size() && !(bytes[at] == std::byte{'V'} && bytes[at + 1] == std::byte{'X'}))
     ++at;
   auto versioned = bytes;
   versioned[at + 4] = std::byte{2};
