@@ -1,13 +1,14 @@
 // cameratest/hull-recorder: the test end of a camera chain. Each iteration it gathers the hull
 // slabs it receives into the grid and appends the frame to a binary file: u64 iteration, f64
-// simulation time, i32 nx ny nz, f64 origin[3], f64 voxel size, then the nx*ny*nz occupancy
-// bytes; and the number of slabs as a u32 before the bytes.
+// simulation time, i64 capture time (the capture-ns stamp, -1 when absent), i32 nx ny nz, f64
+// origin[3], f64 voxel size, u32 number of slabs, then the nx*ny*nz occupancy bytes.
 #include <cstdio>
 #include <fstream>
 #include <optional>
 #include <string>
 
 #include "vrflow/camera/hull_message.hpp"
+#include "vrflow/camera/image_message.hpp"
 #include "vrflow/module/module.hpp"
 #include "vrflow/module/start.hpp"
 
@@ -40,6 +41,7 @@ int main() {
     if (!grid) continue;
     write(module.iteration());
     write(in.view().stamps().simTime);
+    write(camera::captureTimeNs(in.view()).value_or(-1));
     write(grid->spec.nx);
     write(grid->spec.ny);
     write(grid->spec.nz);

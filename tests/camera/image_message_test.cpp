@@ -60,7 +60,7 @@ TEST(ImageMessage, MalformedImagesAreNamed) {
     std::int32_t value;
     std::string expected;
   };
-  for (const Case& c : {Case{0, 0, "not an image (no 'VXI1' header)"},
+  for (const Case& c : {Case{0, 0, "image expected, no 'VXI1' header"},
                         Case{4, 2, "image version 2, this build reads 1"},
                         Case{8, -5, "image of impossible size -5x4"},
                         Case{16, CV_32FC1, "image of impossible size 5x4 or type 5"},

@@ -4,6 +4,7 @@
 // module's bad input: one clear error, a non-zero exit, nothing left behind.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -119,6 +120,7 @@ std::string chain(const Rig& rig, int slabs, const std::string& recording,
 struct Frame {
   std::uint64_t iteration = 0;
   double simTime = 0;
+  std::int64_t captureNs = 0;
   GridSpec spec;
   std::uint32_t slabs = 0;
   std::vector<std::uint8_t> occupied;
@@ -133,6 +135,7 @@ std::vector<Frame> readRecording(const std::string& path) {
   };
   for (Frame f; read(f.iteration);) {
     read(f.simTime);
+    read(f.captureNs);
     read(f.spec.nx);
     read(f.spec.ny);
     read(f.spec.nz);
@@ -187,6 +190,9 @@ TEST(CameraModules, FiveCamerasGiveTheHullOfTheCapsulesInOneSlabOrTwoBitForBit) 
     const Frame& frame = frames[f];
     EXPECT_EQ(frame.iteration, f);
     EXPECT_DOUBLE_EQ(frame.simTime, static_cast<double>(f) / kFps);
+    // The capture time went through the silhouettes, the merge and the hull.
+    EXPECT_EQ(frame.captureNs, std::llround(static_cast<double>(f) / kFps * 1e9));
+    EXPECT_EQ(slabbed[f].captureNs, frame.captureNs);
     EXPECT_EQ(frame.slabs, 1u);
     EXPECT_EQ(slabbed[f].slabs, 2u);
     EXPECT_TRUE(frame.occupied == slabbed[f].occupied) << "frame " << f << ": 1 slab vs 2 slabs";

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <string>
 
+#include "raw_form.hpp"
 #include "vrflow/message/packed.hpp"
 
 namespace vrflow::camera {
@@ -35,14 +36,10 @@ void addContours(msg::MessageBuilder& builder, std::uint64_t resourceId,
 }
 
 Result<std::vector<std::vector<cv::Point>>> readContours(const msg::ResourceView& resource) {
-  const auto body = resource.raw();
+  const auto checked = rawFormBody(resource, kMagic, kVersion, kHeaderSize, "contours");
+  if (!checked) return checked.error();
+  const auto body = *checked;
   const std::string what = "resource " + std::to_string(resource.id()) + ": ";
-  if (resource.kind() != msg::ResourceKind::Raw || body.size() < kHeaderSize ||
-      std::memcmp(body.data(), kMagic, 4) != 0)
-    return Error{what + "not contours (no 'VXC1' header)"};
-  if (const auto version = msg::loadRaw<std::uint32_t>(body.data() + 4); version != kVersion)
-    return Error{what + "contours version " + std::to_string(version) + ", this build reads " +
-                 std::to_string(kVersion)};
   const auto count = msg::loadRaw<std::uint32_t>(body.data() + 8);
   std::vector<std::vector<cv::Point>> contours;
   std::size_t at = kHeaderSize;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "raw_form.hpp"
 #include "vrflow/message/packed.hpp"
 
 namespace vrflow::camera {
@@ -29,14 +30,10 @@ void addImage(msg::MessageBuilder& builder, std::uint64_t resourceId, const cv::
 }
 
 Result<cv::Mat> readImage(const msg::ResourceView& resource) {
-  const auto body = resource.raw();
+  const auto checked = rawFormBody(resource, kMagic, kVersion, kImageHeaderSize, "image");
+  if (!checked) return checked.error();
+  const auto body = *checked;
   const std::string what = "resource " + std::to_string(resource.id()) + ": ";
-  if (resource.kind() != msg::ResourceKind::Raw || body.size() < kImageHeaderSize ||
-      std::memcmp(body.data(), kMagic, 4) != 0)
-    return Error{what + "not an image (no 'VXI1' header)"};
-  if (const auto version = msg::loadRaw<std::uint32_t>(body.data() + 4); version != kVersion)
-    return Error{what + "image version " + std::to_string(version) + ", this build reads " +
-                 std::to_string(kVersion)};
   const auto width = msg::loadRaw<std::int32_t>(body.data() + 8);
   const auto height = msg::loadRaw<std::int32_t>(body.data() + 12);
   const auto type = msg::loadRaw<std::int32_t>(body.data() + 16);
