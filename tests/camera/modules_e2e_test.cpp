@@ -45,11 +45,14 @@ struct Rig {
   TempDir dir;
   std::vector<std::string> calibrations;
   std::string keyframes;
-  Rig() {
-    const auto cameras = cameraRing(kCameras);
+  /// With `lensDistortion`, every camera has barrel distortion (k1 -0.4, k2 0.12).
+  explicit Rig(bool lensDistortion = false) {
+    auto cameras = cameraRing(kCameras);
     for (int n = 0; n < kCameras; ++n) {
+      auto& camera = cameras[static_cast<std::size_t>(n)];
+      if (lensDistortion) camera.distortion = (cv::Mat_<double>(1, 5) << -0.4, 0.12, 0, 0, 0);
       calibrations.push_back(dir.file("cam" + std::to_string(n) + ".yml"));
-      EXPECT_TRUE(saveCalibration(cameras[static_cast<std::size_t>(n)], calibrations.back()).ok());
+      EXPECT_TRUE(saveCalibration(camera, calibrations.back()).ok());
     }
     keyframes = dir.write("wave.keys", waveKeyframes());
   }
@@ -214,13 +217,10 @@ TEST(CameraModules, FiveCamerasGiveTheHullOfTheCapsulesInOneSlabOrTwoBitForBit) 
   }
 }
 
-TEST(CameraModules, Mog2SilhouettesGiveTheHullToo) {
-  Rig rig;
-  const int iterations = kEmptyFrames + 2;
-  const auto run = runChain(rig, 1, rig.dir.file("mog2.bin"), iterations, "mog2");
-  ASSERT_EQ(run.exitCode, 0) << run.err;
-  expectNothingLeft();
-  const auto frames = readRecording(rig.dir.file("mog2.bin"));
+// The hull of a run's user frames against the capsules' exact voxelisation, each at least `bound`.
+void expectUserFramesMatchTheCapsules(const Rig& rig, const std::string& recording, int iterations,
+                                      const char* what, double bound = 0.85) {
+  const auto frames = readRecording(recording);
   ASSERT_EQ(frames.size(), static_cast<std::size_t>(iterations));
   auto track = KeyframeTrack::load(rig.keyframes);
   ASSERT_TRUE(track.ok());
@@ -230,9 +230,30 @@ TEST(CameraModules, Mog2SilhouettesGiveTheHullToo) {
     hull.occupied = frames[f].occupied;
     const double iou =
         intersectionOverUnion(hull, SyntheticUser(track->poseAt(frames[f].simTime)).voxelize(spec));
-    std::printf("mog2, frame %zu: hull IoU %.4f\n", f, iou);
-    EXPECT_GE(iou, 0.85) << "frame " << f;
+    std::printf("%s, frame %zu: hull IoU %.4f\n", what, f, iou);
+    EXPECT_GE(iou, bound) << what << ", frame " << f;
   }
+}
+
+TEST(CameraModules, Mog2SilhouettesGiveTheHullToo) {
+  Rig rig;
+  const int iterations = kEmptyFrames + 2;
+  const auto run = runChain(rig, 1, rig.dir.file("mog2.bin"), iterations, "mog2");
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  expectNothingLeft();
+  expectUserFramesMatchTheCapsules(rig, rig.dir.file("mog2.bin"), iterations, "mog2");
+}
+
+TEST(CameraModules, CamerasWithLensDistortionAreRenderedDistortedAndCarvedUndistorted) {
+  Rig rig(true);
+  const int iterations = kEmptyFrames + 2;
+  const auto run = runChain(rig, 1, rig.dir.file("distorted.bin"), iterations);
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  expectNothingLeft();
+  // Measured 0.909 (as without distortion); a hull that carved the distorted masks as if they
+  // were pinhole measured 0.895: the bound tells the two apart.
+  expectUserFramesMatchTheCapsules(rig, rig.dir.file("distorted.bin"), iterations, "distorted",
+                                   0.9);
 }
 
 // A capture (and silhouette) pair alone, for the bad-input cases.
