@@ -10,7 +10,7 @@ export CCACHE_NOHASHDIR := 1
 
 # Every Debian package the project needs to build, test and benchmark.
 PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-rt-14-dev \
-  libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-video-dev libopencv-imgcodecs-dev \
+  libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-video-dev libopencv-imgcodecs-dev libopencv-videoio-dev \
   libgtest-dev libpugixml-dev libcli11-dev \
   nlohmann-json3-dev libxxhash-dev libzmq3-dev libopenmpi-dev openmpi-bin libxml2-utils procps \
   libbullet-dev libeigen3-dev libevdev-dev libosmesa6-dev libglfw3-dev xvfb xdotool libpng-dev qt6-base-dev libgraphviz-dev \

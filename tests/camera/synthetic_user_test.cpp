@@ -7,20 +7,13 @@
 #include <sstream>
 
 #include "process_helpers.hpp"
+#include "user_keys.hpp"
 #include "vrflow/camera/synthetic_scene.hpp"
 
 namespace vrflow::camera {
 namespace {
 
 using vrflow::testing::TempDir;
-
-std::string keyText(double t, const UserPose& pose) {
-  std::ostringstream out;
-  for (std::size_t i = 0; i < pose.size(); ++i)
-    out << t << ' ' << kUserJoints[i] << ' ' << pose[i][0] << ' ' << pose[i][1] << ' ' << pose[i][2]
-        << '\n';
-  return out.str();
-}
 
 TEST(Keyframes, PosesAreInterpolatedLinearlyAndHeldAtTheEnds) {
   UserPose raised = standingPose();

@@ -3,6 +3,7 @@
 // synthetic frames of the moving user, with the straightforward carving (cv::projectPoints of every
 // voxel into every mask) measured in the same run as the baseline. One JSON line per case:
 // {cameras, width, height, voxels, stage, ms_per_frame, iou, machine}. `--quick`: a smoke run.
+// The stages `modules_*` run the chain as modules (capture, silhouette, hull) through `vrflow run`.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "modules_stage.hpp"
 #include "vrflow/camera/distance_field.hpp"
 #include "vrflow/camera/hull_mesh.hpp"
 #include "vrflow/camera/silhouette.hpp"
@@ -151,6 +153,21 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
   }
 }
 
+// The module chain: 5 synthetic captures (their colour rendering included) -> silhouettes ->
+// merge -> hull, per frame: the run's wall time, and each kind's compute time.
+void runModules(int cameraCount, cv::Size size, int voxels, int iterations,
+                const std::string& host) {
+  const ModuleChainTimes times = runModuleChain(cameraCount, size, voxels, iterations);
+  if (!times.error.empty()) {
+    std::fprintf(stderr, "vrflow-bench-camera: %s\n", times.error.c_str());
+    return;
+  }
+  print(cameraCount, size, voxels, "modules_capture", times.captureMs, -1, host);
+  print(cameraCount, size, voxels, "modules_silhouette", times.silhouetteMs, -1, host);
+  print(cameraCount, size, voxels, "modules_hull", times.hullMs, -1, host);
+  print(cameraCount, size, voxels, "modules_wall", times.wallMsPerFrame, -1, host);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -159,9 +176,11 @@ int main(int argc, char** argv) {
   const int frames = quick ? 2 : 10, repeats = quick ? 1 : 3;
   if (quick) {
     runCase(5, {320, 240}, 32, frames, repeats, true, host);
+    runModules(5, {320, 240}, 32, 8, host);
     return 0;
   }
   runCase(5, {640, 480}, 128, frames, repeats, true, host);
+  runModules(5, {640, 480}, 128, 60, host);
   runCase(5, {640, 480}, 64, frames, repeats, true, host);
   runCase(4, {640, 480}, 128, frames, repeats, false, host);
   runCase(3, {640, 480}, 128, frames, repeats, false, host);

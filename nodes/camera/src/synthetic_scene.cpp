@@ -23,7 +23,9 @@ cv::Mat roomTexture(cv::Size size, int seed) {
   return texture;
 }
 
-void addNoise(cv::Mat& image, double noise, std::uint64_t noiseSeed) {
+}  // namespace
+
+void addSensorNoise(cv::Mat& image, double noise, std::uint64_t noiseSeed) {
   if (noise <= 0) return;
   cv::RNG rng(noiseSeed);
   cv::Mat n(image.size(), CV_16SC3);
@@ -33,8 +35,6 @@ void addNoise(cv::Mat& image, double noise, std::uint64_t noiseSeed) {
   wide += n;
   wide.convertTo(image, CV_8UC3);
 }
-
-}  // namespace
 
 // Heights (m) of the ring's cameras in turn: low ones see under the arms and the torso, high
 // ones over them.
@@ -58,7 +58,7 @@ GridSpec userVolume(int cells) {
 
 cv::Mat renderBackground(cv::Size size, int seed, double noise, std::uint64_t noiseSeed) {
   cv::Mat image = roomTexture(size, seed);
-  addNoise(image, noise, noiseSeed);
+  addSensorNoise(image, noise, noiseSeed);
   return image;
 }
 
@@ -69,7 +69,7 @@ cv::Mat renderUserImage(const SyntheticUser& user, const CameraCalibration& came
   cv::RNG rng(static_cast<std::uint64_t>(seed) + 101);
   rng.fill(cloth, cv::RNG::UNIFORM, cv::Scalar(10, 20, 150), cv::Scalar(40, 50, 230));
   cloth.copyTo(image, user.renderMask(camera));
-  addNoise(image, noise, noiseSeed);
+  addSensorNoise(image, noise, noiseSeed);
   return image;
 }
 

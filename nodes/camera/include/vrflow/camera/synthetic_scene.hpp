@@ -23,6 +23,9 @@ GridSpec userVolume(int cells);
 /// standard deviation `noise` (grey levels) drawn from `noiseSeed`. CV_8UC3.
 cv::Mat renderBackground(cv::Size size, int seed, double noise, std::uint64_t noiseSeed);
 
+/// Adds Gaussian sensor noise of standard deviation `noise` (grey levels, 0: none) drawn from
+/// `noiseSeed` to a CV_8UC3 image, saturating.
+void addSensorNoise(cv::Mat& image, double noise, std::uint64_t noiseSeed);
 /// The room with the user: the user's exact mask filled with a textured cloth, then the noise.
 cv::Mat renderUserImage(const SyntheticUser& user, const CameraCalibration& camera, int seed,
                         double noise, std::uint64_t noiseSeed);
