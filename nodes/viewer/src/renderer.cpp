@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "draw_water.hpp"
 #include "vrflow/message/eigen.hpp"
 #include "vrflow/message/shape.hpp"
 
@@ -285,6 +286,10 @@ void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass,
         break;
       }
       case ObjectKind::Fluid: {
+        if (object.surfaceId != 0) {
+          drawWater(scene, object.surfaceId, shadowPass);
+          break;
+        }
         const auto* xyz = scene.particles(object.particlesId);
         if (!xyz || xyz->empty() || shadowPass) break;
         const auto& c = settings.particleColour;

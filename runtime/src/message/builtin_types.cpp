@@ -50,6 +50,7 @@ const ObjectType& fluidType() {
                                                           {"particles", ParamKind::Id},
                                                           {"velocityField", ParamKind::Id},
                                                           {"pressureField", ParamKind::Id},
+                                                          {"surface", ParamKind::Id},
                                                       });
   return type;
 }
