@@ -3,11 +3,13 @@
 #include "vrflow/fluid/surface.hpp"
 
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
 #include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/ParticlesToLevelSet.h>
 #include <openvdb/tools/VolumeToMesh.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <string>
@@ -50,16 +52,75 @@ bool onWall(const SurfaceSettings& s, const openvdb::Vec3s& a, const openvdb::Ve
   return false;
 }
 
+// phi = 1/2 - density / full density at the voxels' corners (negative inside, as a level set),
+// over the particles' box widened by the kernel; 1/2 (outside) elsewhere. The kernel's radius
+// is two particle spacings (a cell for 8 particles per cell), whatever the voxels.
+openvdb::FloatGrid::Ptr densityGrid(const std::vector<float>& xyz, const SurfaceSettings& s) {
+  const double dx = s.voxelSize;
+  const int kernel = std::max(1, static_cast<int>(std::lround(2.0 * s.particleSpacing / dx)));
+  const auto taps = static_cast<std::size_t>(2 * kernel);
+  std::array<double, 3> low{}, high{};
+  for (std::size_t a = 0; a < 3; ++a) low[a] = high[a] = xyz[a];
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    low[i % 3] = std::min(low[i % 3], static_cast<double>(xyz[i]));
+    high[i % 3] = std::max(high[i % 3], static_cast<double>(xyz[i]));
+  }
+  std::array<double, 3> origin{};
+  std::array<std::size_t, 3> size{};
+  for (std::size_t a = 0; a < 3; ++a) {
+    origin[a] = std::floor(low[a] / dx) * dx - (kernel + 1) * dx;
+    size[a] = static_cast<std::size_t>(std::ceil((high[a] - origin[a]) / dx)) +
+              static_cast<std::size_t>(kernel) + 2;
+  }
+  const openvdb::CoordBBox box(
+      openvdb::Coord(0, 0, 0),
+      openvdb::Coord(static_cast<int>(size[0]) - 1, static_cast<int>(size[1]) - 1,
+                     static_cast<int>(size[2]) - 1));
+  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, 0.0f);
+  // A particle weighs (1 - |d| / R) per axis on the corners within R voxels: inside a full
+  // block, the weights sum to (R dx / spacing)^3.
+  const double full = std::pow(kernel * dx / s.particleSpacing, 3.0);
+  float* data = dense.data();
+  std::array<std::vector<double>, 3> w;
+  for (auto& axis : w) axis.resize(taps);
+  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) {
+    std::array<std::size_t, 3> base{};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const double g = (xyz[i + a] - origin[a]) / dx;
+      const int first = static_cast<int>(std::floor(g)) - kernel + 1;
+      base[a] = static_cast<std::size_t>(first);
+      for (std::size_t n = 0; n < taps; ++n) {
+        w[a][n] = std::max(0.0, 1.0 - std::abs(g - (first + static_cast<int>(n))) / kernel);
+      }
+    }
+    for (std::size_t k = 0; k < taps; ++k) {
+      for (std::size_t j = 0; j < taps; ++j) {
+        const double wjk = w[1][j] * w[2][k] / full;
+        // LayoutXYZ: x fastest.
+        float* row = data + base[0] + size[0] * ((base[1] + j) + size[1] * (base[2] + k));
+        for (std::size_t n = 0; n < taps; ++n) row[n] += static_cast<float>(w[0][n] * wjk);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < dense.valueCount(); ++i) data[i] = 0.5f - data[i];
+  auto grid = openvdb::FloatGrid::create(0.5f);
+  auto transform = openvdb::math::Transform::createLinearTransform(dx);
+  transform->postTranslate(openvdb::Vec3d(origin[0], origin[1], origin[2]));
+  grid->setTransform(transform);
+  openvdb::tools::copyFromDense(dense, *grid, 0.0f);
+  return grid;
+}
+
 }  // namespace
 
 Result<SurfaceMesh> extractSurface(const std::vector<float>& xyz, const SurfaceSettings& s) {
-  if (!positive(s.voxelSize) || !positive(s.particleRadius) || !std::isfinite(s.inset) ||
-      s.inset < 0.0 || !std::isfinite(s.wallBand) || s.wallBand < 0.0) {
+  if (!positive(s.voxelSize) || !positive(s.particleSpacing) || !positive(s.particleRadius) ||
+      !std::isfinite(s.inset) || s.inset < 0.0 || !std::isfinite(s.wallBand) || s.wallBand < 0.0) {
     return makeError(
-        "fluid surface: voxel size, particle radius, inset and wall band must be "
-        "finite, the first two positive");
+        "fluid surface: voxel size, particle spacing and radius, inset and wall band "
+        "must be finite, the first three positive");
   }
-  if (s.particleRadius < 1.5 * s.voxelSize) {
+  if (s.method == SurfaceMethod::Spheres && s.particleRadius < 1.5 * s.voxelSize) {
     return makeError("fluid surface: particle radius " + std::to_string(s.particleRadius) +
                      " m is under 1.5 voxels of " + std::to_string(s.voxelSize) + " m");
   }
@@ -71,8 +132,6 @@ Result<SurfaceMesh> extractSurface(const std::vector<float>& xyz, const SurfaceS
   static std::once_flag initialised;
   std::call_once(initialised, [] { openvdb::initialize(); });
 
-  // The rebuilt level set's inner band reaches the inset and two voxels beyond.
-  const double inBand = s.inset / s.voxelSize + 2.0;
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
   std::vector<openvdb::Vec4I> quads;
@@ -80,6 +139,12 @@ Result<SurfaceMesh> extractSurface(const std::vector<float>& xyz, const SurfaceS
   // output must not depend on scheduling).
   tbb::task_arena arena(1);
   arena.execute([&] {
+    if (s.method == SurfaceMethod::Density) {
+      openvdb::tools::volumeToMesh(*densityGrid(xyz, s), points, triangles, quads, 0.0, 0.0, true);
+      return;
+    }
+    // The rebuilt level set's inner band reaches the inset and two voxels beyond.
+    const double inBand = s.inset / s.voxelSize + 2.0;
     auto spheres = openvdb::createLevelSet<openvdb::FloatGrid>(s.voxelSize, 3.0);
     openvdb::tools::ParticlesToLevelSet<openvdb::FloatGrid> raster(*spheres);
     raster.setGrainSize(0);
@@ -93,12 +158,24 @@ Result<SurfaceMesh> extractSurface(const std::vector<float>& xyz, const SurfaceS
     openvdb::tools::volumeToMesh(*grid, points, triangles, quads, -s.inset, 0.0, true);
   });
 
-  mesh.xyz.reserve(points.size() * 3);
-  for (const auto& p : points) mesh.xyz.insert(mesh.xyz.end(), {p[0], p[1], p[2]});
-  // volumeToMesh's polygons are clockwise seen from outside: each is emitted reversed.
+  // Only the vertices of the triangles kept, in the order they are first used.
+  std::vector<std::uint32_t> index(points.size(), UINT32_MAX);
+  const auto vertex = [&](std::uint32_t v) {
+    if (index[v] == UINT32_MAX) {
+      index[v] = static_cast<std::uint32_t>(mesh.xyz.size() / 3);
+      mesh.xyz.insert(mesh.xyz.end(), {points[v][0], points[v][1], points[v][2]});
+    }
+    return index[v];
+  };
+  // volumeToMesh's polygons are counter-clockwise seen from outside for a plain scalar grid
+  // (the density) and clockwise for a level set (the spheres'): those are emitted reversed.
+  const bool reverse = s.method == SurfaceMethod::Spheres;
   const auto add = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
     if (onWall(s, points[a], points[b], points[c])) return;
-    mesh.indices.insert(mesh.indices.end(), {a, c, b});
+    const std::uint32_t first = vertex(a);
+    const std::uint32_t second = vertex(reverse ? c : b);
+    const std::uint32_t third = vertex(reverse ? b : c);
+    mesh.indices.insert(mesh.indices.end(), {first, second, third});
   };
   for (const auto& t : triangles) add(t[0], t[1], t[2]);
   for (const auto& q : quads) {

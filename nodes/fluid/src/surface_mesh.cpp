@@ -12,6 +12,7 @@ SurfaceSettings surfaceSettings(const FluidSettings& fluid, int voxelsPerCell) {
   SurfaceSettings s;
   const double h = fluid.cellSize;
   const double spacing = h / std::cbrt(static_cast<double>(fluid.particlesPerCell));
+  s.particleSpacing = spacing;
   s.voxelSize = h / std::max(voxelsPerCell, 1);
   s.particleRadius = std::max(2.0 * spacing, 1.5 * s.voxelSize);
   s.inset = s.particleRadius - 0.5 * spacing;

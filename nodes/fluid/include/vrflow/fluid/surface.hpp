@@ -9,17 +9,27 @@
 #include "vrflow/fluid/settings.hpp"
 #include "vrflow/message/values.hpp"
 
-// The liquid's surface as a triangle mesh, built from its particles: each particle is a sphere
-// rasterised into a narrow-band level set (OpenVDB's ParticlesToLevelSet), the union of spheres
-// is moved inwards so that a flat block of particles gives its block's faces, and the level set
-// is meshed (OpenVDB's volumeToMesh, quads split into triangles). Faces lying on the grid's walls
-// are left out: a viewer sees the free surface, and the liquid's side against a wall is the wall.
-// One thread (an own TBB arena), deterministic: the same particles give the same bits.
+// The liquid's surface as a triangle mesh, built from its particles in one of two ways, then
+// meshed by OpenVDB's volumeToMesh (quads split into triangles):
+// - Density (the default): the particles' number density, splatted with a tent kernel of two
+//   voxels' radius onto the voxels' corners, whose isosurface at half the density of a full
+//   block of particles is the liquid's boundary (for a flat block, its face).
+// - Spheres: each particle is a sphere rasterised into a narrow-band level set (OpenVDB's
+//   ParticlesToLevelSet), rebuilt as a signed distance and moved inwards so that a flat block of
+//   particles gives its block's faces. Slower (the benchmark), kept for comparison.
+// Faces lying on the grid's walls are left out: a viewer sees the free surface, and the liquid's
+// side against a wall is the wall. One thread (an own TBB arena), deterministic: the same
+// particles give the same bits.
 
 namespace vrflow::fluid {
 
+/// How the particles become a volume to mesh (see above).
+enum class SurfaceMethod { Density, Spheres };
+
 /// How the surface is built. surfaceSettings() derives them from the fluid's settings.
 struct SurfaceSettings {
+  SurfaceMethod method = SurfaceMethod::Density;
+  double particleSpacing = 1.0 / 64.0;  ///< of the seeded particles (m): sets the full density
   double voxelSize = 1.0 / 64.0;       ///< edge of the level set's voxels (m)
   double particleRadius = 1.0 / 32.0;  ///< radius of each particle's sphere (m), >= 1.5 voxels
   double inset = 0.75 / 32.0;          ///< how far the union of spheres is moved inwards (m)
@@ -27,9 +37,10 @@ struct SurfaceSettings {
   double wallBand = 1.0 / 64.0;        ///< "on a wall": all three corners within this of its plane
 };
 
-/// The settings for a fluid: `voxelsPerCell` voxels along a cell's edge, spheres of twice the
-/// particle spacing (at least 1.5 voxels) moved in by that radius less half a spacing (the
-/// outermost particles of a seeded block lie half a spacing inside its face), walls = the grid.
+/// The settings for a fluid: `voxelsPerCell` voxels along a cell's edge, the density method;
+/// for the spheres method, spheres of twice the particle spacing (at least 1.5 voxels) moved in
+/// by that radius less half a spacing (the outermost particles of a seeded block lie half a
+/// spacing inside its face); walls = the grid.
 SurfaceSettings surfaceSettings(const FluidSettings& fluid, int voxelsPerCell);
 
 /// A triangle mesh: xyz floats per vertex, three vertex indices per triangle, counter-clockwise
