@@ -65,7 +65,7 @@ demo: build
 	fi
 	@rm -rf out/demo && mkdir -p out/demo
 	cd out/demo && $(abspath $(BUILD))/bin/vrflow run $(CURDIR)/examples/paper_scene/paper_scene_fluid.xml \
-	  --iterations 300 --no-progress --report report.json
+	  --iterations 300 --no-progress --report report.json --set water.surface=on
 	@cd out/demo && if [ -f demo.mp4 ]; then \
 	  ffmpeg -loglevel error -y -sseof -0.2 -i demo.mp4 -frames:v 1 -update 1 frame.png; \
 	else cp "$$(ls demo_*.png | tail -1)" frame.png; fi
