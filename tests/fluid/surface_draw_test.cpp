@@ -17,6 +17,14 @@ using testing::feed;
 const std::vector<float> kQuad{-1, 0.5f, 0, 1, 0.5f, 0, 1, 1.5f, 0, -1, 1.5f, 0};
 const std::vector<std::uint32_t> kTriangles{0, 1, 2, 0, 2, 3};
 
+// Fluid object 50 naming the quad (resource 500) by `param`: its surface or its particles.
+bool feedQuad(SceneCache& scene, std::uint32_t param) {
+  return feed(scene, [&](msg::MessageBuilder& b) {
+    b.addMesh(500, true, kQuad, kTriangles);
+    b.addObject(50, msg::fluidType(), msg::ObjectOp::Add).set(param, std::uint64_t{500});
+  });
+}
+
 Image renderCentre(const SceneCache& scene) {
   RenderSettings s;
   s.width = 64;
@@ -40,11 +48,7 @@ std::array<int, 3> centre(const Image& image) {
 
 TEST(SurfaceDrawing, FluidObjectNamingASurfaceIsDrawnAsBlueWater) {
   SceneCache scene;
-  ASSERT_TRUE(feed(scene, [&](msg::MessageBuilder& b) {
-    b.addMesh(500, true, kQuad, kTriangles);
-    b.addObject(50, msg::fluidType(), msg::ObjectOp::Add)
-        .set(msg::FluidParam::kSurface, std::uint64_t{500});
-  }));
+  ASSERT_TRUE(feedQuad(scene, msg::FluidParam::kSurface));
   ASSERT_NE(scene.meshIndices(500), nullptr);
   EXPECT_EQ(*scene.meshIndices(500), kTriangles);
   const auto water = centre(renderCentre(scene));
@@ -59,11 +63,7 @@ TEST(SurfaceDrawing, FluidObjectNamingASurfaceIsDrawnAsBlueWater) {
 TEST(SurfaceDrawing, WithoutTheSurfaceTheSameMeshIsDrawnAsParticlesOnly) {
   // The same mesh named as particles: only its four vertices are drawn, the centre stays empty.
   SceneCache scene;
-  ASSERT_TRUE(feed(scene, [&](msg::MessageBuilder& b) {
-    b.addMesh(500, true, kQuad, kTriangles);
-    b.addObject(50, msg::fluidType(), msg::ObjectOp::Add)
-        .set(msg::FluidParam::kParticles, std::uint64_t{500});
-  }));
+  ASSERT_TRUE(feedQuad(scene, msg::FluidParam::kParticles));
   SceneCache empty;
   EXPECT_EQ(centre(renderCentre(scene)), centre(renderCentre(empty)));
 }
@@ -72,11 +72,7 @@ TEST(SurfaceDrawing, WithoutTheSurfaceTheSameMeshIsDrawnAsParticlesOnly) {
 // grow when a sender replaces its objects).
 TEST(SurfaceDrawing, TheSurfaceIsDroppedWithItsObject) {
   SceneCache scene;
-  ASSERT_TRUE(feed(scene, [&](msg::MessageBuilder& b) {
-    b.addMesh(500, true, kQuad, kTriangles);
-    b.addObject(50, msg::fluidType(), msg::ObjectOp::Add)
-        .set(msg::FluidParam::kSurface, std::uint64_t{500});
-  }));
+  ASSERT_TRUE(feedQuad(scene, msg::FluidParam::kSurface));
   ASSERT_NE(scene.meshIndices(500), nullptr);
   ASSERT_TRUE(feed(scene, [&](msg::MessageBuilder& b) { b.addDelete(50, msg::fluidType()); }));
   EXPECT_EQ(scene.meshIndices(500), nullptr);
