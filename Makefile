@@ -15,7 +15,7 @@ PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-r
   nlohmann-json3-dev libxxhash-dev libzmq3-dev libopenmpi-dev openmpi-bin libxml2-utils procps \
   libbullet-dev libeigen3-dev libevdev-dev libosmesa6-dev libglfw3-dev xvfb xdotool libpng-dev qt6-base-dev libgraphviz-dev \
   libsodium-dev openssh-server openssh-client clang-format dpkg-dev libspdlog-dev \
-  munge slurmctld slurmd slurm-client python3-jsonschema bsdutils
+  munge slurmctld slurmd slurm-client python3-jsonschema bsdutils libopenvdb-dev libboost-dev libtbb-dev
 
 .PHONY: deps build test check format demo clean install
 
@@ -65,7 +65,7 @@ demo: build
 	fi
 	@rm -rf out/demo && mkdir -p out/demo
 	cd out/demo && $(abspath $(BUILD))/bin/vrflow run $(CURDIR)/examples/paper_scene/paper_scene_fluid.xml \
-	  --iterations 300 --no-progress --report report.json
+	  --iterations 300 --no-progress --report report.json --set water.surface=on
 	@cd out/demo && if [ -f demo.mp4 ]; then \
 	  ffmpeg -loglevel error -y -sseof -0.2 -i demo.mp4 -frames:v 1 -update 1 frame.png; \
 	else cp "$$(ls demo_*.png | tail -1)" frame.png; fi

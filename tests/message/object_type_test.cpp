@@ -21,6 +21,7 @@ TEST(ObjectType, BuiltinParameterIndicesMatchTheirConstants) {
   EXPECT_EQ(massSpringType().indexOf("bounds"), MassSpringParam::kBounds);
   EXPECT_EQ(massSpringType().param(MassSpringParam::kPinned).kind, ParamKind::Bytes);
   EXPECT_EQ(fluidType().indexOf("pressureField"), FluidParam::kPressureField);
+  EXPECT_EQ(fluidType().indexOf("surface"), FluidParam::kSurface);
   EXPECT_EQ(userType().indexOf("sdf"), UserParam::kSdf);
   EXPECT_EQ(pointType().indexOf("mass"), PointParam::kMass);
   EXPECT_FALSE(pointType().indexOf("colour").has_value());

@@ -5,7 +5,8 @@
 // `fluid` (its own fluid object, then its particles as a dynamic Mesh resource of xyz floats
 // with no triangles; with `particle-regions` a b c, one fluid object per box of an a x b x c
 // split of the grid, each with its own particles and the bounds of them, so that a route
-// filter sends a viewer only the regions it sees).
+// filter sends a viewer only the regions it sees; with `surface` on, each region's part of the
+// liquid's surface as a dynamic Mesh with triangles instead of its particles).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -18,6 +19,7 @@
 #include "final_state.hpp"
 #include "node_forces.hpp"
 #include "vrflow/fluid/solver.hpp"
+#include "vrflow/fluid/surface.hpp"
 #include "vrflow/message/builtin_types.hpp"
 #include "vrflow/module/module.hpp"
 #include "vrflow/module/start.hpp"
@@ -137,6 +139,13 @@ int main(int argc, char** argv) {
 
   const auto blocks = module.params().getInt("blocks");
   const std::string job = module.params().getString("job");
+  const bool withSurface = module.params().getString("surface") == "on";
+  if (withSurface && !job.empty()) {
+    return fail("surface = on with job = '" + job +
+                "': a block of a job holds only its own particles (use blocks instead)");
+  }
+  const fluid::SurfaceSettings surfaceSettings =
+      fluid::surfaceSettings(s, static_cast<int>(module.params().getInt("surface-resolution")));
   if (!job.empty() && blocks > 1) {
     return fail("blocks = " + std::to_string(blocks) + " with job = '" + job +
                 "': a module of an MPI job is one block of it (leave blocks at 1)");
@@ -286,28 +295,46 @@ int main(int argc, char** argv) {
     }
 
     const auto& xyz = jobBlock ? solver.particlePositions() : stepped->particles;
-    auto out = module.newMessage(512 + 160 * fluidIds.size() +
-                                 (sendParticles ? xyz.size() * sizeof(float) : 0));
+    // With the surface, each region's part of it replaces its particles (and their bounds).
+    std::vector<fluid::SurfaceRegion> surface;
+    std::size_t payloadBytes = sendParticles ? xyz.size() * sizeof(float) : 0;
+    if (withSurface && sendParticles) {
+      auto mesh = fluid::extractSurface(xyz, surfaceSettings);
+      if (!mesh) return fail(mesh.error().message);
+      surface = fluid::splitSurface(*mesh, regions.grid, regions.counts);
+      payloadBytes = 4 * (mesh->xyz.size() + mesh->indices.size()) + 64 * surface.size();
+    }
+    auto out = module.newMessage(512 + 160 * fluidIds.size() + payloadBytes);
     out.builder().setSimTime(time);
     out.builder().setTimeStep(dt);
     const bool split = regions.size() > 1;
-    if (split && sendParticles) regions.split(xyz);
+    if (split && sendParticles && !withSurface) regions.split(xyz);
+    const auto addPayload = [&](std::size_t r, const std::vector<float>& particles) {
+      if (withSurface) {
+        out.builder().addMesh(particlesIds[r], true, surface[r].mesh.xyz, surface[r].mesh.indices);
+      } else {
+        out.builder().addMesh(particlesIds[r], true, particles, {});
+      }
+    };
     for (std::size_t r = 0; r < fluidIds.size(); ++r) {
       // One region: the object's bounds are the grid's, sent once. Regions: the bounds of their
       // particles, sent with every copy of them (the meshes first, as a route filter wants).
       if (module.iteration() == 0 || (split && sendParticles)) {
         const bool add = module.iteration() == 0;
         const msg::Aabb bounds = !split                    ? ownBounds
+                                 : !surface.empty()        ? surface[r].bounds
                                  : !regions.bounds.empty() ? regions.bounds[r]
                                                            : regions.box(static_cast<int>(r));
-        if (sendParticles)
-          out.builder().addMesh(particlesIds[r], true, split ? regions.xyz[r] : xyz, {});
+        if (sendParticles) addPayload(r, split && !withSurface ? regions.xyz[r] : xyz);
         auto object = out.builder().addObject(fluidIds[r], msg::fluidType(),
                                               add ? msg::ObjectOp::Add : msg::ObjectOp::Update);
         object.set(msg::FluidParam::kBounds, bounds);
-        if (add) object.set(msg::FluidParam::kParticles, particlesIds[r]);
+        if (add) {
+          object.set(withSurface ? msg::FluidParam::kSurface : msg::FluidParam::kParticles,
+                     particlesIds[r]);
+        }
       } else if (sendParticles) {
-        out.builder().addMesh(particlesIds[r], true, xyz, {});
+        addPayload(r, xyz);
       }
     }
     if (!module.put(objectsOut, std::move(out))) {

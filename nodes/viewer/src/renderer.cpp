@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "draw_water.hpp"
 #include "edge_blend.hpp"
 #include "vrflow/message/eigen.hpp"
 #include "vrflow/message/shape.hpp"
@@ -294,6 +295,10 @@ void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass,
         break;
       }
       case ObjectKind::Fluid: {
+        if (object.surfaceId != 0) {
+          drawWater(scene, object.surfaceId, shadowPass);
+          break;
+        }
         const auto* xyz = scene.particles(object.particlesId);
         if (!xyz || xyz->empty() || shadowPass) break;
         const auto& c = settings.particleColour;

@@ -118,6 +118,11 @@ const std::vector<float>* SceneCache::particles(std::uint64_t id) const {
   return it == particles_.end() ? nullptr : &it->second;
 }
 
+const std::vector<std::uint32_t>* SceneCache::meshIndices(std::uint64_t id) const {
+  const auto it = meshIndices_.find(id);
+  return it == meshIndices_.end() ? nullptr : &it->second;
+}
+
 void SceneCache::apply(const msg::MessageView& message) {
   ++stats_.messages;
   for (const auto chunk : message) {
@@ -194,6 +199,7 @@ void SceneCache::applyObject(const msg::ObjectView& object) {
       break;
     case ObjectKind::Fluid:
       if (auto r = object.idParam(msg::FluidParam::kParticles)) cached.particlesId = *r;
+      if (auto r = object.idParam(msg::FluidParam::kSurface)) cached.surfaceId = *r;
       if (auto b = object.aabb(msg::FluidParam::kBounds)) cached.bounds = *b;
       break;
   }
@@ -206,6 +212,13 @@ void SceneCache::applyResource(const msg::ResourceView& resource) {
       auto& xyz = particles_[id];
       xyz.resize(mesh->xyz().size());
       mesh->xyz().copyTo(xyz);
+      if (mesh->indexCount() > 0) {
+        auto& indices = meshIndices_[id];
+        indices.resize(mesh->indexCount());
+        mesh->indices().copyTo(indices);
+      } else {
+        meshIndices_.erase(id);
+      }
     }
     return;
   }
@@ -260,8 +273,9 @@ void SceneCache::dropUnreferenced() {
   if (otherRaw_.empty() && particles_.empty()) return;
   std::set<std::uint64_t> named;
   for (const auto& [id, object] : objects_) {
-    if (object.kind == ObjectKind::Fluid) named.insert(object.particlesId);
+    if (object.kind == ObjectKind::Fluid) named.insert({object.particlesId, object.surfaceId});
   }
+  std::erase_if(meshIndices_, [&](const auto& entry) { return !named.contains(entry.first); });
   std::erase_if(otherRaw_, [&](const auto& entry) { return !named.contains(entry.first); });
   std::erase_if(particles_, [&](const auto& entry) { return !named.contains(entry.first); });
 }

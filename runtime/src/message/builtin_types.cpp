@@ -52,6 +52,7 @@ const ObjectType& fluidType() {
                                                           {"particles", ParamKind::Id},
                                                           {"velocityField", ParamKind::Id},
                                                           {"pressureField", ParamKind::Id},
+                                                          {"surface", ParamKind::Id},
                                                       });
   return type;
 }

@@ -52,7 +52,8 @@ struct FluidParam {
     kBounds,         ///< Aabb
     kParticles,      ///< Id of a resource
     kVelocityField,  ///< Id of a vector-field resource
-    kPressureField   ///< Id of a scalar-field resource
+    kPressureField,  ///< Id of a scalar-field resource
+    kSurface         ///< Id of a Mesh resource: the liquid's surface (triangles)
   };
 };
 

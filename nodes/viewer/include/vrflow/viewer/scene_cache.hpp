@@ -40,6 +40,7 @@ struct CachedObject {
   std::vector<double> positions;       ///< massspring: xyz per mass
   std::vector<std::uint32_t> surface;  ///< massspring: three mass indices per triangle
   std::uint64_t particlesId = 0;       ///< fluid: the particle resource
+  std::uint64_t surfaceId = 0;         ///< fluid: the surface mesh resource (0: none, particles)
   std::optional<msg::Aabb> bounds;     ///< the sender's `bounds` (a point: its position)
 };
 
@@ -74,6 +75,9 @@ class SceneCache {
   const DrawMesh* shapeMesh(std::uint64_t id) const;
   /// The latest particle positions (xyz floats) of resource `id`, or nullptr.
   const std::vector<float>* particles(std::uint64_t id) const;
+  /// The triangles (three vertex indices each) of Mesh resource `id`, whose vertices
+  /// particles(id) holds, or nullptr when it has none (a fluid's surface has them).
+  const std::vector<std::uint32_t>* meshIndices(std::uint64_t id) const;
   /// Raw and particle resources held. After each message those no object names are dropped, so
   /// a sender that makes a new resource id every iteration does not grow the cache.
   std::size_t heldResources() const { return otherRaw_.size() + particles_.size(); }
@@ -94,6 +98,7 @@ class SceneCache {
   std::map<std::uint64_t, std::size_t> otherRaw_;
   std::map<std::uint64_t, std::shared_ptr<const DrawMesh>> shapes_;  // nullptr: rejected
   std::map<std::uint64_t, std::vector<float>> particles_;
+  std::map<std::uint64_t, std::vector<std::uint32_t>> meshIndices_;
   SceneStats stats_;
 };
 
