@@ -65,7 +65,9 @@ void writeSample(const std::string& path) {
   for (std::uint64_t it = 0; it < 15; ++it) {
     ASSERT_TRUE((*writer)->add(0, it, 1000 + 10 * it, message("chain", it)));
     ASSERT_TRUE((*writer)->add(1, it, 1005 + 10 * it, message("springs", it, 40)));
-    if (it % 5 == 4) ASSERT_TRUE((*writer)->flush());
+    if (it % 5 == 4) {
+      ASSERT_TRUE((*writer)->flush());
+    }
   }
   ASSERT_TRUE((*writer)->close());
 }
