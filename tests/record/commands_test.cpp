@@ -102,6 +102,37 @@ TEST(RecordCommands, ReplayAtTheRecordedPaceGivesTheSameDigestsToo) {
   EXPECT_TRUE(leftoverProcesses().empty());
 }
 
+// pace step: one recorded iteration per message on beginIt, here the downstream recorder's
+// endIt (a cycle started by one initial message), in the live run and in the replay alike.
+TEST(RecordCommands, ReplaySteppedByBeginItGivesTheSameDigests) {
+  TempDir dir;
+  std::string xml = readFile(pipeline());
+  const auto insert = [&xml](const std::string& after, const std::string& text) {
+    const auto at = xml.find(after);
+    ASSERT_NE(at, std::string::npos) << after;
+    xml.insert(at + after.size(), text);
+  };
+  insert(R"(<input port="events" initial-messages="1"/>)",
+         R"(<input port="beginIt" initial-messages="1"/>)");
+  insert(R"(<connection from="relay.out" to="recorder.in"/>)",
+         R"(<connection from="recorder.endIt" to="chain.beginIt"/>)");
+  const std::string app = dir.write("stepped.xml", xml);
+  const auto recorded = vrflowIn(
+      dir.file("rec"), "record " + app +
+                           " --connections chain.objects -o s.vrrec -n 30 --report rec.json "
+                           "--no-progress");
+  ASSERT_EQ(recorded.exitCode, 0) << recorded.err;
+  const auto replayed =
+      vrflowIn(dir.file("replay"), "replay " + dir.file("rec/s.vrrec") + " " + app +
+                                       " --replace chain --pace step -n 30 --report r.json "
+                                       "--no-progress");
+  ASSERT_EQ(replayed.exitCode, 0) << replayed.err;
+  const auto live = digests(dir.file("rec/rec.json"));
+  EXPECT_TRUE(live.contains("recorder.endIt"));
+  EXPECT_EQ(digests(dir.file("replay/r.json"), "chain", "objects"), live);
+  EXPECT_TRUE(leftoverProcesses().empty());
+}
+
 // One line on stderr, exit status 2.
 void expectOneError(const CommandResult& result, const std::string& expected) {
   EXPECT_EQ(result.exitCode, 2) << result.err;
