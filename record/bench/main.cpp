@@ -58,11 +58,13 @@ std::vector<std::vector<std::byte>> makeMessages(int count) {
 
 int main(int argc, char** argv) {
   CLI::App cli{"vrflow-bench-record: recording and replay throughput against plain write()"};
-  int count = 512, repeats = 3, level = 1;
+  int count = 512, repeats = 3, level = 1, workers = 0, chunkKib = 1024;
   std::string dir = "/tmp";
   cli.add_option("--messages", count, "Messages per pass")->check(CLI::Range(1, 100000));
   cli.add_option("--repeats", repeats, "Passes (one line each)")->check(CLI::Range(1, 100));
   cli.add_option("--level", level, "zstd level of the recording")->check(CLI::Range(-7, 19));
+  cli.add_option("--workers", workers, "zstd worker threads")->check(CLI::Range(0, 64));
+  cli.add_option("--chunk-kib", chunkKib, "Chunk size (KiB)")->check(CLI::Range(1, 1 << 20));
   cli.add_option("--dir", dir, "Folder for the files written (removed after)");
   CLI11_PARSE(cli, argc, argv);
 
@@ -94,7 +96,10 @@ int main(int argc, char** argv) {
 
     start = Clock::now();
     auto writer = vrflow::record::RecordingWriter::create(
-        recordPath, {{"fluid", "objects", "objects"}}, {.level = level});
+        recordPath, {{"fluid", "objects", "objects"}},
+        {.level = level,
+         .chunkBytes = static_cast<std::size_t>(chunkKib) * 1024,
+         .workers = workers});
     if (!writer) {
       std::fprintf(stderr, "%s\n", writer.error().message.c_str());
       return 1;
@@ -138,9 +143,11 @@ int main(int argc, char** argv) {
     }
     std::printf(
         "{\"bench\":\"record\",\"host\":\"%s\",\"pass\":%d,\"messages\":%d,\"mib\":%.2f,"
-        "\"level\":%d,\"record_mib_s\":%.1f,\"replay_mib_s\":%.1f,\"write_mib_s\":%.1f,"
+        "\"level\":%d,\"workers\":%d,\"chunk_kib\":%d,\"record_mib_s\":%.1f,\"replay_mib_s\":%.1f,"
+        "\"write_mib_s\":%.1f,"
         "\"record_over_write\":%.3f,\"compression_ratio\":%.2f}\n",
-        host, pass, count, mib, level, mib / recordS, mib / replayS, mib / writeS, writeS / recordS,
+        host, pass, count, mib, level, workers, chunkKib, mib / recordS, mib / replayS,
+        mib / writeS, writeS / recordS,
         static_cast<double>(bytes) / static_cast<double>(fileBytes));
   }
   ::unlink(plainPath.c_str());

@@ -53,6 +53,7 @@ int main() {
   record::WriterSettings settings;
   settings.level = static_cast<int>(module.params().getInt("level"));
   settings.chunkBytes = static_cast<std::size_t>(module.params().getInt("chunk-kib")) * 1024;
+  settings.workers = static_cast<int>(module.params().getInt("workers"));
   const auto flushNs = static_cast<std::uint64_t>(module.params().getInt("flush-ms")) * 1000000;
   auto writer = record::RecordingWriter::create(path, *connections, settings);
   if (!writer) return fail(writer.error().message);

@@ -4,6 +4,7 @@
 #include <unistd.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -56,6 +57,16 @@ Result<std::unique_ptr<RecordingWriter>> RecordingWriter::create(
   if (writer->zstd_->context == nullptr) return makeError("zstd: cannot create a context");
   ZSTD_CCtx_setParameter(writer->zstd_->context, ZSTD_c_compressionLevel, settings.level);
   ZSTD_CCtx_setParameter(writer->zstd_->context, ZSTD_c_checksumFlag, 1);
+  if (settings.workers > 0) {
+    const std::size_t nbWorkers =
+        ZSTD_CCtx_setParameter(writer->zstd_->context, ZSTD_c_nbWorkers, settings.workers);
+    if (ZSTD_isError(nbWorkers) != 0) {
+      return makeError(std::string("zstd: no worker threads: ") + ZSTD_getErrorName(nbWorkers));
+    }
+    const auto job = std::max<std::size_t>(
+        settings.chunkBytes / static_cast<std::size_t>(settings.workers), std::size_t{512} << 10);
+    ZSTD_CCtx_setParameter(writer->zstd_->context, ZSTD_c_jobSize, static_cast<int>(job));
+  }
   writer->fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (writer->fd_ < 0) return makeError("cannot write '" + path + "': " + std::strerror(errno));
   std::vector<std::byte> header(kFileHeaderBytes);

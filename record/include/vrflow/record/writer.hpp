@@ -17,6 +17,9 @@ struct WriterSettings {
   int level = 1;  ///< zstd compression level (negative: faster, larger)
   /// A chunk is compressed and written once its records reach this many bytes (or at flush()).
   std::size_t chunkBytes = std::size_t{1} << 20;
+  /// zstd worker threads compressing a chunk in parallel (0: in the caller's thread). A chunk
+  /// is split into jobs of about chunkBytes / workers.
+  int workers = 0;
 };
 
 /// Writes one recording (docs/recording.md): the header at create(), then chunks as records
