@@ -280,6 +280,15 @@ int recordRun(RecordCommands& c) {
   if (!connections) return refuse("record", connections.error().message);
   if (c.recording.empty()) c.recording = loaded->application.name + ".vrrec";
   const std::string file = std::filesystem::absolute(c.recording).lexically_normal().string();
+  // Checked before anything starts: a run must not end unable to write what it recorded.
+  const auto folder = std::filesystem::path(file).parent_path();
+  std::error_code error;
+  if (!std::filesystem::is_directory(folder, error) || std::filesystem::is_directory(file, error)) {
+    return refuse("record", "cannot write the recording to '" + c.recording + "': " +
+                                (std::filesystem::is_directory(file, error)
+                                     ? std::string("it is a folder")
+                                     : "folder '" + folder.string() + "' does not exist"));
+  }
   // Every module keeps its iteration count; the recorder takes what comes until its inputs end.
   run::RunOptions options;
   if (c.iterations > 0) {

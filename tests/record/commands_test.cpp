@@ -152,6 +152,10 @@ TEST(RecordCommands, BadInputIsOneClearErrorAndLeavesNothingBehind) {
                  "output 'nope' (its outputs: objects)");
   expectOneError(vrflowIn(dir.path(), "record " + pipeline() + " --connections ghost.objects -n 5"),
                  "has no module 'ghost'");
+  expectOneError(vrflowIn(dir.path(), "record " + pipeline() +
+                                          " --connections chain.objects -o nowhere/c.vrrec -n 5"),
+                 "vrflow record: cannot write the recording to 'nowhere/c.vrrec': folder '" +
+                     dir.file("nowhere") + "' does not exist");
   expectOneError(vrflowIn(dir.path(), "record " + pipeline() + " --connections chain -n 5"),
                  "'chain' is not MODULE.PORT");
 
