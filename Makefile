@@ -12,7 +12,7 @@ export CCACHE_NOHASHDIR := 1
 PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-rt-14-dev \
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-video-dev libopencv-imgcodecs-dev libopencv-videoio-dev \
   libgtest-dev libpugixml-dev libcli11-dev \
-  nlohmann-json3-dev libxxhash-dev libzmq3-dev libopenmpi-dev openmpi-bin libxml2-utils procps \
+  nlohmann-json3-dev libxxhash-dev libzstd-dev libzmq3-dev libopenmpi-dev openmpi-bin libxml2-utils procps \
   libbullet-dev libeigen3-dev libevdev-dev libosmesa6-dev libglfw3-dev xvfb xdotool libpng-dev qt6-base-dev libgraphviz-dev \
   libsodium-dev openssh-server openssh-client clang-format dpkg-dev libspdlog-dev \
   munge slurmctld slurmd slurm-client python3-jsonschema bsdutils libopenvdb-dev libboost-dev libtbb-dev

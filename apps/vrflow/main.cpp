@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "record_commands.hpp"
 #include "runs_commands.hpp"
 #include "types_command.hpp"
 #include "vrflow/app/package_files.hpp"
@@ -298,6 +299,8 @@ int main(int argc, char** argv) {
   auto* typesCommand = vrflow::apps::addTypesCommand(cli, typesOptions);
   vrflow::cli::RunsCommands runsCommands;
   vrflow::cli::addRunsCommands(cli, runsCommands);
+  vrflow::cli::RecordCommands recordCommands;
+  vrflow::cli::addRecordCommands(cli, recordCommands);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -306,6 +309,7 @@ int main(int argc, char** argv) {
   }
 
   if (const auto code = vrflow::cli::runRunsCommand(runsCommands)) return *code;
+  if (const auto code = vrflow::cli::runRecordCommand(recordCommands)) return *code;
   if (monitorCommand->parsed()) {
     if (monitorFollowEvents) return vrflow::launcher::followEvents(monitorRun);
     return monitorSource.empty()
