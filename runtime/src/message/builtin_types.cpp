@@ -63,6 +63,7 @@ const ObjectType& userType() {
                                                          {"bounds", ParamKind::Aabb},
                                                          {"mesh", ParamKind::Id},
                                                          {"sdf", ParamKind::Id},
+                                                         {"velocityField", ParamKind::Id},
                                                      });
   return type;
 }
