@@ -1,0 +1,48 @@
+#include "user_scenes.hpp"
+
+#include <sstream>
+
+#include "vrflow/camera/synthetic_user.hpp"
+
+namespace vrflow::testing {
+
+std::string shiftedUserKeys(double start, double end, const msg::Vec3& shift) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "# the standing pose, moved by " << shift[0] << " " << shift[1] << " " << shift[2]
+      << " between " << start << " and " << end << " s\n";
+  const auto pose = camera::standingPose();
+  for (const double t : {start, end})
+    for (std::size_t j = 0; j < pose.size(); ++j) {
+      const double f = t == start ? 0.0 : 1.0;
+      out << t << " " << camera::kUserJoints[j] << " " << pose[j][0] + f * shift[0] << " "
+          << pose[j][1] + f * shift[1] << " " << pose[j][2] + f * shift[2] << "\n";
+    }
+  return out.str();
+}
+
+UserModules userModules(const std::string& keys, int cells, const msg::Vec3& origin, double edge,
+                        const std::string& to) {
+  std::ostringstream modules, connections;
+  modules << R"(    <module id="truth" package="camera" type="user-truth" host="local">
+      <param name="keyframes" value=")"
+          << keys << R"("/>
+      <param name="cells" value=")"
+          << cells << R"("/>
+      <param name="volume-origin" value=")"
+          << origin[0] << " " << origin[1] << " " << origin[2] << R"("/>
+      <param name="volume-edge" value=")"
+          << edge << R"("/>
+    </module>
+    <module id="user" package="camera" type="user-animator" host="local"/>
+)";
+  connections << R"(    <connection from="truth.hull" to="user.hull"/>
+)";
+  std::istringstream targets(to);
+  for (std::string target; targets >> target;)
+    connections << R"(    <connection from="user.objects" to=")" << target << R"("/>
+)";
+  return {modules.str(), connections.str()};
+}
+
+}  // namespace vrflow::testing
