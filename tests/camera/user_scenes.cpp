@@ -6,19 +6,20 @@
 
 namespace vrflow::testing {
 
-std::string shiftedUserKeys(double start, double end, const msg::Vec3& shift) {
+std::string userKeys(const std::vector<std::pair<double, msg::Vec3>>& keys) {
   std::ostringstream out;
   out.precision(17);
-  out << "# the standing pose, moved by " << shift[0] << " " << shift[1] << " " << shift[2]
-      << " between " << start << " and " << end << " s\n";
+  out << "# the standing pose, translated\n";
   const auto pose = camera::standingPose();
-  for (const double t : {start, end})
-    for (std::size_t j = 0; j < pose.size(); ++j) {
-      const double f = t == start ? 0.0 : 1.0;
-      out << t << " " << camera::kUserJoints[j] << " " << pose[j][0] + f * shift[0] << " "
-          << pose[j][1] + f * shift[1] << " " << pose[j][2] + f * shift[2] << "\n";
-    }
+  for (const auto& [t, shift] : keys)
+    for (std::size_t j = 0; j < pose.size(); ++j)
+      out << t << " " << camera::kUserJoints[j] << " " << pose[j][0] + shift[0] << " "
+          << pose[j][1] + shift[1] << " " << pose[j][2] + shift[2] << "\n";
   return out.str();
+}
+
+std::string shiftedUserKeys(double start, double end, const msg::Vec3& shift) {
+  return userKeys({{start, {0, 0, 0}}, {end, shift}});
 }
 
 UserModules userModules(const std::string& keys, int cells, const msg::Vec3& origin, double edge,

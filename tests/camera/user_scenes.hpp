@@ -3,13 +3,18 @@
 // pose as a whole, and the application files that put it beside rigid bodies, a net or water.
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "vrflow/message/values.hpp"
 
 namespace vrflow::testing {
 
-/// A keyframe file: the standing pose (vrflow::camera::standingPose) held until `start`, then
-/// translated by `shift` (m) until `end` (s), then held.
+/// A keyframe file: the standing pose (vrflow::camera::standingPose) translated by each key's
+/// shift (m) at its time (s), interpolated between keys, held before the first and after the last.
+std::string userKeys(const std::vector<std::pair<double, msg::Vec3>>& keys);
+
+/// The standing pose held until `start`, then translated by `shift` (m) until `end` (s), then held.
 std::string shiftedUserKeys(double start, double end, const msg::Vec3& shift);
 
 /// The modules and connections that bring the user into an application: `truth` (camera
