@@ -377,8 +377,7 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     for (const auto& [id, user] : users_) spacing = std::min(spacing, user->spacing);
     for (const Impl::Entry* e : bodies) {
       if (e->body.kinematic) continue;
-      userContacts(e->body, surfaceSamples(e->body.shape, 2 * spacing), users_,
-                   p.speculativeDistance, surface);
+      userContacts(e->body, 2 * spacing, users_, p.speculativeDistance, surface);
     }
     for (const SurfaceContact& s : surface) {
       Constraint c{};

@@ -65,14 +65,16 @@ std::vector<Vec3> surfaceSamples(const msg::Shape& shape, double spacing) {
   return samples;
 }
 
-void userContacts(const Body& body, const std::vector<Vec3>& samples,
+void userContacts(const Body& body, double spacing,
                   const std::map<std::uint64_t, const camera::UserSurface*>& users, double reach,
                   std::vector<SurfaceContact>& out) {
   if (body.kinematic) return;
   const msg::Aabb box = msg::worldBounds(body.shape, body.position, body.orientation);
   const double radius = isRound(body.shape) ? body.shape.radius : 0.0;
+  std::vector<Vec3> samples;
   for (const auto& [id, user] : users) {
     if (!near(box, user->bounds, reach + user->spacing)) continue;
+    if (samples.empty()) samples = surfaceSamples(body.shape, spacing);
     for (const Vec3& local : samples) {
       const Vec3 centre = add(body.position, msg::rotate(body.orientation, local));
       const double distance = user->distance(centre) - radius;

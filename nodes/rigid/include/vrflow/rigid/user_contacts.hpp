@@ -32,8 +32,9 @@ struct SurfaceContact {
 std::vector<Vec3> surfaceSamples(const msg::Shape& shape, double spacing);
 
 /// Contacts of `body` (dynamic) with every user whose bounds it comes within `reach` of, in user
-/// id order, then sample order.
-void userContacts(const Body& body, const std::vector<Vec3>& samples,
+/// id order, then sample order; the body is sampled (surfaceSamples) `spacing` apart, only when a
+/// user is near.
+void userContacts(const Body& body, double spacing,
                   const std::map<std::uint64_t, const camera::UserSurface*>& users, double reach,
                   std::vector<SurfaceContact>& out);
 
