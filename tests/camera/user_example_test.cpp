@@ -5,9 +5,9 @@
 
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 
 #include "process_helpers.hpp"
+#include "user_scenes.hpp"
 
 namespace vrflow::testing {
 namespace {
@@ -41,17 +41,10 @@ TEST(CameraUserExample, TheHandPushesTheCrateOffTheTableAndPressesTheNet) {
   EXPECT_GT(crate[2], 0.95);
 
   // The net (its plane at 1.15 m) is pressed under the left hand (x 0.66, z 0.6).
-  std::istringstream net(readFile(dir.file("net-final.txt")));
-  std::string line;
-  std::getline(net, line);
-  std::getline(net, line);
+  const auto net = netPositions(readFile(dir.file("net-final.txt")));
+  ASSERT_EQ(net.size(), 169u);
   double lowest = 1e9;
-  for (int i = 0; i < 169 && std::getline(net, line); ++i) {
-    std::istringstream fields(line);
-    double x = 0, y = 0, z = 0;
-    fields >> x >> y >> z;
-    lowest = std::min(lowest, y);
-  }
+  for (const auto& p : net) lowest = std::min(lowest, p[1]);
   EXPECT_LT(lowest, 1.15 - 0.04);
   EXPECT_TRUE(leftoverProcesses().empty());
   EXPECT_TRUE(vrflowShmEntries().empty());

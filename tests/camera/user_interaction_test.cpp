@@ -135,19 +135,14 @@ std::string netApp(const TempDir& dir, const msg::Vec3& shift) {
 
 // The height of the net's node nearest the hand's line (x -0.33, z 0.58).
 double heightUnderTheHand(const std::string& netFile) {
-  std::istringstream in(netFile);
-  std::string line;
-  std::getline(in, line);
-  std::getline(in, line);
+  const auto nodes = netPositions(netFile);
+  EXPECT_EQ(nodes.size(), 169u);
   double best = 1e9, height = 0;
-  for (int i = 0; i < 169 && std::getline(in, line); ++i) {
-    std::istringstream fields(line);
-    double x = 0, y = 0, z = 0;
-    fields >> x >> y >> z;
-    const double d = std::hypot(x + 0.33, z - 0.58);
+  for (const auto& p : nodes) {
+    const double d = std::hypot(p[0] + 0.33, p[2] - 0.58);
     if (d < best) {
       best = d;
-      height = y;
+      height = p[1];
     }
   }
   EXPECT_LT(best, 0.01);

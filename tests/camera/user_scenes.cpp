@@ -22,6 +22,23 @@ std::string shiftedUserKeys(double start, double end, const msg::Vec3& shift) {
   return userKeys({{start, {0, 0, 0}}, {end, shift}});
 }
 
+std::vector<msg::Vec3> netPositions(const std::string& netFile) {
+  std::istringstream in(netFile);
+  std::string word;
+  std::size_t nodes = 0;
+  in >> word >> word >> word >> nodes;  // "massspring 1", "nodes N"
+  std::vector<msg::Vec3> positions;
+  std::string line;
+  std::getline(in, line);
+  for (std::size_t i = 0; i < nodes && std::getline(in, line); ++i) {
+    std::istringstream fields(line);
+    msg::Vec3 p{};
+    fields >> p[0] >> p[1] >> p[2];
+    positions.push_back(p);
+  }
+  return positions;
+}
+
 UserModules userModules(const std::string& keys, int cells, const msg::Vec3& origin, double edge,
                         const std::string& to) {
   std::ostringstream modules, connections;

@@ -17,6 +17,9 @@ std::string userKeys(const std::vector<std::pair<double, msg::Vec3>>& keys);
 /// The standing pose held until `start`, then translated by `shift` (m) until `end` (s), then held.
 std::string shiftedUserKeys(double start, double end, const msg::Vec3& shift);
 
+/// The node positions of a mass-spring net file (the animator's state-file), one xyz per node.
+std::vector<msg::Vec3> netPositions(const std::string& netFile);
+
 /// The modules and connections that bring the user into an application: `truth` (camera
 /// user-truth on `keys`, `cells` voxels per edge of the cube of `edge` m at `origin`) feeding
 /// `user` (camera user-animator), whose objects go to every interactor named in `to`
