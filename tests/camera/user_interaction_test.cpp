@@ -197,5 +197,32 @@ TEST(UserInteraction, SlabsThatDoNotMakeTheGridStopTheRunNamingTheParameter) {
   EXPECT_TRUE(vrflowShmEntries().empty());
 }
 
+TEST(UserInteraction, MoreSlabsThanCellsOrAMissingKeyframeFileStopTheRun) {
+  TempDir dir;
+  const std::string base = rigidApp(dir, {0, 0, 0.3});
+  const std::string truth =
+      R"(<module id="truth" package="camera" type="user-truth" host="local">)";
+  std::string app = base;
+  app.replace(app.find(truth), truth.size(), truth + R"(<param name="slabs" value="65"/>)");
+  auto result =
+      runCommand({binDir() + "/vrflow", "run", dir.write("slabs.xml", app), "-n", "10"}, 60);
+  EXPECT_NE(result.exitCode, 0);
+  EXPECT_LT(result.exitCode, 128);
+  EXPECT_NE((result.out + result.err).find("parameter 'slabs' (65) exceeds 'cells' (64)"),
+            std::string::npos)
+      << result.out << result.err;
+
+  app = base;
+  const std::string keys = dir.file("user.keys");
+  app.replace(app.find(keys), keys.size(), dir.file("absent.keys"));
+  result = runCommand({binDir() + "/vrflow", "run", dir.write("absent.xml", app), "-n", "10"}, 60);
+  EXPECT_NE(result.exitCode, 0);
+  EXPECT_LT(result.exitCode, 128);
+  EXPECT_NE((result.out + result.err).find("absent.keys"), std::string::npos)
+      << result.out << result.err;
+  EXPECT_TRUE(leftoverProcesses().empty());
+  EXPECT_TRUE(vrflowShmEntries().empty());
+}
+
 }  // namespace
 }  // namespace vrflow::testing
