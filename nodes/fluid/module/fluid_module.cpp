@@ -255,6 +255,12 @@ int main(int argc, char** argv) {
     fluid::BlockStep request;
     request.dt = dt;
     request.bodies = bodies;
+    // Captured users after the bodies, in one solver only (a block's step travels as bytes,
+    // which carry shapes, not users' fields).
+    if (!group && !jobBlock) {
+      const auto users = world.users(&near);
+      request.bodies.insert(request.bodies.end(), users.begin(), users.end());
+    }
     request.points = points;
     request.gatherParticles = sendParticles && !jobBlock;
     request.stats = withStats;
@@ -277,12 +283,12 @@ int main(int argc, char** argv) {
         forces.builder().addForce(f.id, {f.force, f.torque, f.point, f.duration});
       }
     }
-    if (!points.empty() && stepped->forces.size() >= bodies.size() + points.size()) {
+    if (!points.empty() && stepped->forces.size() >= request.bodies.size() + points.size()) {
       // A net is held whole by a block, so its nodes are reported by the same one.
       std::vector<fluid::PointMass> reportedPoints;
       std::vector<fluid::BodyForce> nodeForces;
       for (std::size_t p = 0; p < points.size(); ++p) {
-        const auto& f = stepped->forces[bodies.size() + p];
+        const auto& f = stepped->forces[request.bodies.size() + p];
         if (!f.reported) continue;
         reportedPoints.push_back(points[p]);
         nodeForces.push_back(f);

@@ -72,7 +72,7 @@ Status World::apply(const msg::MessageView& message) {
       if (auto b = object->aabb(msg::MassSpringParam::kBounds)) net.bounds = *b;
     }
   }
-  return {};
+  return users_.apply(message);
 }
 
 std::vector<RigidBody> World::rigidBodies(const msg::Aabb* near) const {
@@ -85,6 +85,20 @@ std::vector<RigidBody> World::rigidBodies(const msg::Aabb* near) const {
     out.back().shape = shape->second;
     // The rigid package sends kinematic bodies (infinite mass) with mass 0.
     out.back().kinematic = !(rigid.body.mass > 0.0);
+  }
+  return out;
+}
+
+std::vector<RigidBody> World::users(const msg::Aabb* near) const {
+  std::vector<RigidBody> out;
+  for (const auto& [id, user] : users_.ready()) {
+    if (!meets(user->bounds, near)) continue;
+    RigidBody body;
+    body.id = id;
+    body.position = user->position;
+    body.kinematic = true;
+    body.surface = user;
+    out.push_back(body);
   }
   return out;
 }

@@ -6,11 +6,13 @@
 #include <string>
 #include <vector>
 
+#include "vrflow/camera/user_copy.hpp"
 #include "vrflow/fluid/solver.hpp"
 #include "vrflow/message/reader.hpp"
 
 // The fluid module's copy of the objects it couples with: rigid bodies (and their shape
-// resources) and, optionally, mass-spring nodes as independent point masses. Only changes
+// resources), captured users (their distance and velocity fields) and, optionally, mass-spring
+// nodes as independent point masses. Only changes
 // travel, so each chunk updates the copy; objects of other types are ignored.
 
 namespace vrflow::fluid {
@@ -30,6 +32,10 @@ class World {
   /// Mass-spring nodes (empty when nodeRadius is 0), in net id then node order; with `near`,
   /// every node of the nets whose bounds meet it (or never came).
   std::vector<PointMass> pointMasses(const msg::Aabb* near = nullptr) const;
+  /// Captured users (type `user`) whose distance field has arrived, as kinematic bodies with
+  /// their `surface`, in id order; with `near`, those whose bounds meet it. Valid until the next
+  /// apply().
+  std::vector<RigidBody> users(const msg::Aabb* near = nullptr) const;
   /// Rigid objects seen without their shape (not coupled yet), for the log.
   std::vector<std::string> uncoupled() const;
 
@@ -47,6 +53,7 @@ class World {
   std::map<std::uint64_t, Rigid> rigids_;
   std::map<std::uint64_t, Net> nets_;
   std::map<std::uint64_t, msg::Shape> shapes_;
+  camera::UserCopy users_;
 };
 
 }  // namespace vrflow::fluid

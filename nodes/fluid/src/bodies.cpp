@@ -28,6 +28,12 @@ std::string name(std::uint64_t id) {
   return "body " + std::to_string(id);
 }
 
+/// Signed distance of world point x to the body's surface.
+double distanceOf(const PreparedBody& body, const Vector3d& x) {
+  if (body.surface) return body.surface->distance(msg::toVec3(x));
+  return msg::signedDistance(body.shape, toLocal(body, x)).distance;
+}
+
 Status finish(PreparedBody& p) {
   if (auto status = msg::validateShape(p.shape); !status) {
     return makeError("fluid: " + name(p.id) + ": bad shape: " + status.error().message);
@@ -66,6 +72,15 @@ Result<PreparedBody> prepareBody(const RigidBody& body, double liquidDensity) {
   p.angularVelocity = body.angularVelocity;
   p.mass = body.mass;
   p.kinematic = body.kinematic;
+  if (body.surface) {
+    // A captured user: immovable, as dense as the kinematic bodies, bounded by its voxels.
+    p.surface = body.surface;
+    p.kinematic = true;
+    p.position = body.surface->position;
+    p.density = kKinematicDensityRatio * liquidDensity;
+    p.bounds = body.surface->bounds;
+    return p;
+  }
   if (body.kinematic) {
     // Infinite mass, for the projection the shape filled at kKinematicDensityRatio times the
     // liquid's density (finish() derives the density from this mass and the volume).
@@ -97,6 +112,14 @@ Result<PreparedBody> preparePoint(const PointMass& point) {
 }
 
 void pushOut(const PreparedBody& body, double* x, double margin) {
+  if (body.surface) {
+    const msg::Vec3 at{x[0], x[1], x[2]};
+    const double distance = body.surface->distance(at);
+    if (distance >= 0.0) return;
+    const msg::Vec3 n = body.surface->normal(at);
+    msg::asVector3(x) += (-distance + margin) * asEigen(n);
+    return;
+  }
   const auto sd = msg::signedDistance(body.shape, toLocal(body, msg::asVector3(x)));
   if (sd.distance >= 0.0) return;
   const Vector3d n = asEigen(body.orientation) * asEigen(sd.normal);
@@ -105,6 +128,7 @@ void pushOut(const PreparedBody& body, double* x, double margin) {
 }
 
 msg::Vec3 rigidVelocity(const PreparedBody& body, const msg::Vec3& x) {
+  if (body.surface) return body.surface->velocityAt(x);
   const Vector3d r = asEigen(x) - asEigen(body.position);
   return msg::toVec3(asEigen(body.linearVelocity) + asEigen(body.angularVelocity).cross(r));
 }
@@ -137,8 +161,7 @@ void rasterise(const Grid& g, const std::vector<PreparedBody>& bodies, std::vect
             if (a >= 0) x[a] -= 0.5 * g.h;
             auto& slot = a < 0 ? cellBody[g.cell(i, j, k)] : faceBody[a][g.face(a, i, j, k)];
             if (slot >= 0) continue;
-            if (msg::signedDistance(body.shape, toLocal(body, x)).distance < 0.0)
-              slot = static_cast<int>(b);
+            if (distanceOf(body, x) < 0.0) slot = static_cast<int>(b);
           }
         }
       }

@@ -22,8 +22,9 @@ struct PreparedBody {
   msg::Vec3 linearVelocity{};
   msg::Vec3 angularVelocity{};
   double mass = 1.0;
-  double density = 1.0;  ///< mass / volume, used in the projection
-  msg::Aabb bounds;      ///< world bounds
+  double density = 1.0;                          ///< mass / volume, used in the projection
+  msg::Aabb bounds;                              ///< world bounds
+  const camera::UserSurface* surface = nullptr;  ///< a captured user: distance and velocity fields
 };
 
 /// `liquidDensity` gives kinematic bodies theirs (kKinematicDensityRatio times it).

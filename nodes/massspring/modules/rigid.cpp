@@ -1,6 +1,7 @@
 // massspring/rigid: the rigid / mass-spring interactor. Nodes of every net against every rigid
 // shape (signed distance in the body frame); node forces to the nets, and to each touched rigid
 // one ForceEvent with the opposite total force at its centre of mass and the torque about it.
+// Nodes against every captured user (type `user`) too: node forces only, the user is immovable.
 #include <cstdio>
 
 #include "common.hpp"
@@ -13,7 +14,9 @@ int main() {
   return modules::runContactInteractor(
       "vrflow-massspring-rigid", [](Module& module, const SceneCopy& scene,
                                     const ContactParams& contact, ContactMemory* memory) {
-        const auto result = rigidContacts(scene.nets(), scene.rigids(), contact, memory);
+        auto result = rigidContacts(scene.nets(), scene.rigids(), contact, memory);
+        const auto users = scene.users();
+        if (!users.empty()) addUserContacts(scene.nets(), users, contact, result);
         auto out =
             modules::nodeForcesMessage(module, result.nodeForces, result.rigidForces.size() * 128);
         for (const auto& [id, force] : result.rigidForces) out.builder().addForce(id, force);

@@ -464,3 +464,39 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
 }
 
 }  // namespace vrflow::massspring
+
+namespace vrflow::massspring {
+
+void addUserContacts(const std::map<std::uint64_t, Net>& nets,
+                     const std::map<std::uint64_t, const camera::UserSurface*>& users,
+                     const ContactParams& p, ContactForces& out) {
+  for (const auto& [userId, user] : users) {
+    for (const auto& [netId, net] : nets) {
+      const msg::Aabb netBox = bounds(net);
+      bool near = true;
+      for (int k = 0; k < 3; ++k)
+        near = near && netBox.min[k] <= user->bounds.max[k] + p.thickness &&
+               netBox.max[k] >= user->bounds.min[k] - p.thickness;
+      if (!near) continue;
+      const Adjacency adj = adjacency(net);
+      for (std::size_t i = 0; i < net.nodeCount(); ++i) {
+        if (net.pinned[i]) continue;
+        const Vector3d x = positionOf(net, i);
+        if (!inBox(x, user->bounds, p.thickness)) continue;
+        const double distance = user->distance(msg::toVec3(x));
+        if (distance >= p.thickness) continue;
+        const Vector3d n = asEigen(user->normal(msg::toVec3(x)));
+        if (n.isZero(0.0)) continue;
+        // The user is infinitely heavy and moves with its surface velocity.
+        const Vector3d relative = velocityOf(net, i) - asEigen(user->velocityAt(msg::toVec3(x)));
+        const double f =
+            contactMagnitude(distance, relative.dot(n), effectiveInvMass(net, adj, i, n, p), p);
+        if (f <= 0) continue;
+        addTo(forcesOf(out, netId, net), i, n * f);
+        ++out.contacts;
+      }
+    }
+  }
+}
+
+}  // namespace vrflow::massspring

@@ -111,6 +111,7 @@ Status SceneCopy::apply(const msg::MessageView& message) {
       if (auto v = object->idParam(P::kShape)) entry.shapeId = *v;
     }
   }
+  if (auto status = users_.apply(message); !status) fail(status.error().message);
   return result;
 }
 

@@ -1,8 +1,10 @@
 // rigid/interactor: keeps a copy of the rigid objects it receives, finds their contacts with
 // Bullet and answers with the contact impulses of our sequential impulse solver, as force events
-// over the step (the animator applies them).
+// over the step (the animator applies them). Captured users (type `user`) are solids of infinite
+// mass the bodies collide with through their distance field and surface velocity.
 #include <cstdio>
 
+#include "vrflow/camera/user_copy.hpp"
 #include "vrflow/module/module.hpp"
 #include "vrflow/module/start.hpp"
 #include "vrflow/rigid/contact_solver.hpp"
@@ -24,11 +26,16 @@ int main() {
   const double fallbackDt = module.params().getFloat("dt");
   rigid::RigidContactSolver solver(params);
   rigid::RigidObjectCopy copy;
+  camera::UserCopy users;
   while (module.wait()) {
     const Message& received = module.get(ports->objects);
     std::vector<std::uint64_t> deleted;
     if (received.valid()) {
       if (auto status = copy.apply(received.view(), &deleted); !status) {
+        std::fprintf(stderr, "vrflow-rigid-interactor: %s\n", status.error().message.c_str());
+        return 1;
+      }
+      if (auto status = users.apply(received.view()); !status) {
         std::fprintf(stderr, "vrflow-rigid-interactor: %s\n", status.error().message.c_str());
         return 1;
       }
@@ -48,6 +55,7 @@ int main() {
       }
     }
     const double dt = module.timeStep() > 0 ? module.timeStep() : fallbackDt;
+    solver.setUsers(users.ready());
     const auto impulses = solver.solve(dt);
     auto out = module.newMessage(64 + impulses.size() * 112);
     for (const auto& [id, event] : impulses) out.builder().addForce(id, event);

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <string>
 
+#include "vrflow/rigid/user_contacts.hpp"
+
 namespace vrflow::rigid {
 namespace {
 
@@ -217,10 +219,12 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   const std::size_t n = impl_->entries.size();
   std::vector<Impl::Entry*> bodies;
   bodies.reserve(n);
-  std::vector<double> invMass(n);
-  std::vector<RowMatrix3d> invInertia(n);
-  std::vector<Eigen::Vector3d> v(n), w(n), linear(n, Eigen::Vector3d::Zero()),
-      angular(n, Eigen::Vector3d::Zero());
+  // Slot n stands for the captured users: infinite mass, at rest (their surface velocity is a
+  // constraint's `surface`).
+  std::vector<double> invMass(n + 1, 0.0);
+  std::vector<RowMatrix3d> invInertia(n + 1, RowMatrix3d::Zero());
+  std::vector<Eigen::Vector3d> v(n + 1, Eigen::Vector3d::Zero()), w(n + 1, Eigen::Vector3d::Zero()),
+      linear(n + 1, Eigen::Vector3d::Zero()), angular(n + 1, Eigen::Vector3d::Zero());
   for (auto& [id, entry] : impl_->entries) {
     const std::size_t k = bodies.size();
     entry->dense = k;
@@ -251,20 +255,59 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     double target;
     double friction;  // the pair's coefficient
     Eigen::Vector3d accRoll;
-    RowMatrix3d rollMass;  // inverse of (Ia^-1 + Ib^-1)
-    bool rolls;            // a sphere or capsule is involved
-    btManifoldPoint* point;
+    RowMatrix3d rollMass;    // inverse of (Ia^-1 + Ib^-1)
+    bool rolls;              // a sphere or capsule is involved
+    btManifoldPoint* point;  // Bullet's point (warm starting), null for a user contact
+    Eigen::Vector3d surface = Eigen::Vector3d::Zero();  // b's surface velocity (users)
   };
   std::vector<Constraint> constraints;
   auto velocityAlong = [&](const Constraint& c, int axis) {
     return v[c.a].dot(c.dir[axis]) + w[c.a].dot(c.raxd[axis]) - v[c.b].dot(c.dir[axis]) -
-           w[c.b].dot(c.rbxd[axis]);
+           w[c.b].dot(c.rbxd[axis]) - c.surface.dot(c.dir[axis]);
   };
   auto push = [&](const Constraint& c, int axis, double impulse) {
     v[c.a] += c.dir[axis] * (impulse * invMass[c.a]);
     w[c.a] += c.ia[axis] * impulse;
     v[c.b] -= c.dir[axis] * (impulse * invMass[c.b]);
     w[c.b] -= c.ib[axis] * impulse;
+  };
+
+  // The Jacobian of contact c at `middle` along `normal` (from b to a), its effective masses and
+  // its target normal velocity (speculative below a gap, restitution, Baumgarte beyond slop).
+  auto setUp = [&](Constraint& c, const Eigen::Vector3d& middle, const Eigen::Vector3d& positionA,
+                   const Eigen::Vector3d& positionB, const Eigen::Vector3d& normal, double distance,
+                   bool kinematicA, bool kinematicB, double restitution) {
+    c.ra = middle - positionA;
+    c.rb = middle - positionB;
+    c.dir[0] = normal;
+    tangents(normal, c.dir[1], c.dir[2]);
+    for (int axis = 0; axis < 3; ++axis) {
+      c.raxd[axis] = c.ra.cross(c.dir[axis]);
+      c.rbxd[axis] = c.rb.cross(c.dir[axis]);
+      c.ia[axis] = invInertia[c.a] * c.raxd[axis];
+      c.ib[axis] = invInertia[c.b] * c.rbxd[axis];
+      const double k =
+          invMass[c.a] + invMass[c.b] + c.ia[axis].dot(c.raxd[axis]) + c.ib[axis].dot(c.rbxd[axis]);
+      c.mass[axis] = k > 0 ? 1.0 / k : 0.0;
+    }
+    const double vn = velocityAlong(c, 0);
+    const bool bounce = vn < -p.restitutionThreshold;
+    // Gravity's pull along the normal, bringing the pair together (a dynamic body falls).
+    const Eigen::Vector3d g = asEigen(p.gravity);
+    const double pull =
+        -((kinematicA ? Eigen::Vector3d::Zero() : g) - (kinematicB ? Eigen::Vector3d::Zero() : g))
+             .dot(normal);
+    const auto rebound = [&](double gap) {
+      return reboundVelocity(restitution, vn, gap, std::max(pull, 0.0), dt);
+    };
+    if (distance > 0) {
+      // Speculative: approach allowed up to the gap; a bounce when the gap closes this step.
+      c.target = -distance / dt;
+      if (bounce && vn * dt < -distance) c.target = std::max(c.target, rebound(distance));
+    } else {
+      c.target = std::max(bounce ? rebound(distance) : 0.0,
+                          p.baumgarte / dt * std::max(-distance - p.slop, 0.0));
+    }
   };
 
   // Manifolds in the order of their pair of ids (then Bullet's order, deterministic too).
@@ -305,19 +348,10 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       const Eigen::Vector3d pa = fromBt(pt.getPositionWorldOnA());
       const Eigen::Vector3d pb = fromBt(pt.getPositionWorldOnB());
       const Eigen::Vector3d middle = (pa + pb) * 0.5;
-      c.ra = middle - asEigen(ea->body.position);
-      c.rb = middle - asEigen(eb->body.position);
-      c.dir[0] = normal;
-      tangents(normal, c.dir[1], c.dir[2]);
-      for (int axis = 0; axis < 3; ++axis) {
-        c.raxd[axis] = c.ra.cross(c.dir[axis]);
-        c.rbxd[axis] = c.rb.cross(c.dir[axis]);
-        c.ia[axis] = invInertia[c.a] * c.raxd[axis];
-        c.ib[axis] = invInertia[c.b] * c.rbxd[axis];
-        const double k = invMass[c.a] + invMass[c.b] + c.ia[axis].dot(c.raxd[axis]) +
-                         c.ib[axis].dot(c.rbxd[axis]);
-        c.mass[axis] = k > 0 ? 1.0 / k : 0.0;
-      }
+      const double distance = pt.getDistance();
+      setUp(c, middle, asEigen(ea->body.position), asEigen(eb->body.position), normal, distance,
+            ea->body.kinematic, eb->body.kinematic,
+            combinedRestitution(ea->body.restitution, eb->body.restitution, p.restitution));
       auto round = [](const Impl::Entry* e) {
         return e->body.shape.kind == msg::ShapeKind::Sphere ||
                e->body.shape.kind == msg::ShapeKind::Capsule;
@@ -327,33 +361,39 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
         c.rollMass = inverse(invInertia[c.a] + invInertia[c.b]);
       }
       c.friction = combinedFriction(ea->body.friction, eb->body.friction, p.friction);
-      const double distance = pt.getDistance();
-      const double vn = velocityAlong(c, 0);
-      const bool bounce = vn < -p.restitutionThreshold;
-      // Gravity's pull along the normal, bringing the pair together (a dynamic body falls).
-      const Eigen::Vector3d g = asEigen(p.gravity);
-      const double pull = -((ea->body.kinematic ? Eigen::Vector3d::Zero() : g) -
-                            (eb->body.kinematic ? Eigen::Vector3d::Zero() : g))
-                               .dot(normal);
-      const auto rebound = [&](double gap) {
-        const double e =
-            combinedRestitution(ea->body.restitution, eb->body.restitution, p.restitution);
-        return reboundVelocity(e, vn, gap, std::max(pull, 0.0), dt);
-      };
-      if (distance > 0) {
-        // Speculative: approach allowed up to the gap; a bounce when the gap closes this step.
-        c.target = -distance / dt;
-        if (bounce && vn * dt < -distance) c.target = std::max(c.target, rebound(distance));
-      } else {
-        c.target = std::max(bounce ? rebound(distance) : 0.0,
-                            p.baumgarte / dt * std::max(-distance - p.slop, 0.0));
-      }
       if (p.warmStart) {
         c.acc = {pt.m_appliedImpulse, pt.m_appliedImpulseLateral1, pt.m_appliedImpulseLateral2};
       }
       constraints.push_back(c);
       contacts_.push_back(
           {ea->body.id, eb->body.id, msg::toVec3(pb), msg::toVec3(normal), distance});
+    }
+  }
+
+  // Contacts with the captured users (slot n: infinite mass; their surface moves), no warm start.
+  if (!users_.empty()) {
+    std::vector<SurfaceContact> surface;
+    double spacing = users_.begin()->second->spacing;
+    for (const auto& [id, user] : users_) spacing = std::min(spacing, user->spacing);
+    for (const Impl::Entry* e : bodies) {
+      if (e->body.kinematic) continue;
+      userContacts(e->body, 2 * spacing, users_, p.speculativeDistance, surface);
+    }
+    for (const SurfaceContact& s : surface) {
+      Constraint c{};
+      c.a = impl_->entries.at(s.body)->dense;
+      c.b = n;
+      c.point = nullptr;
+      c.accRoll.setZero();
+      c.rolls = false;
+      c.surface = asEigen(s.surfaceVelocity);
+      // The user has the interactor's friction and restitution (its own are unset: -1).
+      const Body& body = bodies[c.a]->body;
+      c.friction = combinedFriction(body.friction, -1, p.friction);
+      setUp(c, asEigen(s.point), asEigen(body.position), asEigen(s.point), asEigen(s.normal),
+            s.distance, false, true, combinedRestitution(body.restitution, -1, p.restitution));
+      constraints.push_back(c);
+      contacts_.push_back({s.body, s.surface, s.point, s.normal, s.distance});
     }
   }
 
@@ -395,9 +435,11 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
 
   // The impulses each body received: the sums of the accumulated contact impulses.
   for (const Constraint& c : constraints) {
-    c.point->m_appliedImpulse = static_cast<btScalar>(c.acc[0]);
-    c.point->m_appliedImpulseLateral1 = static_cast<btScalar>(c.acc[1]);
-    c.point->m_appliedImpulseLateral2 = static_cast<btScalar>(c.acc[2]);
+    if (c.point != nullptr) {
+      c.point->m_appliedImpulse = static_cast<btScalar>(c.acc[0]);
+      c.point->m_appliedImpulseLateral1 = static_cast<btScalar>(c.acc[1]);
+      c.point->m_appliedImpulseLateral2 = static_cast<btScalar>(c.acc[2]);
+    }
     const Eigen::Vector3d impulse =
         c.dir[0] * c.acc[0] + (c.dir[1] * c.acc[1] + c.dir[2] * c.acc[2]);
     linear[c.a] += impulse;

@@ -64,6 +64,7 @@ const ObjectType& userType() {
                                                          {"bounds", ParamKind::Aabb},
                                                          {"mesh", ParamKind::Id},
                                                          {"sdf", ParamKind::Id},
+                                                         {"velocityField", ParamKind::Id},
                                                      });
   return type;
 }

@@ -62,11 +62,12 @@ const ObjectType& userType();
 /// Parameter indices of userType().
 struct UserParam {
   enum : std::uint32_t {
-    kPosition,     ///< Vec3
-    kOrientation,  ///< Quat
-    kBounds,       ///< Aabb
-    kMesh,         ///< Id of a mesh resource
-    kSdf           ///< Id of a signed-distance-field resource
+    kPosition,      ///< Vec3
+    kOrientation,   ///< Quat
+    kBounds,        ///< Aabb
+    kMesh,          ///< Id of a mesh resource
+    kSdf,           ///< Id of a signed-distance-field resource
+    kVelocityField  ///< Id of a vector-field resource: the velocity of the surface (m/s)
   };
 };
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+#include "vrflow/camera/user_surface.hpp"
 #include "vrflow/fluid/settings.hpp"
 #include "vrflow/message/shape.hpp"
 #include "vrflow/message/values.hpp"
@@ -31,6 +32,9 @@ struct RigidBody {
   /// user): it pushes the liquid with kKinematicDensityRatio times its density; mass is ignored
   /// and its force is meaningless.
   bool kinematic = false;
+  /// A captured user (nodes/camera) in place of `shape`: a kinematic solid given by its distance
+  /// field, whose surface moves with its velocity field. It must outlive the step.
+  const camera::UserSurface* surface = nullptr;
 };
 
 /// Density of kinematic bodies in the projection, relative to the liquid's.

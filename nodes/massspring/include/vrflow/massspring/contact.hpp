@@ -5,6 +5,7 @@
 #include <tuple>
 #include <vector>
 
+#include "vrflow/camera/user_surface.hpp"
 #include "vrflow/massspring/net.hpp"
 #include "vrflow/message/shape.hpp"
 
@@ -82,6 +83,14 @@ ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const Cont
 ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
                             const std::map<std::uint64_t, RigidBody>& rigids,
                             const ContactParams& params, ContactMemory* memory = nullptr);
+
+/// Nodes of every net against every captured user (nodes/camera: its distance field and surface
+/// velocity): the header's response with the user infinitely heavy, a node's relative velocity
+/// taken against the user's surface velocity where it is. Node forces only: nothing pushes the
+/// user. Users and nets in id order. The forces are added to `out`'s node forces.
+void addUserContacts(const std::map<std::uint64_t, Net>& nets,
+                     const std::map<std::uint64_t, const camera::UserSurface*>& users,
+                     const ContactParams& params, ContactForces& out);
 
 /// Closest point of triangle abc to p, with its barycentric weights (Ericson's algorithm).
 struct TrianglePoint {

@@ -4,6 +4,7 @@
 #include <map>
 #include <string>
 
+#include "vrflow/camera/user_copy.hpp"
 #include "vrflow/massspring/contact.hpp"
 #include "vrflow/massspring/net.hpp"
 #include "vrflow/message/builder.hpp"
@@ -30,6 +31,8 @@ class SceneCopy {
   const std::map<std::uint64_t, Net>& nets() const { return nets_; }
   /// The rigids whose shape resource has arrived.
   std::map<std::uint64_t, RigidBody> rigids() const;
+  /// The captured users (type `user`) whose distance field has arrived.
+  std::map<std::uint64_t, const camera::UserSurface*> users() const { return users_.ready(); }
 
  private:
   struct RigidEntry {
@@ -39,6 +42,7 @@ class SceneCopy {
   std::map<std::uint64_t, Net> nets_;
   std::map<std::uint64_t, RigidEntry> rigids_;
   std::map<std::uint64_t, msg::Shape> shapes_;
+  camera::UserCopy users_;
 };
 
 }  // namespace vrflow::massspring

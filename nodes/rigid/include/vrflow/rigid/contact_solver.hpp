@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "vrflow/base/result.hpp"
+#include "vrflow/camera/user_surface.hpp"
 #include "vrflow/message/object_type.hpp"  // before values.hpp, or -Wshadow
 #include "vrflow/message/values.hpp"
 #include "vrflow/rigid/body.hpp"
@@ -84,6 +85,12 @@ class RigidContactSolver {
   bool contains(std::uint64_t id) const;
   std::size_t size() const;
 
+  /// The captured users the bodies collide with (user_contacts.hpp), as solids of infinite mass
+  /// moving with their surface velocity; they must outlive the next solve(). Empty: none.
+  void setUsers(std::map<std::uint64_t, const camera::UserSurface*> users) {
+    users_ = std::move(users);
+  }
+
   /// Collision detection on the current local copy, then the impulse solve over dt. Returns a
   /// force event per dynamic body that receives a non-zero impulse, ordered by id.
   std::vector<std::pair<std::uint64_t, msg::ForceEvent>> solve(double dt);
@@ -96,6 +103,7 @@ class RigidContactSolver {
   std::unique_ptr<Impl> impl_;
   ContactParams params_;
   std::vector<ContactInfo> contacts_;
+  std::map<std::uint64_t, const camera::UserSurface*> users_;
 };
 
 }  // namespace vrflow::rigid

@@ -1,0 +1,217 @@
+// The user animator's library: the surface velocity estimated from consecutive distance fields
+// against the known motion of a translating sphere and a turning synthetic user, and the user
+// object's round trip through a message (user_object.hpp, user_copy.hpp, user_surface.hpp).
+#include "vrflow/camera/user_velocity.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "vrflow/camera/distance_field.hpp"
+#include "vrflow/camera/synthetic_user.hpp"
+#include "vrflow/camera/user_copy.hpp"
+#include "vrflow/camera/user_object.hpp"
+#include "vrflow/message/builtin_types.hpp"
+#include "vrflow/message/byte_sink.hpp"
+
+namespace vrflow::camera {
+namespace {
+
+// A solid given by its analytic signed distance.
+template <typename Distance>
+VoxelGrid voxelize(const GridSpec& spec, Distance distance) {
+  VoxelGrid grid(spec);
+  for (int k = 0; k < spec.nz; ++k)
+    for (int j = 0; j < spec.ny; ++j)
+      for (int i = 0; i < spec.nx; ++i)
+        grid.occupied[spec.index(i, j, k)] = distance(spec.centre(i, j, k)) <= 0 ? 1 : 0;
+  return grid;
+}
+
+// Normal speeds, estimated and true, over the cells within one voxel of the surface.
+struct SpeedError {
+  double meanAbs = 0;   ///< mean |estimated - true| normal speed (m/s)
+  double meanTrue = 0;  ///< mean |true normal speed|, for scale
+  int cells = 0;
+};
+
+template <typename Distance, typename Velocity>
+SpeedError normalSpeedError(const GridSpec& spec, const std::vector<float>& sdf,
+                            const std::vector<float>& velocity, Distance distance,
+                            Velocity trueVelocity) {
+  SpeedError e;
+  const double h = 1e-4;
+  for (int k = 0; k < spec.nz; ++k)
+    for (int j = 0; j < spec.ny; ++j)
+      for (int i = 0; i < spec.nx; ++i) {
+        const std::size_t c = spec.index(i, j, k);
+        if (std::abs(sdf[c]) > spec.voxelSize) continue;
+        const cv::Vec3d x = spec.centre(i, j, k);
+        cv::Vec3d n;
+        for (int a = 0; a < 3; ++a) {
+          cv::Vec3d d(0, 0, 0);
+          d[a] = h;
+          n[a] = (distance(x + d) - distance(x - d)) / (2 * h);
+        }
+        if (cv::norm(n) < 0.5) continue;
+        n /= cv::norm(n);
+        const cv::Vec3d estimated(velocity[3 * c], velocity[3 * c + 1], velocity[3 * c + 2]);
+        const double truth = trueVelocity(x).dot(n);
+        e.meanAbs += std::abs(estimated.dot(n) - truth);
+        e.meanTrue += std::abs(truth);
+        ++e.cells;
+      }
+  if (e.cells > 0) {
+    e.meanAbs /= e.cells;
+    e.meanTrue /= e.cells;
+  }
+  return e;
+}
+
+TEST(SurfaceVelocity, TranslatingSphereGivesItsNormalSpeed) {
+  const GridSpec spec = GridSpec::cube({-0.7, -0.7, -0.7}, 1.4, 64);  // 2.2 cm voxels
+  const double dt = 0.04;
+  const cv::Vec3d v(0.5, -0.2, 0.3), c0(0.01, 0.02, -0.03), c1 = c0 + v * dt;  // 2.4 cm a frame
+  auto sphereAt = [](cv::Vec3d c) {
+    return [c](const cv::Vec3d& x) { return cv::norm(x - c) - 0.3; };
+  };
+  const auto before = signedDistanceField(voxelize(spec, sphereAt(c0)));
+  const auto now = signedDistanceField(voxelize(spec, sphereAt(c1)));
+  const auto velocity = surfaceVelocity(spec, before, now, dt);
+  const auto e =
+      normalSpeedError(spec, now, velocity, sphereAt(c1), [&](const cv::Vec3d&) { return v; });
+  std::printf(
+      "translating sphere (|v| %.2f m/s, %.2f voxels a frame): mean normal-speed error "
+      "%.3f m/s over %d cells, mean true normal speed %.3f m/s\n",
+      cv::norm(v), cv::norm(v) * dt / spec.voxelSize, e.meanAbs, e.cells, e.meanTrue);
+  ASSERT_GT(e.cells, 1000);
+  EXPECT_LT(e.meanAbs, 0.3 * e.meanTrue);
+}
+
+TEST(SurfaceVelocity, TurningUserGivesTheNormalSpeedOfTheRotation) {
+  // The standing user turning about the vertical axis through the pelvis at 1.5 rad/s: its
+  // arms sweep (up to 1 m/s at the hands), its round torso hardly moves its surface.
+  const GridSpec spec = GridSpec::cube({-0.8, 0.45, -0.8}, 1.6, 64);  // 2.5 cm voxels
+  const double dt = 0.03, omega = 1.5;
+  const cv::Vec3d pivot(0, 0.95, 0);
+  auto turned = [&](double angle) {
+    UserPose pose = standingPose();
+    for (auto& joint : pose) {
+      const cv::Vec3d r = joint - pivot;
+      joint = pivot + cv::Vec3d(std::cos(angle) * r[0] + std::sin(angle) * r[2], r[1],
+                                -std::sin(angle) * r[0] + std::cos(angle) * r[2]);
+    }
+    return SyntheticUser(pose);
+  };
+  const SyntheticUser before = turned(0), now = turned(omega * dt);
+  const auto sdfBefore = signedDistanceField(before.voxelize(spec));
+  const auto sdfNow = signedDistanceField(now.voxelize(spec));
+  const auto velocity = surfaceVelocity(spec, sdfBefore, sdfNow, dt);
+  // d/dt of the rotation above: omega x r with omega = (0, omega, 0).
+  const auto e = normalSpeedError(
+      spec, sdfNow, velocity, [&](const cv::Vec3d& x) { return now.signedDistance(x); },
+      [&](const cv::Vec3d& x) {
+        const cv::Vec3d r = x - pivot;
+        return cv::Vec3d(omega * r[2], 0, -omega * r[0]);
+      });
+  std::printf(
+      "turning user (%.1f rad/s): mean normal-speed error %.3f m/s over %d cells, mean "
+      "true normal speed %.3f m/s\n",
+      omega, e.meanAbs, e.cells, e.meanTrue);
+  ASSERT_GT(e.cells, 1000);
+  EXPECT_LT(e.meanAbs, 0.5 * e.meanTrue);
+}
+
+TEST(SurfaceVelocity, StillUserAndEmptyFramesGiveZero) {
+  const GridSpec spec = GridSpec::cube({-0.7, 0.45, -0.5}, 1.4, 32);
+  const auto sdf = signedDistanceField(SyntheticUser(standingPose()).voxelize(spec));
+  for (float c : surfaceVelocity(spec, sdf, sdf, 0.01)) ASSERT_EQ(c, 0.0f);
+  const auto empty = signedDistanceField(VoxelGrid(spec));
+  for (const auto& [a, b] : {std::pair{&empty, &sdf}, std::pair{&sdf, &empty}})
+    for (float c : surfaceVelocity(spec, *a, *b, 0.01)) ASSERT_EQ(c, 0.0f);
+  EXPECT_EQ(surfaceVelocity(spec, sdf, sdf, 0.01).size(), 3 * spec.count());
+}
+
+msg::MessageView finish(msg::MessageBuilder& builder) {
+  const std::size_t size = builder.finish();
+  EXPECT_GT(size, 0u);
+  auto view = msg::MessageView::parse(builder.bytes().first(size));
+  EXPECT_TRUE(view.ok()) << view.error().message;
+  return *view;
+}
+
+TEST(UserObject, RoundTripsThroughAMessageToWhatInteractorsSample) {
+  const GridSpec spec = GridSpec::cube({-0.5, -0.5, -0.5}, 1.0, 40);
+  const cv::Vec3d centre(0.05, -0.02, 0.01);
+  auto sphere = [&](const cv::Vec3d& x) { return cv::norm(x - centre) - 0.25; };
+  const VoxelGrid grid = voxelize(spec, sphere);
+  UserFrame frame = describeUser(grid);
+  frame.velocity.assign(3 * spec.count(), 0.0f);
+  for (std::size_t c = 0; c < spec.count(); ++c) frame.velocity[3 * c] = 0.75f;
+  EXPECT_NEAR(frame.position[0], centre[0], 1e-3);
+  EXPECT_NEAR(frame.bounds.min[1], centre[1] - 0.25, spec.voxelSize);
+  EXPECT_NEAR(frame.bounds.max[2], centre[2] + 0.25, spec.voxelSize);
+  EXPECT_TRUE(frame.mesh.isClosed());
+
+  msg::VectorSink sink;
+  msg::MessageBuilder builder(sink);
+  writeUser(builder, {11, 12, 13, 14}, frame, true);
+  UserCopy copy;
+  ASSERT_TRUE(copy.apply(finish(builder)).ok());
+  const auto users = copy.ready();
+  ASSERT_EQ(users.size(), 1u);
+  const UserSurface& user = *users.at(11);
+  EXPECT_EQ(user.position, frame.position);
+  // Within a voxel of the analytic distance inside, near and beyond the grid.
+  for (const msg::Vec3& p : {msg::Vec3{0.15, -0.02, 0.01}, msg::Vec3{0.3, 0.0, 0.0},
+                             msg::Vec3{0.1, 0.2, -0.1}, msg::Vec3{0.9, 0.0, 0.0}})
+    EXPECT_NEAR(user.distance(p), sphere({p[0], p[1], p[2]}), spec.voxelSize) << p[0];
+  const msg::Vec3 n = user.normal({0.35, -0.02, 0.01});
+  EXPECT_NEAR(n[0], 1.0, 0.05);
+  EXPECT_NEAR(user.velocityAt({0.3, 0.0, 0.0})[0], 0.75, 1e-6);
+  EXPECT_EQ(user.velocityAt({2.0, 0.0, 0.0}), (msg::Vec3{0, 0, 0}));
+
+  // An update moves it; a delete removes it.
+  builder.reset();
+  frame.position = {0.5, 0.5, 0.5};
+  writeUser(builder, {11, 12, 13, 14}, frame, false);
+  ASSERT_TRUE(copy.apply(finish(builder)).ok());
+  EXPECT_EQ(copy.all().at(11).position, frame.position);
+  builder.reset();
+  builder.addDelete(11, msg::userType());
+  ASSERT_TRUE(copy.apply(finish(builder)).ok());
+  EXPECT_TRUE(copy.ready().empty());
+}
+
+TEST(UserObject, AFieldOfTheWrongKindOrGridIsAnErrorNamingTheUser) {
+  const GridSpec spec = GridSpec::cube({0, 0, 0}, 1.0, 4);
+  msg::VectorSink sink;
+  msg::MessageBuilder builder(sink);
+  std::vector<float> three(3 * spec.count(), 0.0f), one(spec.count(), 1.0f);
+  builder.addField(13, true, {4, 4, 4}, 3, {0, 0, 0}, 0.25, three);  // the sdf as vectors
+  builder.addObject(11, msg::userType(), msg::ObjectOp::Add)
+      .set(msg::UserParam::kSdf, std::uint64_t{13});
+  UserCopy copy;
+  auto status = copy.apply(finish(builder));
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.error().message.find("user 11: resource 13 (sdf) is not a scalar field"),
+            std::string::npos)
+      << status.error().message;
+  EXPECT_TRUE(copy.ready().empty());
+
+  builder.reset();
+  builder.addField(13, true, {4, 4, 4}, 1, {0, 0, 0}, 0.25, one);
+  builder.addField(14, true, {2, 2, 2}, 3, {0, 0, 0}, 0.5, std::span(three).first(24));
+  builder.addObject(11, msg::userType(), msg::ObjectOp::Update)
+      .set(msg::UserParam::kVelocityField, std::uint64_t{14});
+  status = copy.apply(finish(builder));
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.error().message.find("another grid"), std::string::npos)
+      << status.error().message;
+  EXPECT_EQ(copy.ready().size(), 1u);  // the distance field arrived; the velocity did not
+  EXPECT_EQ(copy.ready().at(11)->velocityAt({0.5, 0.5, 0.5}), (msg::Vec3{0, 0, 0}));
+}
+
+}  // namespace
+}  // namespace vrflow::camera
