@@ -68,6 +68,26 @@ TEST(SurfaceDrawing, WithoutTheSurfaceTheSameMeshIsDrawnAsParticlesOnly) {
   EXPECT_EQ(centre(renderCentre(scene)), centre(renderCentre(empty)));
 }
 
+// A captured user's hull (a user object naming a mesh) is drawn opaque, in its skin colour.
+TEST(SurfaceDrawing, AUserObjectIsDrawnAsItsMeshInSkinColour) {
+  SceneCache scene;
+  ASSERT_TRUE(feed(scene, [&](msg::MessageBuilder& b) {
+    b.addMesh(600, true, kQuad, kTriangles);
+    b.addObject(60, msg::userType(), msg::ObjectOp::Add)
+        .set(msg::UserParam::kMesh, std::uint64_t{600})
+        .set(msg::UserParam::kPosition, msg::Vec3{0, 1, 0});
+  }));
+  const auto user = centre(renderCentre(scene));
+  // Lit skin: red above green above blue, clearly not the background.
+  EXPECT_GT(user[0], user[1]);
+  EXPECT_GT(user[1], user[2]);
+  EXPECT_GT(user[0] - user[2], 40);
+  SceneCache empty;
+  EXPECT_NE(user, centre(renderCentre(empty)));
+  ASSERT_TRUE(feed(scene, [&](msg::MessageBuilder& b) { b.addDelete(60, msg::userType()); }));
+  EXPECT_EQ(scene.meshIndices(600), nullptr);
+}
+
 // A surface resource no object names any more is dropped with its triangles (the cache does not
 // grow when a sender replaces its objects).
 TEST(SurfaceDrawing, TheSurfaceIsDroppedWithItsObject) {

@@ -33,9 +33,10 @@ DrawMesh waterMesh(const std::vector<float>& xyz, const std::vector<std::uint32_
   return mesh;
 }
 
-void drawWater(const SceneCache& scene, std::uint64_t surfaceId, bool shadowPass) {
-  const auto* xyz = scene.particles(surfaceId);
-  const auto* indices = scene.meshIndices(surfaceId);
+void drawSmoothMesh(const SceneCache& scene, std::uint64_t meshId, bool shadowPass,
+                    const std::array<float, 4>& colour) {
+  const auto* xyz = scene.particles(meshId);
+  const auto* indices = scene.meshIndices(meshId);
   if (xyz == nullptr || indices == nullptr) return;
   const DrawMesh mesh = waterMesh(*xyz, *indices);
   if (mesh.indices.empty()) return;
@@ -57,12 +58,15 @@ void drawWater(const SceneCache& scene, std::uint64_t surfaceId, bool shadowPass
   glLightfv(GL_LIGHT0, GL_SPECULAR, white);
   glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, shine);
   glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, 48.0f);
-  glEnable(GL_BLEND);
-  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-  glColor4f(kWaterColour[0], kWaterColour[1], kWaterColour[2], kWaterColour[3]);
+  const bool blend = colour[3] < 1.0f;
+  if (blend) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  }
+  glColor4f(colour[0], colour[1], colour[2], colour[3]);
   glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.indices.size()), GL_UNSIGNED_INT,
                  mesh.indices.data());
-  glDisable(GL_BLEND);
+  if (blend) glDisable(GL_BLEND);
   glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, black);
   glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, 0.0f);
   glLightfv(GL_LIGHT0, GL_SPECULAR, black);

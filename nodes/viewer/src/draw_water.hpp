@@ -6,8 +6,8 @@
 
 #include "vrflow/viewer/scene_cache.hpp"
 
-// A fluid's surface mesh drawn as water: smooth (area-weighted) normals, a water colour, a
-// specular highlight from the key light, slightly transparent.
+// Dynamic meshes drawn smooth: a fluid's surface as water (a water colour, a specular highlight
+// from the key light, slightly transparent) and a captured user's hull (opaque, a skin colour).
 
 namespace vrflow::viewer {
 
@@ -18,8 +18,18 @@ inline constexpr std::array<float, 4> kWaterColour{0.16f, 0.46f, 0.78f, 0.82f};
 /// its triangles' normals. Triangles naming a vertex that does not exist are left out.
 DrawMesh waterMesh(const std::vector<float>& xyz, const std::vector<std::uint32_t>& indices);
 
-/// Draws the surface of resource `surfaceId` of `scene`, if it has arrived with triangles; in the
-/// shadow pass flat in the current colour (the caller's shadow state), else as lit water.
-void drawWater(const SceneCache& scene, std::uint64_t surfaceId, bool shadowPass);
+/// A captured user's colour (opaque).
+inline constexpr std::array<float, 4> kUserColour{0.86f, 0.64f, 0.52f, 1.0f};
+
+/// Draws mesh resource `meshId` of `scene`, if it has arrived with triangles, with smooth normals:
+/// in the shadow pass flat in the current colour (the caller's shadow state), else lit in
+/// `colour` with a highlight, blended over what lies behind when its alpha is below 1.
+void drawSmoothMesh(const SceneCache& scene, std::uint64_t meshId, bool shadowPass,
+                    const std::array<float, 4>& colour);
+
+/// A fluid's surface as water.
+inline void drawWater(const SceneCache& scene, std::uint64_t surfaceId, bool shadowPass) {
+  drawSmoothMesh(scene, surfaceId, shadowPass, kWaterColour);
+}
 
 }  // namespace vrflow::viewer

@@ -312,6 +312,9 @@ void Renderer::Impl::drawObjects(const SceneCache& scene, bool shadowPass,
         glEnable(GL_LIGHTING);
         break;
       }
+      case ObjectKind::User:
+        drawSmoothMesh(scene, object.surfaceId, shadowPass, kUserColour);
+        break;
     }
   }
 }

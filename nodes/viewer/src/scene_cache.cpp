@@ -26,6 +26,7 @@ std::optional<ObjectKind> kindOf(std::uint32_t typeId) {
   if (typeId == msg::massSpringType().id()) return ObjectKind::MassSpring;
   if (typeId == msg::fluidType().id()) return ObjectKind::Fluid;
   if (typeId == msg::pointType().id()) return ObjectKind::Point;
+  if (typeId == msg::userType().id()) return ObjectKind::User;
   return std::nullopt;
 }
 
@@ -202,6 +203,11 @@ void SceneCache::applyObject(const msg::ObjectView& object) {
       if (auto r = object.idParam(msg::FluidParam::kSurface)) cached.surfaceId = *r;
       if (auto b = object.aabb(msg::FluidParam::kBounds)) cached.bounds = *b;
       break;
+    case ObjectKind::User:
+      if (auto r = object.idParam(msg::UserParam::kMesh)) cached.surfaceId = *r;
+      if (auto p = object.vec3(msg::UserParam::kPosition)) cached.position = *p;
+      if (auto b = object.aabb(msg::UserParam::kBounds)) cached.bounds = *b;
+      break;
   }
 }
 
@@ -274,6 +280,7 @@ void SceneCache::dropUnreferenced() {
   std::set<std::uint64_t> named;
   for (const auto& [id, object] : objects_) {
     if (object.kind == ObjectKind::Fluid) named.insert({object.particlesId, object.surfaceId});
+    if (object.kind == ObjectKind::User) named.insert(object.surfaceId);
   }
   std::erase_if(meshIndices_, [&](const auto& entry) { return !named.contains(entry.first); });
   std::erase_if(otherRaw_, [&](const auto& entry) { return !named.contains(entry.first); });

@@ -28,7 +28,7 @@ struct DrawMesh {
 };
 
 /// What kind of drawing an object gets.
-enum class ObjectKind { Rigid, MassSpring, Fluid, Point };
+enum class ObjectKind { Rigid, MassSpring, Fluid, Point, User };
 
 /// One object as last seen.
 struct CachedObject {
@@ -40,7 +40,7 @@ struct CachedObject {
   std::vector<double> positions;       ///< massspring: xyz per mass
   std::vector<std::uint32_t> surface;  ///< massspring: three mass indices per triangle
   std::uint64_t particlesId = 0;       ///< fluid: the particle resource
-  std::uint64_t surfaceId = 0;         ///< fluid: the surface mesh resource (0: none, particles)
+  std::uint64_t surfaceId = 0;  ///< fluid: the surface mesh (0: none, particles); user: its mesh
   std::optional<msg::Aabb> bounds;     ///< the sender's `bounds` (a point: its position)
 };
 
