@@ -2,7 +2,9 @@
 // right hand pushes the crate off the table onto the floor, then its left hand presses the net;
 // every module runs every iteration and nothing is left behind.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -30,7 +32,13 @@ TEST(CameraUserExample, TheHandPushesTheCrateOffTheTableAndPressesTheNet) {
     ran.insert(module["id"].get<std::string>());
   }
   EXPECT_EQ(ran, (std::set<std::string>{"truth", "user", "bodies", "contacts", "field", "net",
-                                        "net-contacts"}));
+                                        "net-contacts", "view"}));
+  // The viewer drew iterations 0, 50, ..., 200 (the user among the objects).
+  for (int frame = 0; frame < 5; ++frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frames/frame_%06d.png", frame);
+    EXPECT_EQ(access(dir.file(name).c_str(), F_OK), 0) << name;
+  }
 
   // The crate (third body) started on the table top (y 1.5, z 0.8, the table's far edge at
   // z 0.95) and ends on the floor beyond the edge.
