@@ -30,11 +30,11 @@ enum class SurfaceMethod { Density, Spheres };
 struct SurfaceSettings {
   SurfaceMethod method = SurfaceMethod::Density;
   double particleSpacing = 1.0 / 64.0;  ///< of the seeded particles (m): sets the full density
-  double voxelSize = 1.0 / 64.0;       ///< edge of the level set's voxels (m)
-  double particleRadius = 1.0 / 32.0;  ///< radius of each particle's sphere (m), >= 1.5 voxels
-  double inset = 0.75 / 32.0;          ///< how far the union of spheres is moved inwards (m)
-  msg::Aabb walls{};                   ///< the grid's box: faces lying on its walls are left out
-  double wallBand = 1.0 / 64.0;        ///< "on a wall": all three corners within this of its plane
+  double voxelSize = 1.0 / 64.0;        ///< edge of the level set's voxels (m)
+  double particleRadius = 1.0 / 32.0;   ///< radius of each particle's sphere (m), >= 1.5 voxels
+  double inset = 0.75 / 32.0;           ///< how far the union of spheres is moved inwards (m)
+  msg::Aabb walls{};                    ///< the grid's box: faces lying on its walls are left out
+  double wallBand = 1.0 / 64.0;         ///< "on a wall": all three corners within this of its plane
 };
 
 /// The settings for a fluid: `voxelsPerCell` voxels along a cell's edge, the density method;

@@ -41,7 +41,7 @@ struct CachedObject {
   std::vector<std::uint32_t> surface;  ///< massspring: three mass indices per triangle
   std::uint64_t particlesId = 0;       ///< fluid: the particle resource
   std::uint64_t surfaceId = 0;  ///< fluid: the surface mesh (0: none, particles); user: its mesh
-  std::optional<msg::Aabb> bounds;     ///< the sender's `bounds` (a point: its position)
+  std::optional<msg::Aabb> bounds;  ///< the sender's `bounds` (a point: its position)
 };
 
 /// Counters a viewer reports (and tests check).
