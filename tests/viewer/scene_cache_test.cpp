@@ -237,9 +237,13 @@ TEST(SceneCache, ResourcesNoObjectNamesAreNotKept) {
 
 TEST(SceneCache, EventsAndUnknownTypesAreIgnored) {
   LoggedScene s;
+  // A type of some package the viewer knows nothing of (users are drawn since they have a mesh).
+  const auto created = msg::ObjectType::create("custom", {{"position", msg::ParamKind::Vec3}});
+  ASSERT_TRUE(created.ok());
+  const msg::ObjectType& custom = created.value();
   ASSERT_TRUE(feed(s.scene, [&](msg::MessageBuilder& b) {
     b.addForce(1, msg::ForceEvent{});
-    b.addObject(2, msg::userType(), msg::ObjectOp::Add).set(msg::UserParam::kPosition, msg::Vec3{});
+    b.addObject(2, custom, msg::ObjectOp::Add).set(0, msg::Vec3{});
   }));
   EXPECT_TRUE(s.scene.objects().empty());
   EXPECT_EQ(s.scene.stats().ignoredChunks, 2u);
