@@ -204,10 +204,15 @@ void Transport::finish(double seconds) {
 
 void Transport::stop() {
   Impl& t = *impl_;
-  t.stopped.store(true);
-  if (t.running.exchange(false)) {
+  std::thread loop;
+  {
+    std::lock_guard lock(t.mutex);  // against connectPeers() starting the loop meanwhile
+    t.stopped.store(true);
+    if (t.running.exchange(false)) loop = std::move(t.thread);
+  }
+  if (loop.joinable()) {
     t.wake();
-    t.thread.join();
+    loop.join();
   }
   // Under the lock: a routing thread that has just seen `stopped` false (in a sink's push or
   // close, or in receive()) holds it while it touches a link or an inbox, and looks again once

@@ -308,8 +308,15 @@ Status Transport::connectPeers(const std::vector<PeerAddress>& peers) {
     tuneSocket(fd);
     t.newLink(fd, true, peer.index);
   }
-  t.running.store(true);
-  t.thread = std::thread([&t] { t.loop(); });
+  {
+    // Under the lock that stop() takes: a stop() from another thread either comes first (no
+    // loop starts) or finds the loop's thread to join (it never joins one not yet assigned, nor
+    // leaves one running that the destructor would then destroy joinable).
+    std::lock_guard startLock(t.mutex);
+    if (t.stopped.load()) return makeError("the transport was stopped before its peers connected");
+    t.running.store(true);
+    t.thread = std::thread([&t] { t.loop(); });
+  }
   std::unique_lock lock(t.mutex);
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration<double>(t.options.connectSeconds);
