@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "raw_form.hpp"
 #include "vrflow/message/packed.hpp"
 
 namespace vrflow::camera {
@@ -35,14 +36,10 @@ void addHullSlab(msg::MessageBuilder& builder, std::uint64_t resourceId, const V
 }
 
 Result<HullSlabView> readHullSlab(const msg::ResourceView& resource) {
-  const auto body = resource.raw();
+  auto checked = rawFormBody(resource, kMagic, kVersion, kHullSlabHeaderSize, "hull slab");
+  if (!checked) return checked.error();
+  const auto body = *checked;
   const std::string what = "resource " + std::to_string(resource.id()) + ": ";
-  if (resource.kind() != msg::ResourceKind::Raw || body.size() < kHullSlabHeaderSize ||
-      std::memcmp(body.data(), kMagic, 4) != 0)
-    return Error{what + "not a hull slab (no 'VXH1' header)"};
-  if (const auto version = msg::loadRaw<std::uint32_t>(body.data() + 4); version != kVersion)
-    return Error{what + "hull slab version " + std::to_string(version) + ", this build reads " +
-                 std::to_string(kVersion)};
   HullSlabView slab;
   slab.spec.nx = msg::loadRaw<std::int32_t>(body.data() + 8);
   slab.spec.ny = msg::loadRaw<std::int32_t>(body.data() + 12);
