@@ -35,6 +35,7 @@ struct Options {
   int warmup = 3;
   int bodies = 0;
   int maxParticles = 200000;
+  int threads = 1;
   double dt = 0.005;
   bool serial = false;
   bool localBodies = false;
@@ -58,16 +59,17 @@ bool parse(int argc, char** argv, Options& o) {
     } else if (a == "--serial") {
       o.serial = true;
     } else if (a == "--nx" || a == "--ny" || a == "--nz" || a == "--steps" || a == "--bodies" ||
-               a == "--warmup" || a == "--max-particles") {
+               a == "--warmup" || a == "--max-particles" || a == "--threads") {
       if (!next(v)) return false;
       const int n = static_cast<int>(v);
-      (a == "--nx"       ? o.nx
-       : a == "--ny"     ? o.ny
-       : a == "--nz"     ? o.nz
-       : a == "--steps"  ? o.steps
-       : a == "--warmup" ? o.warmup
-       : a == "--bodies" ? o.bodies
-                         : o.maxParticles) = n;
+      (a == "--nx"        ? o.nx
+       : a == "--ny"      ? o.ny
+       : a == "--nz"      ? o.nz
+       : a == "--steps"   ? o.steps
+       : a == "--warmup"  ? o.warmup
+       : a == "--bodies"  ? o.bodies
+       : a == "--threads" ? o.threads
+                          : o.maxParticles) = n;
     } else if (a == "--h") {
       if (!next(o.h)) return false;
     } else if (a == "--dt") {
@@ -155,7 +157,7 @@ int main(int argc, char** argv) {
     if (rank == 0) {
       std::fprintf(stderr,
                    "usage: vrflow-fluid-blocks [--nx N --ny N --nz N --h M --dt S --steps N "
-                   "--warmup N --bodies N --max-particles N --serial --local-bodies "
+                   "--warmup N --bodies N --max-particles N --threads N --serial --local-bodies "
                    "--bodies-in-liquid]\n");
     }
     MPI_Finalize();
@@ -172,6 +174,7 @@ int main(int argc, char** argv) {
   s.nz = o.nz;
   s.cellSize = o.h;
   s.maxParticles = o.maxParticles;
+  s.threads = o.threads;
   auto created = fluid::FluidSolver::create(s);
   if (!created) {
     if (rank == 0)
@@ -285,13 +288,13 @@ int main(int argc, char** argv) {
     }
     const int n = std::max(1, timedSteps);
     std::printf(
-        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"serial\":%s,\"steps\":%d,"
+        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"threads\":%d,\"serial\":%s,\"steps\":%d,"
         "\"particles\":%zu,\"ms_per_step\":%.3f,\"cpu_ms_per_step\":%.3f,\"cg_iterations\":%.1f,"
         "\"pressure_ms_per_step\":%.3f,\"cg_bytes_per_step\":%.0f,\"bandwidth_gbs\":%.3f,"
         "\"volume\":%.9g,\"mean_y\":%.9g,\"max_speed\":%.6g,\"body_y\":[%s],"
         "\"wet_bodies_first_timed\":%d,\"digest\":\"%016llx\"}\n",
-        o.nx, o.ny, o.nz, o.bodies, size, o.serial ? "true" : "false", o.steps, particles,
-        1e3 * timed / n, 1e3 * cpuTimed / n, static_cast<double>(cgIterations) / n,
+        o.nx, o.ny, o.nz, o.bodies, size, o.threads, o.serial ? "true" : "false", o.steps,
+        particles, 1e3 * timed / n, 1e3 * cpuTimed / n, static_cast<double>(cgIterations) / n,
         1e3 * pressureTime / n, bytes / n, pressureTime > 0 ? bytes / pressureTime / 1e9 : 0.0,
         volume, meanY, speed, ys.c_str(), wetFirstTimed, static_cast<unsigned long long>(fnv(all)));
   }

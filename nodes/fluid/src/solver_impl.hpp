@@ -182,6 +182,7 @@ struct FluidSolver::Impl {
     return static_cast<std::uint32_t>(grid.cell(i, j, k));
   }
   std::vector<std::size_t> sortStart;
+  std::vector<std::size_t> planeStart;  ///< after sorting: first particle of each plane k0..k1
   std::vector<double> posScratch, velScratch;
   // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
   // and an order that does not depend on history.
@@ -208,6 +209,10 @@ struct FluidSolver::Impl {
   // definitions): call them only from particles.cpp, where the load-time choice is made.
   void splatParticles();
   void sampleAndAdvectParticles(double dt);
+  // The particles [p0, p1) of both loops; splatRange adds to face planes planeLo to planeHi
+  // only.
+  void splatRange(std::size_t p0, std::size_t p1, int planeLo, int planeHi);
+  void sampleAndAdvectRange(double dt, std::size_t p0, std::size_t p1, bool storeCells);
 
   // Fills faces without a value from the mean of valid neighbours, `layers` rings deep. Only
   // rows (j, k) with a valid face in them or next to them can gain values; the others (deep in
