@@ -1,7 +1,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "parallel.hpp"
 #include "solver_impl.hpp"
 #include "transfer.hpp"
 
@@ -196,12 +195,12 @@ void FluidSolver::Impl::splatParticles() {
   }
   auto first = [&](int k) { return planeStart[static_cast<std::size_t>(k - k0)]; };
   constexpr int kAll = 1 << 29;  // "every plane"
-  detail::forRanges(settings.threads, runs, static_cast<std::size_t>(runs),
-                    [&](std::size_t r, std::size_t) {
-                      const int lo = border[r], hi = border[r + 1];
-                      splatRange(first(lo), first(hi), r == 0 ? -kAll : lo + 1,
-                                 static_cast<int>(r) + 1 == runs ? kAll : hi - 2);
-                    });
+  workers->forRanges(runs, static_cast<std::size_t>(runs),
+                     [&](std::size_t r, std::size_t, std::size_t) {
+                       const int lo = border[r], hi = border[r + 1];
+                       splatRange(first(lo), first(hi), r == 0 ? -kAll : lo + 1,
+                                  static_cast<int>(r) + 1 == runs ? kAll : hi - 2);
+                     });
   for (int t = 1; t < runs; ++t) {
     const int b = border[static_cast<std::size_t>(t)];
     splatRange(first(b - 2), first(b + 2), b - 1, b);
@@ -253,7 +252,7 @@ void FluidSolver::Impl::sampleAndAdvectParticles(double dt) {
   posScratch.resize(pos.size());
   // Each particle's update reads the grid and writes the particle only: any split gives the
   // same bits.
-  detail::forRanges(settings.threads, settings.threads, n, [&](std::size_t p0, std::size_t p1) {
+  workers->forRanges(settings.threads, n, [&](std::size_t, std::size_t p0, std::size_t p1) {
     sampleAndAdvectRange(dt, p0, p1, storeCells);
   });
   cellsKnown = storeCells;

@@ -15,6 +15,7 @@ Result<std::unique_ptr<FluidSolver>> FluidSolver::create(const FluidSettings& se
   if (auto status = validateSettings(settings); !status) return status.error();
   auto impl = std::make_unique<Impl>();
   impl->settings = settings;
+  impl->workers = std::make_unique<detail::Workers>(settings.threads);
   impl->rng = settings.seed;
   auto& g = impl->grid;
   g.nx = settings.nx;

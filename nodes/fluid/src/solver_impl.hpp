@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "bodies.hpp"
 #include "grid.hpp"
+#include "parallel.hpp"
 #include "pressure.hpp"
 #include "vrflow/fluid/block_comm.hpp"
 #include "vrflow/fluid/solver.hpp"
@@ -25,6 +27,7 @@ using detail::PreparedBody;
 
 struct FluidSolver::Impl {
   FluidSettings settings;
+  std::unique_ptr<detail::Workers> workers;  ///< settings.threads threads
   Grid grid;
   double invH = 1.0;
   int k0 = 0, k1 = 0;       // this block's cell planes
@@ -219,7 +222,11 @@ struct FluidSolver::Impl {
   // air) are skipped.
   std::vector<unsigned char> rowState;  // per row: bit 0 some face valid, bit 1 every face valid
   std::vector<std::size_t> filled;
+  std::vector<std::vector<std::size_t>> filledPerThread;
   void extrapolate(std::vector<double>* field, int layers);
+  // One plane of a pass of extrapolate(): fills faces of plane k, listing them in `out`.
+  void fillPlane(int a, int k, double* value, const unsigned char* ok,
+                 std::vector<std::size_t>& out) const;
 
   // Rigid motion on the faces of bodies, of kinematic bodies' cells and between a body's cell
   // and air; `kinematicOnly` re-imposes it on kinematic bodies after gravity (a moving wall does
