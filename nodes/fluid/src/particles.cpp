@@ -160,7 +160,7 @@ void FluidSolver::Impl::particlesToGrid() {
     std::fill(u[a].begin(), u[a].begin() + ps * k0, 0.0);
     std::fill(u[a].begin() + ps * kEnd(a), u[a].end(), 0.0);
     const double* in = acc[a].data();
-    forOwnFaces(a, [&](std::size_t f, int, int, int) {
+    forOwnFacesThreaded(a, [&](std::size_t f, int, int, int) {
       const double w = in[2 * f + 1];
       if (w > 1e-9) {
         u[a][f] = in[2 * f] / w;

@@ -220,7 +220,7 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   m.zeroWalls(m.u);
   for (int a = 0; a < 3; ++a) {
     const double dv = m.settings.gravity[static_cast<std::size_t>(a)] * dt;
-    m.forOwnFaces(a, [&](std::size_t f, int, int, int) {
+    m.forOwnFacesThreaded(a, [&](std::size_t f, int, int, int) {
       m.uOld[a][f] = m.u[a][f];
       m.u[a][f] += dv;
     });

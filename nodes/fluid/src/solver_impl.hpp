@@ -131,12 +131,18 @@ struct FluidSolver::Impl {
   // Loops over this block's faces of component a (with the along-axis index).
   template <typename F>
   void forOwnFaces(int a, F&& f) const {
-    const int ke = kEnd(a);
-    for (int k = k0; k < ke; ++k) {
-      for (int j = 0; j < grid.fdim(a, 1); ++j) {
-        std::size_t idx = grid.face(a, 0, j, k);
-        for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
-      }
+    for (int k = k0; k < kEnd(a); ++k) forOwnFacesInPlane(a, k, f);
+  }
+  // The same among the solver's threads (a face written from its own values only).
+  template <typename F>
+  void forOwnFacesThreaded(int a, F&& f) const {
+    forPlanes(k0, kEnd(a), [&](int k) { forOwnFacesInPlane(a, k, f); });
+  }
+  template <typename F>
+  void forOwnFacesInPlane(int a, int k, F&& f) const {
+    for (int j = 0; j < grid.fdim(a, 1); ++j) {
+      std::size_t idx = grid.face(a, 0, j, k);
+      for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
     }
   }
 
@@ -147,20 +153,36 @@ struct FluidSolver::Impl {
   // forOwnFaces() restricted to the rows of faces with a cell that is not air on either side.
   template <typename F>
   void forFacesNearMatter(int a, F&& f) const {
-    const int ke = kEnd(a);
+    for (int k = k0; k < kEnd(a); ++k) forFacesNearMatterInPlane(a, k, f);
+  }
+  // The same, the planes cut into runs among the solver's threads: for passes that write each
+  // face from values no other face of the pass writes.
+  template <typename F>
+  void forFacesNearMatterThreaded(int a, F&& f) const {
+    forPlanes(k0, kEnd(a), [&](int k) { forFacesNearMatterInPlane(a, k, f); });
+  }
+  template <typename F>
+  void forFacesNearMatterInPlane(int a, int k, F&& f) const {
     const int ny = grid.ny, nz = grid.nz;
-    auto busy = [&](int j, int k) {
-      return j >= 0 && j < ny && k >= 0 && k < nz &&
-             rowHasMatter[static_cast<std::size_t>(k) * ny + j];
+    auto busy = [&](int j, int kk) {
+      return j >= 0 && j < ny && kk >= 0 && kk < nz &&
+             rowHasMatter[static_cast<std::size_t>(kk) * ny + j];
     };
-    for (int k = k0; k < ke; ++k) {
-      for (int j = 0; j < grid.fdim(a, 1); ++j) {
-        const bool near = busy(j, k) || (a == 1 && busy(j - 1, k)) || (a == 2 && busy(j, k - 1));
-        if (!near) continue;
-        std::size_t idx = grid.face(a, 0, j, k);
-        for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
-      }
+    for (int j = 0; j < grid.fdim(a, 1); ++j) {
+      const bool near = busy(j, k) || (a == 1 && busy(j - 1, k)) || (a == 2 && busy(j, k - 1));
+      if (!near) continue;
+      std::size_t idx = grid.face(a, 0, j, k);
+      for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
     }
+  }
+  // Calls f(k) for the planes [from, to), cut into one run per thread.
+  template <typename F>
+  void forPlanes(int from, int to, F&& f) const {
+    if (to <= from) return;
+    workers->forRanges(workers->threads(), static_cast<std::size_t>(to - from),
+                       [&](std::size_t, std::size_t b, std::size_t e) {
+                         for (auto k = b; k < e; ++k) f(from + static_cast<int>(k));
+                       });
   }
 
   bool onWall(int a, int i, int j, int k) const {
