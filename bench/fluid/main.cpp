@@ -55,6 +55,9 @@ double streamCopyGBs() {
 nlohmann::json runCase(int nx, int ny, int nz, int bodies, int ranks, int threads, int steps) {
   std::string cmd = std::string(VRFLOW_MPIEXEC) + " --oversubscribe -np " + std::to_string(ranks);
   if (geteuid() == 0) cmd += " --allow-run-as-root";
+  // mpirun binds each rank to one core: a rank's threads would then share that core (oneTBB
+  // starts no worker for a mask of one CPU).
+  if (threads > 1) cmd += " --bind-to none";
   cmd += " " + binDir() + "/vrflow-fluid-blocks --nx " + std::to_string(nx) + " --ny " +
          std::to_string(ny) + " --nz " + std::to_string(nz) + " --h " + std::to_string(1.0 / nx) +
          " --dt 0.005 --warmup 3 --steps " + std::to_string(steps + 3) + " --bodies " +
