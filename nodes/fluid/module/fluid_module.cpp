@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
 
   const auto blocks = module.params().getInt("blocks");
   const std::string job = module.params().getString("job");
-  // Threads and ranks share the cores: by default a block gets its share of them.
+  // Threads and ranks share the cores: 0 gives each block its share of them.
   const auto threads = module.params().getInt("threads");
   const auto cores = static_cast<std::int64_t>(std::max(1u, std::thread::hardware_concurrency()));
   s.threads = static_cast<int>(threads > 0   ? threads
