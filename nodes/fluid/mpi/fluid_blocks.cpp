@@ -288,8 +288,9 @@ int main(int argc, char** argv) {
     }
     const int n = std::max(1, timedSteps);
     std::printf(
-        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"threads\":%d,\"serial\":%s,\"steps\":%d,"
-        "\"particles\":%zu,\"ms_per_step\":%.3f,\"cpu_ms_per_step\":%.3f,\"cg_iterations\":%.1f,"
+        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"threads\":%d,\"serial\":%s,"
+        "\"steps\":%d,\"particles\":%zu,\"ms_per_step\":%.3f,\"cpu_ms_per_step\":%.3f,\"cg_"
+        "iterations\":%.1f,"
         "\"pressure_ms_per_step\":%.3f,\"cg_bytes_per_step\":%.0f,\"bandwidth_gbs\":%.3f,"
         "\"volume\":%.9g,\"mean_y\":%.9g,\"max_speed\":%.6g,\"body_y\":[%s],"
         "\"wet_bodies_first_timed\":%d,\"digest\":\"%016llx\"}\n",
