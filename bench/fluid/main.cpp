@@ -52,13 +52,20 @@ double streamCopyGBs() {
   return 2.0 * 8.0 * static_cast<double>(n) / best / 1e9;
 }
 
-nlohmann::json runCase(int nx, int ny, int nz, int bodies, int ranks, int steps) {
+nlohmann::json runCase(int nx, int ny, int nz, int bodies, int ranks, int threads, int steps) {
   std::string cmd = std::string(VRFLOW_MPIEXEC) + " --oversubscribe -np " + std::to_string(ranks);
   if (geteuid() == 0) cmd += " --allow-run-as-root";
+  // mpirun binds each rank to one core: a rank's threads would then share that core (oneTBB
+  // starts no worker for a mask of one CPU).
+  if (threads > 1) cmd += " --bind-to none";
   cmd += " " + binDir() + "/vrflow-fluid-blocks --nx " + std::to_string(nx) + " --ny " +
          std::to_string(ny) + " --nz " + std::to_string(nz) + " --h " + std::to_string(1.0 / nx) +
          " --dt 0.005 --warmup 3 --steps " + std::to_string(steps + 3) + " --bodies " +
-         std::to_string(bodies) + " --max-particles 2000000";
+         std::to_string(bodies) + " --threads " + std::to_string(threads) +
+         " --max-particles 2000000";
+  // The coupled case: the boxes start in the liquid (floating and sinking), so every timed step
+  // couples them; dropped from above they were still in air over the whole timed window.
+  if (bodies > 0) cmd += " --bodies-in-liquid";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return {};
   std::string out;
@@ -72,6 +79,14 @@ nlohmann::json runCase(int nx, int ny, int nz, int bodies, int ranks, int steps)
     return {};
   }
   return nlohmann::json::parse(out.substr(start, out.find('\n', start) - start));
+}
+
+// The machine's 1-minute load average when a case ends (other work on the cores).
+double loadAverage() {
+  std::ifstream in("/proc/loadavg");
+  double load = -1.0;
+  in >> load;
+  return load;
 }
 
 }  // namespace
@@ -99,12 +114,18 @@ int main(int argc, char** argv) {
   };
   for (const Grid g : {Grid{32, 64, 32}, Grid{64, 128, 64}}) {
     for (int bodies : {0, 20}) {
-      double oneRankMs = 0.0;
-      for (int ranks : {1, 2}) {
+      double baselineMs = 0.0;
+      // One rank of one thread (the serial solver: the same bits as before threads), then the
+      // block's two threads, then two ranks of one thread each.
+      struct Split {
+        int ranks, threads;
+      };
+      for (const Split split : {Split{1, 1}, Split{1, 2}, Split{2, 1}}) {
+        const int ranks = split.ranks;
         const int n = g.nx == 32 ? steps : std::max(4, steps / 4);
         // The copy is measured right before each case, so both see the same machine load.
         const double stream = streamCopyGBs();
-        auto result = runCase(g.nx, g.ny, g.nz, bodies, ranks, n);
+        auto result = runCase(g.nx, g.ny, g.nz, bodies, ranks, split.threads, n);
         if (result.empty()) {
           ++failures;
           continue;
@@ -113,6 +134,7 @@ int main(int argc, char** argv) {
         line["grid"] = result["grid"];
         line["rigid"] = bodies;
         line["ranks"] = ranks;
+        line["threads"] = split.threads;
         line["ms_per_step"] = result["ms_per_step"];
         line["cg_iterations"] = result["cg_iterations"];
         line["pressure_ms_per_step"] = result["pressure_ms_per_step"];
@@ -123,11 +145,23 @@ int main(int argc, char** argv) {
         line["bandwidth_vs_stream"] =
             stream > 0 ? result["bandwidth_gbs"].get<double>() / stream : 0.0;
         const double ms = result["ms_per_step"].get<double>();
-        if (ranks == 1) oneRankMs = ms;
-        if (ranks > 1 && oneRankMs > 0 && ms > 0) line["speedup_vs_1_rank"] = oneRankMs / ms;
+        if (ranks == 1 && split.threads == 1) baselineMs = ms;
+        if (baselineMs > 0 && ms > 0 && baselineMs != ms) {
+          line["speedup_vs_1_rank_1_thread"] = baselineMs / ms;
+        }
         line["particles"] = result["particles"];
+        line["digest"] = result["digest"];
+        // Every box must be in the liquid from the first timed step on, or the case measures
+        // the fluid alone.
+        line["wet_bodies_first_timed"] = result["wet_bodies_first_timed"];
+        if (result["wet_bodies_first_timed"].get<int>() != bodies) {
+          std::fprintf(stderr, "vrflow-bench-fluid: %d of %d bodies wet when timing started\n",
+                       result["wet_bodies_first_timed"].get<int>(), bodies);
+          ++failures;
+        }
         line["steps"] = n;
         line["machine"] = where;
+        line["load_average"] = loadAverage();
         std::printf("%s\n", line.dump().c_str());
         std::fflush(stdout);
       }

@@ -103,5 +103,29 @@ TEST(FluidBlocks, BlocksHoldingOnlyTheBodiesNearThemEqualBlocksHoldingEveryBody)
   }
 }
 
+// The benchmark's coupled case: boxes placed in the liquid column are pushed on by the fluid from
+// the first timed step (the default placement drops them from above the surface, where the same
+// steps leave them in air), and the particles then differ from the run without boxes.
+TEST(FluidBlocks, BoxesPlacedInTheLiquidAreCoupledFromTheFirstTimedStep) {
+  const std::vector<std::string> scene = {"--bodies", "20", "--warmup", "3"};
+  std::vector<std::string> inLiquid = scene;
+  inLiquid.push_back("--bodies-in-liquid");
+  const auto none = runBlocks(1, {"--bodies", "0", "--warmup", "3"});
+  const auto dropped = runBlocks(1, scene);
+  const auto wet = runBlocks(1, inLiquid);
+  ASSERT_FALSE(none.empty());
+  ASSERT_FALSE(dropped.empty());
+  ASSERT_FALSE(wet.empty());
+  EXPECT_EQ(wet["wet_bodies_first_timed"], 20);
+  EXPECT_NE(wet["digest"], none["digest"]);
+  EXPECT_LT(dropped["wet_bodies_first_timed"].get<int>(), 20) << "dropped boxes are all wet now";
+  // Light boxes float near the surface (0.4 m here), heavy ones sank under it.
+  const auto& y = wet["body_y"];
+  ASSERT_EQ(y.size(), 20u);
+  for (std::size_t b = 0; b < y.size(); ++b) {
+    EXPECT_LT(y[b].get<double>(), b % 2 == 0 ? 0.45 : 0.25) << "box " << b;
+  }
+}
+
 }  // namespace
 }  // namespace vrflow::testing

@@ -389,5 +389,48 @@ TEST(FluidModule, ZeroGridSizeIsRejectedByValidation) {
   EXPECT_NE((result.out + result.err).find("ny"), std::string::npos) << result.out << result.err;
 }
 
+TEST(FluidModule, ThreadsOutOfRangeAreRejectedByValidation) {
+  TempDir dir;
+  for (const char* threads : {"65", "-1"}) {
+    const auto app = dir.write(
+        "threads.xml",
+        application(
+            fluidModule(std::string("      <param name=\"threads\" value=\"") + threads + "\"/>\n"),
+            ""));
+    const auto result = runVrflow({"validate", app}, 60);
+    EXPECT_EQ(result.exitCode, 1) << threads;
+    EXPECT_NE((result.out + result.err).find("threads"), std::string::npos)
+        << result.out << result.err;
+  }
+}
+
+// The module's threads change no bit: the test box in the tank's cycle; its trajectory and the
+// fluid's final state (particle centroid and bounds, the box's last force) with 1 and 3 threads
+// are the same text.
+TEST(FluidModule, ThreeThreadsGiveTheSameRunAsOne) {
+  TempDir dir;
+  std::string outputs[2];
+  const char* threads[2] = {"1", "3"};
+  for (int run = 0; run < 2; ++run) {
+    const std::string state = dir.file(std::string("state-") + threads[run] + ".json");
+    const std::string path = dir.file(std::string("box-") + threads[run] + ".csv");
+    const auto app = dir.write(
+        "threads.xml",
+        application(
+            fluidModule(std::string("      <param name=\"threads\" value=\"") + threads[run] +
+                        "\"/>\n      <param name=\"state-file\" value=\"" + state + "\"/>\n") +
+                cycleBox(path),
+            "    <connection from=\"box.objects\" to=\"water.objects\"/>\n"
+            "    <connection from=\"water.forces\" to=\"box.events\"/>\n"));
+    const auto result = runVrflow({"run", app, "--iterations", "40", "--no-progress"}, 120);
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    for (const auto& file : {state, path}) {
+      for (const auto& line : readLines(file)) outputs[run] += line + "\n";
+    }
+  }
+  EXPECT_GT(outputs[0].size(), 1000u);
+  EXPECT_EQ(outputs[1], outputs[0]);
+}
+
 }  // namespace
 }  // namespace vrflow::testing

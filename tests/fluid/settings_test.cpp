@@ -63,6 +63,11 @@ TEST(FluidSettings, BadMaterialAndSolverKnobsAreRejected) {
   s = smallTank(8, 8, 8);
   s.gravity[1] = std::numeric_limits<double>::infinity();
   EXPECT_NE(createError(s).find("gravity"), std::string::npos);
+  for (int threads : {0, -1, 65}) {
+    s = smallTank(8, 8, 8);
+    s.threads = threads;
+    EXPECT_NE(createError(s).find("threads " + std::to_string(threads)), std::string::npos);
+  }
 }
 
 TEST(FluidSettings, AbsurdTimeStepsAreRejectedAndNothingMoves) {

@@ -10,10 +10,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "blocks.hpp"
 #include "final_state.hpp"
@@ -139,6 +141,12 @@ int main(int argc, char** argv) {
 
   const auto blocks = module.params().getInt("blocks");
   const std::string job = module.params().getString("job");
+  // Threads and ranks share the cores: 0 gives each block its share of them.
+  const auto threads = module.params().getInt("threads");
+  const auto cores = static_cast<std::int64_t>(std::max(1u, std::thread::hardware_concurrency()));
+  s.threads = static_cast<int>(threads > 0   ? threads
+                               : job.empty() ? std::max<std::int64_t>(1, cores / blocks)
+                                             : 1);
   const bool withSurface = module.params().getString("surface") == "on";
   if (withSurface && !job.empty()) {
     return fail("surface = on with job = '" + job +

@@ -5,7 +5,10 @@
 // body heights, a digest of the particle positions). `--serial` runs the library without a
 // BlockComm (on one rank) to compare with `mpirun -np 1`. `--local-bodies` gives each block only
 // the boxes near its slab (FluidSolver::setLocalBodies, as the fluid's job modules do) and sums
-// the reported forces over the ranks to integrate every box on every rank.
+// the reported forces over the ranks to integrate every box on every rank. `--bodies-in-liquid`
+// places the boxes in the liquid column instead of above the tank (light ones floating at the
+// surface, heavy ones under it), so that they are coupled from the first step; the JSON's
+// `wet_bodies_first_timed` counts the boxes the fluid pushed on in the first timed step.
 #include <mpi.h>
 
 #include <algorithm>
@@ -32,9 +35,11 @@ struct Options {
   int warmup = 3;
   int bodies = 0;
   int maxParticles = 200000;
+  int threads = 1;
   double dt = 0.005;
   bool serial = false;
   bool localBodies = false;
+  bool bodiesInLiquid = false;
 };
 
 bool parse(int argc, char** argv, Options& o) {
@@ -49,19 +54,22 @@ bool parse(int argc, char** argv, Options& o) {
     double v = 0;
     if (a == "--local-bodies") {
       o.localBodies = true;
+    } else if (a == "--bodies-in-liquid") {
+      o.bodiesInLiquid = true;
     } else if (a == "--serial") {
       o.serial = true;
     } else if (a == "--nx" || a == "--ny" || a == "--nz" || a == "--steps" || a == "--bodies" ||
-               a == "--warmup" || a == "--max-particles") {
+               a == "--warmup" || a == "--max-particles" || a == "--threads") {
       if (!next(v)) return false;
       const int n = static_cast<int>(v);
-      (a == "--nx"       ? o.nx
-       : a == "--ny"     ? o.ny
-       : a == "--nz"     ? o.nz
-       : a == "--steps"  ? o.steps
-       : a == "--warmup" ? o.warmup
-       : a == "--bodies" ? o.bodies
-                         : o.maxParticles) = n;
+      (a == "--nx"        ? o.nx
+       : a == "--ny"      ? o.ny
+       : a == "--nz"      ? o.nz
+       : a == "--steps"   ? o.steps
+       : a == "--warmup"  ? o.warmup
+       : a == "--bodies"  ? o.bodies
+       : a == "--threads" ? o.threads
+                          : o.maxParticles) = n;
     } else if (a == "--h") {
       if (!next(o.h)) return false;
     } else if (a == "--dt") {
@@ -93,6 +101,14 @@ std::vector<Box> makeBoxes(const Options& o, const msg::Aabb& tank) {
                          tank.min[1] + sy * (0.6 + 0.08 * layer) + (row % 2) * 3 * half,
                          tank.min[2] + sz * (0.1 + 0.8 * (row + 0.5) / 4.0)};
     const double density = (b % 2 == 0) ? 500.0 : 2000.0;
+    if (o.bodiesInLiquid) {
+      // The liquid fills x in [0, sx / 2) and y in [0, sy / 2): four columns across it, five
+      // rows along z; a light box floats at the surface, a heavy one starts half-way down.
+      const int c = b % 4, r = (b / 4) % 5, level = b / 20;
+      box.body.position = {tank.min[0] + sx * 0.5 * (c + 0.5) / 4.0,
+                           tank.min[1] + sy * (b % 2 == 0 ? 0.5 : 0.25) - level * 3 * half,
+                           tank.min[2] + sz * (0.1 + 0.8 * (r + 0.5) / 5.0)};
+    }
     box.body.mass = density * 8 * half * half * half;
     boxes.push_back(box);
   }
@@ -141,7 +157,8 @@ int main(int argc, char** argv) {
     if (rank == 0) {
       std::fprintf(stderr,
                    "usage: vrflow-fluid-blocks [--nx N --ny N --nz N --h M --dt S --steps N "
-                   "--warmup N --bodies N --max-particles N --serial --local-bodies]\n");
+                   "--warmup N --bodies N --max-particles N --threads N --serial --local-bodies "
+                   "--bodies-in-liquid]\n");
     }
     MPI_Finalize();
     return 2;
@@ -157,6 +174,7 @@ int main(int argc, char** argv) {
   s.nz = o.nz;
   s.cellSize = o.h;
   s.maxParticles = o.maxParticles;
+  s.threads = o.threads;
   auto created = fluid::FluidSolver::create(s);
   if (!created) {
     if (rank == 0)
@@ -189,6 +207,7 @@ int main(int argc, char** argv) {
   double timed = 0.0, cpuTimed = 0.0, pressureTime = 0.0, bytes = 0.0;
   long long cgIterations = 0;
   int timedSteps = 0;
+  int wetFirstTimed = -1;
   for (int step = 0; step < o.steps; ++step) {
     std::vector<fluid::RigidBody> bodies;
     std::vector<std::size_t> held;  // the boxes this block was given
@@ -231,6 +250,12 @@ int main(int argc, char** argv) {
         for (int a = 0; a < 3; ++a) all[b].force[a] = sums[3 * b + a];
       }
     }
+    if (step == o.warmup) {
+      // A box the fluid pushes on is wet (a box in air gets exactly zero force).
+      wetFirstTimed = 0;
+      for (const auto& f : all)
+        wetFirstTimed += f.force[0] != 0.0 || f.force[1] != 0.0 || f.force[2] != 0.0;
+    }
     for (std::size_t b = 0; b < boxes.size(); ++b)
       integrate(boxes[b], all[b], o.dt, s.gravity, tank);
     const auto& st = solver->lastStats();
@@ -263,15 +288,16 @@ int main(int argc, char** argv) {
     }
     const int n = std::max(1, timedSteps);
     std::printf(
-        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"serial\":%s,\"steps\":%d,"
-        "\"particles\":%zu,\"ms_per_step\":%.3f,\"cpu_ms_per_step\":%.3f,\"cg_iterations\":%.1f,"
+        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"threads\":%d,\"serial\":%s,"
+        "\"steps\":%d,\"particles\":%zu,\"ms_per_step\":%.3f,\"cpu_ms_per_step\":%.3f,\"cg_"
+        "iterations\":%.1f,"
         "\"pressure_ms_per_step\":%.3f,\"cg_bytes_per_step\":%.0f,\"bandwidth_gbs\":%.3f,"
         "\"volume\":%.9g,\"mean_y\":%.9g,\"max_speed\":%.6g,\"body_y\":[%s],"
-        "\"digest\":\"%016llx\"}\n",
-        o.nx, o.ny, o.nz, o.bodies, size, o.serial ? "true" : "false", o.steps, particles,
-        1e3 * timed / n, 1e3 * cpuTimed / n, static_cast<double>(cgIterations) / n,
+        "\"wet_bodies_first_timed\":%d,\"digest\":\"%016llx\"}\n",
+        o.nx, o.ny, o.nz, o.bodies, size, o.threads, o.serial ? "true" : "false", o.steps,
+        particles, 1e3 * timed / n, 1e3 * cpuTimed / n, static_cast<double>(cgIterations) / n,
         1e3 * pressureTime / n, bytes / n, pressureTime > 0 ? bytes / pressureTime / 1e9 : 0.0,
-        volume, meanY, speed, ys.c_str(), static_cast<unsigned long long>(fnv(all)));
+        volume, meanY, speed, ys.c_str(), wetFirstTimed, static_cast<unsigned long long>(fnv(all)));
   }
   MPI_Finalize();
   return 0;

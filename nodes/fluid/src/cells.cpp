@@ -187,10 +187,45 @@ void FluidSolver::Impl::dryBodiesOutOfLiquid(std::size_t bodyCount) {
   }
 }
 
+void FluidSolver::Impl::fillPlane(int a, int k, double* value, const unsigned char* ok,
+                                  std::vector<std::size_t>& out) const {
+  const int dx = grid.fdim(a, 0), dy = grid.fdim(a, 1), dz = grid.fdim(a, 2);
+  const std::size_t sy = static_cast<std::size_t>(dx), sz = sy * static_cast<std::size_t>(dy);
+  for (int j = 0; j < dy; ++j) {
+    const std::size_t r = static_cast<std::size_t>(k) * dy + j;
+    if (rowState[r] & 2) continue;  // nothing to fill
+    const bool near = (rowState[r] & 1) || (j > 0 && (rowState[r - 1] & 1)) ||
+                      (j + 1 < dy && (rowState[r + 1] & 1)) || (k > 0 && (rowState[r - dy] & 1)) ||
+                      (k + 1 < dz && (rowState[r + dy] & 1));
+    if (!near) continue;
+    std::size_t f = grid.face(a, 0, j, k);
+    for (int i = 0; i < dx; ++i, ++f) {
+      if (ok[f]) continue;
+      double total = 0.0;
+      int count = 0;
+      auto take = [&](std::size_t g) {
+        if (ok[g]) {
+          total += value[g];
+          ++count;
+        }
+      };
+      if (i > 0) take(f - 1);
+      if (i + 1 < dx) take(f + 1);
+      if (j > 0) take(f - sy);
+      if (j + 1 < dy) take(f + sy);
+      if (k > 0) take(f - sz);
+      if (k + 1 < dz) take(f + sz);
+      if (count > 0) {
+        value[f] = total / count;
+        out.push_back(f);
+      }
+    }
+  }
+}
+
 void FluidSolver::Impl::extrapolate(std::vector<double>* field, int layers) {
   for (int a = 0; a < 3; ++a) {
     const int dx = grid.fdim(a, 0), dy = grid.fdim(a, 1), dz = grid.fdim(a, 2);
-    const std::size_t sy = static_cast<std::size_t>(dx), sz = sy * static_cast<std::size_t>(dy);
     const int ke = kEnd(a);
     for (int layer = 0; layer < layers; ++layer) {
       exchangeWithValidity(field[a], valid[a], a);
@@ -198,49 +233,36 @@ void FluidSolver::Impl::extrapolate(std::vector<double>* field, int layers) {
       unsigned char* ok = valid[a].data();
       const int kLo = std::max(0, k0 - 1), kHi = std::min(dz, ke + 1);
       rowState.assign(static_cast<std::size_t>(dy) * static_cast<std::size_t>(dz), 0);
-      for (int k = kLo; k < kHi; ++k) {
-        for (int j = 0; j < dy; ++j) {
-          const unsigned char* row = ok + grid.face(a, 0, j, k);
-          int count = 0;
-          for (int i = 0; i < dx; ++i) count += row[i];
-          rowState[static_cast<std::size_t>(k) * dy + j] =
-              static_cast<unsigned char>((count > 0 ? 1 : 0) | (count == dx ? 2 : 0));
-        }
-      }
-      filled.clear();
-      for (int k = k0; k < ke; ++k) {
-        for (int j = 0; j < dy; ++j) {
-          const std::size_t r = static_cast<std::size_t>(k) * dy + j;
-          if (rowState[r] & 2) continue;  // nothing to fill
-          const bool near = (rowState[r] & 1) || (j > 0 && (rowState[r - 1] & 1)) ||
-                            (j + 1 < dy && (rowState[r + 1] & 1)) ||
-                            (k > 0 && (rowState[r - dy] & 1)) ||
-                            (k + 1 < dz && (rowState[r + dy] & 1));
-          if (!near) continue;
-          std::size_t f = grid.face(a, 0, j, k);
-          for (int i = 0; i < dx; ++i, ++f) {
-            if (ok[f]) continue;
-            double total = 0.0;
-            int count = 0;
-            auto take = [&](std::size_t g) {
-              if (ok[g]) {
-                total += value[g];
-                ++count;
+      const int threads = settings.threads;
+      workers->forRanges(
+          threads, static_cast<std::size_t>(kHi - kLo),
+          [&](std::size_t, std::size_t from, std::size_t to) {
+            for (int k = kLo + static_cast<int>(from); k < kLo + static_cast<int>(to); ++k) {
+              for (int j = 0; j < dy; ++j) {
+                const unsigned char* row = ok + grid.face(a, 0, j, k);
+                int count = 0;
+                for (int i = 0; i < dx; ++i) count += row[i];
+                rowState[static_cast<std::size_t>(k) * dy + j] =
+                    static_cast<unsigned char>((count > 0 ? 1 : 0) | (count == dx ? 2 : 0));
               }
-            };
-            if (i > 0) take(f - 1);
-            if (i + 1 < dx) take(f + 1);
-            if (j > 0) take(f - sy);
-            if (j + 1 < dy) take(f + sy);
-            if (k > 0) take(f - sz);
-            if (k + 1 < dz) take(f + sz);
-            if (count > 0) {
-              value[f] = total / count;
-              filled.push_back(f);
             }
-          }
-        }
-      }
+          });
+      // A face is filled from valid neighbours only, and becomes valid after the pass: the
+      // planes are independent within a pass, so threads take runs of them, each listing what
+      // it filled.
+      filledPerThread.resize(static_cast<std::size_t>(threads));
+      workers->forRanges(threads, static_cast<std::size_t>(ke - k0),
+                         [&](std::size_t part, std::size_t from, std::size_t to) {
+                           auto& mine = filledPerThread[part];
+                           mine.clear();
+                           for (int k = k0 + static_cast<int>(from); k < k0 + static_cast<int>(to);
+                                ++k) {
+                             fillPlane(a, k, value, ok, mine);
+                           }
+                         });
+      filled.clear();
+      for (const auto& part : filledPerThread)
+        filled.insert(filled.end(), part.begin(), part.end());
       for (const std::size_t f : filled) ok[f] = 1;
     }
   }

@@ -61,6 +61,10 @@ void FluidSolver::Impl::sortParticles() {
   for (std::size_t c = c0; c < c1; ++c) {
     sortStart[c + 1] = sortStart[c] + static_cast<std::size_t>(particlesInCell[c]);
   }
+  planeStart.resize(static_cast<std::size_t>(k1 - k0) + 1);
+  for (int k = k0; k <= k1; ++k) {
+    planeStart[static_cast<std::size_t>(k - k0)] = sortStart[plane * static_cast<std::size_t>(k)];
+  }
   posScratch.resize(pos.size());
   velScratch.resize(vel.size());
   for (std::size_t p = 0; p < n; ++p) {
@@ -156,7 +160,7 @@ void FluidSolver::Impl::particlesToGrid() {
     std::fill(u[a].begin(), u[a].begin() + ps * k0, 0.0);
     std::fill(u[a].begin() + ps * kEnd(a), u[a].end(), 0.0);
     const double* in = acc[a].data();
-    forOwnFaces(a, [&](std::size_t f, int, int, int) {
+    forOwnFacesThreaded(a, [&](std::size_t f, int, int, int) {
       const double w = in[2 * f + 1];
       if (w > 1e-9) {
         u[a][f] = in[2 * f] / w;
@@ -169,18 +173,54 @@ void FluidSolver::Impl::particlesToGrid() {
   }
 }
 
-VRFLOW_FLUID_HOT void FluidSolver::Impl::splatParticles() {
+void FluidSolver::Impl::splatParticles() {
+  // Threads take consecutive runs of planes (particles are sorted by cell, so a run of planes is
+  // a range of particles). A particle in cell plane k adds to face planes k - 1 to k + 1, so
+  // around a border b between two runs, face planes b - 1 and b get sums from both: each run
+  // leaves those out, and afterwards the particles of planes b - 2 to b + 1 add to them alone,
+  // in particle order. Every face then sums the same terms in the same order as one thread: the
+  // same bits whatever the thread count.
+  constexpr int kMinPlanes = 4;  // keeps the borders' plane ranges apart
+  const int runs = std::max(1, std::min(settings.threads, (k1 - k0) / kMinPlanes));
+  const std::size_t n = pos.size() / 3;
+  std::vector<int> border(static_cast<std::size_t>(runs) + 1, k0);
+  border.back() = k1;
+  for (int t = 1; t < runs; ++t) {
+    // The first plane at which t / runs of the particles lie below, kept kMinPlanes apart.
+    const std::size_t want = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(runs);
+    int k = border[static_cast<std::size_t>(t) - 1] + kMinPlanes;
+    while (k < k1 - kMinPlanes * (runs - t) && planeStart[static_cast<std::size_t>(k - k0)] < want)
+      ++k;
+    border[static_cast<std::size_t>(t)] = k;
+  }
+  auto first = [&](int k) { return planeStart[static_cast<std::size_t>(k - k0)]; };
+  constexpr int kAll = 1 << 29;  // "every plane"
+  workers->forRanges(runs, static_cast<std::size_t>(runs),
+                     [&](std::size_t r, std::size_t, std::size_t) {
+                       const int lo = border[r], hi = border[r + 1];
+                       splatRange(first(lo), first(hi), r == 0 ? -kAll : lo + 1,
+                                  static_cast<int>(r) + 1 == runs ? kAll : hi - 2);
+                     });
+  for (int t = 1; t < runs; ++t) {
+    const int b = border[static_cast<std::size_t>(t)];
+    splatRange(first(b - 2), first(b + 2), b - 1, b);
+  }
+}
+
+VRFLOW_FLUID_HOT void FluidSolver::Impl::splatRange(std::size_t p0, std::size_t p1, int planeLo,
+                                                    int planeHi) {
   const detail::Lattice lattice(grid);
   double* sums[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
-  const std::size_t n = pos.size() / 3;
-  const double* x = pos.data();
-  const double* v = vel.data();
-  for (std::size_t p = 0; p < n; ++p, x += 3, v += 3) {
+  const double* x = pos.data() + 3 * p0;
+  const double* v = vel.data() + 3 * p0;
+  for (std::size_t p = p0; p < p1; ++p, x += 3, v += 3) {
     detail::Located c;
     detail::locate(lattice, x, c);
-    detail::splat(sums[0], detail::stencilOf(lattice, 0, c), v[0]);
-    detail::splat(sums[1], detail::stencilOf(lattice, 1, c), v[1]);
-    detail::splat(sums[2], detail::stencilOf(lattice, 2, c), v[2]);
+    const int zc = c.centreBase[2] - planeLo, zf = c.faceBase[2] - planeLo;
+    const int span = planeHi - planeLo;
+    detail::splat(sums[0], detail::stencilOf(lattice, 0, c), v[0], zc, span);
+    detail::splat(sums[1], detail::stencilOf(lattice, 1, c), v[1], zc, span);
+    detail::splat(sums[2], detail::stencilOf(lattice, 2, c), v[2], zf, span);
   }
 }
 
@@ -205,7 +245,21 @@ void FluidSolver::Impl::gridToParticlesAndAdvect(double dt) {
   sampleAndAdvectParticles(dt);
 }
 
-VRFLOW_FLUID_HOT void FluidSolver::Impl::sampleAndAdvectParticles(double dt) {
+void FluidSolver::Impl::sampleAndAdvectParticles(double dt) {
+  const std::size_t n = pos.size() / 3;
+  const bool storeCells = !comm || comm->size() == 1;
+  if (storeCells) sortCell.resize(n);
+  posScratch.resize(pos.size());
+  // Each particle's update reads the grid and writes the particle only: any split gives the
+  // same bits.
+  workers->forRanges(settings.threads, n, [&](std::size_t, std::size_t p0, std::size_t p1) {
+    sampleAndAdvectRange(dt, p0, p1, storeCells);
+  });
+  cellsKnown = storeCells;
+}
+
+VRFLOW_FLUID_HOT void FluidSolver::Impl::sampleAndAdvectRange(double dt, std::size_t p0,
+                                                              std::size_t p1, bool storeCells) {
   const detail::Lattice lattice(grid);
   const double* pairs[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
   const double flip = settings.flipRatio, pic = 1.0 - flip;
@@ -222,15 +276,11 @@ VRFLOW_FLUID_HOT void FluidSolver::Impl::sampleAndAdvectParticles(double dt) {
   auto clamp = [&](double* y) {
     for (int d = 0; d < 3; ++d) y[d] = std::min(std::max(y[d], lo[d]), hi[d]);
   };
-  const std::size_t n = pos.size() / 3;
-  const bool storeCells = !comm || comm->size() == 1;
-  if (storeCells) sortCell.resize(n);
   // Two passes (velocities and midpoints, then positions) rather than one: within a particle
   // the second interpolation waits for the first, and a pass of short independent chains
   // keeps more particles in flight.
-  posScratch.resize(pos.size());
   double* midpoints = posScratch.data();
-  for (std::size_t p = 0; p < n; ++p) {
+  for (std::size_t p = p0; p < p1; ++p) {
     const double* x = &pos[3 * p];
     double* v = &vel[3 * p];
     detail::Located c;
@@ -248,7 +298,7 @@ VRFLOW_FLUID_HOT void FluidSolver::Impl::sampleAndAdvectParticles(double dt) {
     mid[2] = x[2] + halfDt * g2[0];
     clamp(mid);
   }
-  for (std::size_t p = 0; p < n; ++p) {
+  for (std::size_t p = p0; p < p1; ++p) {
     double* x = &pos[3 * p];
     detail::Located c;
     detail::locate(lattice, midpoints + 3 * p, c);
@@ -258,7 +308,6 @@ VRFLOW_FLUID_HOT void FluidSolver::Impl::sampleAndAdvectParticles(double dt) {
     clamp(x);
     if (storeCells) sortCell[p] = clampedCell(x);
   }
-  cellsKnown = storeCells;
 }
 
 }  // namespace vrflow::fluid

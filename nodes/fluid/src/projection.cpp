@@ -24,7 +24,8 @@ void FluidSolver::Impl::project(double dt) {
   stats.targetDivergence = -settings.volumeCorrection * (1.0 - stats.particleDensity) / dt;
   exchange(u[2], 2, 1);  // the w faces above this block's top plane
   const int dims[3] = {grid.nx, grid.ny, grid.nz};
-  for (int k = k0; k < k1; ++k) {
+  // Each cell writes its own row of the system: planes are independent.
+  forPlanes(k0, k1, [&](int k) {
     for (int j = 0; j < grid.ny; ++j) {
       for (int i = 0; i < grid.nx; ++i) {
         const std::size_t c = grid.cell(i, j, k);
@@ -50,7 +51,7 @@ void FluidSolver::Impl::project(double dt) {
         }
       }
     }
-  }
+  });
   exchangeCells(A.az);  // the product needs the lower block's couplings to this block
   const auto start = std::chrono::steady_clock::now();
   const auto outcome = detail::solvePressure(grid, A, rhs, pressure, settings.cgTolerance,
@@ -64,7 +65,7 @@ void FluidSolver::Impl::project(double dt) {
   stats.bytesTouched = outcome.bytesTouched;
   // Subtract the pressure gradient on every interior face next to an unknown cell.
   for (int a = 0; a < 3; ++a) {
-    forFacesNearMatter(a, [&](std::size_t f, int i, int j, int k) {
+    forFacesNearMatterThreaded(a, [&](std::size_t f, int i, int j, int k) {
       if (onWall(a, i, j, k)) return;
       const std::size_t hi = grid.cell(i, j, k);
       const std::size_t lo = hi - stride(a);
@@ -131,7 +132,7 @@ void FluidSolver::Impl::markProjectedFaces() {
   for (int a = 0; a < 3; ++a) {
     const auto ps = static_cast<std::ptrdiff_t>(planeSize(a));
     std::fill(valid[a].begin() + ps * k0, valid[a].begin() + ps * kEnd(a), 0);
-    forFacesNearMatter(a, [&](std::size_t f, int i, int j, int k) {
+    forFacesNearMatterThreaded(a, [&](std::size_t f, int i, int j, int k) {
       const int along = a == 0 ? i : a == 1 ? j : k;
       // Projected faces and the faces of kinematic bodies keep their values.
       bool touches = false;

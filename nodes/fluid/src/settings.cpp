@@ -42,6 +42,9 @@ Status validateSettings(const FluidSettings& s) {
     return makeError("fluid: max particles " + std::to_string(s.maxParticles) +
                      " must be in [1, 50000000]");
   }
+  if (s.threads < 1 || s.threads > 64) {
+    return makeError("fluid: threads " + std::to_string(s.threads) + " must be in [1, 64]");
+  }
   if (!std::isfinite(s.cgTolerance) || s.cgTolerance <= 0.0 || s.cgTolerance >= 1.0) {
     return makeError("fluid: CG tolerance " + std::to_string(s.cgTolerance) +
                      " must be in (0, 1) (relative residual)");

@@ -15,6 +15,7 @@ Result<std::unique_ptr<FluidSolver>> FluidSolver::create(const FluidSettings& se
   if (auto status = validateSettings(settings); !status) return status.error();
   auto impl = std::make_unique<Impl>();
   impl->settings = settings;
+  impl->workers = std::make_unique<detail::Workers>(settings.threads);
   impl->rng = settings.seed;
   auto& g = impl->grid;
   g.nx = settings.nx;
@@ -219,7 +220,7 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   m.zeroWalls(m.u);
   for (int a = 0; a < 3; ++a) {
     const double dv = m.settings.gravity[static_cast<std::size_t>(a)] * dt;
-    m.forOwnFaces(a, [&](std::size_t f, int, int, int) {
+    m.forOwnFacesThreaded(a, [&](std::size_t f, int, int, int) {
       m.uOld[a][f] = m.u[a][f];
       m.u[a][f] += dv;
     });

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "bodies.hpp"
 #include "grid.hpp"
+#include "parallel.hpp"
 #include "pressure.hpp"
 #include "vrflow/fluid/block_comm.hpp"
 #include "vrflow/fluid/solver.hpp"
@@ -25,6 +27,7 @@ using detail::PreparedBody;
 
 struct FluidSolver::Impl {
   FluidSettings settings;
+  std::unique_ptr<detail::Workers> workers;  ///< settings.threads threads
   Grid grid;
   double invH = 1.0;
   int k0 = 0, k1 = 0;       // this block's cell planes
@@ -128,12 +131,18 @@ struct FluidSolver::Impl {
   // Loops over this block's faces of component a (with the along-axis index).
   template <typename F>
   void forOwnFaces(int a, F&& f) const {
-    const int ke = kEnd(a);
-    for (int k = k0; k < ke; ++k) {
-      for (int j = 0; j < grid.fdim(a, 1); ++j) {
-        std::size_t idx = grid.face(a, 0, j, k);
-        for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
-      }
+    for (int k = k0; k < kEnd(a); ++k) forOwnFacesInPlane(a, k, f);
+  }
+  // The same among the solver's threads (a face written from its own values only).
+  template <typename F>
+  void forOwnFacesThreaded(int a, F&& f) const {
+    forPlanes(k0, kEnd(a), [&](int k) { forOwnFacesInPlane(a, k, f); });
+  }
+  template <typename F>
+  void forOwnFacesInPlane(int a, int k, F&& f) const {
+    for (int j = 0; j < grid.fdim(a, 1); ++j) {
+      std::size_t idx = grid.face(a, 0, j, k);
+      for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
     }
   }
 
@@ -144,20 +153,36 @@ struct FluidSolver::Impl {
   // forOwnFaces() restricted to the rows of faces with a cell that is not air on either side.
   template <typename F>
   void forFacesNearMatter(int a, F&& f) const {
-    const int ke = kEnd(a);
+    for (int k = k0; k < kEnd(a); ++k) forFacesNearMatterInPlane(a, k, f);
+  }
+  // The same, the planes cut into runs among the solver's threads: for passes that write each
+  // face from values no other face of the pass writes.
+  template <typename F>
+  void forFacesNearMatterThreaded(int a, F&& f) const {
+    forPlanes(k0, kEnd(a), [&](int k) { forFacesNearMatterInPlane(a, k, f); });
+  }
+  template <typename F>
+  void forFacesNearMatterInPlane(int a, int k, F&& f) const {
     const int ny = grid.ny, nz = grid.nz;
-    auto busy = [&](int j, int k) {
-      return j >= 0 && j < ny && k >= 0 && k < nz &&
-             rowHasMatter[static_cast<std::size_t>(k) * ny + j];
+    auto busy = [&](int j, int kk) {
+      return j >= 0 && j < ny && kk >= 0 && kk < nz &&
+             rowHasMatter[static_cast<std::size_t>(kk) * ny + j];
     };
-    for (int k = k0; k < ke; ++k) {
-      for (int j = 0; j < grid.fdim(a, 1); ++j) {
-        const bool near = busy(j, k) || (a == 1 && busy(j - 1, k)) || (a == 2 && busy(j, k - 1));
-        if (!near) continue;
-        std::size_t idx = grid.face(a, 0, j, k);
-        for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
-      }
+    for (int j = 0; j < grid.fdim(a, 1); ++j) {
+      const bool near = busy(j, k) || (a == 1 && busy(j - 1, k)) || (a == 2 && busy(j, k - 1));
+      if (!near) continue;
+      std::size_t idx = grid.face(a, 0, j, k);
+      for (int i = 0; i < grid.fdim(a, 0); ++i, ++idx) f(idx, i, j, k);
     }
+  }
+  // Calls f(k) for the planes [from, to), cut into one run per thread.
+  template <typename F>
+  void forPlanes(int from, int to, F&& f) const {
+    if (to <= from) return;
+    workers->forRanges(workers->threads(), static_cast<std::size_t>(to - from),
+                       [&](std::size_t, std::size_t b, std::size_t e) {
+                         for (auto k = b; k < e; ++k) f(from + static_cast<int>(k));
+                       });
   }
 
   bool onWall(int a, int i, int j, int k) const {
@@ -182,6 +207,7 @@ struct FluidSolver::Impl {
     return static_cast<std::uint32_t>(grid.cell(i, j, k));
   }
   std::vector<std::size_t> sortStart;
+  std::vector<std::size_t> planeStart;  ///< after sorting: first particle of each plane k0..k1
   std::vector<double> posScratch, velScratch;
   // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
   // and an order that does not depend on history.
@@ -208,13 +234,21 @@ struct FluidSolver::Impl {
   // definitions): call them only from particles.cpp, where the load-time choice is made.
   void splatParticles();
   void sampleAndAdvectParticles(double dt);
+  // The particles [p0, p1) of both loops; splatRange adds to face planes planeLo to planeHi
+  // only.
+  void splatRange(std::size_t p0, std::size_t p1, int planeLo, int planeHi);
+  void sampleAndAdvectRange(double dt, std::size_t p0, std::size_t p1, bool storeCells);
 
   // Fills faces without a value from the mean of valid neighbours, `layers` rings deep. Only
   // rows (j, k) with a valid face in them or next to them can gain values; the others (deep in
   // air) are skipped.
   std::vector<unsigned char> rowState;  // per row: bit 0 some face valid, bit 1 every face valid
   std::vector<std::size_t> filled;
+  std::vector<std::vector<std::size_t>> filledPerThread;
   void extrapolate(std::vector<double>* field, int layers);
+  // One plane of a pass of extrapolate(): fills faces of plane k, listing them in `out`.
+  void fillPlane(int a, int k, double* value, const unsigned char* ok,
+                 std::vector<std::size_t>& out) const;
 
   // Rigid motion on the faces of bodies, of kinematic bodies' cells and between a body's cell
   // and air; `kinematicOnly` re-imposes it on kinematic bodies after gravity (a moving wall does

@@ -132,9 +132,12 @@ inline Pair gatherPair(const double* pairs, const Stencil& s) {
 /// Adds a particle's velocity component `va` and its weights to `acc`, which holds (sum of
 /// weighted velocities, sum of weights) per face, interleaved so both share a cache line: a face
 /// and its x neighbour are one read-modify-write of four values.
-inline void splat(double* acc, const Stencil& s, double va) {
+/// Only the rows of planes z + dk in [0, span] are added (z: the stencil's first plane, relative
+/// to the first plane to add).
+inline void splat(double* acc, const Stencil& s, double va, int z, int span) {
   const Quad x = Quad{1 - s.fx, 1 - s.fx, s.fx, s.fx} * Quad{va, 1.0, va, 1.0};
   for (int dk = 0; dk < 2; ++dk) {
+    if (static_cast<unsigned>(z + dk) > static_cast<unsigned>(span)) continue;
     const double wz = dk ? s.fz : 1 - s.fz;
     for (int dj = 0; dj < 2; ++dj) {
       const double wyz = wz * (dj ? s.fy : 1 - s.fy);

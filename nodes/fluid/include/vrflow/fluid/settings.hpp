@@ -30,6 +30,9 @@ struct FluidSettings {
   /// 0 turns it off.
   double volumeCorrection = 0.1;
   std::uint64_t seed = 1;  ///< particle jitter seed (results are deterministic)
+  /// Threads of this solver (of each block) for its particle loops and grid passes, 1 to 64.
+  /// The results are the same bits whatever the count.
+  int threads = 1;
 };
 
 /// Largest time step accepted: a step over which gravity alone would move liquid more than
