@@ -1,32 +1,24 @@
 """Where the package finds vrflow's programs and what ships with them, and how it runs them.
 
 The package knows its tree: `_layout.BIN_DIR` (written by CMake) leads from the package's folder
-to the build tree's or the installed tree's `bin/`, beside `share/vrflow/packages`,
-`share/vrflow/composites` and `lib/vrflow/filters`, which `vrflow` itself finds from its own
-folder. Checks done in this process add those folders to the search path variables for the
-call, after what the variables already hold, which is the order `vrflow` searches them in."""
+to the build tree's or the installed tree's `bin/`. vrflow's programs find the tree's packages,
+composites and filter plugins from their own folder; inside the interpreter, the library is told
+that folder (`_app.set_executable_dir`) when the package is imported, so that it searches what
+`vrflow` searches, in the same order."""
 
-import contextlib
 import json
 import os
 import signal
 import subprocess
-import sys
 import tempfile
 
-from . import _layout
+from . import _app, _layout
 from ._errors import RunError, VrflowError
 
 #: The folder of vrflow's programs (`vrflow`, `vrflow-daemon`, the modules).
 BIN_DIR = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                         _layout.BIN_DIR))
-
-# Each search path variable and the folder of the tree it gets last.
-_SEARCH_PATHS = {
-    "VRFLOW_PACKAGE_PATH": os.path.join("share", "vrflow", "packages"),
-    "VRFLOW_COMPOSITE_PATH": os.path.join("share", "vrflow", "composites"),
-    "VRFLOW_FILTER_PATH": os.path.join("lib", "vrflow", "filters"),
-}
+_app.set_executable_dir(BIN_DIR)
 
 
 def program(name="vrflow"):
@@ -36,28 +28,6 @@ def program(name="vrflow"):
         raise VrflowError(f"{path}: no such program; the vrflow Python package expects "
                           f"vrflow's programs in {BIN_DIR} (build them, or install the tree)")
     return path
-
-
-@contextlib.contextmanager
-def tree_search_paths():
-    """Adds this tree's packages, composites and filter plugins to the search path variables
-    for the duration of the block (the library finds them from the running program's folder,
-    which is the interpreter's here)."""
-    root = os.path.dirname(BIN_DIR)
-    interpreter_root = os.path.dirname(os.path.dirname(os.path.realpath(sys.executable)))
-    saved = {name: os.environ.get(name) for name in _SEARCH_PATHS}
-    try:
-        if os.path.realpath(root) != interpreter_root:
-            for name, folder in _SEARCH_PATHS.items():
-                parts = [p for p in (saved[name] or "").split(":") if p]
-                os.environ[name] = ":".join(parts + [os.path.join(root, folder)])
-        yield
-    finally:
-        for name, value in saved.items():
-            if value is None:
-                os.environ.pop(name, None)
-            else:
-                os.environ[name] = value
 
 
 def run_program(command, path, arguments, cwd=None):

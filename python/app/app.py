@@ -24,7 +24,7 @@ import tempfile
 from . import _app
 from ._builder import Node, Port, Ports, Scope, comment_list, endpoint, param_text
 from ._errors import LoadError, RunError, ValidationError, VrflowError
-from ._programs import BIN_DIR, program, run_program, tree_search_paths
+from ._programs import BIN_DIR, program, run_program
 
 __all__ = ["Application", "Validation", "Node", "Port", "Ports", "load", "load_composite", "main",
            "VrflowError", "LoadError", "ValidationError", "RunError", "BIN_DIR", "program",
@@ -179,10 +179,8 @@ class Application(Scope):
         path = self._check_path()
         self._model.file = path
         overrides = [f"{key}={param_text(value)}" for key, value in (set or {}).items()]
-        with tree_search_paths():
-            checked = _app.check(self._text_to_check(path), path,
-                                 [os.fspath(p) for p in packages],
-                                 [os.fspath(c) for c in composites], overrides)
+        checked = _app.check(self._text_to_check(path), path, [os.fspath(p) for p in packages],
+                             [os.fspath(c) for c in composites], overrides)
         return Validation(checked)
 
     def check(self, **options):
@@ -198,9 +196,8 @@ class Application(Scope):
         nodes, --set applied), as a new Application; ValidationError when that fails."""
         path = self._check_path()
         overrides = [f"{key}={param_text(value)}" for key, value in (set or {}).items()]
-        with tree_search_paths():
-            checked = _app.check(self.text(), path, [], [os.fspath(c) for c in composites],
-                                 overrides, validate=False, check_files=False)
+        checked = _app.check(self.text(), path, [], [os.fspath(c) for c in composites],
+                             overrides, validate=False, check_files=False)
         if checked.application is None:
             raise ValidationError(Validation(checked))
         flat = Application()

@@ -13,6 +13,7 @@
 #include "vrflow/app/loader.hpp"
 #include "vrflow/app/package_files.hpp"
 #include "vrflow/app/writer.hpp"
+#include "vrflow/base/executable_dir.hpp"
 #include "vrflow/run/prepare.hpp"
 
 namespace py = pybind11;
@@ -58,6 +59,13 @@ Checked check(const CheckRequest& request) {
                  std::move(prepared.error), prepared.catalogFailed};
 }
 
+// A loaded value as Python gets it: (value, "") or (None, the error).
+template <typename T>
+std::pair<std::optional<T>, std::string> orError(Result<T> loaded) {
+  if (!loaded) return {std::nullopt, loaded.error().message};
+  return {std::move(*loaded), std::string()};
+}
+
 void bindDiagnostics(py::module_& module) {
   py::class_<Diagnostic>(module, "Diagnostic")
       .def_property_readonly("severity",
@@ -84,20 +92,17 @@ void bindDiagnostics(py::module_& module) {
 void bindFiles(py::module_& module) {
   bindDiagnostics(module);
   module.def(
+      "set_executable_dir", [](const std::string& folder) { setExecutableDir(folder); },
+      py::arg("folder"),
+      "Where the library finds the tree's programs and, from there, its packages, composites "
+      "and filter plugins, as vrflow's programs do from their own folder");
+  module.def(
       "load_application",
-      [](const std::string& path) -> std::pair<std::optional<app::Application>, std::string> {
-        auto loaded = app::loadApplicationFile(path);
-        if (!loaded) return {std::nullopt, loaded.error().message};
-        return {std::move(*loaded), std::string()};
-      },
+      [](const std::string& path) { return orError(app::loadApplicationFile(path)); },
       py::arg("path"), "The application in `path`, or (None, the error naming file:line)");
   module.def(
       "load_composite",
-      [](const std::string& path) -> std::pair<std::optional<app::Composite>, std::string> {
-        auto loaded = app::loadCompositeFile(path);
-        if (!loaded) return {std::nullopt, loaded.error().message};
-        return {std::move(*loaded), std::string()};
-      },
+      [](const std::string& path) { return orError(app::loadCompositeFile(path)); },
       py::arg("path"), "The composite in `path` (NAME.vrc.xml), or (None, the error)");
   module.def("save_text", &app::saveApplication, py::arg("application"),
              "The canonical XML text of the application (what the editor opens)");
