@@ -3,10 +3,11 @@ in Python (checked before they are saved, then compared with the program on the 
 for files written by hand."""
 
 import os
+import subprocess
 
 import pytest
 
-from conftest import SOURCE_DIR, vrflow
+from conftest import SOURCE_DIR, VRFLOW, vrflow
 from vrflow import app
 
 
@@ -154,3 +155,22 @@ def test_set_and_package_folders_of_the_file_are_taken_as_vrflow_takes_them(tmp_
     status, printed = vrflow("validate", "--set", "src.count=-4", path)
     assert (status, validation.text) == (1, printed)
     assert "missing-folder" in printed and "below its minimum" in printed
+
+
+def test_expand_gives_the_flat_application_vrflow_expand_prints(tmp_path):
+    path = str(tmp_path / "composite.xml")
+    a = app.Application("expand", path)
+    name = a.define(os.path.join(SOURCE_DIR, "examples/composite_workers/chain.vrc.xml"))
+    a.instance("c0", name)
+    a.instance("c1", name)
+    flat = a.expand()
+    assert len(flat.model.instances) == 0
+    assert {m.id.split(":")[0] for m in flat.model.modules} == {"c0", "c1"}
+    a.save()
+    printed = subprocess.run([VRFLOW, "expand", path], capture_output=True, text=True,
+                             check=True).stdout
+    assert flat.text() == printed
+    broken = app.Application("broken", str(tmp_path / "broken.xml"))
+    broken.instance("ghost", "no_such_composite")
+    with pytest.raises(app.ValidationError, match="no_such_composite"):
+        broken.expand()
