@@ -2,6 +2,10 @@
 a failed or invalid run is a RunError carrying the status, the report and the diagnostics."""
 
 import os
+import signal
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -114,3 +118,33 @@ def test_a_launch_with_a_bad_host_file_is_a_run_error_naming_its_line(tmp_path):
         a.launch(iterations=1, hosts=hosts, cwd=tmp_path)
     assert raised.value.exit_code == 2
     assert f"{hosts}:1" in raised.value.stderr
+
+
+INTERRUPTED_SCRIPT = r"""
+import sys
+from vrflow import app
+a = app.Application("interrupted")
+src = a.module("src", "core/source", size=64)
+sink = a.module("sink", "core/recorder", file="received.csv")
+a.connect(src.out, sink.in_)
+try:
+    a.run(cwd=sys.argv[1], log_dir=sys.argv[1] + "/logs")
+except KeyboardInterrupt:
+    print("interrupted")
+"""
+
+
+def test_ctrl_c_during_run_stops_the_run_and_leaves_nothing_behind(tmp_path):
+    script = subprocess.Popen([sys.executable, "-c", INTERRUPTED_SCRIPT, str(tmp_path)],
+                              stdout=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not os.path.exists(tmp_path / "received.csv") and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert os.path.exists(tmp_path / "received.csv"), "the run did not start"
+    script.send_signal(signal.SIGINT)  # to the interpreter only, not to vrflow
+    output, _ = script.communicate(timeout=60)
+    assert (script.returncode, output) == (0, "interrupted\n")
+    # vrflow was asked to stop as Ctrl-C asks it (not killed), and stopped its run.
+    with open(tmp_path / "logs" / "vrflow.log", encoding="utf-8") as log:
+        assert "interrupted by SIGINT" in log.read()
+    assert processes_in(tmp_path) == []
