@@ -89,7 +89,7 @@ class Application(Scope):
         super().__init__(_app.Application())
         self.model.name = name
         self.model.comments = comment_list(comment)
-        self.path = path
+        self.path = os.fspath(path) if path is not None else None
 
     @property
     def model(self):

@@ -49,10 +49,10 @@ def test_run_returns_the_report_of_vrflow_run(tmp_path):
 
 
 def test_run_saves_the_application_at_its_path_first(tmp_path):
-    path = str(tmp_path / "saved.xml")
-    a = source_to_recorder("saved", path)
+    a = source_to_recorder("saved", tmp_path / "saved.xml")
     report = a.run(iterations=3, cwd=tmp_path)
-    assert report["file"] == path
+    path = str(tmp_path / "saved.xml")
+    assert (a.path, report["file"]) == (path, path)
     assert open(path, encoding="utf-8").read() == a.text()
 
 
