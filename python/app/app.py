@@ -206,7 +206,7 @@ class Application(Scope):
 
     def _run(self, command, arguments, cwd):
         if self.path is not None:
-            return run_program(command, self.save(), arguments, cwd)
+            return run_program(command, os.path.abspath(self.save()), arguments, cwd)
         if any(not os.path.isabs(folder.path) for folder in self._model.packages):
             raise ValueError(f"application '{self.name}' names relative package folders, taken "
                              "from its file's folder: save() it before running it")
@@ -221,8 +221,9 @@ class Application(Scope):
             log_dir=None, cwd=None, args=()):
         """Runs the application on this machine with `vrflow run` and returns its report
         (docs/report.md) as a dict; RunError (status, report, diagnostics) when it fails. It is
-        saved at its path first; one never saved runs from a temporary file. `args` are more
-        options of `vrflow run`."""
+        saved at its path first; one never saved runs from a temporary file. Folders and files
+        given here are taken from Python's working folder; the run works in `cwd` (default:
+        the same). `args` are more options of `vrflow run`."""
         arguments = _common_arguments(packages, composites, set, log_dir)
         if iterations is not None:
             arguments += ["--iterations", str(iterations)]
@@ -241,7 +242,7 @@ class Application(Scope):
         if timeout is not None:
             arguments += ["--timeout", param_text(timeout)]
         if hosts is not None:
-            arguments += ["--hosts", os.fspath(hosts)]
+            arguments += ["--hosts", os.path.abspath(os.fspath(hosts))]
         if backend is not None:
             arguments += ["--backend", backend]
         return self._run("launch", arguments + list(args), cwd)
@@ -256,7 +257,7 @@ def _common_arguments(packages, composites, settings, log_dir):
     for key, value in (settings or {}).items():
         arguments += ["--set", f"{key}={param_text(value)}"]
     if log_dir is not None:
-        arguments += ["--log-dir", os.fspath(log_dir)]
+        arguments += ["--log-dir", os.path.abspath(os.fspath(log_dir))]
     return arguments
 
 
