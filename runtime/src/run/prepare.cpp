@@ -29,7 +29,9 @@ Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs) {
 Prepared prepare(const PrepareSettings& settings) {
   Prepared prepared;
   std::vector<app::Diagnostic>& problems = prepared.diagnostics;
-  auto application = app::loadApplicationFile(settings.file, &problems);
+  auto application = settings.text
+                         ? app::loadApplicationString(*settings.text, settings.file, &problems)
+                         : app::loadApplicationFile(settings.file, &problems);
   if (!application) {
     prepared.error = application.error().message;  // it names the file
     return prepared;

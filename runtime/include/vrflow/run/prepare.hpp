@@ -27,6 +27,9 @@ Result<app::Catalog> loadCatalog(const std::vector<std::string>& extraDirs);
 /// What prepare() does, and with what.
 struct PrepareSettings {
   std::string file;  ///< the application file
+  /// The file's text when it is not read from disk (a model built in code, checked as if saved
+  /// at `file`: relative paths are taken from its folder); nullopt: read `file`.
+  std::optional<std::string> text = std::nullopt;
   /// --packages, searched before the file's <packages> folders and the defaults
   std::vector<std::string> packageDirs;
   std::vector<std::string> compositeDirs;  ///< --composites, searched after the file's folder
