@@ -92,7 +92,7 @@ std::string digestOf(const nlohmann::json& report, const std::string& module,
 // the direct one, byte for byte (a tile is sent every region it shows); each tile gets at
 // least 10x fewer bytes of the liquid than with the particles routed the same way (a tile's
 // bytes less those of the same run without the liquid's payload: the bodies and the net;
-// measured 11.4x over these 16 iterations; 9.3x while a region kept whole the triangles that
+// measured 14.9x over these 16 iterations; 9.3x while a region kept whole the triangles that
 // cross its box, whose bounds then met the neighbouring tiles' volumes: nodes/fluid/README.md);
 // the liquid's forces are the same bits.
 TEST(FluidSurfaceModule, RoutedSurfaceFramesEqualDirectOnesWithFarFewerBytesThanParticles) {

@@ -26,37 +26,59 @@ SurfaceSettings surfaceSettings(const FluidSettings& fluid, int voxelsPerCell) {
 namespace {
 
 using Point = std::array<double, 3>;
+/// A cut's point on an edge of the mesh: the edge's vertices (lower first), the axis and the
+/// index of the plane; the same for the two triangles that share the edge.
+using CutKey = std::array<std::int64_t, 4>;
 
-// The part of polygon `in` on one side of the plane x[axis] = value (below: x <= value),
+/// A point of a clipped triangle: a vertex of the mesh (`vertex` >= 0), a cut of one of its
+/// edges (`shared`: `key` names it), or a point of neither (a second cut at a box's corner).
+struct ClipPoint {
+  Point p{};
+  std::int64_t vertex = -1;
+  bool shared = false;
+  CutKey key{};
+};
+
+// The part of polygon `in` on one side of plane `plane` (x[axis] = value; below: x <= value),
 // Sutherland-Hodgman; the points kept are `in`'s, the new ones `inset` inside the plane (so
-// that the piece's bounds do not touch the neighbouring box: boxes meet when they touch).
-std::vector<Point> clipPolygon(const std::vector<Point>& in, std::size_t axis, double value,
-                               bool below, double inset) {
-  std::vector<Point> out;
-  const auto inside = [&](const Point& p) { return below ? p[axis] <= value : p[axis] >= value; };
+// that the piece's bounds do not touch the neighbouring box: boxes meet when they touch). A cut
+// of an edge between two mesh vertices is computed from its lower vertex, so that both triangles
+// of the edge get the same point.
+std::vector<ClipPoint> clipPolygon(const std::vector<ClipPoint>& in, std::size_t axis, int plane,
+                                   double value, bool below, double inset) {
+  std::vector<ClipPoint> out;
+  const auto inside = [&](const ClipPoint& q) {
+    return below ? q.p[axis] <= value : q.p[axis] >= value;
+  };
   for (std::size_t i = 0; i < in.size(); ++i) {
-    const Point& a = in[i];
-    const Point& b = in[(i + 1) % in.size()];
+    const ClipPoint& a = in[i];
+    const ClipPoint& b = in[(i + 1) % in.size()];
     if (inside(a)) out.push_back(a);
-    if (inside(a) != inside(b)) {
-      const double t = (value - a[axis]) / (b[axis] - a[axis]);
-      Point p;
-      for (std::size_t c = 0; c < 3; ++c) p[c] = a[c] + t * (b[c] - a[c]);
-      p[axis] = below ? value - inset : value + inset;
-      out.push_back(p);
+    if (inside(a) == inside(b)) continue;
+    const bool edge = a.vertex >= 0 && b.vertex >= 0;
+    const ClipPoint& from = edge && b.vertex < a.vertex ? b : a;
+    const ClipPoint& to = &from == &a ? b : a;
+    const double t = (value - from.p[axis]) / (to.p[axis] - from.p[axis]);
+    ClipPoint cut;
+    for (std::size_t c = 0; c < 3; ++c) cut.p[c] = from.p[c] + t * (to.p[c] - from.p[c]);
+    cut.p[axis] = below ? value - inset : value + inset;
+    if (edge) {
+      cut.shared = true;
+      cut.key = {from.vertex, to.vertex, static_cast<std::int64_t>(axis), plane};
     }
+    out.push_back(cut);
   }
   return out;
 }
 
 // Twice the area of a polygon (a fan from its first point).
-double doubleArea(const std::vector<Point>& poly) {
+double doubleArea(const std::vector<ClipPoint>& poly) {
   double sum = 0.0;
   for (std::size_t i = 1; i + 1 < poly.size(); ++i) {
     Point u, v;
     for (std::size_t c = 0; c < 3; ++c) {
-      u[c] = poly[i][c] - poly[0][c];
-      v[c] = poly[i + 1][c] - poly[0][c];
+      u[c] = poly[i].p[c] - poly[0].p[c];
+      v[c] = poly[i + 1].p[c] - poly[0].p[c];
     }
     sum +=
         std::sqrt(std::pow(u[1] * v[2] - u[2] * v[1], 2) + std::pow(u[2] * v[0] - u[0] * v[2], 2) +
@@ -80,8 +102,9 @@ std::vector<SurfaceRegion> splitSurface(const SurfaceMesh& mesh, const msg::Aabb
   const auto regionOf = [&](const std::array<int, 3>& box) {
     return static_cast<std::size_t>(box[0] + counts[0] * (box[1] + counts[1] * box[2]));
   };
-  // Per region: the index there of each vertex of `mesh` it holds.
+  // Per region: the index there of each vertex of `mesh` it holds, and of each cut of an edge.
   std::vector<std::map<std::uint32_t, std::uint32_t>> local(regions);
+  std::vector<std::map<CutKey, std::uint32_t>> cuts(regions);
   const auto addVertex = [&](std::size_t region, std::uint32_t global) {
     auto& part = out[region].mesh;
     const auto [it, added] =
@@ -113,36 +136,47 @@ std::vector<SurfaceRegion> splitSurface(const SurfaceMesh& mesh, const msg::Aabb
     }
     // Across boxes: cut at their planes, so that each box holds only what lies in it and its
     // bounds stay inside it (a route then sends it only to the views that meet the box).
-    std::vector<Point> triangle;
+    std::vector<ClipPoint> triangle;
     for (std::size_t c = 0; c < 3; ++c) {
       const float* v = &mesh.xyz[3 * mesh.indices[t + c]];
-      triangle.push_back({v[0], v[1], v[2]});
+      triangle.push_back({{v[0], v[1], v[2]}, mesh.indices[t + c], false, {}});
     }
     const double whole = doubleArea(triangle);
     std::array<int, 3> box{};
     for (box[2] = low[2]; box[2] <= high[2]; ++box[2]) {
       for (box[1] = low[1]; box[1] <= high[1]; ++box[1]) {
         for (box[0] = low[0]; box[0] <= high[0]; ++box[0]) {
-          std::vector<Point> piece = triangle;
+          std::vector<ClipPoint> piece = triangle;
           for (std::size_t a = 0; a < 3 && piece.size() >= 3; ++a) {
             const double inset = 1e-5 * step[a];
             if (box[a] > 0) {
-              piece = clipPolygon(piece, a, grid.min[a] + step[a] * box[a], false, inset);
+              piece = clipPolygon(piece, a, box[a], grid.min[a] + step[a] * box[a], false, inset);
             }
             if (box[a] + 1 < counts[a] && piece.size() >= 3) {
-              piece = clipPolygon(piece, a, grid.min[a] + step[a] * (box[a] + 1), true, inset);
+              piece = clipPolygon(piece, a, box[a] + 1, grid.min[a] + step[a] * (box[a] + 1), true,
+                                  inset);
             }
           }
           // Pieces of no area (a corner or an edge on a plane) are left out.
           if (piece.size() < 3 || doubleArea(piece) <= 1e-9 * whole) continue;
           const std::size_t region = regionOf(box);
           auto& part = out[region].mesh;
-          const auto first = static_cast<std::uint32_t>(part.vertexCount());
-          for (const Point& p : piece) {
-            for (std::size_t c = 0; c < 3; ++c) part.xyz.push_back(static_cast<float>(p[c]));
+          std::vector<std::uint32_t> corners;
+          for (const ClipPoint& q : piece) {
+            if (q.vertex >= 0) {
+              corners.push_back(addVertex(region, static_cast<std::uint32_t>(q.vertex)));
+              continue;
+            }
+            const auto next = static_cast<std::uint32_t>(part.vertexCount());
+            const auto [it, added] = q.shared ? cuts[region].try_emplace(q.key, next)
+                                              : std::pair{cuts[region].end(), true};
+            if (added) {
+              for (std::size_t c = 0; c < 3; ++c) part.xyz.push_back(static_cast<float>(q.p[c]));
+            }
+            corners.push_back(added ? next : it->second);
           }
-          for (std::uint32_t i = 1; i + 1 < piece.size(); ++i) {
-            part.indices.insert(part.indices.end(), {first, first + i, first + i + 1});
+          for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
+            part.indices.insert(part.indices.end(), {corners[0], corners[i], corners[i + 1]});
           }
         }
       }
