@@ -1,15 +1,9 @@
 #include "wall_view.hpp"
 
-#include <QEvent>
 #include <QGraphicsRectItem>
 #include <QGraphicsScene>
 #include <QGraphicsTextItem>
 #include <QGraphicsView>
-#include <QHBoxLayout>
-#include <QKeyEvent>
-#include <QLabel>
-#include <QToolButton>
-#include <QVBoxLayout>
 #include <cmath>
 
 #include "canvas_style.hpp"
@@ -29,39 +23,12 @@ QString metres(double m) {
 
 WallView::WallView(QWidget* parent, viewer::Wall wall, const app::Application& app,
                    const QString& path)
-    : QWidget(parent),
-      wall_(std::move(wall)),
-      path_(new QLabel(path)),
-      back_(new QToolButton),
-      view_(new QGraphicsView) {
-  setObjectName("wallView");
-  setAutoFillBackground(true);
-  auto* layout = new QVBoxLayout(this);
-  layout->setContentsMargins(0, 0, 0, 0);
-  layout->setSpacing(0);
-  auto* bar = new QWidget;
-  bar->setObjectName("breadcrumb");
-  auto* barLayout = new QHBoxLayout(bar);
-  barLayout->setContentsMargins(6, 3, 6, 3);
-  back_->setText("\u25C0 Back");
-  back_->setToolTip("Back to the application (Esc)");
-  barLayout->addWidget(back_);
-  path_->setTextInteractionFlags(Qt::TextSelectableByMouse);
-  barLayout->addWidget(path_, 1);
-  layout->addWidget(bar);
-  layout->addWidget(view_, 1);
-  connect(back_, &QToolButton::clicked, this, &WallView::closeRequested);
-
+    : CanvasOverlay(parent, path, "wallView"), wall_(std::move(wall)), view_(new QGraphicsView) {
   view_->setScene(new QGraphicsScene(view_));
   view_->setRenderHint(QPainter::Antialiasing);
   view_->setBackgroundBrush(QColor(245, 245, 245));
   build(app);
-
-  parent->installEventFilter(this);
-  view_->installEventFilter(this);
-  setGeometry(parent->rect());
-  show();
-  raise();
+  setContent(view_);
   view_->setFocus();
 }
 
@@ -115,10 +82,6 @@ void WallView::build(const app::Application& app) {
   scene->setSceneRect(QRectF(0, 0, width * kMm, height * kMm).adjusted(-40, -40, 40, 40));
 }
 
-QString WallView::breadcrumb() const {
-  return path_->text();
-}
-
 QGraphicsRectItem* WallView::tileItem(const std::string& id) const {
   const auto it = tiles_.find(id);
   return it == tiles_.end() ? nullptr : it->second;
@@ -127,17 +90,6 @@ QGraphicsRectItem* WallView::tileItem(const std::string& id) const {
 QString WallView::tileText(const std::string& id) const {
   const auto it = texts_.find(id);
   return it == texts_.end() ? QString() : it->second;
-}
-
-bool WallView::eventFilter(QObject* watched, QEvent* event) {
-  if (watched == parent() && event->type() == QEvent::Resize) {
-    setGeometry(parentWidget()->rect());
-  } else if (event->type() == QEvent::KeyPress &&
-             static_cast<QKeyEvent*>(event)->key() == Qt::Key_Escape) {
-    Q_EMIT closeRequested();
-    return true;
-  }
-  return QWidget::eventFilter(watched, event);
 }
 
 void WallView::resizeEvent(QResizeEvent* event) {

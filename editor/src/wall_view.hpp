@@ -4,33 +4,28 @@
 // (an instance of the display_wall composite, or a viewer module with `wall`): each tile where it
 // hangs on the wall, with its id, host, X display and pixels, the mullions between them.
 
-#include <QWidget>
 #include <map>
 #include <string>
 
+#include "canvas_overlay.hpp"
 #include "vrflow/app/model.hpp"
 #include "vrflow/viewer/wall.hpp"
 
 class QGraphicsRectItem;
 class QGraphicsView;
-class QLabel;
-class QToolButton;
 
 namespace vrflow::editor::gui {
 
-class WallView : public QWidget {
+class WallView : public CanvasOverlay {
   Q_OBJECT
 
  public:
   /// Shows `wall` over `parent`, which it covers while open; `app` gives the tiles' hosts their
-  /// colours and addresses; `path` is the bar's text.
+  /// colours and addresses; `path` is the bar's text ("APPLICATION › NODE (wall FILE: ...)").
   WallView(QWidget* parent, viewer::Wall wall, const app::Application& app, const QString& path);
 
   /// "COLS x ROWS tiles of W x H m, mullions B": the wall in a few words.
   static QString describe(const viewer::Wall& wall);
-  /// The bar: "APPLICATION › NODE (wall FILE: COLS x ROWS tiles ...)".
-  QString breadcrumb() const;
-  QToolButton* backButton() const { return back_; }
   QGraphicsView* view() const { return view_; }
   const viewer::Wall& wall() const { return wall_; }
   /// The rectangle drawn for tile `id` (scene units: millimetres of the wall), or nullptr.
@@ -38,20 +33,13 @@ class WallView : public QWidget {
   /// The text shown on tile `id` (id, host and address, display, pixels, window).
   QString tileText(const std::string& id) const;
 
- Q_SIGNALS:
-  /// "Back" (or Escape): return to the application.
-  void closeRequested();
-
  protected:
-  bool eventFilter(QObject* watched, QEvent* event) override;
   void resizeEvent(QResizeEvent* event) override;
 
  private:
   void build(const app::Application& app);
 
   viewer::Wall wall_;
-  QLabel* path_;
-  QToolButton* back_;
   QGraphicsView* view_;
   std::map<std::string, QGraphicsRectItem*> tiles_;
   std::map<std::string, QString> texts_;
