@@ -126,6 +126,40 @@ TEST(DisplayWall, TheRecordedMosaicOfTheSwapLockedWallEqualsOneViewOfTheWholeWal
   EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
 }
 
+// With a swap margin the tiles swap at the latest tile's ready time plus the margin: a tile draws
+// frame k after showing k - 1, so no tile shows frame k earlier than the margin after the last
+// tile showed k - 1 (without it the lock only orders them).
+TEST(DisplayWall, WithASwapMarginNoTileShowsAFrameBeforeTheMarginAfterTheLastShowedThePrevious) {
+  TempDir dir;
+  const auto file = dir.write("display_wall.xml", application(dir));
+  constexpr int kFrames = 6;
+  constexpr double kMarginS = 0.1;
+  const auto result = vrflow::testing::runCommand(
+      {"/bin/sh", "-c",
+       "cd '" + dir.path() + "' && exec '" + vrflow::testing::binDir() + "/vrflow' run '" + file +
+           "' --composites '" + exampleDir() + "' -n " + std::to_string(kFrames) +
+           " --set wall.swap_margin=100 --no-progress"},
+      180);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::vector<std::vector<double>> shown(4);
+  for (int t = 0; t < 4; ++t) {
+    for (const auto& line :
+         vrflow::testing::readLines(dir.file("display-wall/t" + std::to_string(t) + ".swaps"))) {
+      shown[t].push_back(std::stod(line.substr(line.find(' ') + 1)));
+    }
+    ASSERT_EQ(shown[t].size(), static_cast<std::size_t>(kFrames - 1)) << "tile " << t;
+  }
+  for (int k = 1; k + 1 < kFrames; ++k) {
+    double last = 0, first = 1e300;
+    for (const auto& times : shown) {
+      last = std::max(last, times[k - 1]);
+      first = std::min(first, times[k]);
+    }
+    EXPECT_GE(first - last, kMarginS - 1e-4) << "frame " << k;
+  }
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+}
+
 // The 4 x 4 example (tiles of 60 x 34 pixels, the small liquid) launched over its four loopback
 // hosts with the composites of `composites`, for `frames` iterations; the report.
 nlohmann::json launchFourByFour(const TempDir& dir, const std::string& composites, int frames) {
