@@ -54,6 +54,7 @@ struct CanvasState {
 
 class QuickAdd;
 class CompositeView;
+class WallView;
 
 class Canvas : public QGraphicsView {
   Q_OBJECT
@@ -166,6 +167,14 @@ class Canvas : public QGraphicsView {
   bool openComposite(const std::string& id);
   /// The open composite's view, or nullptr when the application is shown.
   CompositeView* compositeView() const { return compositeView_; }
+  /// The wall file node `id` uses (its `wall` parameter: a display_wall instance or a viewer
+  /// module), resolved beside the application file; empty when it has none.
+  std::string wallFileOf(const std::string& id) const;
+  /// Shows the wall of node `id` over the canvas, its tiles where they hang; false with the
+  /// reason in lastRefusal() when the node has no wall or its file cannot be read.
+  bool openWall(const std::string& id);
+  /// The open wall's view, or nullptr.
+  WallView* wallView() const { return wallView_; }
   /// A read-only canvas (an opened composite's inside) shows and offers no edit.
   void setReadOnly(bool readOnly);
   /// The connection highlighted as the target of a node drop, or nullopt.
@@ -191,6 +200,7 @@ class Canvas : public QGraphicsView {
   void hoverWireForSpec(const QString& spec, QPoint at);
   bool dropSpecOnWire(const QString& spec, QPoint at);
   void closeComposite();
+  void closeWall();
   void quickAddChosen(const QString& spec);
   std::optional<std::size_t> wireAt(QPoint viewPos, const std::string& node) const;
   void setWireHover(std::optional<std::size_t> index, const std::optional<std::string>& refusal,
@@ -198,6 +208,7 @@ class Canvas : public QGraphicsView {
 
   QuickAdd* quickAdd_ = nullptr;
   CompositeView* compositeView_ = nullptr;
+  WallView* wallView_ = nullptr;
   std::optional<std::size_t> wireHover_;  ///< a connection the drop would accept
   std::optional<std::size_t> wireShown_;  ///< the connection drawn highlighted
   std::optional<app::Endpoint> quickAddWire_;

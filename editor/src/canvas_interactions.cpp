@@ -255,6 +255,13 @@ void Canvas::collapseSelection() {
 
 void Canvas::mouseDoubleClickEvent(QMouseEvent* event) {
   NodeItem* node = nodeAt(event->position().toPoint());
+  if (event->button() == Qt::LeftButton && node != nullptr && !readOnly_ &&
+      !wallFileOf(node->id()).empty()) {
+    // A node that uses a wall file (a display wall) opens as the wall.
+    openWall(node->id());
+    event->accept();
+    return;
+  }
   if (event->button() == Qt::LeftButton && node != nullptr && node->kind() == NodeKind::Instance &&
       !readOnly_) {
     openComposite(node->id());

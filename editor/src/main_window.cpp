@@ -162,6 +162,10 @@ MainWindow::MainWindow(EditorOptions options, QWidget* parent)
                   ->setEnabled(!runs_->runId().isEmpty());
             }
             menu.addAction("Duplicate", this, &MainWindow::duplicateSelection);
+            if (ids.size() == 1 && !canvas_->wallFileOf(ids.front()).empty()) {
+              menu.addAction("Show wall", this,
+                             [this, id = ids.front()] { canvas_->openWall(id); });
+            }
             if (ids.size() == 1 && nodeKind(app_, ids.front()) == NodeKind::Instance) {
               menu.addAction("Open composite", this,
                              [this, id = ids.front()] { canvas_->openComposite(id); });

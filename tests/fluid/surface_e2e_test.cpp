@@ -90,9 +90,10 @@ std::string digestOf(const nlohmann::json& report, const std::string& module,
 
 // The surface as 4 x 1 x 4 regions, routed to the tile that sees each: every routed frame is
 // the direct one, byte for byte (a tile is sent every region it shows); each tile gets at
-// least 8x fewer bytes of the liquid than with the particles routed the same way (a tile's
+// least 10x fewer bytes of the liquid than with the particles routed the same way (a tile's
 // bytes less those of the same run without the liquid's payload: the bodies and the net;
-// measured 9.3x over these 16 iterations, short of the 10x: see nodes/fluid/README.md);
+// measured 14.9x over these 16 iterations; 9.3x while a region kept whole the triangles that
+// cross its box, whose bounds then met the neighbouring tiles' volumes: nodes/fluid/README.md);
 // the liquid's forces are the same bits.
 TEST(FluidSurfaceModule, RoutedSurfaceFramesEqualDirectOnesWithFarFewerBytesThanParticles) {
   TempDir dir;
@@ -134,7 +135,7 @@ TEST(FluidSurfaceModule, RoutedSurfaceFramesEqualDirectOnesWithFarFewerBytesThan
         tile.c_str(), surface / kIterations, points / kIterations, points / surface,
         bytes / kIterations, particleBytes.at(tile) / kIterations, particleBytes.at(tile) / bytes);
     EXPECT_GT(surface, 0.0) << tile;
-    EXPECT_GT(points, 8.0 * surface) << tile;
+    EXPECT_GT(points, 10.0 * surface) << tile;
   }
   // The surface changes what the fluid sends, not what it computes.
   EXPECT_EQ(digestOf(routed, "water", "forces"), digestOf(particles, "water", "forces"));

@@ -1,9 +1,13 @@
-// examples/display_wall end to end: the demo scene on a swap-locked 2 x 2 wall (the example's
-// composite), recorded by vrflow-wall-mosaic, against one viewer of the whole wall in the same run.
+// examples/display_wall end to end: the paper scene with its fluid's surface on a swap-locked
+// 2 x 2 wall (the example's composite), recorded by vrflow-wall-mosaic, against one viewer of the
+// whole wall in the same run; the 4 x 4 wall over four loopback hosts, its filters per host.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "../runtime/process_helpers.hpp"
@@ -28,6 +32,22 @@ std::string exampleDir() {
   return vrflow::testing::sourceDir() + "/examples/display_wall";
 }
 
+// An example application made small for CI: the scene file by its full path, the wall file of
+// `wall`, and the liquid on a grid of half the resolution (16 x 32 x 16 cells of 0.125 m: the
+// same pool, 8 times fewer particles; still 4 x 1 x 4 surface regions).
+std::string smallExample(const std::string& file, const std::string& wallName,
+                         const std::string& wall) {
+  std::string app = vrflow::testing::readFile(exampleDir() + "/" + file);
+  replaceAll(app, "\"../paper_scene/scene.json\"",
+             "\"" + vrflow::testing::sourceDir() + "/examples/paper_scene/scene.json\"");
+  replaceAll(app, "value=\"" + wallName + "\"", "value=\"" + wall + "\"");
+  replaceAll(app, "name=\"nx\" value=\"32\"", "name=\"nx\" value=\"16\"");
+  replaceAll(app, "name=\"ny\" value=\"64\"", "name=\"ny\" value=\"32\"");
+  replaceAll(app, "name=\"nz\" value=\"32\"", "name=\"nz\" value=\"16\"");
+  replaceAll(app, "name=\"cell-size\" value=\"0.0625\"", "name=\"cell-size\" value=\"0.125\"");
+  return app;
+}
+
 // The example with a wall file of `dir` (the example's geometry at 160 x 90 pixels per tile and
 // without mullions, so that the mosaic can equal one view), plus a viewer `whole` drawing a
 // one-tile wall of the same size and place, fed by the same scene.
@@ -39,10 +59,7 @@ std::string application(const TempDir& dir) {
   dir.write("whole.wall",
             "grid 1 1\npixels 320 180\nsize 3.2 1.8\ncentre 0 1.3 3.5\n"
             "right 1 0 0\nup 0 1 0\neye 0 2.4 7.5\ntile whole 0 0 h0 :0 0 0\n");
-  std::string app = vrflow::testing::readFile(exampleDir() + "/display_wall.xml");
-  replaceAll(app, "\"../paper_scene/scene.json\"",
-             "\"" + vrflow::testing::sourceDir() + "/examples/paper_scene/scene.json\"");
-  replaceAll(app, "value=\"wall_2x2.wall\"", "value=\"" + dir.file("wall.wall") + "\"");
+  std::string app = smallExample("display_wall.xml", "wall_2x2.wall", dir.file("wall.wall"));
   replaceAll(app, "  </modules>",
              "    <module id=\"whole\" package=\"viewer\" type=\"viewer\" host=\"h0\">"
              "<param name=\"wall\" value=\"" +
@@ -53,10 +70,12 @@ std::string application(const TempDir& dir) {
                  "</module>\n  </modules>");
   replaceAll(app, "    <connection from=\"scene.out\" to=\"wall.objects\"/>",
              "    <connection from=\"scene.out\" to=\"wall.objects\"/>\n"
-             "    <connection from=\"scene.out\" to=\"whole.objects\"/>");
+             "    <connection from=\"scene.out\" to=\"whole.objects\"/>\n"
+             "    <connection from=\"water.fluid\" to=\"whole.objects\"/>");
   return app;
 }
 
+// The tiles draw the liquid's surface routed to them, the whole view all of it.
 TEST(DisplayWall, TheRecordedMosaicOfTheSwapLockedWallEqualsOneViewOfTheWholeWall) {
   TempDir dir;
   const auto file = dir.write("display_wall.xml", application(dir));
@@ -107,29 +126,101 @@ TEST(DisplayWall, TheRecordedMosaicOfTheSwapLockedWallEqualsOneViewOfTheWholeWal
   EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
 }
 
-// The 4 x 4 example over four loopback hosts (vrflow launch, tiles of 60 x 34 pixels): every
-// tile on every host shows frames 0, 1, ... in step, and the recorder joins all 16.
-TEST(DisplayWall, TheFourByFourWallOverFourLoopbackHostsShowsEveryFrameInStep) {
+// With a swap margin the tiles swap at the latest tile's ready time plus the margin: a tile draws
+// frame k after showing k - 1, so no tile shows frame k earlier than the margin after the last
+// tile showed k - 1 (without it the lock only orders them).
+TEST(DisplayWall, WithASwapMarginNoTileShowsAFrameBeforeTheMarginAfterTheLastShowedThePrevious) {
   TempDir dir;
+  const auto file = dir.write("display_wall.xml", application(dir));
+  constexpr int kFrames = 6;
+  constexpr double kMarginS = 0.1;
+  const auto result = vrflow::testing::runCommand(
+      {"/bin/sh", "-c",
+       "cd '" + dir.path() + "' && exec '" + vrflow::testing::binDir() + "/vrflow' run '" + file +
+           "' --composites '" + exampleDir() + "' -n " + std::to_string(kFrames) +
+           " --set wall.swap_margin=100 --no-progress"},
+      180);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::vector<std::vector<double>> shown(4);
+  for (int t = 0; t < 4; ++t) {
+    for (const auto& line :
+         vrflow::testing::readLines(dir.file("display-wall/t" + std::to_string(t) + ".swaps"))) {
+      shown[t].push_back(std::stod(line.substr(line.find(' ') + 1)));
+    }
+    ASSERT_EQ(shown[t].size(), static_cast<std::size_t>(kFrames - 1)) << "tile " << t;
+  }
+  for (int k = 1; k + 1 < kFrames; ++k) {
+    double last = 0, first = 1e300;
+    for (const auto& times : shown) {
+      last = std::max(last, times[k - 1]);
+      first = std::min(first, times[k]);
+    }
+    EXPECT_GE(first - last, kMarginS - 1e-4) << "frame " << k;
+  }
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+}
+
+// The 4 x 4 example (tiles of 60 x 34 pixels, the small liquid) launched over its four loopback
+// hosts with the composites of `composites`, for `frames` iterations; the report.
+nlohmann::json launchFourByFour(const TempDir& dir, const std::string& composites, int frames) {
   std::string wall = vrflow::testing::readFile(exampleDir() + "/wall_4x4.wall");
   replaceAll(wall, "pixels 240 135", "pixels 60 34");
   dir.write("wall.wall", wall);
-  std::string app = vrflow::testing::readFile(exampleDir() + "/display_wall_4x4.xml");
-  replaceAll(app, "\"../paper_scene/scene.json\"",
-             "\"" + vrflow::testing::sourceDir() + "/examples/paper_scene/scene.json\"");
-  replaceAll(app, "value=\"wall_4x4.wall\"", "value=\"" + dir.file("wall.wall") + "\"");
-  const auto file = dir.write("display_wall_4x4.xml", app);
+  const auto file =
+      dir.write("display_wall_4x4.xml",
+                smallExample("display_wall_4x4.xml", "wall_4x4.wall", dir.file("wall.wall")));
   fs::create_directories(dir.file("display-wall-4x4"));
-  constexpr int kFrames = 8;
   const auto result = vrflow::testing::runCommand(
       {"/bin/sh", "-c",
        "cd '" + dir.path() + "' && exec '" + vrflow::testing::binDir() + "/vrflow' launch '" +
-           file + "' --composites '" + exampleDir() + "' -n " + std::to_string(kFrames) +
+           file + "' --composites '" + composites + "' -n " + std::to_string(frames) +
            " --no-progress --report report.json"},
-      180);
-  ASSERT_EQ(result.exitCode, 0) << result.err;
-  const auto report = vrflow::testing::readFile(dir.file("report.json"));
-  EXPECT_NE(report.find("\"hosts\": 4"), std::string::npos) << report;
+      240);
+  EXPECT_EQ(result.exitCode, 0) << result.err;
+  return nlohmann::json::parse(vrflow::testing::readFile(dir.file("report.json")), nullptr, false);
+}
+
+// The host of a node of the 4 x 4 example: a module's from the report; the wall's filters
+// `objects-hN`, `ready-hN`, `swap-hN` on hN unless `flat` (every filter on h0, as the composite
+// placed them before), every other filter on h0.
+std::string hostOf(const nlohmann::json& report, const std::string& endpoint, bool flat) {
+  const std::string node = endpoint.substr(0, endpoint.rfind('.'));
+  for (const auto& module : report["modules"]) {
+    if (module["id"] == node) return module["host"];
+  }
+  const auto dash = node.rfind("-h");
+  if (!flat && node.rfind("wall:", 0) == 0 && dash != std::string::npos) {
+    return node.substr(dash + 1);
+  }
+  return "h0";
+}
+
+// Bytes per connection kind crossing from one host to another, by the sending node's name
+// without the wall's prefix and host suffix ("objects", "liquid", "swap", "ready", ...).
+std::map<std::string, double> bytesCrossingHosts(const nlohmann::json& report, bool flat) {
+  std::map<std::string, double> crossing;
+  for (const auto& c : report["connections"]) {
+    const std::string from = c["from"], to = c["to"];
+    if (hostOf(report, from, flat) == hostOf(report, to, flat)) continue;
+    std::string kind = from.substr(0, from.rfind('.'));
+    if (kind.rfind("wall:", 0) == 0) kind = kind.substr(5);
+    if (const auto dash = kind.rfind("-h"); dash != std::string::npos) kind.resize(dash);
+    if (kind.size() > 1 && kind[0] == 't' && std::isdigit(static_cast<unsigned char>(kind[1]))) {
+      kind = "tile " + c["to"].get<std::string>().substr(c["to"].get<std::string>().rfind('.') + 1);
+    }
+    crossing[kind] += c["bytes"].get<double>();
+  }
+  return crossing;
+}
+
+// The 4 x 4 example over four loopback hosts: every tile on every host shows frames 0, 1, ...
+// in step, and the recorder joins all 16.
+TEST(DisplayWall, TheFourByFourWallOverFourLoopbackHostsShowsEveryFrameInStep) {
+  TempDir dir;
+  constexpr int kFrames = 8;
+  const auto report = launchFourByFour(dir, exampleDir(), kFrames);
+  ASSERT_FALSE(report.is_discarded());
+  EXPECT_EQ(report["timing"]["hosts"], 4);
   for (int t = 0; t < 16; ++t) {
     const auto lines =
         vrflow::testing::readLines(dir.file("display-wall-4x4/t" + std::to_string(t) + ".swaps"));
@@ -146,6 +237,57 @@ TEST(DisplayWall, TheFourByFourWallOverFourLoopbackHostsShowsEveryFrameInStep) {
   const auto last = readPng(dir.file("mosaic/wall_000007.png"));
   ASSERT_TRUE(last.ok());
   EXPECT_EQ(last->width, 4 * 60 + 3 * 1);  // 1.5 cm mullions at 60 px per 0.8 m: 1 pixel
+  EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
+  EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
+}
+
+// The composite's trees per host: the scene and the swap release cross to each remote host once
+// and fan out there, so the bytes of the broadcast objects crossing hosts are a quarter of what
+// the same wall sends with every filter on h0 (each of the 12 remote tiles its own copy), and the
+// tiles get the same bytes either way.
+TEST(DisplayWall, FiltersPlacedPerHostSendEachRemoteHostOneCopyInsteadOfOnePerTile) {
+  TempDir perHostDir, flatDir;
+  constexpr int kFrames = 6;
+  const auto perHost = launchFourByFour(perHostDir, exampleDir(), kFrames);
+  // The same composite with every filter on h0.
+  std::string composite = vrflow::testing::readFile(exampleDir() + "/display_wall.vrc.xml");
+  for (const std::string kind : {"broadcast\" host=\"h${h}", "merge\" host=\"h${h}"}) {
+    std::string flat = kind;
+    replaceAll(flat, "h${h}", "h0");
+    replaceAll(composite, kind, flat);
+  }
+  ASSERT_EQ(composite.find("type=\"broadcast\" host=\"h${h}"), std::string::npos);
+  fs::create_directories(flatDir.file("composites"));
+  flatDir.write("composites/display_wall.vrc.xml", composite);
+  const auto flat = launchFourByFour(flatDir, flatDir.file("composites"), kFrames);
+  ASSERT_FALSE(perHost.is_discarded());
+  ASSERT_FALSE(flat.is_discarded());
+  const auto perHostCrossing = bytesCrossingHosts(perHost, false);
+  const auto flatCrossing = bytesCrossingHosts(flat, true);
+  double scene = 0;
+  for (const auto& c : perHost["connections"]) {
+    if (c["to"] == "wall:objects.in") scene = c["bytes"];
+  }
+  ASSERT_GT(scene, 0);
+  // Per host: one copy of the scene to each of h1, h2, h3; flat: one to each of 12 tiles.
+  EXPECT_EQ(perHostCrossing.at("objects"), 3 * scene);
+  EXPECT_EQ(flatCrossing.at("objects"), 12 * scene);
+  EXPECT_EQ(perHostCrossing.at("swap") * 4, flatCrossing.at("swap"));
+  // What the tiles are sent does not change: the same bytes into every tile's objects input.
+  double perHostTiles = 0, flatTiles = 0;
+  for (const auto& c : perHost["connections"]) {
+    if (c["to"].get<std::string>().ends_with(".objects")) perHostTiles += c["bytes"].get<double>();
+  }
+  for (const auto& c : flat["connections"]) {
+    if (c["to"].get<std::string>().ends_with(".objects")) flatTiles += c["bytes"].get<double>();
+  }
+  EXPECT_EQ(perHostTiles, flatTiles);
+  double perHostTotal = 0, flatTotal = 0;
+  for (const auto& [kind, bytes] : perHostCrossing) perHostTotal += bytes;
+  for (const auto& [kind, bytes] : flatCrossing) flatTotal += bytes;
+  RecordProperty("bytes_crossing_hosts_per_host", std::to_string(perHostTotal));
+  RecordProperty("bytes_crossing_hosts_flat", std::to_string(flatTotal));
+  EXPECT_LT(perHostTotal, flatTotal);
   EXPECT_TRUE(vrflow::testing::leftoverProcesses().empty());
   EXPECT_TRUE(vrflow::testing::vrflowShmEntries().empty());
 }

@@ -178,8 +178,9 @@ TEST(ViewerModule, BadParametersStopTheRunNamingModuleAndParameter) {
         Case{param("tile", "2 0 2 2"), "parameter 'tile' expects 'COL ROW COLS ROWS'"},
         Case{param("tile", "0 0 2"), "parameter 'tile'"},
         Case{param("interest-box", "0 0 0 1 1"), "parameter 'interest-box'"},
-        Case{param("view-depth", "0.01"),
-             "parameter 'view-depth' must be beyond the near plane"}}) {
+        Case{param("view-depth", "0.01"), "parameter 'view-depth' must be beyond the near plane"},
+        Case{param("swap-margin", "-1"), "swap-margin"},
+        Case{param("swap-margin", "soon"), "swap-margin"}}) {
     TempDir dir;
     const auto result = run(dir, application(param("output-dir", dir.file("f")) + c.params));
     EXPECT_NE(result.exitCode, 0) << c.params;

@@ -1,8 +1,15 @@
-// vrflow-bench-wall: the demo scene on the swap-locked 4 x 4 wall of examples/display_wall
-// (16 tiles over 4 loopback hosts, `vrflow launch`) against one viewer of the whole wall, in one
-// run. One JSON line per configuration: {tiles, hosts, payload, iterations, fps,
-// bytes_per_tile_per_frame, swap_skew_us_p99, machine}. The payload is the objects the scene
-// sends (rigid bodies and the net: "objects"; no fluid in this scene). `--quick`: 10 iterations.
+// vrflow-bench-wall: the paper's scene with its fluid on the swap-locked 4 x 4 wall of
+// examples/display_wall (16 tiles over 4 loopback hosts, `vrflow launch`) against one viewer of
+// the whole wall, in one run. One JSON line per configuration: {tiles, hosts, payload, routing,
+// swap_margin_ms, iterations, fps, bytes_per_tile_per_frame, liquid_bytes_per_tile_per_frame,
+// wall_bytes_per_frame, swap_skew_us_p50, swap_skew_us_p99, machine}.
+// - payload "surface": the liquid's surface regions routed per tile (the example as it is);
+// - payload "particles", routing "broadcast": the particles sent whole to every tile (the
+//   paper's failure case): the route's volumes are never sent (its `stamp` renamed), so every
+//   tile keeps `initially="all"`;
+// - the surface wall again with swap-margin (the swaps released at an absolute time);
+// - one view through the whole wall, the surface drawn.
+// `--iterations N` (default 100); `--quick`: 10.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -11,7 +18,6 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -35,18 +41,26 @@ std::string machine() {
 struct Config {
   std::string app;     // in examples/display_wall
   std::string frames;  // the folder its viewers write into
+  std::string payload;
+  std::string routing;
+  std::string settings;  // --set arguments
+  double swapMarginMs = 0;
   std::regex tileInput;
   int tiles = 0;
   int hosts = 0;
 };
 
-// The 99th percentile of the spread of the tiles' swap times per frame (microseconds), from the
-// swap logs; -1 without logs (one tile).
-double swapSkewP99(const fs::path& frames, int tiles) {
+struct Skew {
+  double p50 = -1, p99 = -1;
+};
+
+// The spread of the tiles' swap times per frame (microseconds), from the swap logs: its 50th
+// and 99th percentiles; -1 without logs (one tile).
+Skew swapSkew(const fs::path& frames, int tiles) {
   std::vector<std::map<long, double>> logs;
   for (int t = 0; t < tiles; ++t) {
     std::ifstream in(frames / ("t" + std::to_string(t) + ".swaps"));
-    if (!in) return -1;
+    if (!in) return {};
     std::map<long, double> swaps;
     long frame = 0;
     double seconds = 0;
@@ -68,30 +82,57 @@ double swapSkewP99(const fs::path& frames, int tiles) {
     }
     if (everywhere) skews.push_back(1e6 * (hi - lo));
   }
-  if (skews.empty()) return -1;
+  if (skews.empty()) return {};
   std::sort(skews.begin(), skews.end());
-  return skews[std::min(skews.size() - 1,
-                        static_cast<std::size_t>(0.99 * static_cast<double>(skews.size())))];
+  const auto at = [&skews](double q) {
+    return skews[std::min(skews.size() - 1,
+                          static_cast<std::size_t>(q * static_cast<double>(skews.size())))];
+  };
+  return {at(0.5), at(0.99)};
+}
+
+std::string orNull(double value) {
+  return value < 0 ? "null" : std::to_string(static_cast<long>(value));
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
-  const int iterations = quick ? 10 : 100;
+  int iterations = 100;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--quick") {
+      iterations = 10;
+    } else if (arg == "--iterations" && i + 1 < argc) {
+      iterations = std::atoi(argv[++i]);
+    } else {
+      std::fprintf(stderr, "usage: vrflow-bench-wall [--quick | --iterations N]\n");
+      return 2;
+    }
+  }
+  if (iterations < 2) {
+    std::fprintf(stderr, "vrflow-bench-wall: --iterations must be at least 2\n");
+    return 2;
+  }
   const fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   const fs::path examples = fs::path(VRFLOW_SOURCE_DIR) / "examples/display_wall";
   const std::string host = machine();
+  const std::regex wallTiles(R"(wall:t\d+\.objects)");
   const std::vector<Config> configs{
-      {"display_wall_4x4.xml", "display-wall-4x4", std::regex(R"(wall:t\d+\.objects)"), 16, 4},
-      {"one_view.xml", "one-view", std::regex(R"(view\.objects)"), 1, 1}};
+      {"display_wall_4x4.xml", "display-wall-4x4", "surface", "route", "", 0, wallTiles, 16, 4},
+      {"display_wall_4x4.xml", "display-wall-4x4", "particles", "broadcast",
+       "--set water.surface=off --set wall:liquid.stamp=never-sent", 0, wallTiles, 16, 4},
+      {"display_wall_4x4.xml", "display-wall-4x4", "surface", "route", "--set wall.swap_margin=30",
+       30, wallTiles, 16, 4},
+      {"one_view.xml", "one-view", "surface", "direct", "", 0, std::regex(R"(view\.objects)"), 1,
+       1}};
   for (const auto& config : configs) {
     const fs::path dir = fs::temp_directory_path() / ("vrflow-bench-wall-" + config.frames);
     fs::remove_all(dir);
     fs::create_directories(dir / config.frames);
     const std::string command = "cd '" + dir.string() + "' && '" + (bin / "vrflow").string() +
                                 "' launch '" + (examples / config.app).string() + "' -n " +
-                                std::to_string(iterations) +
+                                std::to_string(iterations) + " " + config.settings +
                                 " --no-progress --report report.json > run.log 2>&1";
     if (std::system(command.c_str()) != 0) {
       std::fprintf(stderr, "vrflow-bench-wall: %s failed; see %s/run.log\n", config.app.c_str(),
@@ -104,21 +145,30 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "vrflow-bench-wall: no report in %s\n", dir.c_str());
       return 1;
     }
-    double bytes = 0, messages = 0;
+    // Bytes into the tiles' objects inputs; the liquid's: those from the route (the wall) or
+    // the fluid (one view).
+    double bytes = 0, liquid = 0;
     for (const auto& c : report["connections"]) {
       if (!std::regex_match(c["to"].get<std::string>(), config.tileInput)) continue;
+      const std::string from = c["from"];
       bytes += c["bytes"].get<double>();
-      messages += c["messages"].get<double>();
+      if (from.rfind("wall:liquid.", 0) == 0 || from == "water.fluid") {
+        liquid += c["bytes"].get<double>();
+      }
     }
+    const double frames = static_cast<double>(iterations);
     const double wall = report["timing"]["wall_s"].get<double>();
-    const double skew = swapSkewP99(dir / config.frames, config.tiles);
+    const Skew skew = swapSkew(dir / config.frames, config.tiles);
     std::printf(
-        "{\"tiles\": %d, \"hosts\": %d, \"payload\": \"objects\", \"iterations\": %d, "
-        "\"fps\": %.2f, \"bytes_per_tile_per_frame\": %.0f, \"swap_skew_us_p99\": %s, "
+        "{\"tiles\": %d, \"hosts\": %d, \"payload\": \"%s\", \"routing\": \"%s\", "
+        "\"swap_margin_ms\": %g, \"iterations\": %d, \"fps\": %.2f, "
+        "\"bytes_per_tile_per_frame\": %.0f, \"liquid_bytes_per_tile_per_frame\": %.0f, "
+        "\"wall_bytes_per_frame\": %.0f, \"swap_skew_us_p50\": %s, \"swap_skew_us_p99\": %s, "
         "\"machine\": \"%s\"}\n",
-        config.tiles, config.hosts, iterations, iterations / wall,
-        messages > 0 ? bytes / messages : 0.0,
-        skew < 0 ? "null" : std::to_string(static_cast<long>(skew)).c_str(), host.c_str());
+        config.tiles, config.hosts, config.payload.c_str(), config.routing.c_str(),
+        config.swapMarginMs, iterations, frames / wall, bytes / (config.tiles * frames),
+        liquid / (config.tiles * frames), bytes / frames, orNull(skew.p50).c_str(),
+        orNull(skew.p99).c_str(), host.c_str());
     std::fflush(stdout);
     fs::remove_all(dir);
   }

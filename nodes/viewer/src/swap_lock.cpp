@@ -6,10 +6,34 @@
 
 namespace vrflow::viewer {
 
-void stampReady(msg::MessageBuilder& builder, std::uint64_t frame) {
+void stampReady(msg::MessageBuilder& builder, std::uint64_t frame,
+                std::optional<std::int64_t> readyNs) {
   builder.setStampsOnly(true);
   builder.addInt64Stamp("frame-min", static_cast<std::int64_t>(frame));
   builder.addInt64Stamp("frame-max", static_cast<std::int64_t>(frame));
+  if (readyNs) builder.addInt64Stamp("ready-ns", *readyNs);
+}
+
+std::int64_t realtimeNs() {
+  timespec t{};
+  clock_gettime(CLOCK_REALTIME, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+std::optional<std::int64_t> swapTime(const msg::StampsView& stamps, std::int64_t marginNs) {
+  const auto ready = stamps.user.find("ready-ns");
+  const auto ns = ready ? ready->asInt64() : std::nullopt;
+  if (!ns) return std::nullopt;
+  return *ns + marginNs;
+}
+
+void sleepUntilRealtime(std::int64_t ns) {
+  timespec until{};
+  until.tv_sec = static_cast<time_t>(ns / 1'000'000'000);
+  until.tv_nsec = static_cast<long>(ns % 1'000'000'000);
+  // Interrupted by a signal: sleep on for what is left (a stop ends the run through wait()).
+  while (clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &until, nullptr) == EINTR) {
+  }
 }
 
 Result<std::optional<std::uint64_t>> releasedFrame(const msg::StampsView& stamps) {

@@ -17,8 +17,20 @@
 
 namespace vrflow::viewer {
 
-/// Stamps a `ready` message for frame `frame`.
-void stampReady(msg::MessageBuilder& builder, std::uint64_t frame);
+/// Stamps a `ready` message for frame `frame`; with `readyNs`, also the int stamp `ready-ns`:
+/// when the frame was drawn (CLOCK_REALTIME, nanoseconds), for a release at an absolute time.
+void stampReady(msg::MessageBuilder& builder, std::uint64_t frame,
+                std::optional<std::int64_t> readyNs = std::nullopt);
+
+/// CLOCK_REALTIME now, in nanoseconds (the clock the trace and the swap logs stamp).
+std::int64_t realtimeNs();
+
+/// When every tile swaps the frame a release lets through: the latest tile's `ready-ns` (the
+/// merges join it with `ready-ns:max`) plus `marginNs`; nullopt when the release carries none.
+std::optional<std::int64_t> swapTime(const msg::StampsView& stamps, std::int64_t marginNs);
+
+/// Sleeps until CLOCK_REALTIME reaches `ns` (at once when it has passed).
+void sleepUntilRealtime(std::int64_t ns);
 
 /// The frame a release message lets through: its frame-min when it equals frame-max; nullopt
 /// for a message without them (the initial message that starts the cycle); an error when they

@@ -214,6 +214,8 @@ int main() {
     if (!opened) return fail(opened.error());
     writer = std::move(*opened);
   }
+  // Swap at an absolute time (the latest tile's ready + margin) instead of at the release.
+  const auto swapMarginNs = static_cast<std::int64_t>(values.getFloat("swap-margin") * 1e6);
   auto swapLog = viewer::SwapLog::open(values.getString("swap-log"));
   if (!swapLog) return fail(swapLog.error());
   const auto& t = render.tile;
@@ -262,6 +264,10 @@ int main() {
         break;
       }
       if (drawn) {
+        const auto& stamps = module.get(release).view().stamps();
+        if (const auto at = viewer::swapTime(stamps, swapMarginNs); at && swapMarginNs > 0) {
+          viewer::sleepUntilRealtime(*at);
+        }
         if (window) window->swap();
         swapLog->shown(*readied);
         ++shown;
@@ -351,7 +357,8 @@ int main() {
     if (ready.connected()) {
       // Every iteration, drawn or not (`every`), so the barrier never waits on this tile.
       auto out = module.newMessage();
-      viewer::stampReady(out.builder(), module.iteration());
+      viewer::stampReady(out.builder(), module.iteration(),
+                         swapMarginNs > 0 ? std::optional(viewer::realtimeNs()) : std::nullopt);
       if (!module.put(ready, std::move(out))) break;
       readied = module.iteration();
     }

@@ -58,16 +58,19 @@ struct SurfaceMesh {
 /// empty mesh.
 Result<SurfaceMesh> extractSurface(const std::vector<float>& xyz, const SurfaceSettings& settings);
 
-/// One box of a split of the grid and the part of the surface whose triangles' centroids lie in
-/// it, with its own vertex list.
+/// One box of a split of the grid and the part of the surface in it, with its own vertex list.
 struct SurfaceRegion {
   SurfaceMesh mesh;
-  msg::Aabb bounds{};  ///< the box of its vertices, or the region's box when it holds none
+  /// The box of its vertices, kept 1e-5 of a box inside the planes it shares with other boxes
+  /// (so that a view that only touches the box does not meet it); the region's box when it
+  /// holds nothing.
+  msg::Aabb bounds{};
 };
 
 /// Cuts `mesh` into the counts[0] x counts[1] x counts[2] boxes of `grid` (x fastest), as the
-/// module's particle regions: a triangle goes to the box holding its centroid (the last box
-/// along an axis takes what lies beyond the grid).
+/// module's particle regions: a triangle within one box goes to it whole; one across boxes is
+/// clipped at their planes, each piece (a fan of triangles with new vertices) to its box. The
+/// first and last box along an axis take what lies beyond the grid.
 std::vector<SurfaceRegion> splitSurface(const SurfaceMesh& mesh, const msg::Aabb& grid,
                                         const std::array<int, 3>& counts);
 
