@@ -37,13 +37,18 @@ std::vector<double> position(const std::string& stateFile, std::size_t index) {
   return state["bodies"].at(index)["position"].get<std::vector<double>>();
 }
 
-// MODULE.PORT -> "messages:last_digest" of every output of a report.
+// MODULE.PORT -> "messages:last_digest" of every output of a report; a replay's out0 stands
+// for the one output of its module that the recording holds (docs/recording.md).
 std::map<std::string, std::string> digests(const std::string& report) {
+  const std::map<std::string, std::string> replayed = {{"grab.out0", "grab.forces"},
+                                                       {"tool.out0", "tool.objects"}};
   std::map<std::string, std::string> all;
   const auto json = nlohmann::json::parse(readFile(report));
-  for (const auto& o : json["outputs"])
-    all[o["module"].get<std::string>() + "." + o["port"].get<std::string>()] =
-        o["messages"].dump() + ":" + o["last_digest"].dump();
+  for (const auto& o : json["outputs"]) {
+    std::string name = o["module"].get<std::string>() + "." + o["port"].get<std::string>();
+    if (const auto found = replayed.find(name); found != replayed.end()) name = found->second;
+    all[name] = o["messages"].dump() + ":" + o["last_digest"].dump();
+  }
   return all;
 }
 
