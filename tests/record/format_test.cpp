@@ -230,6 +230,63 @@ TEST(RecordingFormat, ACorruptedChunkIsOneErrorNamingItsByte) {
                                      ": the chunk header does not match the index (corrupted)");
 }
 
+// Chunks stored uncompressed (what the writer does while its compression thread is busy):
+// zstd frames of raw blocks (128 KiB each, so several per chunk here) that the same reader
+// decodes and checks; a flipped byte in a stored block fails the frame's checksum.
+TEST(RecordingFormat, StoredChunksAreReadBackByteForByteAndChecked) {
+  TempDir dir;
+  const std::string path = dir.file("stored.vrrec");
+  auto writer =
+      RecordingWriter::create(path, kConnections, {.chunkBytes = 300 << 10, .compress = false});
+  ASSERT_TRUE(writer);
+  for (std::uint64_t it = 0; it < 400; ++it)
+    ASSERT_TRUE((*writer)->add(0, it, 1000 + it, message("chain", it, 2000)));
+  ASSERT_TRUE((*writer)->close());
+  EXPECT_EQ((*writer)->storedChunks(), (*writer)->chunksWritten());
+  auto reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader) << reader.error().message;
+  ASSERT_GE((*reader)->chunks().size(), 2u);
+  for (const auto& chunk : (*reader)->chunks()) EXPECT_GT(chunk.compressedBytes, chunk.rawBytes);
+  const auto records = allRecords(**reader);
+  ASSERT_EQ(records.size(), 400u);
+  for (std::uint64_t it = 0; it < 400; ++it) {
+    EXPECT_EQ(records[it].first.arrivalNs, 1000 + it);
+    EXPECT_EQ(records[it].second, message("chain", it, 2000)) << it;
+  }
+  const auto chunk = (*reader)->chunks()[1];
+  auto bytes = readBytes(path);
+  bytes[chunk.offset + vrflow::record::kChunkHeaderBytes + chunk.compressedBytes / 2] ^=
+      std::byte{0x01};
+  writeBytes(path, bytes);
+  auto corrupted = RecordingReader::open(path);
+  ASSERT_TRUE(corrupted);
+  auto bad = (*corrupted)->readChunk(1);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("(corrupted)"), std::string::npos) << bad.error().message;
+}
+
+// With the compression thread on, a chunk is compressed by it or stored when it is busy: any
+// mix reads back the same, in order.
+TEST(RecordingFormat, CompressedAndStoredChunksMixedReadBackInOrder) {
+  TempDir dir;
+  const std::string path = dir.file("mixed.vrrec");
+  auto writer = RecordingWriter::create(path, kConnections, {.level = 19, .chunkBytes = 64 << 10});
+  ASSERT_TRUE(writer);
+  for (std::uint64_t it = 0; it < 2000; ++it)
+    ASSERT_TRUE((*writer)->add(it % 2 == 0 ? 0 : 1, it, it, message("chain", it, 1000)));
+  ASSERT_TRUE((*writer)->close());
+  auto reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader) << reader.error().message;
+  EXPECT_EQ((*reader)->chunks().size(), (*writer)->chunksWritten());
+  const auto records = allRecords(**reader);
+  ASSERT_EQ(records.size(), 2000u);
+  for (std::uint64_t it = 0; it < 2000; ++it) {
+    EXPECT_EQ(records[it].first.iteration, it);
+    EXPECT_EQ(records[it].first.connection, it % 2);
+    EXPECT_EQ(records[it].second, message("chain", it, 1000)) << it;
+  }
+}
+
 TEST(RecordingFormat, AnotherFormatVersionIsRefusedNamingBothVersions) {
   TempDir dir;
   const std::string path = dir.file("sample.vrrec");
