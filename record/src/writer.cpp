@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <limits.h>
+#include <sys/file.h>
 #include <sys/uio.h>
 #include <unistd.h>
 #include <xxhash.h>
@@ -85,6 +86,8 @@ Result<std::unique_ptr<RecordingWriter>> RecordingWriter::create(
   }
   writer->fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (writer->fd_ < 0) return makeError("cannot write '" + path + "': " + std::strerror(errno));
+  // Held until close(): tells a reader that the file is being written (beingWritten()).
+  (void)::flock(writer->fd_, LOCK_EX | LOCK_NB);
   std::vector<std::byte> header(kFileHeaderBytes);
   std::memcpy(header.data(), kFileMagic.data(), kFileMagic.size());
   putU32(header.data() + 8, kFormatVersion);

@@ -287,6 +287,49 @@ TEST(RecordingFormat, CompressedAndStoredChunksMixedReadBackInOrder) {
   }
 }
 
+// `vrflow inspect` on a recording that a writer has open reads what is there: its whole
+// chunks, the chunk in progress at its end left out. The same bytes with no writer behind them
+// are a truncated file.
+TEST(RecordingFormat, InspectReadsAFileBeingWrittenUpToItsLastWholeChunk) {
+  TempDir dir;
+  const std::string path = dir.file("live.vrrec");
+  auto writer = RecordingWriter::create(path, kConnections);
+  ASSERT_TRUE(writer);
+  for (std::uint64_t it = 0; it < 6; ++it) {
+    ASSERT_TRUE((*writer)->add(0, it, 1000 + it, message("chain", it)));
+    if (it % 3 == 2) {
+      ASSERT_TRUE((*writer)->flush());
+    }
+  }
+  EXPECT_TRUE(RecordingReader::beingWritten(path));
+  // The first bytes of a third chunk, as a reader may find them while the writer writes it
+  // (a copy of the first chunk's first 20 bytes).
+  const auto whole = readBytes(path);
+  const auto first = (*RecordingReader::open(path))->chunks().at(0).offset;
+  auto growing = whole;
+  growing.insert(growing.end(), whole.begin() + static_cast<long>(first),
+                 whole.begin() + static_cast<long>(first) + 20);
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::app);  // the writer's lock stays
+    out.write(reinterpret_cast<const char*>(growing.data() + whole.size()), 20);
+  }
+  const auto inspect = [&](const std::string& file) {
+    return vrflow::testing::runCommand({vrflow::testing::binDir() + "/vrflow", "inspect", file},
+                                       30);
+  };
+  const auto live = inspect(path);
+  ASSERT_EQ(live.exitCode, 0) << live.err;
+  EXPECT_NE(live.out.find("none yet: the file is being written"), std::string::npos) << live.out;
+  EXPECT_NE(live.out.find("Messages:       6\n"), std::string::npos) << live.out;
+  EXPECT_NE(live.out.find("Chunks:         2\n"), std::string::npos) << live.out;
+  const std::string copy = dir.file("copy.vrrec");  // no writer has it open
+  writeBytes(copy, growing);
+  EXPECT_FALSE(RecordingReader::beingWritten(copy));
+  const auto truncated = inspect(copy);
+  EXPECT_EQ(truncated.exitCode, 2);
+  EXPECT_NE(truncated.err.find("(truncated)"), std::string::npos) << truncated.err;
+}
+
 TEST(RecordingFormat, AnotherFormatVersionIsRefusedNamingBothVersions) {
   TempDir dir;
   const std::string path = dir.file("sample.vrrec");
