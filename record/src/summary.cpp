@@ -143,7 +143,8 @@ std::string summaryJson(const Summary& s) {
     list.push_back(e);
   }
   j["connections"] = list;
-  return j.dump(2);
+  // Names come from the file: bytes that are not UTF-8 become U+FFFD instead of throwing.
+  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 }  // namespace vrflow::record

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "process_helpers.hpp"
 #include "vrflow/message/builder.hpp"
@@ -328,6 +329,25 @@ TEST(RecordingFormat, InspectReadsAFileBeingWrittenUpToItsLastWholeChunk) {
   const auto truncated = inspect(copy);
   EXPECT_EQ(truncated.exitCode, 2);
   EXPECT_NE(truncated.err.find("(truncated)"), std::string::npos) << truncated.err;
+}
+
+// Found by fuzz_recording_reader: a connection name that is not UTF-8 made `inspect --json`
+// throw out of nlohmann::json (the program aborted); its bad bytes are now replaced.
+TEST(RecordingFormat, InspectJsonOfANameThatIsNotUtf8ReplacesItsBadBytes) {
+  TempDir dir;
+  const std::string path = dir.file("latin1.vrrec");
+  auto writer = RecordingWriter::create(path, {{"gr\xfc\xdf", "out", "events"}});
+  ASSERT_TRUE(writer);
+  ASSERT_TRUE((*writer)->add(0, 0, 10, message("x", 0)));
+  ASSERT_TRUE((*writer)->close());
+  auto reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader);
+  auto summary = vrflow::record::summarize(**reader);
+  ASSERT_TRUE(summary);
+  std::string text;
+  ASSERT_NO_THROW(text = vrflow::record::summaryJson(*summary));
+  const auto json = nlohmann::json::parse(text);
+  EXPECT_EQ(json["connections"][0]["module"], "gr\xef\xbf\xbd\xef\xbf\xbd");
 }
 
 TEST(RecordingFormat, AnotherFormatVersionIsRefusedNamingBothVersions) {
