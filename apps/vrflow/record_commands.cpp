@@ -327,7 +327,10 @@ int replayRun(RecordCommands& c) {
 }
 
 int inspect(const RecordCommands& c) {
-  auto reader = record::RecordingReader::open(c.recording);
+  // A file a recorder is writing ends in a chunk in progress, not a truncation: read what is
+  // there.
+  auto reader = record::RecordingReader::open(c.recording,
+                                              record::RecordingReader::beingWritten(c.recording));
   if (!reader) return refuse("inspect", reader.error().message);
   auto summary = record::summarize(**reader);
   if (!summary) return refuse("inspect", summary.error().message);

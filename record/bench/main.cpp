@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -94,30 +95,45 @@ int main(int argc, char** argv) {
     ::close(fd);
     const double writeS = secondsSince(start);
 
-    start = Clock::now();
-    auto writer = vrflow::record::RecordingWriter::create(
-        recordPath, {{"fluid", "objects", "objects"}},
-        {.level = level,
-         .chunkBytes = static_cast<std::size_t>(chunkKib) * 1024,
-         .workers = workers});
-    if (!writer) {
-      std::fprintf(stderr, "%s\n", writer.error().message.c_str());
-      return 1;
-    }
-    std::uint64_t iteration = 0;
-    for (const auto& m : messages) {
-      if (auto added = (*writer)->add(0, iteration, 1000 + iteration, m); !added) {
-        std::fprintf(stderr, "%s\n", added.error().message.c_str());
-        return 1;
+    // The recording, the same bytes: first with the caller compressing every chunk (the writer
+    // before its compression thread), then as the recorder writes them.
+    struct Recorded {
+      double seconds = 0;
+      std::uint64_t fileBytes = 0, storedChunks = 0, chunks = 0;
+    };
+    const auto record = [&](bool thread) -> std::optional<Recorded> {
+      const auto begin = Clock::now();
+      auto writer = vrflow::record::RecordingWriter::create(
+          recordPath, {{"fluid", "objects", "objects"}},
+          {.level = level,
+           .chunkBytes = static_cast<std::size_t>(chunkKib) * 1024,
+           .workers = workers,
+           .compressionThread = thread});
+      if (!writer) {
+        std::fprintf(stderr, "%s\n", writer.error().message.c_str());
+        return std::nullopt;
       }
-      ++iteration;
-    }
-    if (auto closed = (*writer)->close(); !closed) {
-      std::fprintf(stderr, "%s\n", closed.error().message.c_str());
-      return 1;
-    }
-    const double recordS = secondsSince(start);
-    const std::uint64_t fileBytes = (*writer)->fileBytes();
+      std::uint64_t iteration = 0;
+      for (const auto& m : messages) {
+        if (auto added = (*writer)->add(0, iteration, 1000 + iteration, m); !added) {
+          std::fprintf(stderr, "%s\n", added.error().message.c_str());
+          return std::nullopt;
+        }
+        ++iteration;
+      }
+      if (auto closed = (*writer)->close(); !closed) {
+        std::fprintf(stderr, "%s\n", closed.error().message.c_str());
+        return std::nullopt;
+      }
+      return Recorded{secondsSince(begin), (*writer)->fileBytes(), (*writer)->storedChunks(),
+                      (*writer)->chunksWritten()};
+    };
+    const auto inlined = record(false);
+    if (!inlined) return 1;
+    const auto recorded = record(true);
+    if (!recorded) return 1;
+    const double recordS = recorded->seconds;
+    const std::uint64_t fileBytes = recorded->fileBytes;
 
     // Replay's side: open, decompress and check every message (layout included).
     start = Clock::now();
@@ -144,11 +160,15 @@ int main(int argc, char** argv) {
     std::printf(
         "{\"bench\":\"record\",\"host\":\"%s\",\"pass\":%d,\"messages\":%d,\"mib\":%.2f,"
         "\"level\":%d,\"workers\":%d,\"chunk_kib\":%d,\"record_mib_s\":%.1f,\"replay_mib_s\":%.1f,"
-        "\"write_mib_s\":%.1f,"
-        "\"record_over_write\":%.3f,\"compression_ratio\":%.2f}\n",
+        "\"write_mib_s\":%.1f,\"record_over_write\":%.3f,\"compression_ratio\":%.2f,"
+        "\"stored_chunks\":%llu,\"chunks\":%llu,\"record_inline_mib_s\":%.1f,"
+        "\"inline_over_write\":%.3f,\"inline_compression_ratio\":%.2f}\n",
         host, pass, count, mib, level, workers, chunkKib, mib / recordS, mib / replayS,
-        mib / writeS, writeS / recordS,
-        static_cast<double>(bytes) / static_cast<double>(fileBytes));
+        mib / writeS, writeS / recordS, static_cast<double>(bytes) / static_cast<double>(fileBytes),
+        static_cast<unsigned long long>(recorded->storedChunks),
+        static_cast<unsigned long long>(recorded->chunks), mib / inlined->seconds,
+        writeS / inlined->seconds,
+        static_cast<double>(bytes) / static_cast<double>(inlined->fileBytes));
   }
   ::unlink(plainPath.c_str());
   ::unlink(recordPath.c_str());

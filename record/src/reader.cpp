@@ -1,6 +1,7 @@
 #include "vrflow/record/reader.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zstd.h>
@@ -19,6 +20,14 @@ std::uint64_t padTo8(std::uint64_t n) {
 }
 
 }  // namespace
+
+bool RecordingReader::beingWritten(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool locked = ::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);  // releases the shared lock when it was taken
+  return locked;
+}
 
 Result<std::unique_ptr<RecordingReader>> RecordingReader::open(const std::string& path,
                                                                bool growing) {

@@ -22,6 +22,7 @@ Result<Summary> summarize(RecordingReader& reader) {
   s.path = reader.path();
   s.version = reader.version();
   s.closed = reader.closed();
+  s.beingWritten = reader.growing() && !reader.closed();
   s.fileBytes = reader.usedBytes();
   for (const auto& c : reader.connections()) s.connections.push_back({.connection = c});
   s.chunks = reader.chunks().size();
@@ -86,7 +87,9 @@ std::string formatSummary(const Summary& s) {
   };
   add("File:", s.path);
   add("Format version:", std::to_string(s.version));
-  add("Index:", s.closed ? "written at close" : "rebuilt by scanning (the file was not closed)");
+  add("Index:", s.closed         ? "written at close"
+                : s.beingWritten ? "none yet: the file is being written (what it held so far)"
+                                 : "rebuilt by scanning (the file was not closed)");
   std::snprintf(line, sizeof line, "%s (messages %s, zstd ratio %.2f)", mib(s.fileBytes).c_str(),
                 mib(s.messageBytes).c_str(), ratio(s));
   add("Size:", line);
@@ -114,6 +117,7 @@ std::string summaryJson(const Summary& s) {
   j["file"] = s.path;
   j["version"] = s.version;
   j["closed"] = s.closed;
+  j["being_written"] = s.beingWritten;
   j["file_bytes"] = s.fileBytes;
   j["message_bytes"] = s.messageBytes;
   j["raw_bytes"] = s.rawBytes;
@@ -139,7 +143,8 @@ std::string summaryJson(const Summary& s) {
     list.push_back(e);
   }
   j["connections"] = list;
-  return j.dump(2);
+  // Names come from the file: bytes that are not UTF-8 become U+FFFD instead of throwing.
+  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 }  // namespace vrflow::record

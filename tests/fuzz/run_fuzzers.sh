@@ -13,7 +13,8 @@ cmake -S "$src/tests/fuzz/standalone" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=
   -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 # A failed build shows its log (the fuzz run would otherwise fail without a word).
 cmake --build "$build" >"$build/build.log" 2>&1 || { cat "$build/build.log" >&2; exit 1; }
-for target in message_reader app_loader composite_loader frame_reader control_channel; do
+for target in message_reader app_loader composite_loader frame_reader control_channel \
+  recording_reader; do
   corpus=$(mktemp -d)
   cp "$src"/tests/fuzz/corpus/${target%%_*}/* "$corpus"/ 2>/dev/null || true
   echo "fuzzing $target for ${seconds}s"

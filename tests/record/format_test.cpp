@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "process_helpers.hpp"
 #include "vrflow/message/builder.hpp"
@@ -228,6 +229,125 @@ TEST(RecordingFormat, ACorruptedChunkIsOneErrorNamingItsByte) {
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().message, path + ": byte " + std::to_string(chunk.offset) +
                                      ": the chunk header does not match the index (corrupted)");
+}
+
+// Chunks stored uncompressed (what the writer does while its compression thread is busy):
+// zstd frames of raw blocks (128 KiB each, so several per chunk here) that the same reader
+// decodes and checks; a flipped byte in a stored block fails the frame's checksum.
+TEST(RecordingFormat, StoredChunksAreReadBackByteForByteAndChecked) {
+  TempDir dir;
+  const std::string path = dir.file("stored.vrrec");
+  auto writer =
+      RecordingWriter::create(path, kConnections, {.chunkBytes = 300 << 10, .compress = false});
+  ASSERT_TRUE(writer);
+  for (std::uint64_t it = 0; it < 400; ++it)
+    ASSERT_TRUE((*writer)->add(0, it, 1000 + it, message("chain", it, 2000)));
+  ASSERT_TRUE((*writer)->close());
+  EXPECT_EQ((*writer)->storedChunks(), (*writer)->chunksWritten());
+  auto reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader) << reader.error().message;
+  ASSERT_GE((*reader)->chunks().size(), 2u);
+  for (const auto& chunk : (*reader)->chunks()) EXPECT_GT(chunk.compressedBytes, chunk.rawBytes);
+  const auto records = allRecords(**reader);
+  ASSERT_EQ(records.size(), 400u);
+  for (std::uint64_t it = 0; it < 400; ++it) {
+    EXPECT_EQ(records[it].first.arrivalNs, 1000 + it);
+    EXPECT_EQ(records[it].second, message("chain", it, 2000)) << it;
+  }
+  const auto chunk = (*reader)->chunks()[1];
+  auto bytes = readBytes(path);
+  bytes[chunk.offset + vrflow::record::kChunkHeaderBytes + chunk.compressedBytes / 2] ^=
+      std::byte{0x01};
+  writeBytes(path, bytes);
+  auto corrupted = RecordingReader::open(path);
+  ASSERT_TRUE(corrupted);
+  auto bad = (*corrupted)->readChunk(1);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("(corrupted)"), std::string::npos) << bad.error().message;
+}
+
+// With the compression thread on, a chunk is compressed by it or stored when it is busy: any
+// mix reads back the same, in order.
+TEST(RecordingFormat, CompressedAndStoredChunksMixedReadBackInOrder) {
+  TempDir dir;
+  const std::string path = dir.file("mixed.vrrec");
+  auto writer = RecordingWriter::create(path, kConnections, {.level = 19, .chunkBytes = 64 << 10});
+  ASSERT_TRUE(writer);
+  for (std::uint64_t it = 0; it < 2000; ++it)
+    ASSERT_TRUE((*writer)->add(it % 2 == 0 ? 0 : 1, it, it, message("chain", it, 1000)));
+  ASSERT_TRUE((*writer)->close());
+  auto reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader) << reader.error().message;
+  EXPECT_EQ((*reader)->chunks().size(), (*writer)->chunksWritten());
+  const auto records = allRecords(**reader);
+  ASSERT_EQ(records.size(), 2000u);
+  for (std::uint64_t it = 0; it < 2000; ++it) {
+    EXPECT_EQ(records[it].first.iteration, it);
+    EXPECT_EQ(records[it].first.connection, it % 2);
+    EXPECT_EQ(records[it].second, message("chain", it, 1000)) << it;
+  }
+}
+
+// `vrflow inspect` on a recording that a writer has open reads what is there: its whole
+// chunks, the chunk in progress at its end left out. The same bytes with no writer behind them
+// are a truncated file.
+TEST(RecordingFormat, InspectReadsAFileBeingWrittenUpToItsLastWholeChunk) {
+  TempDir dir;
+  const std::string path = dir.file("live.vrrec");
+  auto writer = RecordingWriter::create(path, kConnections);
+  ASSERT_TRUE(writer);
+  for (std::uint64_t it = 0; it < 6; ++it) {
+    ASSERT_TRUE((*writer)->add(0, it, 1000 + it, message("chain", it)));
+    if (it % 3 == 2) {
+      ASSERT_TRUE((*writer)->flush());
+    }
+  }
+  EXPECT_TRUE(RecordingReader::beingWritten(path));
+  // The first bytes of a third chunk, as a reader may find them while the writer writes it
+  // (a copy of the first chunk's first 20 bytes).
+  const auto whole = readBytes(path);
+  const auto first = (*RecordingReader::open(path))->chunks().at(0).offset;
+  auto growing = whole;
+  growing.insert(growing.end(), whole.begin() + static_cast<long>(first),
+                 whole.begin() + static_cast<long>(first) + 20);
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::app);  // the writer's lock stays
+    out.write(reinterpret_cast<const char*>(growing.data() + whole.size()), 20);
+  }
+  const auto inspect = [&](const std::string& file) {
+    return vrflow::testing::runCommand({vrflow::testing::binDir() + "/vrflow", "inspect", file},
+                                       30);
+  };
+  const auto live = inspect(path);
+  ASSERT_EQ(live.exitCode, 0) << live.err;
+  EXPECT_NE(live.out.find("none yet: the file is being written"), std::string::npos) << live.out;
+  EXPECT_NE(live.out.find("Messages:       6\n"), std::string::npos) << live.out;
+  EXPECT_NE(live.out.find("Chunks:         2\n"), std::string::npos) << live.out;
+  const std::string copy = dir.file("copy.vrrec");  // no writer has it open
+  writeBytes(copy, growing);
+  EXPECT_FALSE(RecordingReader::beingWritten(copy));
+  const auto truncated = inspect(copy);
+  EXPECT_EQ(truncated.exitCode, 2);
+  EXPECT_NE(truncated.err.find("(truncated)"), std::string::npos) << truncated.err;
+}
+
+// Found by fuzz_recording_reader: a connection name that is not UTF-8 made `inspect --json`
+// throw out of nlohmann::json (the program aborted); its bad bytes are now replaced.
+TEST(RecordingFormat, InspectJsonOfANameThatIsNotUtf8ReplacesItsBadBytes) {
+  TempDir dir;
+  const std::string path = dir.file("latin1.vrrec");
+  auto writer = RecordingWriter::create(path, {{"gr\xfc\xdf", "out", "events"}});
+  ASSERT_TRUE(writer);
+  ASSERT_TRUE((*writer)->add(0, 0, 10, message("x", 0)));
+  ASSERT_TRUE((*writer)->close());
+  auto reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader);
+  auto summary = vrflow::record::summarize(**reader);
+  ASSERT_TRUE(summary);
+  std::string text;
+  ASSERT_NO_THROW(text = vrflow::record::summaryJson(*summary));
+  const auto json = nlohmann::json::parse(text);
+  EXPECT_EQ(json["connections"][0]["module"], "gr\xef\xbf\xbd\xef\xbf\xbd");
 }
 
 TEST(RecordingFormat, AnotherFormatVersionIsRefusedNamingBothVersions) {

@@ -1,6 +1,7 @@
 // `vrflow run --trace`: the message arrows (Chrome trace-event flows) of real runs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -146,6 +147,56 @@ TEST_F(TraceTest, EveryPartOfAMergedInputHasItsArrow) {
   EXPECT_EQ(arrows.byName["b -> three"], 25);
   EXPECT_EQ(arrows.byName["c -> three"], 25);
   EXPECT_EQ(arrows.backwards, 0);
+}
+
+// The start times of the arrows named `name`, in order.
+std::vector<double> arrowStarts(const std::string& path, const std::string& name) {
+  const auto trace = nlohmann::json::parse(readFile(path));
+  std::vector<double> starts;
+  for (const auto& e : trace["traceEvents"]) {
+    if (e["ph"] == "s" && e["name"] == name) starts.push_back(e["ts"].get<double>());
+  }
+  std::sort(starts.begin(), starts.end());
+  return starts;
+}
+
+TEST_F(TraceTest, AMessageRenumberedByRepeatOrDecimateStartsAtItsOriginalsPut) {
+  // repeat (count 4) sends src's message i as iterations 4i..4i+3, decimate (count 4) sends
+  // src's message 4g+3 as iteration g: each arrow starts at the put of the message it carries,
+  // never at the put of src's message of the renumbered iteration (a later one for repeat: the
+  // arrow ran backwards).
+  const auto recorder = [&](const std::string& id) {
+    return module(id, "core/recorder",
+                  "      <param name=\"file\" value=\"" + dir.file(id + ".csv") + "\"/>\n");
+  };
+  const auto file = dir.write(
+      "app.xml",
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"trace\" version=\"1\">\n"
+      "  <hosts>\n    <host id=\"h1\" address=\"127.0.0.1\"/>\n  </hosts>\n  <modules>\n" +
+          module("src", "core/source") + recorder("direct") + recorder("fast") + recorder("slow") +
+          "  </modules>\n  <filters>\n"
+          "    <filter id=\"up\" type=\"repeat\"><param name=\"count\" value=\"4\"/></filter>\n"
+          "    <filter id=\"down\" type=\"decimate\"><param name=\"count\" value=\"4\"/></filter>\n"
+          "  </filters>\n  <connections>\n" +
+          connect("src.out", "direct.in") + connect("src.out", "up.in") +
+          connect("up.out", "fast.in") + connect("src.out", "down.in") +
+          connect("down.out", "slow.in") + "  </connections>\n</application>\n");
+  const auto result = runVrflow({"run", file, "-n", "40", "--trace", dir.file("t.json")}, 60);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  auto arrows = arrowsOf(dir.file("t.json"));
+  EXPECT_EQ(arrows.byName["src -> direct"], 40);
+  EXPECT_EQ(arrows.byName["src -> fast"], 160);
+  EXPECT_EQ(arrows.byName["src -> slow"], 10);
+  EXPECT_EQ(arrows.backwards, 0);
+  // src's puts, in order, as the direct receiver's arrows start at them.
+  const auto puts = arrowStarts(dir.file("t.json"), "src -> direct");
+  ASSERT_EQ(puts.size(), 40u);
+  const auto fast = arrowStarts(dir.file("t.json"), "src -> fast");
+  ASSERT_EQ(fast.size(), 160u);
+  for (std::size_t r = 0; r < fast.size(); ++r) EXPECT_EQ(fast[r], puts[r / 4]) << r;
+  const auto slow = arrowStarts(dir.file("t.json"), "src -> slow");
+  ASSERT_EQ(slow.size(), 10u);
+  for (std::size_t g = 0; g < slow.size(); ++g) EXPECT_EQ(slow[g], puts[4 * g + 3]) << g;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 
 #include "vrflow/base/version.hpp"
@@ -79,25 +80,64 @@ Result<HostTrace> hostTraceFromJson(const std::string& text) {
 
 namespace {
 
-// Per module: the modules whose outputs reach it through filters only.
-std::map<std::string, std::set<std::string>> modulesFeeding(const app::Application& application) {
+// How a filter on the way renumbers the messages it passes (docs/filters.md): `repeat` sends
+// message i as i*count .. i*count+count-1; `decimate` (restamp on, its default) sends the last
+// of group g (messages g*count .. g*count+count-1) as g. Other filters keep the iteration stamp.
+struct Renumbering {
+  enum class Kind { Repeat, Decimate } kind;
+  uint64_t count;
+  /// The iteration the message had before the filter, from the one it has after it.
+  uint64_t before(uint64_t after) const {
+    return kind == Kind::Repeat ? after / count : after * count + count - 1;
+  }
+};
+
+std::optional<Renumbering> renumberingOf(const app::Filter& filter) {
+  const auto value = [&](const std::string& name, const std::string& fallback) {
+    for (const auto& p : filter.params)
+      if (p.name == name) return p.value;
+    return fallback;
+  };
+  const bool repeat = filter.type == "repeat";
+  if (!repeat && !(filter.type == "decimate" && value("restamp", "true") == "true")) {
+    return std::nullopt;
+  }
+  uint64_t count = 10;  // both filters' default
+  try {
+    count = std::stoull(value("count", "10"));
+  } catch (const std::exception&) {
+    return std::nullopt;  // validation refused such a file before it ran
+  }
+  if (count <= 1) return std::nullopt;
+  return Renumbering{repeat ? Renumbering::Kind::Repeat : Renumbering::Kind::Decimate, count};
+}
+
+// Per module: the modules whose outputs reach it through filters only, each with the
+// renumberings on the way, from the receiver upwards (the first path found when there are
+// several).
+using Feeders = std::map<std::string, std::vector<Renumbering>>;
+std::map<std::string, Feeders> modulesFeeding(const app::Application& application) {
   std::set<std::string> modules;
   for (const auto& m : application.modules) modules.insert(m.id);
+  std::map<std::string, std::optional<Renumbering>> filters;
+  for (const auto& f : application.filters) filters[f.id] = renumberingOf(f);
   std::map<std::string, std::vector<std::string>> into;  // node -> nodes connected to its inputs
   for (const auto& c : application.connections) into[c.to.node].push_back(c.from.node);
-  std::map<std::string, std::set<std::string>> feeding;
+  std::map<std::string, Feeders> feeding;
   for (const auto& m : application.modules) {
     auto& found = feeding[m.id];
     std::set<std::string> seen;
-    std::vector<std::string> pending{m.id};
+    std::vector<std::pair<std::string, std::vector<Renumbering>>> pending{{m.id, {}}};
     while (!pending.empty()) {
-      const std::string node = std::move(pending.back());
+      const auto [node, way] = std::move(pending.back());
       pending.pop_back();
       for (const auto& from : into[node]) {
         if (modules.count(from) != 0) {
-          found.insert(from);
+          found.emplace(from, way);
         } else if (seen.insert(from).second) {
-          pending.push_back(from);  // a filter: look further up
+          auto further = way;  // a filter: look further up
+          if (const auto renumbering = filters[from]) further.push_back(*renumbering);
+          pending.emplace_back(from, std::move(further));
         }
       }
     }
@@ -190,7 +230,7 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
     std::map<std::string, const Put*> firstOfModule;
     const Put* earliest = nullptr;  // across hosts, clocks are aligned only so well
     for (const auto& p : candidates) {
-      if (known && fed->second.count(p.module) == 0) continue;
+      if (known && !fed->second.contains(p.module)) continue;
       if (earliest == nullptr || p.ts < earliest->ts) earliest = &p;
       if (p.ts > ts) continue;
       auto& first = firstOfModule[p.module];
@@ -224,8 +264,20 @@ std::string chromeTrace(const app::Application& application, const std::vector<H
         const std::vector<std::pair<uint32_t, uint64_t>> messages =
             merged != parts.end() ? merged->second : std::vector{received};
         const double ts = us(h, e.event.endNs);
-        for (const auto& message : messages) {
-          const auto put = puts.find(message);
+        // A message renumbered on its way (repeat, decimate) is its sender's message of the
+        // iteration it had before; the sender is the feeder whose id hashes to its source.
+        const auto fed = feeders.find(receiver);
+        const auto original = [&](std::pair<uint32_t, uint64_t> message) {
+          if (fed == feeders.end()) return message;
+          for (const auto& [feeder, way] : fed->second) {
+            if (way.empty() || msg::fnv1a32(feeder) != message.first) continue;
+            for (const auto& renumbering : way) message.second = renumbering.before(message.second);
+            break;
+          }
+          return message;
+        };
+        for (const auto& part : messages) {
+          const auto put = puts.find(original(part));
           if (put == puts.end()) continue;  // an initial message, or one a filter made
           const Put* from = deliveringPut(put->second, receiver, ts);
           if (from == nullptr) continue;

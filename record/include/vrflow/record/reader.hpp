@@ -31,6 +31,9 @@ class RecordingReader {
   /// it is left out, and refresh() picks it up once complete.
   static Result<std::unique_ptr<RecordingReader>> open(const std::string& path,
                                                        bool growing = false);
+  /// True when a RecordingWriter has `path` open (it holds a lock on it until close()): the
+  /// file is being written, and its end may be a chunk in progress rather than a truncation.
+  static bool beingWritten(const std::string& path);
   ~RecordingReader();
   RecordingReader(const RecordingReader&) = delete;
   RecordingReader& operator=(const RecordingReader&) = delete;
@@ -45,6 +48,8 @@ class RecordingReader {
   const std::vector<ChunkInfo>& chunks() const { return chunks_; }
   /// True when the file ends with its index and trailer (the recorder closed it).
   bool closed() const { return closed_; }
+  /// Opened as a growing file (open(path, true)).
+  bool growing() const { return growing_; }
   /// Bytes of the file that hold complete parts (header, chunks, index).
   std::uint64_t usedBytes() const { return scanned_; }
 

@@ -27,7 +27,8 @@ struct ConnectionSummary {
 struct Summary {
   std::string path;
   std::uint32_t version = kFormatVersion;
-  bool closed = false;  ///< index read from the file (else rebuilt by scanning)
+  bool closed = false;        ///< index read from the file (else rebuilt by scanning)
+  bool beingWritten = false;  ///< read as a growing file: what was there when it was read
   std::uint64_t fileBytes = 0;
   std::uint64_t messageBytes = 0;  ///< uncompressed message bytes
   std::uint64_t rawBytes = 0;      ///< chunks before compression (records with their headers)
