@@ -11,7 +11,6 @@
 #include <cstring>
 
 #include "vrflow/daemon/daemon.hpp"
-#include "vrflow/message/ids.hpp"
 #include "vrflow/net/control.hpp"
 #include "vrflow/run/log.hpp"
 
@@ -69,9 +68,6 @@ Result<std::unique_ptr<ControlLink>> ControlLink::create(const app::Application&
   link->selfIndex_ = hostIndex(application, host);
   if (link->selfIndex_ < 0) return makeError("no host '" + host + "' in the application");
   const app::Host& self = application.hosts[static_cast<std::size_t>(link->selfIndex_)];
-  auto id = msg::hostIdFromAddress(self.address);
-  if (!id) return makeError("host '" + host + "': " + id.error().message);
-  link->hostId_ = *id;
 
   net::TransportOptions options;
   options.selfIndex = link->selfIndex_;
@@ -209,7 +205,6 @@ void ControlLink::sendOn(Inbox& inbox, const net::ControlEvent& event) {
 }
 
 void ControlLink::configure(daemon::DaemonOptions& options) {
-  options.hostId = hostId_;
   options.transport = transport_.get();
   options.remote = remote_;
   options.connectionChannels = localChannels_;

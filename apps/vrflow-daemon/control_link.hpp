@@ -81,7 +81,6 @@ class ControlLink final : public run::HostLink {
   std::string host_;
   int selfIndex_ = 0;
   bool stopped_ = false;  ///< the launcher said stop (or went away)
-  uint32_t hostId_ = 0;
   std::unique_ptr<net::Transport> transport_;
   std::vector<net::RemoteConnection> remote_;
   std::vector<uint32_t> localChannels_;

@@ -374,6 +374,17 @@ TEST(CameraModules, HullRefusesABadSlabAndMasksThatDoNotMatchItsCalibrations) {
            Case{param("calibrations", rig.calibrations[0] + " " + rig.dir.file("nope.yml")),
                 "parameter 'calibrations': "},
            Case{param("calibrations", ""), "no calibration file given"},
+           // A list: relative names are relative to its folder, errors name its file:line.
+           Case{param("calibration-list",
+                      rig.dir.write("bad.list",
+                                    "# cameras\n" + rig.calibrations[0] + "\n\nnope.yml\n")),
+                "parameter 'calibration-list': " + rig.dir.file("bad.list") +
+                    ":4: " + rig.dir.file("nope.yml")},
+           Case{param("calibration-list", rig.dir.write("empty.list", "# none\n")),
+                "names no calibration file"},
+           Case{calibrations +
+                    param("calibration-list", rig.dir.write("one.list", rig.calibrations[0])),
+                "give parameter 'calibrations' or 'calibration-list', not both"},
            // One mask (the merge below has one input) for five calibrations.
            Case{calibrations, "1 masks for 5 calibrations"},
        }) {

@@ -1,6 +1,6 @@
-// examples/camera_user through the real `vrflow run`, as its README says to run it: the user's
-// right hand pushes the crate off the table onto the floor, then its left hand presses the net;
-// every module runs every iteration and nothing is left behind.
+// examples/camera_user_small through the real `vrflow run`, as its README says to run it: the
+// user's right hand pushes the crate off the table onto the floor, then its left hand presses the
+// net; every module runs every iteration and nothing is left behind.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -20,8 +20,8 @@ TEST(CameraUserExample, TheHandPushesTheCrateOffTheTableAndPressesTheNet) {
   const auto result =
       runCommand({"/bin/sh", "-c",
                   "cd '" + dir.path() + "' && exec '" + binDir() + "/vrflow' run '" + sourceDir() +
-                      "/examples/camera_user/camera_user.xml' -n " + std::to_string(iterations) +
-                      " --report report.json"},
+                      "/examples/camera_user_small/camera_user_small.xml' -n " +
+                      std::to_string(iterations) + " --report report.json"},
                  300);
   ASSERT_EQ(result.exitCode, 0) << result.out << result.err;
   const auto report = nlohmann::json::parse(readFile(dir.file("report.json")));

@@ -17,14 +17,14 @@ constexpr int64_t kPollNs = 1'000'000;
 // output port "out" (port 1), both connected; the table is published unless told otherwise.
 struct OneModule {
   explicit OneModule(bool publish = true) {
-    auto created = Segment::create(8 << 20, 1);
+    auto created = Segment::create(8 << 20);
     EXPECT_TRUE(created.ok());
     segment = std::move(*created);
     auto made = ControlTableDaemon::create(segment, 1);
     EXPECT_TRUE(made.ok());
     table = *made;
     daemon = table.slot(0);
-    daemon.describe("m", "local", 0, false);
+    daemon.describe("m", "local", 0x12345678u, 0, false);
     EXPECT_TRUE(daemon.setParams("gain=2\n").ok());
     auto in = daemon.addPort("in", true, false, true, 4);
     auto out = daemon.addPort("out", false, false, true, 4);
@@ -50,6 +50,7 @@ TEST(ModuleSlot, AModuleFindsWhatTheDaemonSetUp) {
   auto user = ModuleSlotUser::join(run.segment, 0);
   ASSERT_TRUE(user.ok()) << user.error().message;
   EXPECT_EQ(user->id(), "m");
+  EXPECT_EQ(user->idPrefix(), 0x12345678u);
   EXPECT_EQ(user->portCount(), 2);
   EXPECT_EQ(user->findPort("in", true), 0);
   EXPECT_EQ(user->findPort("out", false), 1);
@@ -162,7 +163,7 @@ TEST(ModuleSlot, AWaitingPortTheModuleScribbledOutOfRangeReadsAsNone) {
 }
 
 TEST(BlockRef, CopiesShareTheBlockAndTheLastOneFreesIt) {
-  auto segment = Segment::create(8 << 20, 1);
+  auto segment = Segment::create(8 << 20);
   ASSERT_TRUE(segment.ok());
   const uint64_t handle = segment->allocate(100);
   {

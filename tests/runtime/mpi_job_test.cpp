@@ -13,8 +13,10 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "process_helpers.hpp"
+#include "vrflow/message/ids.hpp"
 
 namespace vrflow::testing {
 namespace {
@@ -143,6 +145,17 @@ TEST_F(MpiJobRun, ModulesOfOneJobAreTheRanksOfOneMpirunInModuleOrder) {
       EXPECT_EQ(row.rankSum, want.rankSum) << id;
     }
   }
+  // The ranks' object ids carry their modules' prefixes (docs/message-layout.md, "Ids"): the
+  // ranks of one job never make the same id.
+  std::set<std::uint64_t> prefixes;
+  for (const auto& id : ids) {
+    const auto rows = readCsvRows(dir.file(id + ".csv"));
+    ASSERT_FALSE(rows.empty()) << id;
+    const std::uint64_t object = std::stoull(rows.front()[5]);
+    EXPECT_EQ(object >> 32, msg::fnv1a32(id)) << id;
+    prefixes.insert(object >> 32);
+  }
+  EXPECT_EQ(prefixes.size(), ids.size());
   // One mpirun, for the job of three; its ranks get the modules' slots, not a module of their own.
   const auto calls = readLines(dir.file("mpirun.log"));
   ASSERT_EQ(calls.size(), 1u);

@@ -2,11 +2,9 @@
 
 #include <gtest/gtest.h>
 #include <sys/mman.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <set>
 #include <thread>
 #include <vector>
 
@@ -17,7 +15,7 @@ namespace vrflow::ipc {
 namespace {
 
 TEST(Segment, ReleasedBlocksAreReusedForTheSameSizeClass) {
-  auto segment = Segment::create(8 << 20, 1);
+  auto segment = Segment::create(8 << 20);
   ASSERT_TRUE(segment.ok()) << segment.error().message;
   const uint64_t a = segment->allocate(100);
   ASSERT_NE(a, 0u);
@@ -27,7 +25,7 @@ TEST(Segment, ReleasedBlocksAreReusedForTheSameSizeClass) {
 }
 
 TEST(Segment, BlockIsFreedOnlyWhenTheLastReferenceIsDropped) {
-  auto segment = Segment::create(8 << 20, 1);
+  auto segment = Segment::create(8 << 20);
   ASSERT_TRUE(segment.ok());
   const uint64_t a = segment->allocate(1000);
   segment->retain(a);
@@ -38,14 +36,14 @@ TEST(Segment, BlockIsFreedOnlyWhenTheLastReferenceIsDropped) {
 }
 
 TEST(Segment, ExhaustionReturnsNoBlockInsteadOfCrashing) {
-  auto segment = Segment::create(2 << 20, 1);
+  auto segment = Segment::create(2 << 20);
   ASSERT_TRUE(segment.ok());
   EXPECT_EQ(segment->allocate(4 << 20), 0u);
   EXPECT_EQ(segment->allocate(std::size_t{1} << 40), 0u);
 }
 
 TEST(Segment, ForgedHandlesAreRecognised) {
-  auto segment = Segment::create(2 << 20, 1);
+  auto segment = Segment::create(2 << 20);
   ASSERT_TRUE(segment.ok());
   const uint64_t a = segment->allocate(10);
   EXPECT_TRUE(segment->validHandle(a));
@@ -54,36 +52,8 @@ TEST(Segment, ForgedHandlesAreRecognised) {
   EXPECT_FALSE(segment->validHandle(uint64_t{1} << 40));
 }
 
-TEST(Segment, IdsAreUniqueAcrossConcurrentProcesses) {
-  auto segment = Segment::create(16 << 20, 0x7f000001);
-  ASSERT_TRUE(segment.ok());
-  constexpr int kProcesses = 4;
-  constexpr int kIds = 20000;
-  const uint64_t table = segment->reserve(sizeof(uint64_t) * kProcesses * kIds);
-  ASSERT_NE(table, 0u);
-  std::vector<pid_t> children;
-  for (int p = 0; p < kProcesses; ++p) {
-    const pid_t pid = fork();
-    if (pid == 0) {
-      auto* out = segment->at<uint64_t>(table) + p * kIds;
-      for (int i = 0; i < kIds; ++i) out[i] = segment->newId();
-      _exit(0);
-    }
-    children.push_back(pid);
-  }
-  for (const pid_t pid : children) {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-  }
-  std::set<uint64_t> ids(segment->at<uint64_t>(table),
-                         segment->at<uint64_t>(table) + kProcesses * kIds);
-  EXPECT_EQ(ids.size(), static_cast<std::size_t>(kProcesses * kIds));
-  for (const uint64_t id : ids) EXPECT_EQ(id >> 32, 0x7f000001u);
-}
-
 TEST(Segment, ConcurrentAllocationAndReleaseKeepsAccountsBalanced) {
-  auto segment = Segment::create(64 << 20, 1);
+  auto segment = Segment::create(64 << 20);
   ASSERT_TRUE(segment.ok());
   auto work = [&] {
     std::vector<uint64_t> held;

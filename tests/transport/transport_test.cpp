@@ -92,8 +92,8 @@ struct LinkedPair {
   auto a = Transport::listen(optionsFor(0, secret));
   auto b = Transport::listen(optionsFor(1, secret));
   if (!a.ok() || !b.ok()) return ::testing::AssertionFailure() << "listen failed";
-  auto segA = ipc::Segment::create(segmentBytes, 0x7f000001);
-  auto segB = ipc::Segment::create(segmentBytes, 0x7f000002);
+  auto segA = ipc::Segment::create(segmentBytes);
+  auto segB = ipc::Segment::create(segmentBytes);
   if (!segA.ok() || !segB.ok()) return ::testing::AssertionFailure() << "no segment";
   pair.a = std::move(*a);
   pair.b = std::move(*b);

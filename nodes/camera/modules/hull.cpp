@@ -4,7 +4,6 @@
 // modules' outputs, camera n's mask n-th), in the order of `calibrations`.
 #include <cstdio>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -30,14 +29,15 @@ int main() {
   const auto fail = [&](const std::string& why) {
     return camera::moduleError(module, kProgram, why);
   };
+  auto files = camera::calibrationFiles(params.getString("calibrations"),
+                                        params.getString("calibration-list"));
+  if (!files) return fail(files.error().message);
   std::vector<camera::CameraCalibration> cameras;
-  std::istringstream files(params.getString("calibrations"));
-  for (std::string file; files >> file;) {
+  for (const auto& [file, parameter] : *files) {
     auto calibration = camera::loadCalibration(file);
-    if (!calibration) return fail("parameter 'calibrations': " + calibration.error().message);
+    if (!calibration) return fail(parameter + ": " + calibration.error().message);
     cameras.push_back(*calibration);
   }
-  if (cameras.empty()) return fail("parameter 'calibrations': no calibration file given");
   const auto cells = static_cast<int>(params.getInt("cells"));
   const auto origin = params.getVec3("origin");
   const camera::GridSpec spec =

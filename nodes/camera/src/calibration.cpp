@@ -1,6 +1,8 @@
 #include "vrflow/camera/calibration.hpp"
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace vrflow::camera {
 
@@ -128,6 +130,40 @@ CameraCalibration lookAtCamera(cv::Size size, double focal, const cv::Vec3d& eye
   camera.rotation = {x[0], x[1], x[2], y[0], y[1], y[2], z[0], z[1], z[2]};
   camera.translation = -(camera.rotation * eye);
   return camera;
+}
+
+Result<std::vector<std::pair<std::string, std::string>>> calibrationFiles(const std::string& names,
+                                                                          const std::string& list) {
+  std::vector<std::pair<std::string, std::string>> files;
+  std::istringstream words(names);
+  for (std::string file; words >> file;) files.emplace_back(file, "parameter 'calibrations'");
+  if (!files.empty() && !list.empty()) {
+    return makeError("give parameter 'calibrations' or 'calibration-list', not both");
+  }
+  if (list.empty()) {
+    if (files.empty()) {
+      return makeError(
+          "parameter 'calibrations': no calibration file given (or give 'calibration-list')");
+    }
+    return files;
+  }
+  std::ifstream in(list);
+  if (!in) return makeError("parameter 'calibration-list': cannot read " + list);
+  const std::filesystem::path folder = std::filesystem::path(list).parent_path();
+  int number = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++number;
+    const auto begin = line.find_first_not_of(" \t\r");
+    if (begin == std::string::npos || line[begin] == '#') continue;
+    const auto end = line.find_last_not_of(" \t\r");
+    const std::filesystem::path file(line.substr(begin, end - begin + 1));
+    files.emplace_back((file.is_relative() ? folder / file : file).lexically_normal().string(),
+                       "parameter 'calibration-list': " + list + ":" + std::to_string(number));
+  }
+  if (files.empty()) {
+    return makeError("parameter 'calibration-list': " + list + " names no calibration file");
+  }
+  return files;
 }
 
 }  // namespace vrflow::camera

@@ -123,9 +123,10 @@ std::array<float, 3> hsvToRgb(double h, double s, double v) {
 }  // namespace
 
 std::array<float, 3> objectColour(std::uint64_t id) {
-  // Ids are hostId << 32 | counter, and a sender's objects usually have consecutive counters:
-  // stepping the hue by the golden ratio per counter keeps neighbours far apart on the colour
-  // wheel; the host part (hashed, splitmix64) shifts the whole sequence.
+  // Ids are prefix << 32 | counter (the prefix names the module that made them), and a
+  // sender's objects usually have consecutive counters: stepping the hue by the golden ratio
+  // per counter keeps neighbours far apart on the colour wheel; the prefix (hashed, splitmix64)
+  // shifts the whole sequence.
   std::uint64_t z = (id >> 32) + 0x9E3779B97F4A7C15ull;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;

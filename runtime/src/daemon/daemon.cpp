@@ -33,7 +33,7 @@ Result<std::unique_ptr<Daemon>> Daemon::create(const app::Application& applicati
   std::unique_ptr<Daemon> daemon(new Daemon());
   Impl& d = *daemon->impl_;
   d.options = options;
-  auto segment = ipc::Segment::create(options.segmentBytes, options.hostId);
+  auto segment = ipc::Segment::create(options.segmentBytes);
   if (!segment) return segment.error();
   d.segment = std::move(*segment);
   d.graph = std::make_unique<Graph>(d.segment);

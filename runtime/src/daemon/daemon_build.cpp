@@ -7,6 +7,7 @@
 #include "daemon_impl.hpp"
 #include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/daemon/filter_spec.hpp"
+#include "vrflow/message/ids.hpp"
 
 // Builds a daemon's routing network from the application: module slots and rings, a filter
 // node per module port and per filter, a queue per connection, sinks to other hosts.
@@ -22,6 +23,15 @@ std::string filterOwner(const std::string& id, const std::string& type) {
 }
 
 }  // namespace
+
+std::map<std::string, uint32_t, std::less<>> idPrefixesOf(const app::Application& application) {
+  std::vector<std::string> ids;
+  for (const auto& module : application.modules) ids.push_back(module.id);
+  const std::vector<uint32_t> prefixes = msg::idPrefixes(ids);
+  std::map<std::string, uint32_t, std::less<>> byId;
+  for (std::size_t m = 0; m < ids.size(); ++m) byId.emplace(ids[m], prefixes[m]);
+  return byId;
+}
 
 Result<Node*> Daemon::Impl::addNode(const std::string& id, const std::string& type,
                                     Parameters params, std::vector<std::string> inputs,
@@ -53,6 +63,8 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
   moduleOutputs.resize(application.modules.size());
   hasDataInputs.resize(application.modules.size());
   graph->countsIterations = options.iterationLimit != 0 || !options.moduleIterationLimits.empty();
+  const auto idPrefixes =
+      options.idPrefixes.empty() ? idPrefixesOf(application) : options.idPrefixes;
 
   // Which ports are connected.
   std::map<std::pair<std::string, std::string>, int> fanIn;
@@ -84,7 +96,13 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
         limit != options.moduleIterationLimits.end()) {
       iterationLimit = limit->second;
     }
-    slot.describe(module.id, host, iterationLimit, module.endIt == app::EndItTiming::AfterWait);
+    const auto prefix = idPrefixes.find(module.id);
+    if (prefix == idPrefixes.end()) {
+      return makeError("module '" + module.id +
+                       "' is not among the application's modules that ids were made for");
+    }
+    slot.describe(module.id, host, prefix->second, iterationLimit,
+                  module.endIt == app::EndItTiming::AfterWait);
     if (options.trace) {
       if (auto status = slot.addTraceRing(); !status) return status.error();
     }

@@ -51,10 +51,11 @@ TraceRing* ModuleSlotUser::traceRing() const {
   return segment_->at<TraceRing>(slot_->traceOffset);
 }
 
-void ModuleSlotDaemon::describe(std::string_view id, std::string_view host, uint64_t iterationLimit,
-                                bool endItAfterWait) {
+void ModuleSlotDaemon::describe(std::string_view id, std::string_view host, uint32_t idPrefix,
+                                uint64_t iterationLimit, bool endItAfterWait) {
   copyName(slot_->id, id);
   copyName(slot_->host, host);
+  slot_->idPrefix = idPrefix;
   slot_->iterationLimit = iterationLimit;
   slot_->endItAfterWait = endItAfterWait ? 1 : 0;
 }
@@ -125,8 +126,6 @@ Result<ControlTableDaemon> ControlTableDaemon::create(Segment& segment, uint32_t
   owner.table_->modulesOffset = slotsOffset;
   for (uint32_t m = 0; m < moduleCount; ++m)
     new (segment.at<ModuleSlot>(slotsOffset) + m) ModuleSlot();
-  segment.header().idCounter.store((std::min<uint32_t>(moduleCount, kIdBlockModules) + 1)
-                                   << kIdBlockBits);
   return owner;
 }
 

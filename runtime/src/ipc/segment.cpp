@@ -12,8 +12,6 @@
 #include <string>
 #include <utility>
 
-#include "vrflow/message/ids.hpp"
-
 #if defined(__SANITIZE_THREAD__)
 #include <sanitizer/tsan_interface.h>
 #endif
@@ -82,7 +80,7 @@ Segment::~Segment() {
   if (fd_ >= 0) close(fd_);
 }
 
-Result<Segment> Segment::create(std::size_t bytes, uint32_t hostId) {
+Result<Segment> Segment::create(std::size_t bytes) {
   if (bytes < 1 << 20) return makeError("shared-memory segment must be at least 1 MiB");
   const int fd = memfd_create("vrflow-segment", MFD_CLOEXEC);
   if (fd < 0) return makeError(errnoText("cannot create the shared-memory segment"));
@@ -98,7 +96,6 @@ Result<Segment> Segment::create(std::size_t bytes, uint32_t hostId) {
   Segment segment(fd, static_cast<std::byte*>(base), bytes);
   auto* header = new (base) SegmentHeader();
   header->size = bytes;
-  header->hostId = hostId;
   header->bump.store((sizeof(SegmentHeader) + 63) & ~uint64_t{63});
   for (auto& head : header->freeHeads) head.store(0);
   return segment;
@@ -201,11 +198,6 @@ bool Segment::validHandle(uint64_t handle) const {
   if (k < kMinBlockClass || k > kMaxBlockClass) return false;
   if (!contains(handle, uint64_t{1} << k)) return false;
   return block(handle).used <= payloadCapacity(handle);
-}
-
-uint64_t Segment::newId() const {
-  const uint32_t counter = header_->idCounter.fetch_add(1, std::memory_order_relaxed) + 1;
-  return msg::makeId(header_->hostId, counter);
 }
 
 }  // namespace vrflow::ipc

@@ -1,47 +1,37 @@
 #include "vrflow/message/ids.hpp"
 
-#include <optional>
-#include <string>
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+#include <unordered_set>
 
 namespace vrflow::msg {
-namespace {
 
-// Parses "a.b.c.d" with four decimal parts 0..255 and no leading zeros; nullopt otherwise.
-std::optional<std::uint32_t> parseDottedQuad(std::string_view text) {
-  std::uint32_t bits = 0;
-  std::size_t pos = 0;
-  for (int part = 0; part < 4; ++part) {
-    if (part > 0) {
-      if (pos >= text.size() || text[pos] != '.') return std::nullopt;
-      ++pos;
-    }
-    const std::size_t start = pos;
-    std::uint32_t value = 0;
-    while (pos < text.size() && text[pos] >= '0' && text[pos] <= '9' && pos - start < 3) {
-      value = value * 10u + static_cast<std::uint32_t>(text[pos] - '0');
-      ++pos;
-    }
-    const std::size_t digits = pos - start;
-    if (digits == 0 || value > 255 || (digits > 1 && text[start] == '0')) return std::nullopt;
-    bits = (bits << 8) | value;
+std::vector<std::uint32_t> idPrefixes(const std::vector<std::string>& moduleIds) {
+  std::vector<std::size_t> order(moduleIds.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return moduleIds[a] < moduleIds[b]; });
+  // First pass: every module's own hash, and who keeps it (the smallest id that has it).
+  std::vector<std::uint32_t> prefixes(moduleIds.size(), 0);
+  std::unordered_map<std::uint32_t, std::size_t> keeper;
+  for (const std::size_t m : order) {
+    const std::uint32_t hash = fnv1a32(moduleIds[m]);
+    if (hash != 0 && keeper.emplace(hash, m).second) prefixes[m] = hash;
   }
-  if (pos != text.size()) return std::nullopt;
-  return bits;
-}
-
-}  // namespace
-
-Result<std::uint32_t> hostIdFromAddress(std::string_view address) {
-  if (address.empty()) return makeError("cannot derive a host id from an empty host address");
-  if (const auto ipv4 = parseDottedQuad(address)) {
-    if (*ipv4 == 0) {
-      return makeError(
-          "cannot derive a host id from '0.0.0.0': it names no host; give the "
-          "host's own address");
-    }
-    return *ipv4;
+  // Second pass, in id order: the others probe upwards past every hash and every taken value.
+  std::unordered_set<std::uint32_t> taken;
+  for (const auto& [hash, m] : keeper) taken.insert(hash);
+  for (const std::size_t m : order) {
+    if (prefixes[m] != 0) continue;
+    std::uint32_t candidate = fnv1a32(moduleIds[m]);
+    do {
+      ++candidate;  // wraps past 2^32 - 1 to 0, which is skipped
+    } while (candidate == 0 || taken.contains(candidate));
+    taken.insert(candidate);
+    prefixes[m] = candidate;
   }
-  return fnv1a32(address);
+  return prefixes;
 }
 
 }  // namespace vrflow::msg

@@ -14,6 +14,7 @@
 #include <deque>
 #include <map>
 #include <new>
+#include <optional>
 #include <vector>
 
 #include "vrflow/base/assert.hpp"
@@ -77,8 +78,7 @@ msg::MessageBuilder& OutgoingMessage::builder() {
 struct Module::Impl {
   ipc::Segment segment;
   ipc::ModuleSlotUser slot;
-  std::atomic<uint32_t> idNext{0};  // this module's own block of ids (ipc::kIdBlockBits)
-  uint32_t idEnd = 0;
+  std::optional<msg::IdSource> ids;  // this module's ids, from init(): its prefix, a counter
   std::string id;
   std::deque<InputPort> inputs;
   std::deque<OutputPort> outputs;
@@ -254,12 +254,11 @@ Status Module::init() {
   auto slot = ipc::ModuleSlotUser::join(m.segment, index);
   if (!slot) return slot.error();
   m.slot = *slot;
-  if (index < static_cast<long>(ipc::kIdBlockModules)) {
-    const auto block = static_cast<uint32_t>(index + 1);
-    m.idNext.store(block << ipc::kIdBlockBits);
-    m.idEnd = (block + 1) << ipc::kIdBlockBits;
-  }
   m.id = m.slot.id();
+  if (m.slot.idPrefix() == 0) {
+    return makeError("cannot join the run: the daemon gave module '" + m.id + "' no id prefix");
+  }
+  m.ids.emplace(m.slot.idPrefix());
   m.slot.setPid(static_cast<int32_t>(getpid()));
   slotToMarkOutOfMemory.store(&m.slot);
   if (std::get_new_handler() == nullptr) std::set_new_handler(&markOutOfMemory);
@@ -447,9 +446,10 @@ const Parameters& Module::params() const {
 }
 
 uint64_t Module::newId() {
-  const uint32_t next = impl_->idNext.fetch_add(1, std::memory_order_relaxed);
-  if (next < impl_->idEnd) return msg::makeId(impl_->segment.header().hostId, next);
-  return impl_->segment.newId();
+  VRFLOW_ASSERT(impl_->initialized, "newId() before init()");
+  auto id = impl_->ids->next();
+  if (!id) exitOnParameterError(Error{"module '" + impl_->id + "': " + id.error().message});
+  return *id;
 }
 
 int Module::exitStatus() const {

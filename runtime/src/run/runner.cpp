@@ -22,7 +22,6 @@
 #include "vrflow/app/mpi_job.hpp"
 #include "vrflow/base/assert.hpp"
 #include "vrflow/daemon/daemon.hpp"
-#include "vrflow/message/ids.hpp"
 #include "vrflow/run/events.hpp"
 #include "vrflow/run/log.hpp"
 #include "vrflow/run/registry.hpp"
@@ -70,11 +69,9 @@ RunOutcome runApplication(const app::Application& application, const app::Catalo
                                             ? moduleIterations(application, options.iterations)
                                             : options.moduleIterations;
   daemonOptions.trace = options.trace || !options.tracePath.empty();
-  if (!application.hosts.empty()) {
-    if (auto id = msg::hostIdFromAddress(application.hosts.front().address)) {
-      daemonOptions.hostId = *id;
-    }
-  }
+  // Ids are the whole application's, whatever share of it this daemon serves.
+  daemonOptions.idPrefixes = daemon::idPrefixesOf(
+      options.wholeApplication != nullptr ? *options.wholeApplication : application);
   if (options.hostLink != nullptr) options.hostLink->configure(daemonOptions);
 
   auto daemon = daemon::Daemon::create(application, catalog, daemonOptions);

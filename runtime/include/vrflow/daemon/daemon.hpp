@@ -25,7 +25,9 @@ struct DaemonOptions {
   /// Per module id, replaces iterationLimit (multi-rate: see app::iterationRates).
   std::map<std::string, uint64_t, std::less<>> moduleIterationLimits;
   std::size_t defaultCapacity = 16;  ///< messages buffered per connection
-  uint32_t hostId = 0x7f000001;      ///< from the host's address
+  /// Per module id of the whole application (every host), the prefix of its object ids
+  /// (msg::idPrefixes); empty: derived from the application the daemon serves.
+  std::map<std::string, uint32_t, std::less<>> idPrefixes;
   /// Warn when a connection's buffer has stayed full this long (ns).
   uint64_t fullWarningNs = 2'000'000'000;
   /// Gives every module a trace ring (ipc::TraceRing) for `--trace`.
@@ -39,6 +41,9 @@ struct DaemonOptions {
   /// empty when the application given is the whole one.
   std::vector<uint32_t> connectionChannels;
 };
+
+/// The prefix of each module's object ids in `application` (msg::idPrefixes of its module ids).
+std::map<std::string, uint32_t, std::less<>> idPrefixesOf(const app::Application& application);
 
 /// A module the daemon serves: what to start and where its shared state lives.
 struct ModuleProcess {

@@ -50,14 +50,6 @@ struct TraceMerge {
   uint64_t partIteration = 0;
 };
 
-/// Object ids (host id << 32 | counter): module slot i draws its first 2^kIdBlockBits ids from
-/// its own block of counter values, [(i + 1) << kIdBlockBits, (i + 2) << kIdBlockBits), so the
-/// ids of a run do not depend on which process asks first (same run, same bits). Later ids, and
-/// those of slots past kIdBlockModules, come from the host's shared counter, which the daemon
-/// starts above every block.
-inline constexpr uint32_t kIdBlockBits = 20;
-inline constexpr uint32_t kIdBlockModules = 4094;
-
 /// Single-producer (the module), single-consumer (the supervisor) ring of trace events; a
 /// module that finds it full drops the event and counts it.
 struct TraceRing {

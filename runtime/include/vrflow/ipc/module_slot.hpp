@@ -45,7 +45,7 @@ class ModuleSlot {
   char id[kNameBytes] = {};
   char host[kNameBytes] = {};
   uint32_t portCount = 0;
-  uint32_t pad = 0;
+  uint32_t idPrefix = 0;  ///< the high 32 bits of the module's object ids (msg::idPrefixes)
   PortSlot ports[kMaxPortsPerModule];
   Doorbell bell;                         ///< the daemon rings it when this module may go on
   std::atomic<uint32_t> state{0};        ///< a ModuleState

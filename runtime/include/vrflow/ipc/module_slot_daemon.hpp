@@ -22,9 +22,10 @@ class ModuleSlotDaemon {
  public:
   ModuleSlotDaemon() = default;
 
-  /// Set-up, before the module starts: names, limits, timing of endIt.
-  void describe(std::string_view id, std::string_view host, uint64_t iterationLimit,
-                bool endItAfterWait);
+  /// Set-up, before the module starts: names, the prefix of its object ids (msg::idPrefixes),
+  /// limits, timing of endIt.
+  void describe(std::string_view id, std::string_view host, uint32_t idPrefix,
+                uint64_t iterationLimit, bool endItAfterWait);
   /// Set-up: gives the module a trace ring (`--trace`).
   Status addTraceRing();
   /// Set-up: the module's "name=value\n" parameter text.

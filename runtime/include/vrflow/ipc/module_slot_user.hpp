@@ -30,6 +30,8 @@ class ModuleSlotUser {
   bool joined() const { return slot_ != nullptr; }
   /// The module's id in the application (as the daemon wrote it).
   std::string_view id() const { return slot_->id; }
+  /// The high 32 bits of the module's object ids (msg::idPrefixes).
+  uint32_t idPrefix() const { return slot_->idPrefix; }
   /// Ports of the module, in manifest order.
   int portCount() const { return static_cast<int>(slot_->portCount); }
   std::string_view portName(int port) const { return slot_->ports[port].name; }

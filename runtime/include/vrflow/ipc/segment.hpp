@@ -15,7 +15,7 @@ inline constexpr int kMinBlockClass = 7;   // 128 B
 inline constexpr int kMaxBlockClass = 30;  // 1 GiB
 inline constexpr int kBlockClasses = kMaxBlockClass - kMinBlockClass + 1;
 inline constexpr uint32_t kSegmentMagic = 0x53465256;  // "VRFS"
-inline constexpr uint32_t kSegmentVersion = 2;
+inline constexpr uint32_t kSegmentVersion = 3;
 
 /// The header in front of every message block (one cache line).
 struct alignas(64) BlockHeader {
@@ -31,8 +31,6 @@ struct alignas(64) SegmentHeader {
   uint32_t magic = kSegmentMagic;
   uint32_t version = kSegmentVersion;
   uint64_t size = 0;
-  uint32_t hostId = 0;
-  std::atomic<uint32_t> idCounter{0};  ///< per-host object id counter (ids = host id + counter)
   std::atomic<uint32_t> stopRequested{0};
   Doorbell daemonBell;                  ///< modules ring it after pushing or popping
   std::atomic<uint64_t> bump{0};        ///< first never-used byte
@@ -49,7 +47,7 @@ struct alignas(64) SegmentHeader {
 class Segment {
  public:
   /// Creates a segment of `bytes` (sparse: pages are committed when touched).
-  static Result<Segment> create(std::size_t bytes, uint32_t hostId);
+  static Result<Segment> create(std::size_t bytes);
   /// Maps an existing segment from an inherited descriptor.
   static Result<Segment> attach(int fd);
 
@@ -103,9 +101,6 @@ class Segment {
   }
   /// True when `handle` looks like a block this segment handed out (bounds and class checked).
   bool validHandle(uint64_t handle) const;
-
-  /// A new object id, unique on this host across all processes.
-  uint64_t newId() const;
 
  private:
   Segment(int fd, std::byte* base, std::size_t size);

@@ -108,7 +108,7 @@ class Module {
   /// and the parameter and exits with status 1 (docs/module-api.md).
   const Parameters& params() const;
 
-  /// A new object or resource id, unique on this host across processes.
+  /// A new object or resource id, unique in the run and independent of placement.
   uint64_t newId();
 
   /// What main() should return: 1 if an error was reported (e.g. shared memory exhausted in

@@ -10,7 +10,6 @@ namespace vrflow::daemon::testing {
 namespace {
 
 constexpr std::size_t kSegmentBytes = std::size_t{64} << 20;  // sparse: touched pages only
-constexpr uint32_t kHostId = 1;
 
 // What `vrflow validate` says of these parameters of `type`: the first problem, if any.
 std::optional<std::string> paramProblem(const app::FilterType& type,
@@ -45,7 +44,7 @@ Result<std::unique_ptr<FilterHarness>> FilterHarness::create(
       app::parameterSet(spec->declaration.params, given, "filter '" + type + "' (" + type + ")");
   if (!values) return values.error();
 
-  auto segment = ipc::Segment::create(kSegmentBytes, kHostId);
+  auto segment = ipc::Segment::create(kSegmentBytes);
   if (!segment) return segment.error();
   std::unique_ptr<FilterHarness> harness(new FilterHarness(
       std::move(*segment), type, std::move(*values), spec->declaration.portsFor(given)));

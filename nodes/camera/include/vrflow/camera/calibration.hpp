@@ -5,6 +5,8 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "vrflow/base/result.hpp"
 
@@ -31,6 +33,13 @@ struct CameraCalibration {
 /// Reads a calibration written by saveCalibration or OpenCV's tools; one error per missing or
 /// malformed field, naming the file (and the line where OpenCV's parser gives it).
 Result<CameraCalibration> loadCalibration(const std::string& path);
+
+/// The calibration files a module is given, each with what names it in errors: `names` (file
+/// names separated by spaces, as written) or the lines of the file `list` (relative names
+/// relative to the list's folder; blank lines and lines starting with '#' skipped). Errors:
+/// both or neither given, a list that cannot be read, no file named (file:line in messages).
+Result<std::vector<std::pair<std::string, std::string>>> calibrationFiles(const std::string& names,
+                                                                          const std::string& list);
 
 /// Writes `calibration` to `path` (.yml/.yaml or .xml), in the format loadCalibration reads.
 Status saveCalibration(const CameraCalibration& calibration, const std::string& path);
