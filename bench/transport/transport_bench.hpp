@@ -98,6 +98,11 @@ std::string toJsonLine(const BenchResult& result);
 /// Reads back a line written by toJsonLine (used to collect the MPI ranks' results).
 Result<BenchResult> parseJsonLine(std::string_view line);
 
+/// The floor of the local transports: a blocking futex wake-up between this process and a forked
+/// child per one-way trip (ipc::Doorbell and ipc::Ring, no daemon). Forks: call it while the
+/// process has a single thread.
+Result<std::vector<BenchResult>> runWakeupFloor(const BenchSettings& settings);
+
 /// ZeroMQ over ipc:// between this process and a forked child: REQ/REP ping-pong, then PAIR
 /// streaming. Forks, so it must be called while the process has a single thread.
 Result<std::vector<BenchResult>> runZeromq(const BenchSettings& settings);
