@@ -179,7 +179,7 @@ bool Daemon::Impl::pass() {
       popped = true;
       ++graph->operations;
     }
-    if (popped) slot.wake();  // room on the module's output ring
+    if (popped) slot.outputDrained(source.port);  // wakes the module if it waits for room
     const bool moduleDone =
         ended[static_cast<std::size_t>(source.module)].load(std::memory_order_acquire) ||
         slot.finished();

@@ -91,6 +91,10 @@ class ModuleSlotUser {
     while (!out.push(handle)) {
       const uint32_t seen = slot_->bell.prepare();
       if (stopRequested()) return false;
+      // Ask the daemon to ring once it drains this ring, then look again: it may have drained
+      // it before it could see the request (ModuleSlotDaemon::outputDrained).
+      slot.wantsSpace.store(1, std::memory_order_seq_cst);
+      std::atomic_thread_fence(std::memory_order_seq_cst);
       if (out.push(handle)) break;
       slot_->bell.sleep(seen, pollNs);
     }
