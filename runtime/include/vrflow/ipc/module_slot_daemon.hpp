@@ -55,6 +55,12 @@ class ModuleSlotDaemon {
     auto& wants = slot_->ports[port].wantsSpace;
     if (wants.load(std::memory_order_seq_cst) != 0 && wants.exchange(0) != 0) slot_->bell.ring();
   }
+  /// True while the module sleeps (or is about to) in put() for room on output `port`.
+  bool waitsForRoom(int port) const {
+    return slot_->ports[port].wantsSpace.load(std::memory_order_seq_cst) != 0;
+  }
+  /// How often the module's doorbell was rung (wake-ups, also of a module that was awake).
+  uint32_t rings() const { return slot_->bell.prepare(); }
   /// Asks the module to end (EndCause::Unneeded) and wakes it.
   void markUnneeded() const {
     slot_->unneeded.store(1, std::memory_order_release);

@@ -15,7 +15,7 @@ inline constexpr int kMinBlockClass = 7;   // 128 B
 inline constexpr int kMaxBlockClass = 30;  // 1 GiB
 inline constexpr int kBlockClasses = kMaxBlockClass - kMinBlockClass + 1;
 inline constexpr uint32_t kSegmentMagic = 0x53465256;  // "VRFS"
-inline constexpr uint32_t kSegmentVersion = 2;
+inline constexpr uint32_t kSegmentVersion = 3;
 
 /// The header in front of every message block (one cache line).
 struct alignas(64) BlockHeader {
@@ -40,6 +40,9 @@ struct alignas(64) SegmentHeader {
   std::atomic<uint64_t> peakInUseBytes{0};
   std::atomic<uint64_t> failedAllocations{0};  ///< allocate() calls that found no room
   uint64_t controlOffset = 0;                  ///< where the run's control table starts (0: none)
+  /// Busy wait before sleeping on a doorbell, ns (VRFLOW_SPIN_US; 0: none). Set by the daemon
+  /// before any module starts.
+  int64_t spinNs = 0;
   std::atomic<uint64_t> freeHeads[kBlockClasses];  ///< Treiber stacks, tagged against ABA
 };
 
