@@ -84,7 +84,12 @@ Result<BenchResult> readPeerResult(const std::string& transport, std::size_t byt
                                    std::string detail);
 
 /// Calls `runSize` for each of the settings' sizes, in order, and collects the results; stops at
-/// the first error and returns it. Removes `dir` (the run's temporary folder) in both cases.
+/// the first error and returns it.
+Result<std::vector<BenchResult>> forEachSize(
+    const BenchSettings& settings,
+    const std::function<Result<BenchResult>(std::size_t bytes)>& runSize);
+
+/// forEachSize, then removes `dir` (the run's temporary folder), also after an error.
 Result<std::vector<BenchResult>> runEachSize(
     const BenchSettings& settings, const std::filesystem::path& dir,
     const std::function<Result<BenchResult>(std::size_t bytes)>& runSize);

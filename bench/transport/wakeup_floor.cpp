@@ -148,13 +148,7 @@ Result<BenchResult> floorSize(std::size_t bytes, const BenchSettings& settings) 
 }  // namespace
 
 Result<std::vector<BenchResult>> runWakeupFloor(const BenchSettings& settings) {
-  std::vector<BenchResult> results;
-  for (const std::size_t bytes : settings.sizes) {
-    auto result = floorSize(bytes, settings);
-    if (!result) return result.error();
-    results.push_back(*result);
-  }
-  return results;
+  return forEachSize(settings, [&](std::size_t bytes) { return floorSize(bytes, settings); });
 }
 
 }  // namespace vrflow::bench
