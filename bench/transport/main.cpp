@@ -59,8 +59,8 @@ int run(int argc, char** argv) {
   int peerTimeoutS = 30;
   bool mpiRankMode = false;
   app.add_option("--transport", transport,
-                 "Which transports to measure: all, or a comma-separated list of zeromq-ipc, "
-                 "mpi-shm, vrflow-shm, zeromq-tcp, raw-tcp, vrflow-tcp")
+                 "Which transports to measure: all, or a comma-separated list of wakeup-floor, "
+                 "zeromq-ipc, mpi-shm, vrflow-shm, zeromq-tcp, raw-tcp, vrflow-tcp")
       ->capture_default_str();
   app.add_option("--sizes", sizesText, "Message sizes, e.g. 64,4K,1M,16M (K, M: KiB, MiB)")
       ->capture_default_str();
@@ -93,8 +93,9 @@ int run(int argc, char** argv) {
     start = comma + 1;
   }
   for (const auto& name : chosen) {
-    static const std::vector<std::string> known{
-        "all", "zeromq-ipc", "mpi-shm", "vrflow-shm", "zeromq-tcp", "raw-tcp", "vrflow-tcp"};
+    static const std::vector<std::string> known{"all",     "wakeup-floor", "zeromq-ipc",
+                                                "mpi-shm", "vrflow-shm",   "zeromq-tcp",
+                                                "raw-tcp", "vrflow-tcp"};
     if (std::find(known.begin(), known.end(), name) == known.end()) {
       std::cerr << "--transport: unknown transport '" << name << "'\n";
       return 2;
@@ -106,6 +107,10 @@ int run(int argc, char** argv) {
            std::find(chosen.begin(), chosen.end(), name) != chosen.end();
   };
   bool ok = true;
+  // The floor every local transport is compared with, measured first (it forks).
+  if (selected("wakeup-floor")) {
+    ok = report(vrflow::bench::runWakeupFloor(settings)) && ok;
+  }
   if (selected("zeromq-ipc")) {
     ok = report(vrflow::bench::runZeromq(settings)) && ok;
   }

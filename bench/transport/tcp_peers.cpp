@@ -194,13 +194,7 @@ Status launch(const fs::path& app, const fs::path& packages, const BenchSettings
 }  // namespace
 
 Result<std::vector<BenchResult>> runRawTcp(const BenchSettings& settings) {
-  std::vector<BenchResult> results;
-  for (const std::size_t bytes : settings.sizes) {
-    auto result = rawTcpSize(bytes, settings);
-    if (!result) return result.error();
-    results.push_back(*result);
-  }
-  return results;
+  return forEachSize(settings, [&](std::size_t bytes) { return rawTcpSize(bytes, settings); });
 }
 
 Result<std::vector<BenchResult>> runVrflowTcp(const BenchSettings& settings) {

@@ -84,7 +84,12 @@ Result<BenchResult> readPeerResult(const std::string& transport, std::size_t byt
                                    std::string detail);
 
 /// Calls `runSize` for each of the settings' sizes, in order, and collects the results; stops at
-/// the first error and returns it. Removes `dir` (the run's temporary folder) in both cases.
+/// the first error and returns it.
+Result<std::vector<BenchResult>> forEachSize(
+    const BenchSettings& settings,
+    const std::function<Result<BenchResult>(std::size_t bytes)>& runSize);
+
+/// forEachSize, then removes `dir` (the run's temporary folder), also after an error.
 Result<std::vector<BenchResult>> runEachSize(
     const BenchSettings& settings, const std::filesystem::path& dir,
     const std::function<Result<BenchResult>(std::size_t bytes)>& runSize);
@@ -97,6 +102,11 @@ std::string toJsonLine(const BenchResult& result);
 
 /// Reads back a line written by toJsonLine (used to collect the MPI ranks' results).
 Result<BenchResult> parseJsonLine(std::string_view line);
+
+/// The floor of the local transports: a blocking futex wake-up between this process and a forked
+/// child per one-way trip (ipc::Doorbell and ipc::Ring, no daemon). Forks: call it while the
+/// process has a single thread.
+Result<std::vector<BenchResult>> runWakeupFloor(const BenchSettings& settings);
 
 /// ZeroMQ over ipc:// between this process and a forked child: REQ/REP ping-pong, then PAIR
 /// streaming. Forks, so it must be called while the process has a single thread.

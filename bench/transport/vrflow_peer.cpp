@@ -98,22 +98,24 @@ Result<BenchResult> readPeerResult(const std::string& transport, std::size_t byt
   return makeResult(transport, bytes, samples, msgsPerS, std::move(detail));
 }
 
+Result<std::vector<BenchResult>> forEachSize(
+    const BenchSettings& settings,
+    const std::function<Result<BenchResult>(std::size_t bytes)>& runSize) {
+  std::vector<BenchResult> results;
+  for (const std::size_t bytes : settings.sizes) {
+    auto result = runSize(bytes);
+    if (!result) return result.error();
+    results.push_back(std::move(*result));
+  }
+  return results;
+}
+
 Result<std::vector<BenchResult>> runEachSize(
     const BenchSettings& settings, const std::filesystem::path& dir,
     const std::function<Result<BenchResult>(std::size_t bytes)>& runSize) {
-  std::vector<BenchResult> results;
-  Status failure;
-  for (const std::size_t bytes : settings.sizes) {
-    auto result = runSize(bytes);
-    if (!result) {
-      failure = result.error();
-      break;
-    }
-    results.push_back(std::move(*result));
-  }
+  auto results = forEachSize(settings, runSize);
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);
-  if (!failure) return failure.error();
   return results;
 }
 

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstring>
 #include <string>
+#include <thread>
 
 #include "vrflow/ipc/block_ref.hpp"
 #include "vrflow/ipc/module_slot_daemon.hpp"
@@ -127,6 +130,43 @@ TEST(ModuleSlot, TakingFromAFullRingRingsTheDaemonOnlyWhenItAskedForRoom) {
   ASSERT_EQ(user->take(0, taken, kPollNs), ModuleSlotUser::Take::Message);
   run.segment.release(taken);
   EXPECT_NE(bell.prepare(), before);
+}
+
+TEST(ModuleSlot, DrainingAnOutputRingWakesTheModuleOnlyWhenItWaitsForRoom) {
+  OneModule run;
+  auto user = ModuleSlotUser::join(run.segment, 0);
+  ASSERT_TRUE(user.ok());
+  // Room on the ring: puts never ask for it, and draining rings nobody (a module that waits for
+  // its inputs is not woken for nothing).
+  for (const char* text : {"a", "b", "c", "d"}) ASSERT_TRUE(user->put(1, run.block(text), kPollNs));
+  const uint32_t before = run.daemon.rings();
+  uint64_t popped = 0;
+  ASSERT_TRUE(run.output.pop(popped));
+  run.segment.release(popped);
+  run.daemon.outputDrained(1);
+  EXPECT_EQ(run.daemon.rings(), before);
+  EXPECT_FALSE(run.daemon.waitsForRoom(1));
+
+  // A full ring: put() asks for room and sleeps (its timeout far away); draining wakes it.
+  ASSERT_TRUE(user->put(1, run.block("e"), kPollNs));
+  std::atomic<bool> putDone{false};
+  std::thread module([&] {
+    EXPECT_TRUE(user->put(1, run.block("f"), 60'000'000'000));
+    putDone.store(true);
+  });
+  for (int i = 0; i < 10'000 && !run.daemon.waitsForRoom(1); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_TRUE(run.daemon.waitsForRoom(1));
+  EXPECT_FALSE(putDone.load());
+  ASSERT_TRUE(run.output.pop(popped));
+  run.segment.release(popped);
+  run.daemon.outputDrained(1);
+  module.join();  // hangs (a minute) when the drain does not wake it
+  EXPECT_TRUE(putDone.load());
+  EXPECT_NE(run.daemon.rings(), before);
+  EXPECT_FALSE(run.daemon.waitsForRoom(1));
+  while (run.output.pop(popped)) run.segment.release(popped);
 }
 
 TEST(ModuleSlot, TheDaemonReadsWhatTheModuleReports) {

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
+#include <cstdlib>
 #include <mutex>
+#include <string_view>
 #include <thread>
 
 #include "daemon_impl.hpp"
@@ -21,6 +24,20 @@ uint64_t nowNs() {
 
 }  // namespace
 
+Result<int64_t> spinFromEnvironment() {
+  const char* value = std::getenv("VRFLOW_SPIN_US");  // NOLINT(concurrency-mt-unsafe): start-up
+  if (value == nullptr || *value == '\0') return int64_t{0};
+  const std::string_view text(value);
+  int64_t us = -1;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), us);
+  if (ec != std::errc{} || end != text.data() + text.size() || us < 0 || us > kMaxSpinNs / 1000) {
+    return makeError("VRFLOW_SPIN_US='" + std::string(text) +
+                     "': expected a whole number of microseconds from 0 to " +
+                     std::to_string(kMaxSpinNs / 1000) + " (0 or unset: no spinning)");
+  }
+  return us * 1000;
+}
+
 Daemon::Daemon() : impl_(std::make_unique<Impl>()) {}
 
 Daemon::~Daemon() {
@@ -36,12 +53,24 @@ Result<std::unique_ptr<Daemon>> Daemon::create(const app::Application& applicati
   auto segment = ipc::Segment::create(options.segmentBytes);
   if (!segment) return segment.error();
   d.segment = std::move(*segment);
+  if (options.spinNs > kMaxSpinNs) {
+    return makeError("a spin of " + std::to_string(options.spinNs) + " ns is over the limit of " +
+                     std::to_string(kMaxSpinNs) + " ns");
+  }
+  int64_t spinNs = options.spinNs;
+  if (spinNs < 0) {
+    auto fromEnvironment = spinFromEnvironment();
+    if (!fromEnvironment) return fromEnvironment.error();
+    spinNs = *fromEnvironment;
+  }
+  d.segment.header().spinNs = spinNs;  // before any module maps the segment
   d.graph = std::make_unique<Graph>(d.segment);
   d.graph->traceMerges = options.trace;
   if (options.transport != nullptr) {
     options.transport->attachSegment(d.segment);
-    auto* bell = &d.segment.header().daemonBell;
-    options.transport->setArrivalCallback([bell] { bell->ring(); });
+    // A message from another host is routed by the transport's I/O thread that read it, not
+    // handed to the routing thread: one thread hop (a futex wake-up) less per message.
+    options.transport->setArrivalCallback([&d] { d.routeArrivals(); });
   }
   if (auto status = d.build(application, catalog); !status) return status.error();
   return daemon;
@@ -89,6 +118,7 @@ void Daemon::shutdown() {
   if (!d.graph || !d.built) return;
   // Route what the modules sent last (their processes have ended by now), so that the report
   // sees every message that was put.
+  std::lock_guard lock(d.routingMutex);  // a transport's I/O thread may still be routing
   while (d.pass()) {
   }
   d.publishWarnings();
@@ -104,12 +134,34 @@ void Daemon::shutdown() {
   }
 }
 
+void Daemon::Impl::routeArrivals() {
+  auto& bell = segment.header().daemonBell;
+  std::unique_lock lock(routingMutex, std::try_to_lock);
+  if (!lock.owns_lock() || !running.load(std::memory_order_acquire)) {
+    bell.ring();  // the routing thread is at it (or the daemon is not routing): it passes again
+    return;
+  }
+  // A few passes at most: the I/O thread also reads frames and sends heartbeats, and local
+  // modules that keep producing would keep pass() busy for ever (a peer then sees no heartbeat
+  // for its timeout). What is still moving after them is the routing thread's.
+  constexpr int kMaxArrivalPasses = 4;
+  for (int i = 0; i < kMaxArrivalPasses; ++i) {
+    if (!pass()) {
+      // A filter asked for a timer: the routing thread, asleep, must know when to wake.
+      if (graph->wakeAtNs != 0) bell.ring();
+      return;
+    }
+  }
+  bell.ring();
+}
+
 void Daemon::Impl::loop() {
   auto& bell = segment.header().daemonBell;
   uint64_t lastFullCheck = 0;
   uint64_t lastSnapshot = 0;
   while (running.load(std::memory_order_acquire)) {
     const uint32_t seen = bell.prepare();
+    std::unique_lock lock(routingMutex);
     bool progressed = false;
     while (pass()) progressed = true;
     const uint64_t now = nowNs();
@@ -132,6 +184,10 @@ void Daemon::Impl::loop() {
                     ? 0
                     : std::min<int64_t>(sleepNs, static_cast<int64_t>(graph->wakeAtNs - current));
     }
+    lock.unlock();
+    // The opt-in spin: a message that comes soon is routed without the futex wake-up.
+    const int64_t spinNs = segment.header().spinNs;
+    if (spinNs > 0 && sleepNs > 0 && bell.spin(seen, std::min(spinNs, sleepNs))) continue;
     if (sleepNs > 0) bell.sleep(seen, sleepNs);
   }
 }
@@ -179,7 +235,7 @@ bool Daemon::Impl::pass() {
       popped = true;
       ++graph->operations;
     }
-    if (popped) slot.wake();  // room on the module's output ring
+    if (popped) slot.outputDrained(source.port);  // wakes the module if it waits for room
     const bool moduleDone =
         ended[static_cast<std::size_t>(source.module)].load(std::memory_order_acquire) ||
         slot.finished();

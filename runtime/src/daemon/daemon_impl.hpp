@@ -47,6 +47,9 @@ struct Daemon::Impl {
   std::vector<RemoteInput> remoteInputs;  ///< connections arriving from other hosts
   std::vector<std::pair<std::string, PortOutputFilter*>> outputFilters;  // "module.port"
   std::thread thread;
+  /// The routing network (graph, queues, sources): held by the thread that routes, the routing
+  /// thread or a transport's I/O thread on arrivals (routeArrivals).
+  std::mutex routingMutex;
   std::atomic<bool> running{false};
   bool built = false;  ///< the network was fully built (shutdown() has something to drain)
   std::size_t lastBuffered = 0;  ///< messages buffered after the previous pass
@@ -64,6 +67,7 @@ struct Daemon::Impl {
   Result<Node*> addNode(const std::string& id, const std::string& type, Parameters params,
                         std::vector<std::string> inputs, std::vector<std::string> outputs);
   void loop();
+  void routeArrivals();
   bool pass();
   void checkFullQueues(uint64_t now);
   void publishWarnings();

@@ -4,6 +4,7 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <climits>
 #include <ctime>
 
@@ -31,6 +32,23 @@ void Doorbell::sleep(uint32_t seen, int64_t timeoutNs) {
     }
   }
   sleepers.fetch_sub(1, std::memory_order_seq_cst);
+}
+
+bool Doorbell::spin(uint32_t seen, int64_t spinNs) const {
+  using Clock = std::chrono::steady_clock;
+  const auto until = Clock::now() + std::chrono::nanoseconds(spinNs);
+  for (;;) {
+    // Look at the clock only every few rounds: reading it costs more than a look at the word.
+    for (int i = 0; i < 64; ++i) {
+      if (sequence.load(std::memory_order_acquire) != seen) return true;
+#if defined(__x86_64__) || defined(__i386__)
+      __builtin_ia32_pause();
+#elif defined(__aarch64__)
+      asm volatile("yield" ::: "memory");
+#endif
+    }
+    if (Clock::now() >= until) return sequence.load(std::memory_order_seq_cst) != seen;
+  }
 }
 
 void Doorbell::ring() {

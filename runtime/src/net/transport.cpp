@@ -60,10 +60,7 @@ void Transport::setArrivalCallback(std::function<void()> callback) {
 void Transport::addConnection(const RemoteConnection& connection) {
   auto channel = std::make_unique<Channel>();
   channel->remote = connection;
-  const std::size_t capacity = connection.connection.capacity > 0
-                                   ? static_cast<std::size_t>(connection.connection.capacity)
-                                   : 16;
-  channel->credits.store(static_cast<int64_t>(capacity));
+  channel->credits.store(static_cast<int64_t>(channelCapacity(connection)));
   impl_->neededPeers.insert(connection.peer);
   impl_->channels[connection.channel] = std::move(channel);
 }
@@ -130,7 +127,7 @@ std::size_t Transport::receive(uint32_t channel, ipc::Sink& sink, bool& closed) 
   Impl& t = *impl_;
   if (t.stopped.load()) return 0;
   std::size_t moved = 0;
-  std::deque<ipc::BlockRef> taken;
+  bool creditsDue = false;
   {
     std::lock_guard lock(t.mutex);
     if (t.stopped.load()) return 0;
@@ -141,10 +138,11 @@ std::size_t Transport::receive(uint32_t channel, ipc::Sink& sink, bool& closed) 
       ++moved;
     }
     c.creditsToSend += static_cast<uint32_t>(moved);
+    creditsDue = moved > 0 && c.creditsToSend >= creditBatch(c.remote);
     closed = c.closedByPeer && c.inbox.empty();
     if (closed) t.changed.notify_all();  // settle() waits on it
   }
-  if (moved > 0) t.wake();
+  if (creditsDue) t.wake();  // the I/O thread sends them
   return moved;
 }
 

@@ -11,6 +11,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -124,6 +125,17 @@ struct Link {
   uint64_t openedNs = 0, lastReceivedNs = 0, lastSentNs = 0;
   LinkStats stats;
 };
+
+// A connection's queue capacity, as its sender's credits start.
+inline std::size_t channelCapacity(const RemoteConnection& remote) {
+  return remote.connection.capacity > 0 ? static_cast<std::size_t>(remote.connection.capacity) : 16;
+}
+
+// Credits go back once this many are owed (or with other frames of the link): never a frame per
+// message, and the sender, holding the other half, never waits for them.
+inline uint32_t creditBatch(const RemoteConnection& remote) {
+  return static_cast<uint32_t>(std::max<std::size_t>(1, channelCapacity(remote) / 2));
+}
 
 struct Channel {
   RemoteConnection remote;

@@ -131,13 +131,15 @@ void Transport::Impl::checkTimers() {
 void Transport::Impl::loop() {
   std::vector<pollfd> fds;
   while (running.load()) {
-    // Credits for what the routing thread has taken.
+    // Credits for what was routed into the connections' queues: in batches, or along with
+    // frames that leave anyway (a reply, a heartbeat), never a segment of their own per message.
     {
       std::lock_guard lock(mutex);
       for (auto& [channel, c] : channels) {
         if (c->remote.outgoing || c->creditsToSend == 0) continue;
         auto it = linkOfPeer.find(c->remote.peer);
         if (it == linkOfPeer.end()) continue;
+        if (c->creditsToSend < creditBatch(c->remote) && it->second->out.empty()) continue;
         std::byte count[4];
         put32(count, c->creditsToSend);
         queueControl(*it->second, FrameType::Credit, channel, count, sizeof count);

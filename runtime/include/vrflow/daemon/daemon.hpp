@@ -40,10 +40,21 @@ struct DaemonOptions {
   /// Index in the whole application of each of `application.connections` (this host's share);
   /// empty when the application given is the whole one.
   std::vector<uint32_t> connectionChannels;
+  /// Opt-in busy wait (ns) of the daemon and its modules before they sleep for a message, at
+  /// most kMaxSpinNs; -1: from $VRFLOW_SPIN_US (microseconds), 0 when unset.
+  int64_t spinNs = -1;
 };
 
 /// The prefix of each module's object ids in `application` (msg::idPrefixes of its module ids).
 std::map<std::string, uint32_t, std::less<>> idPrefixesOf(const app::Application& application);
+
+/// The longest opt-in spin: 1 ms.
+inline constexpr int64_t kMaxSpinNs = 1'000'000;
+
+/// The spin a daemon uses when DaemonOptions::spinNs is -1: $VRFLOW_SPIN_US in ns, 0 when the
+/// variable is unset or empty; an error naming the variable when it is not a whole number of
+/// microseconds from 0 to 1000.
+Result<int64_t> spinFromEnvironment();
 
 /// A module the daemon serves: what to start and where its shared state lives.
 struct ModuleProcess {

@@ -19,6 +19,12 @@ struct Doorbell {
 
   /// Wakes every sleeper.
   void ring();
+
+  /// Busy-waits up to spinNs for a ring after prepare() returned `seen`, without sleeping; true
+  /// when it was rung meanwhile. The opt-in spin before sleep() (VRFLOW_SPIN_US,
+  /// docs/shared-memory.md): it saves the futex wake-up when the ringer comes soon, at the cost
+  /// of a busy core while it lasts.
+  bool spin(uint32_t seen, int64_t spinNs) const;
 };
 
 static_assert(std::atomic<uint32_t>::is_always_lock_free);

@@ -30,7 +30,8 @@ class PortSlot {
   uint8_t stampsOnly = 0;
   uint8_t pad = 0;
   std::atomic<uint32_t> closed{0};      ///< input: no message will ever come again
-  std::atomic<uint32_t> wantsSpace{0};  ///< input: the daemon waits for room on this ring
+  std::atomic<uint32_t> wantsSpace{0};  ///< who waits for room on this ring: input, the daemon;
+                                        ///< output, the module
   uint64_t ringOffset = 0;              ///< input: daemon -> module; output: module -> daemon
   std::atomic<uint64_t> messages{0};
   std::atomic<uint64_t> bytes{0};

@@ -48,6 +48,20 @@ class ModuleSlotDaemon {
     slot_->ports[port].wantsSpace.store(1, std::memory_order_seq_cst);
     std::atomic_thread_fence(std::memory_order_seq_cst);
   }
+  /// Says that the daemon took messages from output `port`: wakes the module only if it sleeps
+  /// in put() for room on that ring (most puts find room; waking a module that waits for its
+  /// inputs would cost a futex call and a context switch on the latency path for nothing).
+  void outputDrained(int port) const {
+    std::atomic_thread_fence(std::memory_order_seq_cst);  // the pop before the flag's load
+    auto& wants = slot_->ports[port].wantsSpace;
+    if (wants.load(std::memory_order_seq_cst) != 0 && wants.exchange(0) != 0) slot_->bell.ring();
+  }
+  /// True while the module sleeps (or is about to) in put() for room on output `port`.
+  bool waitsForRoom(int port) const {
+    return slot_->ports[port].wantsSpace.load(std::memory_order_seq_cst) != 0;
+  }
+  /// How often the module's doorbell was rung (wake-ups, also of a module that was awake).
+  uint32_t rings() const { return slot_->bell.prepare(); }
   /// Asks the module to end (EndCause::Unneeded) and wakes it.
   void markUnneeded() const {
     slot_->unneeded.store(1, std::memory_order_release);

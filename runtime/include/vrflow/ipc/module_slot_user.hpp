@@ -93,6 +93,10 @@ class ModuleSlotUser {
     while (!out.push(handle)) {
       const uint32_t seen = slot_->bell.prepare();
       if (stopRequested()) return false;
+      // Ask the daemon to ring once it drains this ring, then look again: it may have drained
+      // it before it could see the request (ModuleSlotDaemon::outputDrained).
+      slot.wantsSpace.store(1, std::memory_order_seq_cst);
+      std::atomic_thread_fence(std::memory_order_seq_cst);
       if (out.push(handle)) break;
       slot_->bell.sleep(seen, pollNs);
     }
@@ -109,12 +113,19 @@ class ModuleSlotUser {
     PortSlot& slot = slot_->ports[port];
     Ring& in = ring(port);
     setState(ModuleState::Waiting, port);
+    // The opt-in spin, once per take(): bounded, then the module sleeps as usual.
+    int64_t spinNs = segment_->header().spinNs;
     for (;;) {
       const uint32_t seen = slot_->bell.prepare();
       if (stopRequested()) return Take::RunStopped;
       if (unneeded()) return Take::Unneeded;
       if (in.pop(handle)) break;
       if (slot.closed.load(std::memory_order_acquire) != 0 && in.empty()) return Take::EndOfInput;
+      if (spinNs > 0) {
+        const bool rung = slot_->bell.spin(seen, spinNs);
+        spinNs = 0;
+        if (rung) continue;
+      }
       slot_->bell.sleep(seen, pollNs);
     }
     // Room freed on this ring: wake the daemon only if it is waiting for it.

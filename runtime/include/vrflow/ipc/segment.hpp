@@ -38,6 +38,9 @@ struct alignas(64) SegmentHeader {
   std::atomic<uint64_t> peakInUseBytes{0};
   std::atomic<uint64_t> failedAllocations{0};  ///< allocate() calls that found no room
   uint64_t controlOffset = 0;                  ///< where the run's control table starts (0: none)
+  /// Busy wait before sleeping on a doorbell, ns (VRFLOW_SPIN_US; 0: none). Set by the daemon
+  /// before any module starts.
+  int64_t spinNs = 0;
   std::atomic<uint64_t> freeHeads[kBlockClasses];  ///< Treiber stacks, tagged against ABA
 };
 
