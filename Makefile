@@ -15,7 +15,8 @@ PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-r
   nlohmann-json3-dev libxxhash-dev libzstd-dev libzmq3-dev libopenmpi-dev openmpi-bin libxml2-utils procps \
   libbullet-dev libeigen3-dev libevdev-dev libosmesa6-dev libglfw3-dev xvfb xdotool libpng-dev qt6-base-dev libgraphviz-dev \
   libsodium-dev openssh-server openssh-client clang-format dpkg-dev libspdlog-dev \
-  munge slurmctld slurmd slurm-client python3-jsonschema bsdutils libopenvdb-dev libboost-dev libtbb-dev
+  munge slurmctld slurmd slurm-client python3-jsonschema bsdutils libopenvdb-dev libboost-dev libtbb-dev \
+  pybind11-dev python3-dev python3-numpy python3-pytest
 
 .PHONY: deps build test check format demo clean install
 
