@@ -137,3 +137,16 @@ def test_a_module_started_outside_a_run_cannot_join_and_says_so():
                           timeout=60)
     assert done.returncode == 1
     assert "vrflow._module.Error" in done.stderr
+
+
+def test_wait_releases_the_gil_so_python_threads_run_while_a_module_waits(tmp_path, package):
+    app = application(tmp_path, package, [("p", "producer", {"period": 0.2}),
+                                          ("t", "ticker", {"out": tmp_path / "ticks.txt"})],
+                      [("p.out", "t.in")])
+    result = run(tmp_path, app, "--iterations", "4")
+    assert result.code == 0, result.stderr
+    counts = [int(x) for x in (tmp_path / "ticks.txt").read_text().split()]
+    assert len(counts) == 4
+    # Each wait after the first lasts about the producer's 0.2 s; a thread that sleeps 1 ms per
+    # tick counts far more than 10 in it, and 0 if wait() held the GIL.
+    assert all(c > 10 for c in counts[1:]), counts

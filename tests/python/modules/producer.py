@@ -1,5 +1,7 @@
 """Sends every chunk kind; the raw resource is written in place through a NumPy view."""
 
+import time
+
 import numpy as np
 
 import common  # noqa: F401  (registers the object type)
@@ -11,7 +13,9 @@ module.init()
 params = module.params
 size = params["resource-bytes"]
 scale = params["scale"]
+period = params["period"]
 while module.wait():
+    time.sleep(period)
     i = module.iteration
     message = module.new_message(size_hint=size + 4096)
     message.add_stamp("label", params["label"])
