@@ -148,5 +148,5 @@ def test_wait_releases_the_gil_so_python_threads_run_while_a_module_waits(tmp_pa
     counts = [int(x) for x in (tmp_path / "ticks.txt").read_text().split()]
     assert len(counts) == 4
     # Each wait after the first lasts about the producer's 0.2 s; a thread that sleeps 1 ms per
-    # tick counts far more than 10 in it, and 0 if wait() held the GIL.
-    assert all(c > 10 for c in counts[1:]), counts
+    # tick counts dozens in it even on a loaded machine, and 0 if wait() held the GIL.
+    assert all(c > 3 for c in counts[1:]), counts
