@@ -2,6 +2,7 @@
 #include <bit>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 #include "daemon_impl.hpp"
@@ -40,6 +41,20 @@ std::vector<std::string> scriptEnvironment() {
   }
   environment.push_back("PYTHONPATH=" + path);
   return environment;
+}
+
+// A script module's interpreter: the manifest's, except that the default `python3`, run from a
+// build tree, is the interpreter the build's `vrflow` package was built for (its path is in
+// build/python/vrflow/interpreter.txt), which another python3 first on PATH may not be.
+std::string scriptInterpreter(const std::string& interpreter) {
+  if (interpreter != "python3") return interpreter;
+  const std::filesystem::path bin = executableDir();
+  if (bin.empty()) return interpreter;
+  std::ifstream in(bin.parent_path() / "python" / "vrflow" / "interpreter.txt");
+  std::string path;
+  std::error_code error;
+  if (std::getline(in, path) && std::filesystem::is_regular_file(path, error)) return path;
+  return interpreter;
 }
 
 }  // namespace
@@ -111,6 +126,7 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     }
     modules.push_back({module.id, host, type->executable, {}, {}, static_cast<int>(m)});
     if (!type->script.empty()) {
+      modules.back().executable = scriptInterpreter(type->executable);
       modules.back().arguments = {type->script};
       modules.back().environment = scriptEnvironment();
     }
