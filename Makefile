@@ -16,7 +16,7 @@ PACKAGES := build-essential cmake ninja-build ccache pkg-config clang libclang-r
   libbullet-dev libeigen3-dev libevdev-dev libosmesa6-dev libglfw3-dev xvfb xdotool libpng-dev qt6-base-dev libgraphviz-dev \
   libsodium-dev openssh-server openssh-client clang-format dpkg-dev libspdlog-dev \
   munge slurmctld slurmd slurm-client python3-jsonschema bsdutils libopenvdb-dev libboost-dev libtbb-dev \
-  pybind11-dev python3-dev python3-pytest
+  pybind11-dev python3-dev python3-numpy python3-pytest
 
 .PHONY: deps build test check format demo clean install
 

@@ -169,6 +169,29 @@ TEST(MessageBuilder, ReportsASinkThatCannotGrow) {
   EXPECT_EQ(starved.finish(), 0u);
 }
 
+TEST(MessageBuilder, RawResourceFilledInPlaceReadsBackAsWritten) {
+  VectorSink sink(64);
+  MessageBuilder builder(sink);
+  const std::span<std::byte> body = builder.addRawResourceInPlace(5, true, 13);
+  ASSERT_EQ(body.size(), 13u);
+  for (std::size_t i = 0; i < body.size(); ++i) body[i] = static_cast<std::byte>(i * 3);
+  ASSERT_NE(builder.finish(), 0u);
+  const auto view = MessageView::parse(builder.bytes());
+  ASSERT_TRUE(view) << view.error().message;
+  const auto resource = view->begin()->asResource();
+  ASSERT_TRUE(resource);
+  EXPECT_EQ(resource->id(), 5u);
+  EXPECT_EQ(resource->kind(), ResourceKind::Raw);
+  EXPECT_TRUE(resource->dynamic());
+  ASSERT_EQ(resource->raw().size(), 13u);
+  for (std::size_t i = 0; i < 13; ++i) EXPECT_EQ(resource->raw()[i], static_cast<std::byte>(i * 3));
+
+  BoundedSink small(128);
+  MessageBuilder starved(small);
+  EXPECT_TRUE(starved.addRawResourceInPlace(1, false, 1000).empty());
+  EXPECT_TRUE(starved.failed());
+}
+
 TEST(MessageBuilder, ReusedSinkBuildsMessagesWithoutAllocating) {
   VectorSink sink(4096);
   MessageBuilder builder(sink);

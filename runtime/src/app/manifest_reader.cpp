@@ -141,13 +141,48 @@ void resolveExecutable(ModuleType& type, const std::string& executable,
   }
 }
 
+// What starts a module of this type: a program (`executable`), or a script (`script`, resolved
+// against the manifest's folder) run by its `interpreter` (default python3, looked up on PATH
+// when the module starts; docs/python.md).
+void readProgram(const ReadContext& context, const ElementReader& reader, ModuleType& type) {
+  const bool hasScript = reader.has("script");
+  if (!hasScript) {
+    if (reader.has("interpreter")) {
+      context.error(reader.loc(), "interpreter is set on '" + type.type +
+                                      "', which has no script: set script=\"FILE.py\" or "
+                                      "remove interpreter");
+    }
+    resolveExecutable(type, reader.required("executable"), context.source.file());
+    return;
+  }
+  if (reader.has("executable")) {
+    context.error(reader.loc(), "module type '" + type.type +
+                                    "' sets both executable and script: keep one (a script "
+                                    "runs with its interpreter)");
+  }
+  const std::string script = reader.required("script");
+  const std::string interpreter = reader.text("interpreter", "python3");
+  if (interpreter.empty()) {
+    context.error(reader.loc(), "interpreter of '" + type.type + "' is empty");
+  }
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path folder =
+      fs::absolute(fs::path(context.source.file()), ec).parent_path().lexically_normal();
+  type.script =
+      fs::path(script).is_absolute() ? script : (folder / script).lexically_normal().string();
+  type.executable = interpreter;
+}
+
 ModuleType readModuleType(const ReadContext& context, const pugi::xml_node& node,
                           const std::string& package) {
-  const ElementReader reader(context, node, {"type", "executable", "kind", "mpi-ranks", "mpi-job"});
+  const ElementReader reader(
+      context, node,
+      {"type", "executable", "script", "interpreter", "kind", "mpi-ranks", "mpi-job"});
   ModuleType type;
   type.package = package;
   type.type = reader.required("type");
-  resolveExecutable(type, reader.required("executable"), context.source.file());
+  readProgram(context, reader, type);
   type.kind = reader.keyword("kind", ModuleKind::Other, parseModuleKind,
                              "animator, interactor, viewer, input, other");
   type.loc = reader.loc();

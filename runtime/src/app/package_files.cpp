@@ -66,6 +66,15 @@ void checkExecutable(const ModuleType& type, const Module& module,
                             "layout's bin folder or beside this program; looked in " + folders});
     return;
   }
+  if (!type.script.empty()) {  // run by its interpreter, looked up on PATH as it starts
+    if (::access(type.script.c_str(), R_OK) == 0) return;
+    const std::string reason = std::strerror(errno);
+    problems.push_back({module.loc, Diagnostic::Error,
+                        moduleLabel(module) + ": cannot read its script " +
+                            quotedValue(type.script) + " (" + reason + "), resolved from " +
+                            manifest + " against the manifest's folder"});
+    return;
+  }
   if (type.executable.find('/') == std::string::npos) return;  // a manifest without a file
   if (::access(type.executable.c_str(), X_OK) == 0) return;
   const std::string reason = std::strerror(errno);

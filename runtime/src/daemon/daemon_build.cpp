@@ -2,9 +2,11 @@
 #include <bit>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 #include "daemon_impl.hpp"
+#include "vrflow/base/executable_dir.hpp"
 #include "vrflow/daemon/filter_registry.hpp"
 #include "vrflow/daemon/filter_spec.hpp"
 #include "vrflow/message/ids.hpp"
@@ -20,6 +22,40 @@ constexpr uint32_t kInputRingCapacity = 16;
 // Who a filter node's parameters belong to, as their errors name it.
 std::string filterOwner(const std::string& id, const std::string& type) {
   return "filter '" + id + "' (" + type + ")";
+}
+
+// A script module's environment: its lines reach the log as printed, and it finds the `vrflow`
+// Python package of this build (build/python beside build/bin, put first on PYTHONPATH); an
+// installed vrflow's package is in the interpreter's site-packages, found without help.
+std::vector<std::string> scriptEnvironment() {
+  std::vector<std::string> environment{"PYTHONUNBUFFERED=1"};
+  const std::filesystem::path bin = executableDir();
+  if (bin.empty()) return environment;
+  const std::filesystem::path python = bin.parent_path() / "python";
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(python / "vrflow" / "__init__.py", error)) {
+    return environment;
+  }
+  std::string path = python.string();
+  if (const char* inherited = std::getenv("PYTHONPATH"); inherited != nullptr && *inherited) {
+    path += ":" + std::string(inherited);
+  }
+  environment.push_back("PYTHONPATH=" + path);
+  return environment;
+}
+
+// A script module's interpreter: the manifest's, except that the default `python3`, run from a
+// build tree, is the interpreter the build's `vrflow` package was built for (its path is in
+// build/python/vrflow/interpreter.txt), which another python3 first on PATH may not be.
+std::string scriptInterpreter(const std::string& interpreter) {
+  if (interpreter != "python3") return interpreter;
+  const std::filesystem::path bin = executableDir();
+  if (bin.empty()) return interpreter;
+  std::ifstream in(bin.parent_path() / "python" / "vrflow" / "interpreter.txt");
+  std::string path;
+  std::error_code error;
+  if (std::getline(in, path) && std::filesystem::is_regular_file(path, error)) return path;
+  return interpreter;
 }
 
 }  // namespace
@@ -106,7 +142,12 @@ Status Daemon::Impl::build(const app::Application& application, const app::Catal
     if (options.trace) {
       if (auto status = slot.addTraceRing(); !status) return status.error();
     }
-    modules.push_back({module.id, host, type->executable, static_cast<int>(m)});
+    modules.push_back({module.id, host, type->executable, {}, {}, static_cast<int>(m)});
+    if (!type->script.empty()) {
+      modules.back().executable = scriptInterpreter(type->executable);
+      modules.back().arguments = {type->script};
+      modules.back().environment = scriptEnvironment();
+    }
 
     // Parameters: typed once, the file's values over the manifest's defaults.
     auto moduleParams =

@@ -197,6 +197,14 @@ void MessageBuilder::addRawResource(std::uint64_t id, bool dynamic,
   if (body != nullptr && !bytes.empty()) std::memcpy(body, bytes.data(), bytes.size());
 }
 
+std::span<std::byte> MessageBuilder::addRawResourceInPlace(std::uint64_t id, bool dynamic,
+                                                           std::size_t size) {
+  std::byte* body = appendChunk(ChunkKind::Resource, dynamic ? kResourceDynamic : std::uint8_t{0},
+                                static_cast<std::uint16_t>(ResourceKind::Raw), id, 0, size);
+  if (body == nullptr) return {};
+  return {body, size};
+}
+
 void MessageBuilder::addMesh(std::uint64_t id, bool dynamic, std::span<const float> xyz,
                              std::span<const std::uint32_t> indices) {
   VRFLOW_ASSERT(xyz.size() % 3 == 0, "a mesh has 3 coordinates per vertex");

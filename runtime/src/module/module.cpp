@@ -187,7 +187,11 @@ Module::Module() : impl_(std::make_unique<Impl>()) {
 }
 
 Module::~Module() {
-  if (!impl_->slot.joined()) return;
+  leave();
+}
+
+void Module::leave() {
+  if (!impl_->slot.joined() || impl_->finished) return;
   // Leaving the loop ends the iteration in progress: it counts (docs/module-api.md).
   if (impl_->inIteration) impl_->endIteration();
   impl_->finish(ipc::EndCause::LeftLoop);

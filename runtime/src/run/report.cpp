@@ -127,6 +127,8 @@ nlohmann::ordered_json reportHead(const app::Application& application, const Run
   report["status"] = outcome.status;
   report["exit_code"] = outcome.exitCode;
   report["error"] = outcome.error;
+  // The failed module's last lines (a Python module's traceback), as printed after the error.
+  if (!outcome.detail.empty()) report["error_detail"] = outcome.detail;
   report["iterations_requested"] = iterationsRequested;
   return report;
 }

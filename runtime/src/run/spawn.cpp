@@ -22,11 +22,18 @@ namespace vrflow::run {
 Result<pid_t> spawnModule(const std::string& executable, const std::vector<std::string>& args,
                           int inheritFd, const std::vector<std::string>& extraEnvironment,
                           uint64_t memoryLimitBytes, int outputFd) {
+  // An entry given here replaces the inherited one of the same name (a lookup takes the first).
+  const auto overridden = [&](std::string_view entry) {
+    const std::string_view name = entry.substr(0, entry.find('=') + 1);
+    return std::any_of(extraEnvironment.begin(), extraEnvironment.end(),
+                       [&](const std::string& e) { return e.starts_with(name); });
+  };
   std::vector<std::string> envStrings;
   for (char** e = environ; *e != nullptr; ++e) {
     if (ipc::JoinContract::isContractEntry(*e)) {
       continue;  // ours are set below; inherited ones would shadow them or join a wrong run
     }
+    if (overridden(*e)) continue;
     envStrings.emplace_back(*e);
   }
   for (const auto& e : extraEnvironment) envStrings.push_back(e);

@@ -260,9 +260,11 @@ RunOutcome Supervisor::run() {
     }
     const int output = outputPipe({logIndex_[i]}, viaMpirun, outcome);
     if (output < 0) break;
+    std::vector<std::string> environment = contract.encode();
+    environment.insert(environment.end(), module.environment.begin(), module.environment.end());
     auto pid = viaMpirun ? spawnMpiModule(module.executable, module.mpiRanks, contract, *backing,
                                           options_.moduleMemoryBytes, output)
-                         : spawnModule(module.executable, {}, fd, contract.encode(),
+                         : spawnModule(module.executable, module.arguments, fd, environment,
                                        options_.moduleMemoryBytes, output);
     close(output);
     if (!pid) {

@@ -71,6 +71,10 @@ struct ModuleType {
   /// The folders a bare name was looked for in when none held it (checkModuleFiles() reports
   /// them); empty when `executable` was resolved.
   std::vector<std::string> executableSearched;
+  /// A script module's script (manifest attribute `script`), absolute; empty for a program.
+  /// `executable` is then the script's interpreter (attribute `interpreter`, default python3),
+  /// looked up on PATH when the module starts (docs/python.md).
+  std::string script;
   ModuleKind kind = ModuleKind::Other;
   /// Empty, or the name of an int parameter: when a module's value of it is N > 1, the runtime
   /// starts the module as N MPI ranks through `mpirun` (rank 0 is the module vrflow talks to;

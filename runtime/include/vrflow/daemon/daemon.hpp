@@ -61,6 +61,12 @@ struct ModuleProcess {
   std::string id;
   std::string host;
   std::string executable;
+  /// Arguments after the executable: a script module's script (its executable is the
+  /// interpreter).
+  std::vector<std::string> arguments;
+  /// Environment entries set for the module over the inherited ones (a script module's
+  /// PYTHONPATH to this build's `vrflow` package).
+  std::vector<std::string> environment;
   int slotIndex = 0;
   /// Above 1: started as this many MPI ranks through mpirun (app::ModuleType::mpiRanksParam).
   int mpiRanks = 1;

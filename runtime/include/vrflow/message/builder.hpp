@@ -61,6 +61,10 @@ class MessageBuilder {
   void addDelete(std::uint64_t id, std::uint32_t typeId);
   /// Adds an opaque resource.
   void addRawResource(std::uint64_t id, bool dynamic, std::span<const std::byte> bytes);
+  /// Adds an opaque resource of `size` bytes and returns its body to fill in place (zero copy:
+  /// the data is written straight into the message, its bytes are not cleared). The span is
+  /// valid until the next chunk is added; empty when the sink could not grow.
+  std::span<std::byte> addRawResourceInPlace(std::uint64_t id, bool dynamic, std::size_t size);
   /// Adds a triangle mesh: xyz holds 3 floats per vertex, indices 3 per triangle, each index
   /// below the vertex count.
   void addMesh(std::uint64_t id, bool dynamic, std::span<const float> xyz,

@@ -111,6 +111,12 @@ class Module {
   /// A new object or resource id, unique in the run and independent of placement.
   uint64_t newId();
 
+  /// Leaves the loop now, as destroying the Module does: the iteration in progress counts, the
+  /// run reports "left its loop" and wait() returns false from then on. Messages still held
+  /// stay readable until the Module is destroyed (for language bindings, whose objects may
+  /// outlive the loop).
+  void leave();
+
   /// What main() should return: 1 if an error was reported (e.g. shared memory exhausted in
   /// put()), else 0. A put() that fails because the run stops is not an error.
   int exitStatus() const;
