@@ -24,6 +24,8 @@ const std::vector<std::pair<std::string, std::string>> kSkippedCommands = {
     {"ffmpeg", "needs ffmpeg and the viewer's videos (routed_wall)"},
     {"cd routed-wall", "only to run ffmpeg on the videos (routed_wall)"},
     {"build/bin/vrflow-bench-patterns", "a benchmark (bench/patterns runs it)"},
+    {"../../build/bin/vrflow run ../../examples/interactive/interactive_window.xml",
+     "opens a window for a person's mouse (tests/input runs it under Xvfb)"},
 };
 
 constexpr int kMaxIterations = 20;
