@@ -105,6 +105,19 @@ std::string missingNodePackage(const std::string& example) {
   return {};
 }
 
+// True when the example's own package declares Python script modules (script="...").
+bool usesPythonModules(const std::string& example) {
+  const std::string manifest = sourceDir() + "/examples/" + example + "/vrflow-package.xml";
+  return std::filesystem::exists(manifest) &&
+         readFile(manifest).find("script=\"") != std::string::npos;
+}
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
 class ExampleReadme : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ExampleReadme, CommandsRunAsWrittenFromTheRepositoryRoot) {
@@ -113,6 +126,10 @@ TEST_P(ExampleReadme, CommandsRunAsWrittenFromTheRepositoryRoot) {
   ASSERT_FALSE(blocks.empty()) << "no command in examples/" << example << "/README.md";
   if (const std::string missing = missingNodePackage(example); !missing.empty()) {
     GTEST_SKIP() << "this build has no node package '" << missing << "' (VRFLOW_NODES=OFF)";
+  }
+  if (kSanitized && usesPythonModules(example)) {
+    GTEST_SKIP() << "Python modules: the interpreter cannot load the sanitized vrflow._module "
+                    "(the sanitizer's runtime must come first in the process)";
   }
   TempDir root;
   std::filesystem::create_directory_symlink(std::filesystem::path(binDir()).parent_path(),
