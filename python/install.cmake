@@ -1,11 +1,14 @@
 # `cmake --install build --prefix P` (and `make install PREFIX=P`) puts the Python package
-# vrflow into the interpreter's site-packages under P: P/lib/python3.X/site-packages/vrflow
-# (VRFLOW_PYTHON_INSTALL_DIR, relative to the prefix, names another). The installed package
+# vrflow into the interpreter's package folder under P: with Debian's python3 (it has the
+# deb_system scheme) P/lib/python3/dist-packages/vrflow, which Debian's interpreter searches
+# when P is /usr (the .deb); with another interpreter its posix_prefix purelib,
+# P/lib/python3.X/site-packages/vrflow. VRFLOW_PYTHON_INSTALL_DIR, relative to the prefix,
+# names another folder. The installed package
 # finds P/bin (its programs) through _layout.py, relative, so the tree stays relocatable.
 if(NOT VRFLOW_PYTHON_INSTALL_DIR)
   execute_process(
     COMMAND ${Python3_EXECUTABLE} -c
-      "import sysconfig; print(sysconfig.get_path('purelib', 'posix_prefix', vars={'base': '', 'platbase': ''}).lstrip('/'))"
+      "import sysconfig; s = 'deb_system' if 'deb_system' in sysconfig.get_scheme_names() else 'posix_prefix'; print(sysconfig.get_path('purelib', s, vars={'base': '', 'platbase': ''}).lstrip('/'))"
     OUTPUT_VARIABLE vrflow_python_site OUTPUT_STRIP_TRAILING_WHITESPACE COMMAND_ERROR_IS_FATAL ANY)
   set(VRFLOW_PYTHON_INSTALL_DIR ${vrflow_python_site} CACHE STRING
     "Folder of the Python package vrflow in an installed tree, relative to the prefix")

@@ -26,6 +26,12 @@ for file in ./usr/bin/vrflow ./usr/bin/vrflow-daemon ./usr/bin/vrflow-core-point
   grep -qxF "$file" "$WORK/contents" || fail "the .deb lacks $file"
 done
 if grep -q '^./usr/include/vrflow/run/' "$WORK/contents"; then fail "the .deb holds internal headers"; fi
+# The Python package goes where Debian's python3 looks under /usr: /usr/lib/python3/dist-packages.
+if grep -q '^VRFLOW_PYTHON:BOOL=ON' "$VRFLOW_BUILD_DIR/CMakeCache.txt" &&
+  /usr/bin/python3 -c 'import sysconfig, sys; sys.exit("deb_system" not in sysconfig.get_scheme_names())'; then
+  grep -qxF ./usr/lib/python3/dist-packages/vrflow/app.py "$WORK/contents" ||
+    fail "the .deb lacks ./usr/lib/python3/dist-packages/vrflow/app.py: $(grep -m3 'vrflow/app.py' "$WORK/contents")"
+fi
 
 dpkg-deb -x "$deb" "$WORK/root"
 R=$WORK/root/usr
