@@ -72,10 +72,7 @@ class CanvasWindow : public ::testing::Test {
   QPoint at(QPointF scenePos) const { return canvas()->mapFromScene(scenePos); }
 
   void mouse(QEvent::Type type, QPoint pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
-    QWidget* viewport = canvas()->viewport();
-    QMouseEvent event(type, QPointF(pos), viewport->mapToGlobal(QPointF(pos)), button, buttons,
-                      Qt::NoModifier);
-    QApplication::sendEvent(viewport, &event);
+    sendMouse(canvas(), type, pos, button, buttons);
   }
 
   // Presses the left button at one scene point, moves in steps, releases at another;

@@ -54,10 +54,7 @@ class CanvasInteraction : public ::testing::Test {
   QPoint view(QPointF scene) const { return canvas()->mapFromScene(scene); }
 
   void mouse(QEvent::Type type, QPoint pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
-    QWidget* viewport = canvas()->viewport();
-    QMouseEvent event(type, QPointF(pos), viewport->mapToGlobal(QPointF(pos)), button, buttons,
-                      Qt::NoModifier);
-    QApplication::sendEvent(viewport, &event);
+    sendMouse(canvas(), type, pos, button, buttons);
   }
 
   // Presses the left button at one scene point, moves in steps, releases at another.

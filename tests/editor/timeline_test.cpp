@@ -33,9 +33,7 @@ class Timeline : public LiveWindow {
 
   void mouse(TimelineView* view, QEvent::Type type, QPoint at, Qt::MouseButton button,
              Qt::MouseButtons buttons) {
-    QMouseEvent event(type, QPointF(at), view->viewport()->mapToGlobal(QPointF(at)), button,
-                      buttons, Qt::NoModifier);
-    QApplication::sendEvent(view->viewport(), &event);
+    sendMouse(view, type, at, button, buttons);
     QApplication::processEvents();
   }
 

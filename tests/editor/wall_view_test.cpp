@@ -48,10 +48,7 @@ class WallViewTest : public ::testing::Test {
   }
 
   void mouse(QEvent::Type type, QPoint pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
-    QWidget* viewport = canvas()->viewport();
-    QMouseEvent event(type, QPointF(pos), viewport->mapToGlobal(QPointF(pos)), button, buttons,
-                      Qt::NoModifier);
-    QApplication::sendEvent(viewport, &event);
+    sendMouse(canvas(), type, pos, button, buttons);
   }
 
   void doubleClick(const std::string& node) {

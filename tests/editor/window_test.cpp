@@ -83,10 +83,7 @@ class EditorWindow : public ::testing::Test {
   Canvas* canvas() const { return window_->canvas(); }
 
   void mouse(QEvent::Type type, QPoint pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
-    QWidget* viewport = canvas()->viewport();
-    QMouseEvent event(type, QPointF(pos), viewport->mapToGlobal(QPointF(pos)), button, buttons,
-                      Qt::NoModifier);
-    QApplication::sendEvent(viewport, &event);
+    sendMouse(canvas(), type, pos, button, buttons);
   }
 
   // Presses the left button at one scene point, moves, releases at another.
