@@ -16,8 +16,10 @@
 // another build (DIR is its bin/ folder, e.g. the main branch's), as "network-baseline", in the
 // same rounds: before and after in one run.
 // One JSON line per result: {"variant": V, "objects": N, "iterations_per_s": X, ...};
-// network lines add "cpu_ms_per_iteration" (every process of the run, the daemon's included)
-// and the loop's its own.
+// lines add "cpu_ms_per_iteration" (for the network: every process of the run, the daemon's
+// included; for the loop: its thread) and the load average; network lines add
+// "cpu_of_monolithic", their CPU time over the loop's of the same round: what the network adds
+// in work, which a loaded machine disturbs less than the wall-clock ratio.
 #include <btBulletDynamicsCommon.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -318,6 +320,12 @@ Rate loopRate(Step&& step, int warm, int measured) {
   return Rate{measured / wall, 1e3 * (cpuSeconds(RUSAGE_THREAD) - cpuBefore) / measured};
 }
 
+// The 1-minute load average (other work on the machine), or -1.
+double loadAverage() {
+  double load[1];
+  return getloadavg(load, 1) == 1 ? load[0] : -1;
+}
+
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const std::size_t n = values.size();
@@ -385,7 +393,7 @@ int main(int argc, char** argv) {
     std::vector<Variant> variants{{"network", false, ctx.bin}};
     if (objects == 20) variants.push_back({"network-sequential", true, ctx.bin});
     if (!ctx.baseline.empty()) variants.push_back({"network-baseline", false, ctx.baseline});
-    std::map<std::string, std::vector<double>> ratios;
+    std::map<std::string, std::vector<double>> ratios, cpuRatios;
     for (int round = 0; round < rounds; ++round) {
       Monolithic mono;
       if (auto ok = mono.init(*bodies, objects == 20); !ok) {
@@ -393,9 +401,10 @@ int main(int argc, char** argv) {
         return 2;
       }
       const Rate monoRate = loopRate([&] { mono.step(); }, warm, measured);
-      char extra[160];
-      std::snprintf(extra, sizeof extra, ",\"cpu_ms_per_iteration\":%.3f,\"round\":%d",
-                    monoRate.cpuMsPerIteration, round);
+      char extra[200];
+      std::snprintf(extra, sizeof extra,
+                    ",\"cpu_ms_per_iteration\":%.3f,\"round\":%d,\"load_average\":%.1f",
+                    monoRate.cpuMsPerIteration, round, loadAverage());
       print("monolithic", objects, monoRate.perSecond, extra);
       for (const auto& variant : variants) {
         auto network = networkRate(ctx, variant.bin, objects, variant.sequential, warm, measured);
@@ -406,18 +415,21 @@ int main(int argc, char** argv) {
           continue;
         }
         const double ratio = network->perSecond / monoRate.perSecond;
+        const double cpuRatio = network->cpuMsPerIteration / monoRate.cpuMsPerIteration;
         ratios[variant.name].push_back(ratio);
+        cpuRatios[variant.name].push_back(cpuRatio);
         std::snprintf(extra, sizeof extra,
-                      ",\"of_monolithic\":%.3f,\"cpu_ms_per_iteration\":%.3f,\"round\":%d", ratio,
-                      network->cpuMsPerIteration, round);
+                      ",\"of_monolithic\":%.3f,\"cpu_ms_per_iteration\":%.3f,"
+                      "\"cpu_of_monolithic\":%.3f,\"round\":%d,\"load_average\":%.1f",
+                      ratio, network->cpuMsPerIteration, cpuRatio, round, loadAverage());
         print(variant.name, objects, network->perSecond, extra);
       }
     }
     for (const auto& [name, values] : ratios) {
       std::printf(
           "{\"variant\":\"%s\",\"objects\":%d,\"rounds\":%zu,"
-          "\"of_monolithic_median\":%.3f}\n",
-          name.c_str(), objects, values.size(), median(values));
+          "\"of_monolithic_median\":%.3f,\"cpu_of_monolithic_median\":%.3f}\n",
+          name.c_str(), objects, values.size(), median(values), median(cpuRatios[name]));
     }
     BulletWorld bullet;
     for (const rigid::Body& b : *bodies) bullet.add(b);
