@@ -212,11 +212,16 @@ TEST(MassSpringFormats, NodeForceEvents) {
             (std::vector<NodeForce>{{1, {1, 0, 0}}}));
 }
 
-TEST(MassSpringFormats, NetsTravelAsObjectChunksIntoASceneCopy) {
+// A 3 x 3 grid with the generator's defaults.
+Result<Net> smallGrid() {
   GridParams p;
   p.n = 3;
   p.m = 3;
-  auto net = generateGrid(p);
+  return generateGrid(p);
+}
+
+TEST(MassSpringFormats, NetsTravelAsObjectChunksIntoASceneCopy) {
+  auto net = smallGrid();
   ASSERT_TRUE(net);
   msg::VectorSink sink;
   msg::MessageBuilder builder(sink);
@@ -244,10 +249,7 @@ TEST(MassSpringFormats, NetsTravelAsObjectChunksIntoASceneCopy) {
 // Motion updates are written into the copy in place; one whose sizes disagree with the net is
 // still an error naming the net, and the copy keeps what it had.
 TEST(MassSpringFormats, AMotionUpdateOfTheWrongSizeLeavesTheSceneCopyAsItWas) {
-  GridParams p;
-  p.n = 3;
-  p.m = 3;
-  auto net = generateGrid(p);
+  auto net = smallGrid();
   ASSERT_TRUE(net);
   SceneCopy scene;
   auto apply = [&](auto write) {
