@@ -10,11 +10,22 @@
 //                  Bullet's soft bodies are another solver, so only the rigid part compares).
 // The scene of 20 objects is the demo's (rigid objects and the 20 x 20 net); 200 and 2000 are
 // the rigid package's `boxes:N` scenes (rigid bodies only, in all three forms).
-// One JSON line per result: {"variant": V, "objects": N, "iterations_per_s": X, ...}.
+// The network and the loop are measured alternately, `--rounds` times, so that a machine loaded
+// by other work slows both alike; each line says its round, and a last line per scene gives the
+// median of the rounds' ratios. `--baseline-bin DIR` also runs the network with the programs of
+// another build (DIR is its bin/ folder, e.g. the main branch's), as "network-baseline", in the
+// same rounds: before and after in one run.
+// One JSON line per result: {"variant": V, "objects": N, "iterations_per_s": X, ...};
+// lines add "cpu_ms_per_iteration" (for the network: every process of the run, the daemon's
+// included; for the loop: its thread) and the load average; network lines add
+// "cpu_of_monolithic", their CPU time over the loop's of the same round: what the network adds
+// in work, which a loaded machine disturbs less than the wall-clock ratio.
 #include <btBulletDynamicsCommon.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -45,9 +56,10 @@ constexpr double kDt = 0.01;
 const msg::Vec3 kGravity{0, -9.81, 0};
 
 struct Context {
-  fs::path bin;     // build/bin
-  fs::path source;  // the repository
-  fs::path work;    // scratch folder
+  fs::path bin;       // build/bin
+  fs::path baseline;  // another build's bin/, or empty
+  fs::path source;    // the repository
+  fs::path work;      // scratch folder
 };
 
 std::string quote(const std::string& s) {
@@ -108,14 +120,32 @@ Result<std::string> networkApp(const Context& ctx, int objects, bool sequential)
   return file.string();
 }
 
-// Wall time of `vrflow run` for `iterations`, from its report (spawning included).
-Result<double> runNetwork(const Context& ctx, const std::string& appFile, int iterations) {
+// CPU seconds (user + system) of `who` (RUSAGE_CHILDREN: every waited-for descendant).
+double cpuSeconds(int who) {
+  rusage usage{};
+  getrusage(who, &usage);
+  auto seconds = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6;
+  };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+struct Timing {
+  double wallSeconds = 0;
+  double cpuSeconds = 0;
+};
+
+// Wall time of `vrflow run` for `iterations`, from its report (spawning included), and the CPU
+// time of all its processes, with the programs of `bin`.
+Result<Timing> runNetwork(const Context& ctx, const fs::path& bin, const std::string& appFile,
+                          int iterations) {
   const fs::path report = ctx.work / "report.json";
   fs::remove(report);
   const std::string command = "cd " + quote(ctx.work.string()) + " && " +
-                              quote((ctx.bin / "vrflow").string()) + " run " + quote(appFile) +
-                              " -n " + std::to_string(iterations) + " --no-progress --report " +
+                              quote((bin / "vrflow").string()) + " run " + quote(appFile) + " -n " +
+                              std::to_string(iterations) + " --no-progress --report " +
                               quote(report.string()) + " > run.log 2>&1";
+  const double cpuBefore = cpuSeconds(RUSAGE_CHILDREN);
   if (const int status = std::system(command.c_str()); status != 0) {
     return makeError("vrflow run failed (status " + std::to_string(status) + "); see " +
                      (ctx.work / "run.log").string());
@@ -123,22 +153,27 @@ Result<double> runNetwork(const Context& ctx, const std::string& appFile, int it
   std::ifstream in(report);
   const auto json = nlohmann::json::parse(in, nullptr, false);
   if (json.is_discarded() || !json.contains("timing")) return makeError("unreadable report");
-  return json["timing"]["wall_s"].get<double>();
+  return Timing{json["timing"]["wall_s"].get<double>(), cpuSeconds(RUSAGE_CHILDREN) - cpuBefore};
 }
+
+struct Rate {
+  double perSecond = 0;
+  double cpuMsPerIteration = 0;
+};
 
 // Steady-state rate of the network: the difference of two runs of different lengths cancels the
 // start-up (spawning processes, loading the scene) and the shutdown.
-Result<double> networkRate(const Context& ctx, int objects, bool sequential, int warm,
-                           int measured) {
+Result<Rate> networkRate(const Context& ctx, const fs::path& bin, int objects, bool sequential,
+                         int warm, int measured) {
   auto appFile = networkApp(ctx, objects, sequential);
   if (!appFile) return appFile.error();
-  auto shorter = runNetwork(ctx, *appFile, warm);
+  auto shorter = runNetwork(ctx, bin, *appFile, warm);
   if (!shorter) return shorter.error();
-  auto longer = runNetwork(ctx, *appFile, warm + measured);
+  auto longer = runNetwork(ctx, bin, *appFile, warm + measured);
   if (!longer) return longer.error();
-  const double seconds = *longer - *shorter;
+  const double seconds = longer->wallSeconds - shorter->wallSeconds;
   if (seconds <= 0) return makeError("the longer run was not longer; the machine is too noisy");
-  return measured / seconds;
+  return Rate{measured / seconds, 1e3 * (longer->cpuSeconds - shorter->cpuSeconds) / measured};
 }
 
 // The same solvers in one loop: what one iteration of the network computes, in the network's
@@ -274,13 +309,27 @@ class BulletWorld {
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
 };
 
-// Steps `warm` times, then times `measured` steps.
+// Steps `warm` times, then times `measured` steps (wall and this thread's CPU time).
 template <typename Step>
-double loopRate(Step&& step, int warm, int measured) {
+Rate loopRate(Step&& step, int warm, int measured) {
   for (int i = 0; i < warm; ++i) step();
+  const double cpuBefore = cpuSeconds(RUSAGE_THREAD);
   const auto start = Clock::now();
   for (int i = 0; i < measured; ++i) step();
-  return measured / std::chrono::duration<double>(Clock::now() - start).count();
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  return Rate{measured / wall, 1e3 * (cpuSeconds(RUSAGE_THREAD) - cpuBefore) / measured};
+}
+
+// The 1-minute load average (other work on the machine), or -1.
+double loadAverage() {
+  double load[1];
+  return getloadavg(load, 1) == 1 ? load[0] : -1;
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n == 0 ? 0 : n % 2 == 1 ? values[n / 2] : (values[n / 2 - 1] + values[n / 2]) / 2;
 }
 
 void print(const std::string& variant, int objects, double rate, const std::string& extra = {}) {
@@ -294,9 +343,16 @@ void print(const std::string& variant, int objects, double rate, const std::stri
 int main(int argc, char** argv) {
   CLI::App cli{"vrflow-bench-scene: the demo scene as a network, in one loop, and in Bullet"};
   bool quick = false;
+  int rounds = 3;
+  std::string baseline;
   std::vector<int> sizes{20, 200, 2000};
   cli.add_flag("--quick", quick, "Few iterations, 20 and 200 objects (checks the benchmark runs)");
   cli.add_option("--objects", sizes, "Scene sizes: 20 (the demo scene), or N boxes");
+  cli.add_option("--rounds", rounds, "Network and loop measured alternately this many times")
+      ->check(CLI::Range(1, 100));
+  cli.add_option("--baseline-bin", baseline,
+                 "Another build's bin/ folder: its network runs as 'network-baseline'")
+      ->check(CLI::ExistingDirectory);
   CLI11_PARSE(cli, argc, argv);
   if (quick) sizes = {20, 200};
 
@@ -304,6 +360,14 @@ int main(int argc, char** argv) {
   ctx.bin = fs::canonical("/proc/self/exe").parent_path();
   ctx.source = VRFLOW_SOURCE_DIR;
   ctx.work = fs::temp_directory_path() / ("vrflow-bench-scene-" + std::to_string(::getpid()));
+  if (!baseline.empty()) {
+    ctx.baseline = fs::canonical(baseline);
+    if (!fs::exists(ctx.baseline / "vrflow")) {
+      std::fprintf(stderr, "vrflow-bench-scene: --baseline-bin %s: no 'vrflow' program there\n",
+                   baseline.c_str());
+      return 2;
+    }
+  }
   fs::create_directories(ctx.work);
 
   int failures = 0;
@@ -319,30 +383,57 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "vrflow-bench-scene: %s\n", bodies.error().message.c_str());
       return 2;
     }
-    Monolithic mono;
-    if (auto ok = mono.init(*bodies, objects == 20); !ok) {
-      std::fprintf(stderr, "vrflow-bench-scene: %s\n", ok.error().message.c_str());
-      return 2;
-    }
-    const double monoRate = loopRate([&] { mono.step(); }, warm, measured);
-    // The demo scene as shipped, and (20 objects) with every interactor sequential.
-    for (const bool sequential :
-         objects == 20 ? std::vector<bool>{false, true} : std::vector<bool>{false}) {
-      auto network = networkRate(ctx, objects, sequential, warm, measured);
-      if (!network) {
-        std::fprintf(stderr, "vrflow-bench-scene: network, %d objects: %s\n", objects,
-                     network.error().message.c_str());
-        ++failures;
-        continue;
+    // The networks of this scene: as the demo ships it, every interactor sequential (20
+    // objects), and the baseline build's.
+    struct Variant {
+      const char* name;
+      bool sequential;
+      fs::path bin;
+    };
+    std::vector<Variant> variants{{"network", false, ctx.bin}};
+    if (objects == 20) variants.push_back({"network-sequential", true, ctx.bin});
+    if (!ctx.baseline.empty()) variants.push_back({"network-baseline", false, ctx.baseline});
+    std::map<std::string, std::vector<double>> ratios, cpuRatios;
+    for (int round = 0; round < rounds; ++round) {
+      Monolithic mono;
+      if (auto ok = mono.init(*bodies, objects == 20); !ok) {
+        std::fprintf(stderr, "vrflow-bench-scene: %s\n", ok.error().message.c_str());
+        return 2;
       }
-      char extra[96];
-      std::snprintf(extra, sizeof extra, ",\"of_monolithic\":%.3f", *network / monoRate);
-      print(sequential ? "network-sequential" : "network", objects, *network, extra);
+      const Rate monoRate = loopRate([&] { mono.step(); }, warm, measured);
+      char extra[200];
+      std::snprintf(extra, sizeof extra,
+                    ",\"cpu_ms_per_iteration\":%.3f,\"round\":%d,\"load_average\":%.1f",
+                    monoRate.cpuMsPerIteration, round, loadAverage());
+      print("monolithic", objects, monoRate.perSecond, extra);
+      for (const auto& variant : variants) {
+        auto network = networkRate(ctx, variant.bin, objects, variant.sequential, warm, measured);
+        if (!network) {
+          std::fprintf(stderr, "vrflow-bench-scene: %s, %d objects: %s\n", variant.name, objects,
+                       network.error().message.c_str());
+          ++failures;
+          continue;
+        }
+        const double ratio = network->perSecond / monoRate.perSecond;
+        const double cpuRatio = network->cpuMsPerIteration / monoRate.cpuMsPerIteration;
+        ratios[variant.name].push_back(ratio);
+        cpuRatios[variant.name].push_back(cpuRatio);
+        std::snprintf(extra, sizeof extra,
+                      ",\"of_monolithic\":%.3f,\"cpu_ms_per_iteration\":%.3f,"
+                      "\"cpu_of_monolithic\":%.3f,\"round\":%d,\"load_average\":%.1f",
+                      ratio, network->cpuMsPerIteration, cpuRatio, round, loadAverage());
+        print(variant.name, objects, network->perSecond, extra);
+      }
     }
-    print("monolithic", objects, monoRate);
+    for (const auto& [name, values] : ratios) {
+      std::printf(
+          "{\"variant\":\"%s\",\"objects\":%d,\"rounds\":%zu,"
+          "\"of_monolithic_median\":%.3f,\"cpu_of_monolithic_median\":%.3f}\n",
+          name.c_str(), objects, values.size(), median(values), median(cpuRatios[name]));
+    }
     BulletWorld bullet;
     for (const rigid::Body& b : *bodies) bullet.add(b);
-    print("bullet-world", objects, loopRate([&] { bullet.step(); }, warm, measured),
+    print("bullet-world", objects, loopRate([&] { bullet.step(); }, warm, measured).perSecond,
           objects == 20 ? ",\"note\":\"rigid bodies only\"" : "");
   }
   std::error_code ignored;

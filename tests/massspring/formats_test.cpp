@@ -212,11 +212,16 @@ TEST(MassSpringFormats, NodeForceEvents) {
             (std::vector<NodeForce>{{1, {1, 0, 0}}}));
 }
 
-TEST(MassSpringFormats, NetsTravelAsObjectChunksIntoASceneCopy) {
+// A 3 x 3 grid with the generator's defaults.
+Result<Net> smallGrid() {
   GridParams p;
   p.n = 3;
   p.m = 3;
-  auto net = generateGrid(p);
+  return generateGrid(p);
+}
+
+TEST(MassSpringFormats, NetsTravelAsObjectChunksIntoASceneCopy) {
+  auto net = smallGrid();
   ASSERT_TRUE(net);
   msg::VectorSink sink;
   msg::MessageBuilder builder(sink);
@@ -239,6 +244,40 @@ TEST(MassSpringFormats, NetsTravelAsObjectChunksIntoASceneCopy) {
   ASSERT_TRUE(updateView);
   ASSERT_TRUE(scene.apply(*updateView));
   EXPECT_TRUE(scene.nets().at(42) == moved);
+}
+
+// Motion updates are written into the copy in place; one whose sizes disagree with the net is
+// still an error naming the net, and the copy keeps what it had.
+TEST(MassSpringFormats, AMotionUpdateOfTheWrongSizeLeavesTheSceneCopyAsItWas) {
+  auto net = smallGrid();
+  ASSERT_TRUE(net);
+  SceneCopy scene;
+  auto apply = [&](auto write) {
+    msg::VectorSink sink;
+    msg::MessageBuilder builder(sink);
+    write(builder);
+    builder.finish();
+    auto view = msg::MessageView::parse(builder.bytes());
+    EXPECT_TRUE(view) << view.error().message;
+    return scene.apply(*view);
+  };
+  ASSERT_TRUE(apply([&](msg::MessageBuilder& b) { writeNet(b, 42, *net, true); }));
+  Net moved = *net;
+  for (std::size_t i = 0; i < moved.positions.size(); ++i) moved.positions[i] += 0.25;
+  moved.velocities[7] = -3;
+  ASSERT_TRUE(apply([&](msg::MessageBuilder& b) { writeNet(b, 42, moved, false); }));
+  EXPECT_TRUE(scene.nets().at(42) == moved);  // masses, springs and surface kept
+  const std::vector<double> tooFew(moved.positions.size() - 3, 1.0);
+  const auto status = apply([&](msg::MessageBuilder& b) {
+    b.addObject(42, msg::massSpringType(), msg::ObjectOp::Update)
+        .set(msg::MassSpringParam::kPositions, std::span<const double>(tooFew));
+  });
+  ASSERT_FALSE(status);
+  EXPECT_NE(status.error().message.find("net 42: net: 9 masses but 24 position"), std::string::npos)
+      << status.error().message;
+  EXPECT_TRUE(scene.nets().at(42) == moved);
+  // An update of a net the copy never received is an error too (it has no masses).
+  EXPECT_FALSE(apply([&](msg::MessageBuilder& b) { writeNet(b, 43, moved, false); }));
 }
 
 TEST(MassSpringFormats, RigidsAndTheirShapeResourcesIntoASceneCopy) {

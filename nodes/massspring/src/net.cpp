@@ -64,18 +64,20 @@ Status validateNet(const Net& net) {
   }
   for (std::size_t s = 0; s < net.springs.size(); ++s) {
     const auto& sp = net.springs[s];
-    const std::string name = "net: spring " + std::to_string(s) + " ";
+    // The spring's name only for an error: this loop runs over every spring of every net read.
+    const auto name = [s] { return "net: spring " + std::to_string(s) + " "; };
     if (sp.a >= n || sp.b >= n)
-      return makeError(name + "joins a node out of range (" + std::to_string(n) + " nodes)");
-    if (sp.a == sp.b) return makeError(name + "joins node " + std::to_string(sp.a) + " to itself");
+      return makeError(name() + "joins a node out of range (" + std::to_string(n) + " nodes)");
+    if (sp.a == sp.b)
+      return makeError(name() + "joins node " + std::to_string(sp.a) + " to itself");
     if (!(sp.restLength > 0) || !std::isfinite(sp.restLength))
-      return makeError(name + "rest length must be finite and > 0");
+      return makeError(name() + "rest length must be finite and > 0");
     if (!(sp.stiffness >= 0) || !std::isfinite(sp.stiffness))
-      return makeError(name + "stiffness must be finite and >= 0");
+      return makeError(name() + "stiffness must be finite and >= 0");
     if (!(sp.damping >= 0) || !std::isfinite(sp.damping))
-      return makeError(name + "damping must be finite and >= 0");
+      return makeError(name() + "damping must be finite and >= 0");
     if (!(sp.maxStretch == 0 || (sp.maxStretch >= 1 && std::isfinite(sp.maxStretch)))) {
-      return makeError(name + "maxStretch must be 0 (no limit) or >= 1");
+      return makeError(name() + "maxStretch must be 0 (no limit) or >= 1");
     }
   }
   if (net.surface.size() % 3 != 0)

@@ -5,6 +5,28 @@
 #include "vrflow/message/builtin_types.hpp"
 
 namespace vrflow::massspring {
+namespace {
+
+// Applies an update that carries only positions, velocities and bounds, each of the net's size,
+// in place: no copy of the net and nothing else to check, since the message's parse already
+// rejected NaN and infinite numbers in a known type's parameters (docs/message-layout.md). This
+// is what a moving net sends every iteration. False, with `net` unchanged, for any other update.
+bool updateMotionInPlace(const msg::ObjectView& object, Net& net) {
+  using P = msg::MassSpringParam;
+  if (object.type() == nullptr) return false;  // not checked against the type: validate fully
+  for (const auto index : {P::kMasses, P::kPinned, P::kSprings, P::kSurface})
+    if (object.has(index)) return false;
+  const auto positions = object.doubleArray(P::kPositions);
+  const auto velocities = object.doubleArray(P::kVelocities);
+  if ((positions && positions->size() != net.positions.size()) ||
+      (velocities && velocities->size() != net.velocities.size()))
+    return false;
+  if (positions) positions->copyTo(std::span<double>(net.positions));
+  if (velocities) velocities->copyTo(std::span<double>(net.velocities));
+  return true;
+}
+
+}  // namespace
 
 void writeNet(msg::MessageBuilder& builder, std::uint64_t id, const Net& net, bool full) {
   using P = msg::MassSpringParam;
@@ -55,6 +77,10 @@ Status SceneCopy::apply(const msg::MessageView& message) {
       if (object->op() == msg::ObjectOp::Delete) {
         nets_.erase(object->id());
         continue;
+      }
+      if (object->op() == msg::ObjectOp::Update) {
+        const auto found = nets_.find(object->id());
+        if (found != nets_.end() && updateMotionInPlace(*object, found->second)) continue;
       }
       using P = msg::MassSpringParam;
       Net net = object->op() == msg::ObjectOp::Add ? Net{} : nets_[object->id()];
