@@ -150,9 +150,30 @@ void FluidSolver::Impl::classify(const std::vector<PreparedBody>& bodies) {
 void FluidSolver::Impl::dryBodiesOutOfLiquid(std::size_t bodyCount) {
   inLiquid.assign(bodyCount, 0.0);
   const int dims[3] = {grid.nx, grid.ny, grid.nz};
-  // Body cells of this block holding particles (outside the shape, inside the cell), and from
-  // each of its liquid cells the body cells beside it (kinds and cellBody are known one plane
-  // beyond the slab).
+  // "Down" is the axis and sign of gravity's largest component (none without gravity: every
+  // liquid neighbour then wets a body cell, whatever side it is on).
+  int downAxis = -1, downSign = 0;
+  double strongest = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double g = settings.gravity[static_cast<std::size_t>(a)];
+    if (std::abs(g) > strongest) {
+      strongest = std::abs(g);
+      downAxis = a;
+      downSign = g < 0.0 ? -1 : 1;
+    }
+  }
+  // Twice a liquid cell's particle count above particlesPerCell: its surface lies above its
+  // centre (the ghost-fluid surface sits (n / n0 - 0.5) cells from it).
+  const int halfFull = settings.particlesPerCell;
+  auto wets = [&](std::size_t liquidCell, int a, int side) {
+    if (a != downAxis) return 2 * particlesInCell[liquidCell] > halfFull;  // beside
+    return side == downSign;  // the liquid lies on the body cell, not under it
+  };
+  // A body cell holds liquid when particles lie in it (outside the shape, inside the cell), when
+  // a liquid cell lies on it, or when a liquid cell beside it is more than half full (the
+  // surface there is above the body cell's centre). A liquid cell under it only touches it from
+  // below: a body resting on the surface is dry. Each relation is judged by the block holding
+  // the liquid cell (kinds and cellBody are known one plane beyond the slab).
   for (int k = k0; k < k1; ++k) {
     for (int j = 0; j < grid.ny; ++j) {
       for (int i = 0; i < grid.nx; ++i) {
@@ -163,10 +184,10 @@ void FluidSolver::Impl::dryBodiesOutOfLiquid(std::size_t bodyCount) {
         if (kind[c] != detail::kLiquid) continue;
         const int idx[3] = {i, j, k};
         for (int a = 0; a < 3; ++a) {
-          if (idx[a] > 0 && kind[c - stride(a)] == detail::kBody) {
+          if (idx[a] > 0 && kind[c - stride(a)] == detail::kBody && wets(c, a, -1)) {
             inLiquid[static_cast<std::size_t>(cellBody[c - stride(a)])] = 1.0;
           }
-          if (idx[a] + 1 < dims[a] && kind[c + stride(a)] == detail::kBody) {
+          if (idx[a] + 1 < dims[a] && kind[c + stride(a)] == detail::kBody && wets(c, a, 1)) {
             inLiquid[static_cast<std::size_t>(cellBody[c + stride(a)])] = 1.0;
           }
         }
