@@ -26,11 +26,21 @@ struct Problem {
   std::vector<double> b;
 };
 
-Problem irregularProblem(int nx, int ny, int nz, unsigned seed) {
+// A grid of nx x ny x nz cells with an all-zero system and right-hand side.
+Problem zeroProblem(int nx, int ny, int nz) {
   Problem pr;
   pr.grid.nx = nx;
   pr.grid.ny = ny;
   pr.grid.nz = nz;
+  const std::size_t n = pr.grid.cells();
+  for (auto* v : {&pr.system.diag, &pr.system.ax, &pr.system.ay, &pr.system.az, &pr.b}) {
+    v->assign(n, 0.0);
+  }
+  return pr;
+}
+
+Problem irregularProblem(int nx, int ny, int nz, unsigned seed) {
+  Problem pr = zeroProblem(nx, ny, nz);
   const Grid& g = pr.grid;
   const std::size_t n = g.cells();
   std::mt19937 rng(seed);
@@ -47,8 +57,6 @@ Problem irregularProblem(int nx, int ny, int nz, unsigned seed) {
     }
   }
   auto& A = pr.system;
-  for (auto* v : {&A.diag, &A.ax, &A.ay, &A.az}) v->assign(n, 0.0);
-  pr.b.assign(n, 0.0);
   const std::size_t stride[3] = {1, static_cast<std::size_t>(nx),
                                  static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny)};
   for (int k = 0; k < nz; ++k) {
@@ -83,12 +91,8 @@ Problem irregularProblem(int nx, int ny, int nz, unsigned seed) {
 // for a slab of heavier cells (a body, three times the density), a random right-hand side. Its
 // only Dirichlet condition is the surface: a Poisson matrix whose condition grows with the size.
 Problem tankProblem(int nx, int ny, int nz, unsigned seed) {
-  Problem pr;
-  pr.grid.nx = nx;
-  pr.grid.ny = ny;
-  pr.grid.nz = nz;
+  Problem pr = zeroProblem(nx, ny, nz);
   const Grid& g = pr.grid;
-  const std::size_t n = g.cells();
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const int surface = ny * 3 / 5;
@@ -97,8 +101,6 @@ Problem tankProblem(int nx, int ny, int nz, unsigned seed) {
                                                                                           : 1.0;
   };
   auto& A = pr.system;
-  for (auto* v : {&A.diag, &A.ax, &A.ay, &A.az}) v->assign(n, 0.0);
-  pr.b.assign(n, 0.0);
   for (int k = 0; k < nz; ++k) {
     for (int j = 0; j < surface; ++j) {
       for (int i = 0; i < nx; ++i) {
