@@ -404,6 +404,17 @@ TEST(FluidModule, ThreadsOutOfRangeAreRejectedByValidation) {
   }
 }
 
+TEST(FluidModule, UnknownPreconditionerIsRejectedByValidation) {
+  TempDir dir;
+  const auto app = dir.write(
+      "preconditioner.xml",
+      application(fluidModule("      <param name=\"preconditioner\" value=\"jacobi\"/>\n"), ""));
+  const auto result = runVrflow({"validate", app}, 60);
+  EXPECT_EQ(result.exitCode, 1);
+  EXPECT_NE((result.out + result.err).find("preconditioner"), std::string::npos)
+      << result.out << result.err;
+}
+
 // The module's threads change no bit: the test box in the tank's cycle; its trajectory and the
 // fluid's final state (particle centroid and bounds, the box's last force) with 1 and 3 threads
 // are the same text.

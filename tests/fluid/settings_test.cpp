@@ -70,6 +70,24 @@ TEST(FluidSettings, BadMaterialAndSolverKnobsAreRejected) {
   }
 }
 
+TEST(FluidSettings, PreconditionersAreReadByNameAndOthersAreRefused) {
+  for (const auto p : {FluidPreconditioner::kMic0, FluidPreconditioner::kMultigrid}) {
+    FluidPreconditioner read = p == FluidPreconditioner::kMic0 ? FluidPreconditioner::kMultigrid
+                                                               : FluidPreconditioner::kMic0;
+    ASSERT_TRUE(parsePreconditioner(preconditionerName(p), read));
+    EXPECT_EQ(read, p);
+  }
+  EXPECT_EQ(FluidSettings{}.preconditioner, FluidPreconditioner::kMultigrid);
+  FluidPreconditioner read = FluidPreconditioner::kMic0;
+  for (const char* bad : {"", "MIC0", "jacobi", "multigrid "}) {
+    EXPECT_FALSE(parsePreconditioner(bad, read)) << bad;
+    EXPECT_EQ(read, FluidPreconditioner::kMic0) << bad;
+  }
+  auto s = smallTank(8, 8, 8);
+  s.preconditioner = static_cast<FluidPreconditioner>(7);
+  EXPECT_NE(createError(s).find("preconditioner 7"), std::string::npos);
+}
+
 TEST(FluidSettings, AbsurdTimeStepsAreRejectedAndNothingMoves) {
   auto tank = testing::makeTank(smallTank(8, 8, 8), 0.2);
   const auto before = tank->particlePositions();

@@ -119,6 +119,11 @@ int main(int argc, char** argv) {
   s.maxParticles = static_cast<int>(module.params().getInt("max-particles"));
   s.cgTolerance = module.params().getFloat("cg-tolerance");
   s.cgMaxIterations = static_cast<int>(module.params().getInt("cg-max-iterations"));
+  // The manifest lists the choices; the module checks them again rather than guess.
+  if (!fluid::parsePreconditioner(module.params().getString("preconditioner"), s.preconditioner)) {
+    return fail("preconditioner '" + module.params().getString("preconditioner") +
+                "' is neither multigrid nor mic0");
+  }
   s.volumeCorrection = module.params().getFloat("volume-correction");
   s.origin = module.params().getVec3("origin");
   s.gravity = module.params().getVec3("gravity");

@@ -40,6 +40,7 @@ struct Options {
   bool serial = false;
   bool localBodies = false;
   bool bodiesInLiquid = false;
+  fluid::FluidPreconditioner preconditioner = fluid::FluidSettings{}.preconditioner;
 };
 
 bool parse(int argc, char** argv, Options& o) {
@@ -70,6 +71,8 @@ bool parse(int argc, char** argv, Options& o) {
        : a == "--bodies"  ? o.bodies
        : a == "--threads" ? o.threads
                           : o.maxParticles) = n;
+    } else if (a == "--preconditioner") {
+      if (i + 1 >= argc || !fluid::parsePreconditioner(argv[++i], o.preconditioner)) return false;
     } else if (a == "--h") {
       if (!next(o.h)) return false;
     } else if (a == "--dt") {
@@ -158,7 +161,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr,
                    "usage: vrflow-fluid-blocks [--nx N --ny N --nz N --h M --dt S --steps N "
                    "--warmup N --bodies N --max-particles N --threads N --serial --local-bodies "
-                   "--bodies-in-liquid]\n");
+                   "--bodies-in-liquid --preconditioner mic0|multigrid]\n");
     }
     MPI_Finalize();
     return 2;
@@ -175,6 +178,7 @@ int main(int argc, char** argv) {
   s.cellSize = o.h;
   s.maxParticles = o.maxParticles;
   s.threads = o.threads;
+  s.preconditioner = o.preconditioner;
   auto created = fluid::FluidSolver::create(s);
   if (!created) {
     if (rank == 0)
@@ -288,16 +292,18 @@ int main(int argc, char** argv) {
     }
     const int n = std::max(1, timedSteps);
     std::printf(
-        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"threads\":%d,\"serial\":%s,"
+        "{\"grid\":\"%dx%dx%d\",\"rigid\":%d,\"ranks\":%d,\"threads\":%d,"
+        "\"preconditioner\":\"%s\",\"serial\":%s,"
         "\"steps\":%d,\"particles\":%zu,\"ms_per_step\":%.3f,\"cpu_ms_per_step\":%.3f,\"cg_"
         "iterations\":%.1f,"
         "\"pressure_ms_per_step\":%.3f,\"cg_bytes_per_step\":%.0f,\"bandwidth_gbs\":%.3f,"
         "\"volume\":%.9g,\"mean_y\":%.9g,\"max_speed\":%.6g,\"body_y\":[%s],"
         "\"wet_bodies_first_timed\":%d,\"digest\":\"%016llx\"}\n",
-        o.nx, o.ny, o.nz, o.bodies, size, o.threads, o.serial ? "true" : "false", o.steps,
-        particles, 1e3 * timed / n, 1e3 * cpuTimed / n, static_cast<double>(cgIterations) / n,
-        1e3 * pressureTime / n, bytes / n, pressureTime > 0 ? bytes / pressureTime / 1e9 : 0.0,
-        volume, meanY, speed, ys.c_str(), wetFirstTimed, static_cast<unsigned long long>(fnv(all)));
+        o.nx, o.ny, o.nz, o.bodies, size, o.threads, fluid::preconditionerName(o.preconditioner),
+        o.serial ? "true" : "false", o.steps, particles, 1e3 * timed / n, 1e3 * cpuTimed / n,
+        static_cast<double>(cgIterations) / n, 1e3 * pressureTime / n, bytes / n,
+        pressureTime > 0 ? bytes / pressureTime / 1e9 : 0.0, volume, meanY, speed, ys.c_str(),
+        wetFirstTimed, static_cast<unsigned long long>(fnv(all)));
   }
   MPI_Finalize();
   return 0;

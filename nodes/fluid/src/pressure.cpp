@@ -49,14 +49,58 @@ double lanes(const Quad& v) {
   return (v[0] + v[1]) + (v[2] + v[3]);
 }
 
+// p += alpha s and r -= alpha q on one row, four cells at a time; returns the row's |r|^2.
+VRFLOW_FLUID_HOT double updateRowImpl(const Row& row, double alpha, const double* s,
+                                      const double* q, double* p, double* r) {
+  const std::size_t end = row.c + static_cast<std::size_t>(row.i1 - row.i0) + 1;
+  const Quad a = {alpha, alpha, alpha, alpha};
+  Quad rr4 = {0, 0, 0, 0};
+  std::size_t c = row.c;
+  for (; c + 4 <= end; c += 4) {
+    Quad pv, sv, rv, qv;
+    load(pv, p + c);
+    load(sv, s + c);
+    load(rv, r + c);
+    load(qv, q + c);
+    pv += a * sv;
+    rv -= a * qv;
+    store(p + c, pv);
+    store(r + c, rv);
+    rr4 += rv * rv;
+  }
+  double rr = 0.0;
+  for (; c < end; ++c) {
+    p[c] += alpha * s[c];
+    r[c] -= alpha * q[c];
+    rr += r[c] * r[c];
+  }
+  return rr + lanes(rr4);
+}
+
+// r.z on one row, four cells at a time.
+VRFLOW_FLUID_HOT double dotRowImpl(const Row& row, const double* r, const double* z) {
+  const std::size_t end = row.c + static_cast<std::size_t>(row.i1 - row.i0) + 1;
+  Quad rz4 = {0, 0, 0, 0};
+  std::size_t c = row.c;
+  for (; c + 4 <= end; c += 4) {
+    Quad rv, zv;
+    load(rv, r + c);
+    load(zv, z + c);
+    rz4 += rv * zv;
+  }
+  double rz = 0.0;
+  for (; c < end; ++c) rz += r[c] * z[c];
+  return rz + lanes(rz4);
+}
+
 // q = A s on the unknowns, returning the local part of s.q; s must hold valid halo planes
 // k0 - 1 and k1. Rows above the grid's first plane run four cells at a time with no bounds
 // tests: couplings across the walls are zero and their neighbours lie inside the arrays (s has
 // a plane beyond the grid), and cells that are not unknowns get q = 0. Partial sums of s.q are
 // kept per lane, so the sum is not one chain of dependent additions.
 VRFLOW_FLUID_HOT
-double multiply(const Grid& g, const PressureSystem& A, const double* s, double* q,
-                const std::vector<Row>& rows) {
+double multiplyRange(const Grid& g, const PressureSystem& A, const double* s, double* q,
+                     const Row* first, const Row* last) {
   const std::size_t sy = static_cast<std::size_t>(g.nx), sz = sy * static_cast<std::size_t>(g.ny);
   const double* diag = A.diag.data();
   const double* ax = A.ax.data();
@@ -64,7 +108,8 @@ double multiply(const Grid& g, const PressureSystem& A, const double* s, double*
   const double* az = A.az.data();
   Quad sq4 = {0, 0, 0, 0};
   double sq = 0.0;
-  for (const Row& row : rows) {
+  for (const Row* it = first; it != last; ++it) {
+    const Row& row = *it;
     const std::size_t end = row.c + static_cast<std::size_t>(row.i1 - row.i0) + 1;
     std::size_t c = row.c;
     int i = row.i0;
@@ -182,50 +227,6 @@ void findWaves(const std::vector<Row>& rows, int rowsPerWave, PcgWorkspace& w) {
     }
     w.waves.push_back(wave);
   }
-}
-
-// p += alpha s and r -= alpha q on one row, four cells at a time; returns the row's |r|^2.
-VRFLOW_FLUID_HOT double updateRow(const Row& row, double alpha, const double* s, const double* q,
-                                  double* p, double* r) {
-  const std::size_t end = row.c + static_cast<std::size_t>(row.i1 - row.i0) + 1;
-  const Quad a = {alpha, alpha, alpha, alpha};
-  Quad rr4 = {0, 0, 0, 0};
-  std::size_t c = row.c;
-  for (; c + 4 <= end; c += 4) {
-    Quad pv, sv, rv, qv;
-    load(pv, p + c);
-    load(sv, s + c);
-    load(rv, r + c);
-    load(qv, q + c);
-    pv += a * sv;
-    rv -= a * qv;
-    store(p + c, pv);
-    store(r + c, rv);
-    rr4 += rv * rv;
-  }
-  double rr = 0.0;
-  for (; c < end; ++c) {
-    p[c] += alpha * s[c];
-    r[c] -= alpha * q[c];
-    rr += r[c] * r[c];
-  }
-  return rr + lanes(rr4);
-}
-
-// r.z on one row, four cells at a time.
-VRFLOW_FLUID_HOT double dotRow(const Row& row, const double* r, const double* z) {
-  const std::size_t end = row.c + static_cast<std::size_t>(row.i1 - row.i0) + 1;
-  Quad rz4 = {0, 0, 0, 0};
-  std::size_t c = row.c;
-  for (; c + 4 <= end; c += 4) {
-    Quad rv, zv;
-    load(rv, r + c);
-    load(zv, z + c);
-    rz4 += rv * zv;
-  }
-  double rz = 0.0;
-  for (; c < end; ++c) rz += r[c] * z[c];
-  return rz + lanes(rz4);
 }
 
 // The lanes of one wave: each row's cell at the wave's first i, and its tests. All lanes run
@@ -369,7 +370,7 @@ double forward(const Grid& g, const PcgWorkspace& w, double alpha, const double*
   for (const auto& wave : w.waves) {
     if constexpr (kUpdate) {
       for (int l = 0; l < wave.count; ++l) {
-        rr += updateRow(w.rows[static_cast<std::size_t>(wave.rows[l])], alpha, s, q, p, r);
+        rr += updateRowImpl(w.rows[static_cast<std::size_t>(wave.rows[l])], alpha, s, q, p, r);
       }
     }
     withLanes(wave.count, [&](auto lanes) { forwardWave<lanes()>(g, w, wave, r, t); });
@@ -384,10 +385,15 @@ double backward(const Grid& g, const PcgWorkspace& w, const double* r, const dou
   for (auto it = w.waves.rbegin(); it != w.waves.rend(); ++it) {
     withLanes(it->count, [&](auto lanes) { backwardWave<lanes()>(g, w, *it, t, z); });
     for (int l = it->count - 1; l >= 0; --l) {
-      rz += dotRow(w.rows[static_cast<std::size_t>(it->rows[l])], r, z);
+      rz += dotRowImpl(w.rows[static_cast<std::size_t>(it->rows[l])], r, z);
     }
   }
   return rz;
+}
+
+double multiply(const Grid& g, const PressureSystem& A, const double* s, double* q,
+                const std::vector<Row>& rows) {
+  return multiplyRange(g, A, s, q, rows.data(), rows.data() + rows.size());
 }
 
 template <typename F>
@@ -455,6 +461,20 @@ void mergedReductions(const Grid& g, const PressureSystem& A, const Slab& slab, 
 
 }  // namespace
 
+double multiplyRows(const Grid& grid, const PressureSystem& system, const double* s, double* q,
+                    const Row* first, const Row* last) {
+  return multiplyRange(grid, system, s, q, first, last);
+}
+
+double updateRow(const Row& row, double alpha, const double* s, const double* q, double* p,
+                 double* r) {
+  return updateRowImpl(row, alpha, s, q, p, r);
+}
+
+double dotRow(const Row& row, const double* r, const double* z) {
+  return dotRowImpl(row, r, z);
+}
+
 PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vector<double>& b,
                          std::vector<double>& p, double tol, int maxIterations, BlockComm* comm,
                          PcgWorkspace& w) {
@@ -513,6 +533,9 @@ PcgOutcome solvePressure(const Grid& g, const PressureSystem& A, const std::vect
   }
   const double bNorm = std::sqrt(sumOver(comm, bb));
   if (bNorm == 0.0) return out;
+  if (w.preconditioner == FluidPreconditioner::kMultigrid) {
+    return solveWithMultigrid(g, A, slab.k0, slab.k1, pp, bNorm, tol, maxIterations, comm, w);
+  }
   buildPreconditioner(g, A, slab, w);
   if (comm && comm->size() > 1) {
     mergedReductions(g, A, slab, comm, w, pp, bNorm, tol, maxIterations,

@@ -5,13 +5,16 @@
 #include <vector>
 
 #include "grid.hpp"
+#include "multigrid.hpp"
 #include "vrflow/fluid/block_comm.hpp"
+#include "vrflow/fluid/settings.hpp"
 
 // The pressure Poisson system on the cell grid (7-point, symmetric positive definite on the
 // unknown cells) and its MIC(0)-preconditioned conjugate gradient. With a BlockComm each block
 // solves its slab of planes; the preconditioner is then MIC(0) of the block's own part of the
 // matrix (block Jacobi across blocks, with 0.6 of the dropped couplings moved to the diagonal),
 // so iteration counts and the last bits of the result depend on the number of blocks.
+// The multigrid-preconditioned CG (pressure_multigrid.cpp, multigrid.hpp) is the other choice.
 
 namespace vrflow::fluid::detail {
 
@@ -44,6 +47,14 @@ struct PcgWorkspace {
   /// Rows per wave: 0 chooses by the grid's size (pairs up to 2^17 cells, see pressure.cpp);
   /// every choice gives the same bits.
   int rowsPerWave = 0;
+  /// The preconditioner; the multigrid one runs its passes on `workers` (one thread if null).
+  FluidPreconditioner preconditioner = FluidPreconditioner::kMic0;
+  const Workers* workers = nullptr;
+  Multigrid multigrid;
+  /// Multigrid CG: the first row of each plane of the slab in `rows`, and per-plane partial
+  /// sums (added in plane order: the thread count changes no bit).
+  std::vector<std::size_t> planeRows;
+  std::vector<double> planeSums, planeSums2;
 };
 
 struct PcgOutcome {
@@ -52,6 +63,23 @@ struct PcgOutcome {
   bool converged = true;
   std::uint64_t bytesTouched = 0;
 };
+
+/// q = A s on the rows [first, last) (see pressure.cpp), returning their part of s.q.
+double multiplyRows(const Grid& grid, const PressureSystem& system, const double* s, double* q,
+                    const PcgWorkspace::Row* first, const PcgWorkspace::Row* last);
+
+/// p += alpha s and r -= alpha q on one row; returns the row's |r|^2.
+double updateRow(const PcgWorkspace::Row& row, double alpha, const double* s, const double* q,
+                 double* p, double* r);
+
+/// r.z on one row.
+double dotRow(const PcgWorkspace::Row& row, const double* r, const double* z);
+
+/// The multigrid-preconditioned CG behind solvePressure() (pressure_multigrid.cpp): `w.rows`
+/// are found, r holds b on them, p is zero; returns its outcome.
+PcgOutcome solveWithMultigrid(const Grid& grid, const PressureSystem& system, int k0, int k1,
+                              double* p, double bNorm, double tol, int maxIterations,
+                              BlockComm* comm, PcgWorkspace& work);
 
 /// Solves A p = b to |r| <= tol |b| (2-norms over the whole grid). `p` starts at zero (the last
 /// step's pressure as a first guess measured no better: the right-hand side is dominated by

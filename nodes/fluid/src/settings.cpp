@@ -12,6 +12,21 @@ bool finite3(const msg::Vec3& v) {
 
 }  // namespace
 
+bool parsePreconditioner(const std::string& name, FluidPreconditioner& out) {
+  if (name == "mic0") {
+    out = FluidPreconditioner::kMic0;
+  } else if (name == "multigrid") {
+    out = FluidPreconditioner::kMultigrid;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* preconditionerName(FluidPreconditioner preconditioner) {
+  return preconditioner == FluidPreconditioner::kMic0 ? "mic0" : "multigrid";
+}
+
 Status validateSettings(const FluidSettings& s) {
   const char* names[3] = {"nx", "ny", "nz"};
   const int n[3] = {s.nx, s.ny, s.nz};
@@ -52,6 +67,11 @@ Status validateSettings(const FluidSettings& s) {
   if (!std::isfinite(s.volumeCorrection) || s.volumeCorrection < 0.0 || s.volumeCorrection > 1.0) {
     return makeError("fluid: volume correction " + std::to_string(s.volumeCorrection) +
                      " must be in [0, 1] (fraction of the density error removed per step)");
+  }
+  if (s.preconditioner != FluidPreconditioner::kMic0 &&
+      s.preconditioner != FluidPreconditioner::kMultigrid) {
+    return makeError("fluid: preconditioner " + std::to_string(static_cast<int>(s.preconditioner)) +
+                     " is neither mic0 nor multigrid");
   }
   if (s.cgMaxIterations < 1) {
     return makeError("fluid: CG iteration cap must be at least 1");

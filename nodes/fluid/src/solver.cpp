@@ -16,6 +16,8 @@ Result<std::unique_ptr<FluidSolver>> FluidSolver::create(const FluidSettings& se
   auto impl = std::make_unique<Impl>();
   impl->settings = settings;
   impl->workers = std::make_unique<detail::Workers>(settings.threads);
+  impl->pcg.workers = impl->workers.get();
+  impl->pcg.preconditioner = settings.preconditioner;
   impl->rng = settings.seed;
   auto& g = impl->grid;
   g.nx = settings.nx;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "vrflow/base/result.hpp"
 #include "vrflow/message/values.hpp"
@@ -9,6 +10,12 @@
 // Every value is checked by validateSettings() before a solver is built from it.
 
 namespace vrflow::fluid {
+
+/// The pressure CG's preconditioner.
+enum class FluidPreconditioner {
+  kMic0,       ///< modified incomplete Cholesky: sweeps in cell order, one thread
+  kMultigrid,  ///< one multigrid V-cycle: fewer iterations, every pass on the solver's threads
+};
 
 /// Grid, material and solver settings, with the paper's scene as defaults (32 x 64 x 32 cells).
 struct FluidSettings {
@@ -24,6 +31,9 @@ struct FluidSettings {
   int maxParticles = 200000;           ///< seeding stops with an error beyond this
   double cgTolerance = 1e-6;           ///< pressure solve: stop when |r| <= tol * |b| (2-norm)
   int cgMaxIterations = 1000;          ///< pressure solve: iteration cap
+  /// Pressure solve: the CG's preconditioner (the result agrees to the CG tolerance, not to
+  /// the bit, between the two).
+  FluidPreconditioner preconditioner = FluidPreconditioner::kMultigrid;
   /// Volume control (after Kim et al. 2007, per cell): FLIP particles drift apart or clump, so
   /// each step asks every liquid cell not next to air for a divergence of
   /// -volumeCorrection * (1 - n / n0) / dt, n its particle count, n0 = particlesPerCell.
@@ -38,6 +48,12 @@ struct FluidSettings {
 /// Largest time step accepted: a step over which gravity alone would move liquid more than
 /// this many cells is absurd for the solver (CFL far beyond what particles can follow).
 inline constexpr double kMaxGravityCellsPerStep = 5.0;
+
+/// The preconditioner named `name` ("mic0" or "multigrid"); false for any other name.
+bool parsePreconditioner(const std::string& name, FluidPreconditioner& out);
+
+/// The name of a preconditioner, as parsePreconditioner() reads it.
+const char* preconditionerName(FluidPreconditioner preconditioner);
 
 /// Checks sizes (positive, at most 1024 cells per axis), finite values, ratios in range.
 Status validateSettings(const FluidSettings& settings);
