@@ -11,12 +11,14 @@
 int main() {
   using namespace vrflow;
   using namespace vrflow::massspring;
+  UserContactMemory userMemory;
   return modules::runContactInteractor(
-      "vrflow-massspring-rigid", [](Module& module, const SceneCopy& scene,
-                                    const ContactParams& contact, ContactMemory* memory) {
+      "vrflow-massspring-rigid",
+      [&userMemory](Module& module, const SceneCopy& scene, const ContactParams& contact,
+                    ContactMemory* memory) {
         auto result = rigidContacts(scene.nets(), scene.rigids(), contact, memory);
         const auto users = scene.users();
-        if (!users.empty()) addUserContacts(scene.nets(), users, contact, result);
+        if (!users.empty()) addUserContacts(scene.nets(), users, contact, result, &userMemory);
         auto out =
             modules::nodeForcesMessage(module, result.nodeForces, result.rigidForces.size() * 128);
         for (const auto& [id, force] : result.rigidForces) out.builder().addForce(id, force);
