@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "common.hpp"
+#include "vrflow/camera/capture_stamps.hpp"
 #include "vrflow/massspring/contact.hpp"
 #include "vrflow/massspring/objects.hpp"
 
@@ -22,6 +23,9 @@ int main() {
         auto out =
             modules::nodeForcesMessage(module, result.nodeForces, result.rigidForces.size() * 128);
         for (const auto& [id, force] : result.rigidForces) out.builder().addForce(id, force);
+        // Which camera frame the users came from (nodes/camera, latency in frames).
+        if (const auto frame = scene.userCaptureIteration())
+          out.builder().addInt64Stamp(camera::kUsedCaptureIterationStamp, *frame);
         return out;
       });
 }
