@@ -10,6 +10,8 @@
 
 #include "process_helpers.hpp"
 #include "user_scenes.hpp"
+#include "vrflow/camera/capture_latency.hpp"
+#include "vrflow/camera/capture_stamps.hpp"
 
 namespace vrflow::testing {
 namespace {
@@ -56,6 +58,55 @@ TEST(CameraUserExample, TheHandPushesTheCrateOffTheTableAndPressesTheNet) {
   EXPECT_LT(lowest, 1.15 - 0.04);
   EXPECT_TRUE(leftoverProcesses().empty());
   EXPECT_TRUE(vrflowShmEntries().empty());
+}
+
+// Issue 21's capture-to-interactor latency: `vrflow record` of the rigid and mass-spring
+// interactors' outputs; each message an interactor sends at its iteration k carries the capture
+// iteration c of the user frame it solved against (stamped by user-truth, carried by the user
+// animator), so k - c is the latency in frames. The network joins every chain in lockstep (no
+// initial message between the capture and the interactors): 0 frames, against the issue's 2.
+TEST(CameraUserExample, TheInteractorsUseEachFrameInTheIterationItWasCaptured) {
+  TempDir dir;
+  const auto result = runCommand(
+      {"/bin/sh", "-c",
+       "cd '" + dir.path() + "' && exec '" + binDir() + "/vrflow' record '" + sourceDir() +
+           "/examples/camera_user_small/camera_user_small.xml' --connections "
+           "contacts.forces,net-contacts.forces,user.objects -o latency.vrrec -n 30 --no-progress"},
+      300);
+  ASSERT_EQ(result.exitCode, 0) << result.out << result.err;
+  const auto used =
+      camera::latencyFrames(dir.file("latency.vrrec"), camera::kUsedCaptureIterationStamp);
+  ASSERT_TRUE(used) << used.error().message;
+  for (const char* interactor : {"contacts.forces", "net-contacts.forces"}) {
+    ASSERT_EQ(used->count(interactor), 1u) << interactor << " carried no capture iteration";
+    const auto& frames = used->at(interactor);
+    std::printf("%s: %llu messages, capture to use %lld..%lld frames, first use at %lld\n",
+                interactor, static_cast<unsigned long long>(frames.messages),
+                static_cast<long long>(frames.min), static_cast<long long>(frames.max),
+                static_cast<long long>(frames.firstUseIteration));
+    EXPECT_EQ(frames.messages, 30u) << interactor;
+    EXPECT_EQ(frames.firstUseIteration, 0) << interactor;
+    EXPECT_EQ(frames.min, 0) << interactor;
+    EXPECT_EQ(frames.max, 0) << interactor;
+  }
+  // The user animator's objects carry the frame they were made from.
+  const auto made =
+      camera::latencyFrames(dir.file("latency.vrrec"), camera::kCaptureIterationStamp);
+  ASSERT_TRUE(made) << made.error().message;
+  ASSERT_EQ(made->count("user.objects"), 1u);
+  EXPECT_EQ(made->at("user.objects").max, 0);
+  EXPECT_EQ(made->at("user.objects").messages, 30u);
+  EXPECT_TRUE(leftoverProcesses().empty());
+  EXPECT_TRUE(vrflowShmEntries().empty());
+}
+
+TEST(CameraUserExample, ALatencyReadOfAMissingRecordingIsOneErrorNamingTheFile) {
+  TempDir dir;
+  const auto missing =
+      camera::latencyFrames(dir.file("none.vrrec"), camera::kUsedCaptureIterationStamp);
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("none.vrrec"), std::string::npos)
+      << missing.error().message;
 }
 
 }  // namespace

@@ -158,9 +158,12 @@ TEST(UserInteraction, TheNetDeflectsUnderTheHand) {
               pressed);
   EXPECT_LT(pressed, 1.4 - 0.05);
   EXPECT_GT(pressed, 1.325 - 0.03);
+  // A still user leaves it flat: within 2 mm (measured +1.2 mm). Its exact 1.4 m (1e-6) went
+  // when contacts with a user began removing the whole overlap in one step: whatever node lies
+  // within the contact distance (2 cm) of the still hull is now pushed out at once.
   TempDir still;
   EXPECT_NEAR(heightUnderTheHand(runApp(still, netApp(still, {0, 0, 0}), 40, "net.txt")), 1.4,
-              1e-6);
+              2e-3);
 }
 
 TEST(UserInteraction, AMalformedKeyframeFileStopsTheRunNamingFileAndLine) {

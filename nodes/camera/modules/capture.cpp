@@ -1,5 +1,5 @@
 // camera/capture: one camera's images (synthetic, an image sequence, a video file or a V4L2
-// device) as image resources (image_message.hpp) stamped with their capture time.
+// device) as image resources (image_message.hpp) stamped with their capture time and iteration.
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -46,6 +46,8 @@ int main() {
     builder.setSimTime(static_cast<double>(module.iteration()) / settings.fps);
     builder.setTimeStep(1.0 / settings.fps);
     builder.addInt64Stamp(camera::kCaptureStamp, frame->captureNs);
+    builder.addInt64Stamp(camera::kCaptureIterationStamp,
+                          static_cast<std::int64_t>(module.iteration()));
     camera::addImage(builder, resourceId, frame->image);
     if (!module.put(imageOut, std::move(out))) break;
   }

@@ -84,8 +84,7 @@ int main() {
                                  hull.occupied.size() / static_cast<std::size_t>(n) + 1024);
     out.builder().setSimTime(stamps.simTime);
     out.builder().setTimeStep(stamps.timeStep);
-    if (const auto captured = camera::captureTimeNs(in.view()))
-      out.builder().addInt64Stamp(camera::kCaptureStamp, *captured);
+    camera::copyCaptureStamps(in.view(), out.builder());
     camera::addHullSlab(out.builder(), resourceId, hull, zBegin, zEnd);
     if (!module.put(hullOut, std::move(out))) break;
   }

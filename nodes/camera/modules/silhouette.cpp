@@ -69,8 +69,7 @@ int main() {
     auto out = module.newMessage(static_cast<std::size_t>(mask.total()) + 512);
     out.builder().setSimTime(stamps.simTime);
     out.builder().setTimeStep(stamps.timeStep);
-    if (const auto captured = camera::captureTimeNs(in.view()))
-      out.builder().addInt64Stamp(camera::kCaptureStamp, *captured);
+    camera::copyCaptureStamps(in.view(), out.builder());
     camera::addImage(out.builder(), maskId, mask);
     if (!module.put(maskOut, std::move(out))) break;
     if (wantContours) {

@@ -2,11 +2,13 @@
 // `slabs` hull slabs of one frame from its `hull` input into the voxel model and publishes one
 // object of type `user` on `objects`: position, bounds, and as dynamic resources its mesh, its
 // signed distance field and the velocity of its surface, estimated from this frame's distance
-// field and the previous one (user_velocity.hpp). It takes no events: nothing pushes the user.
+// field and the previous one (user_velocity.hpp), stamped with the capture time and iteration of
+// the frame (capture_stamps.hpp). It takes no events: nothing pushes the user.
 #include <cstdio>
 #include <optional>
 #include <string>
 
+#include "vrflow/camera/capture_stamps.hpp"
 #include "vrflow/camera/hull_message.hpp"
 #include "vrflow/camera/user_object.hpp"
 #include "vrflow/camera/user_velocity.hpp"
@@ -86,6 +88,9 @@ int main() {
                               12 * frame.mesh.vertices.size() + 12 * frame.mesh.triangles.size() +
                               1024;
     auto out = module.newMessage(bytes);
+    out.builder().setSimTime(time);
+    out.builder().setTimeStep(received.view().stamps().timeStep);
+    camera::copyCaptureStamps(received.view(), out.builder());
     camera::writeUser(out.builder(), ids, frame, !previous.has_value());
     if (!module.put(objects, std::move(out))) break;
     previous = std::move(frame);

@@ -2,9 +2,12 @@
 // keyframes at the iteration's time and sends the exact voxelisation of its capsules as `slabs`
 // hull slabs (hull_message.hpp), the message a hull module sends from cameras: the interactions
 // can be run and tested without the vision chain.
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 
+#include "vrflow/camera/capture_stamps.hpp"
 #include "vrflow/camera/hull_message.hpp"
 #include "vrflow/camera/synthetic_user.hpp"
 #include "vrflow/module/module.hpp"
@@ -47,6 +50,11 @@ int main() {
     auto& builder = out.builder();
     builder.setSimTime(time);
     builder.setTimeStep(dt);
+    // The frame's capture stamps, as a capture module's (capture_stamps.hpp).
+    builder.addInt64Stamp(camera::kCaptureStamp,
+                          static_cast<std::int64_t>(std::llround(time * 1e9)));
+    builder.addInt64Stamp(camera::kCaptureIterationStamp,
+                          static_cast<std::int64_t>(module.iteration()));
     for (int s = 0; s < slabs; ++s)
       camera::addHullSlab(builder, ids[static_cast<std::size_t>(s)], grid, s * cells / slabs,
                           (s + 1) * cells / slabs);

@@ -67,9 +67,7 @@ Result<std::vector<cv::Mat>> readImages(const msg::MessageView& message) {
 }
 
 std::optional<std::int64_t> captureTimeNs(const msg::MessageView& message) {
-  for (const auto stamp : message.stamps().user)
-    if (stamp.name() == kCaptureStamp) return stamp.asInt64();
-  return std::nullopt;
+  return int64Stamp(message, kCaptureStamp);
 }
 
 }  // namespace vrflow::camera

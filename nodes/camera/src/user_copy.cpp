@@ -3,6 +3,7 @@
 #include <span>
 #include <string>
 
+#include "vrflow/camera/capture_stamps.hpp"
 #include "vrflow/message/builtin_types.hpp"
 
 namespace vrflow::camera {
@@ -18,6 +19,7 @@ Status UserCopy::apply(const msg::MessageView& message) {
   for (const auto chunk : message) {
     const auto object = chunk.asObject();
     if (!object || object->typeId() != userType) continue;
+    captureIteration_ = int64Stamp(message, kCaptureIterationStamp);
     if (object->op() == msg::ObjectOp::Delete) {
       users_.erase(object->id());
       ids_.erase(object->id());

@@ -469,34 +469,62 @@ namespace vrflow::massspring {
 
 void addUserContacts(const std::map<std::uint64_t, Net>& nets,
                      const std::map<std::uint64_t, const camera::UserSurface*>& users,
-                     const ContactParams& p, ContactForces& out) {
+                     const ContactParams& p, ContactForces& out, UserContactMemory* memory) {
+  UserContactMemory next;
+  // The user cannot give way: the node must be out of it by the end of the step, the whole
+  // overlap removed at once, against the full stiffness of the node's springs (the backward
+  // Euler weight of a node held by springs). The soft defaults let a hand pass through a net.
+  ContactParams userParams = p;
+  userParams.beta = 1.0;
+  userParams.springMassWeight = 1.0;
   for (const auto& [userId, user] : users) {
     for (const auto& [netId, net] : nets) {
       const msg::Aabb netBox = bounds(net);
       bool near = true;
       for (int k = 0; k < 3; ++k)
-        near = near && netBox.min[k] <= user->bounds.max[k] + p.thickness &&
-               netBox.max[k] >= user->bounds.min[k] - p.thickness;
+        near = near && netBox.min[k] <= user->bounds.max[k] + p.thickness + user->spacing &&
+               netBox.max[k] >= user->bounds.min[k] - p.thickness - user->spacing;
       if (!near) continue;
+      const std::vector<msg::Vec3>* before = nullptr;
+      if (memory) {
+        const auto found = memory->entrySides.find({userId, netId});
+        if (found != memory->entrySides.end() && found->second.size() == net.nodeCount())
+          before = &found->second;
+      }
+      auto& sides = next.entrySides[{userId, netId}];
+      sides.assign(net.nodeCount(), msg::Vec3{});
       const Adjacency adj = adjacency(net);
       for (std::size_t i = 0; i < net.nodeCount(); ++i) {
         if (net.pinned[i]) continue;
         const Vector3d x = positionOf(net, i);
-        if (!inBox(x, user->bounds, p.thickness)) continue;
+        // Nodes within a voxel step of the user's box are watched, so that one the user's next
+        // step swallows has its side remembered.
+        if (!inBox(x, user->bounds, p.thickness + user->spacing)) continue;
         const double distance = user->distance(msg::toVec3(x));
-        if (distance >= p.thickness) continue;
-        const Vector3d n = asEigen(user->normal(msg::toVec3(x)));
+        Vector3d n = asEigen(user->normal(msg::toVec3(x)));
         if (n.isZero(0.0)) continue;
+        const Vector3d entered = before ? Vector3d(asEigen((*before)[i])) : Vector3d::Zero();
+        if (distance >= 0) {
+          sides[i] = msg::toVec3(n);
+        } else if (!entered.isZero(0.0)) {
+          // Inside: out of the side it came from, which it keeps until it is out again.
+          if (n.dot(entered) < 0) n = entered;
+          sides[i] = msg::toVec3(entered);
+        }
+        // Contacts only within the thickness of the user's box (its distance field is offset by
+        // half a voxel, so the box is what bounds the contacts).
+        if (distance >= p.thickness || !inBox(x, user->bounds, p.thickness)) continue;
         // The user is infinitely heavy and moves with its surface velocity.
         const Vector3d relative = velocityOf(net, i) - asEigen(user->velocityAt(msg::toVec3(x)));
-        const double f =
-            contactMagnitude(distance, relative.dot(n), effectiveInvMass(net, adj, i, n, p), p);
+        const double f = contactMagnitude(distance, relative.dot(n),
+                                          effectiveInvMass(net, adj, i, n, userParams), userParams);
         if (f <= 0) continue;
         addTo(forcesOf(out, netId, net), i, n * f);
         ++out.contacts;
       }
     }
   }
+  if (memory) *memory = std::move(next);
 }
 
 }  // namespace vrflow::massspring

@@ -4,6 +4,7 @@
 // mass the bodies collide with through their distance field and surface velocity.
 #include <cstdio>
 
+#include "vrflow/camera/capture_stamps.hpp"
 #include "vrflow/camera/user_copy.hpp"
 #include "vrflow/module/module.hpp"
 #include "vrflow/module/start.hpp"
@@ -59,6 +60,9 @@ int main() {
     const auto impulses = solver.solve(dt);
     auto out = module.newMessage(64 + impulses.size() * 112);
     for (const auto& [id, event] : impulses) out.builder().addForce(id, event);
+    // Which camera frame the user solved against came from (nodes/camera, latency in frames).
+    if (const auto frame = users.captureIteration())
+      out.builder().addInt64Stamp(camera::kUsedCaptureIterationStamp, *frame);
     if (!module.put(ports->forces, std::move(out))) break;
   }
   return module.exitStatus();

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 
 #include "vrflow/base/result.hpp"
 #include "vrflow/camera/user_surface.hpp"
@@ -20,6 +21,10 @@ class UserCopy {
   /// naming the user and the resource; the copy keeps what it had for that user.
   Status apply(const msg::MessageView& message);
 
+  /// The capture iteration (capture_stamps.hpp) of the last message that brought a user object,
+  /// nullopt before one or when it carried none: which frame the interactor now sees.
+  std::optional<std::int64_t> captureIteration() const { return captureIteration_; }
+
   /// Every user whose distance field has arrived, by id.
   std::map<std::uint64_t, const UserSurface*> ready() const;
   const std::map<std::uint64_t, UserSurface>& all() const { return users_; }
@@ -30,6 +35,7 @@ class UserCopy {
   };
   std::map<std::uint64_t, UserSurface> users_;
   std::map<std::uint64_t, Ids> ids_;
+  std::optional<std::int64_t> captureIteration_;
 };
 
 }  // namespace vrflow::camera

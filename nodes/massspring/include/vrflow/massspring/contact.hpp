@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "vrflow/camera/user_surface.hpp"
@@ -84,13 +85,25 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
                             const std::map<std::uint64_t, RigidBody>& rigids,
                             const ContactParams& params, ContactMemory* memory = nullptr);
 
+/// What addUserContacts keeps between steps: for each (user, net) pair, the user's outward
+/// normal at each node the last time the node was near the user and outside it (zero: not seen).
+/// A captured user moves by voxel steps, so a thin hand can swallow a node in one step, past the
+/// middle of its thickness; the distance field's gradient then points out of the far side and
+/// would push the node through. The remembered normal says which side the node came from.
+struct UserContactMemory {
+  std::map<std::pair<std::uint64_t, std::uint64_t>, std::vector<msg::Vec3>> entrySides;
+};
+
 /// Nodes of every net against every captured user (nodes/camera: its distance field and surface
 /// velocity): the header's response with the user infinitely heavy, a node's relative velocity
-/// taken against the user's surface velocity where it is. Node forces only: nothing pushes the
-/// user. Users and nets in id order. The forces are added to `out`'s node forces.
+/// taken against the user's surface velocity where it is. A node inside the user whose gradient
+/// points away from the side it entered by (`memory`) is pushed back out of that side. Node
+/// forces only: nothing pushes the user. Users and nets in id order. The forces are added to
+/// `out`'s node forces.
 void addUserContacts(const std::map<std::uint64_t, Net>& nets,
                      const std::map<std::uint64_t, const camera::UserSurface*>& users,
-                     const ContactParams& params, ContactForces& out);
+                     const ContactParams& params, ContactForces& out,
+                     UserContactMemory* memory = nullptr);
 
 /// Closest point of triangle abc to p, with its barycentric weights (Ericson's algorithm).
 struct TrianglePoint {

@@ -33,6 +33,8 @@ class SceneCopy {
   std::map<std::uint64_t, RigidBody> rigids() const;
   /// The captured users (type `user`) whose distance field has arrived.
   std::map<std::uint64_t, const camera::UserSurface*> users() const { return users_.ready(); }
+  /// The capture iteration of the users' last frame (camera::UserCopy::captureIteration).
+  std::optional<std::int64_t> userCaptureIteration() const { return users_.captureIteration(); }
 
  private:
   struct RigidEntry {
