@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -177,6 +178,10 @@ int main(int argc, char** argv) {
   if (quick) {
     runCase(5, {320, 240}, 32, frames, repeats, true, host);
     runModules(5, {320, 240}, 32, 8, host);
+    return 0;
+  }
+  if (argc == 4 && std::strcmp(argv[1], "--case") == 0) {
+    runCase(std::atoi(argv[2]), {640, 480}, std::atoi(argv[3]), frames, repeats, false, host);
     return 0;
   }
   runCase(5, {640, 480}, 128, frames, repeats, true, host);
