@@ -40,6 +40,22 @@ bool sameMesh(const TriangleMesh& a, const TriangleMesh& b) {
   return a.vertices == b.vertices && a.triangles == b.triangles;
 }
 
+TEST(FastChain, HullEqualsTheReferenceCarvingBitForBit) {
+  for (int cameras : {3, 4, 5})
+    for (double phase : {0.0, 1.5, 3.0, 4.5}) {
+      const SyntheticUser user(wavingPose(phase));
+      const Rig rig(cameras, user);
+      for (int cells : {64, 128}) {
+        auto hull = carveVisualHull(rig.views, userVolume(cells));
+        ASSERT_TRUE(hull);
+        VoxelGrid expected(userVolume(cells));
+        reference::carveVisualHull(rig.views, expected);
+        EXPECT_EQ(hull->occupied, expected.occupied)
+            << cameras << " cameras, phase " << phase << ", " << cells << "^3";
+      }
+    }
+}
+
 TEST(FastChain, DistanceFieldAndMeshOfTheUsersHullEqualTheReferenceBitForBit) {
   for (double phase : {0.0, 2.0, 4.0}) {
     const SyntheticUser user(wavingPose(phase));
@@ -74,11 +90,18 @@ TEST(FastChain, DistanceFieldAndMeshOfRandomGridsEqualTheReference) {
 TEST(FastChain, AnyThreadCountGivesTheSameBitsAsOneThread) {
   const SyntheticUser user(wavingPose(1.0));
   const Rig rig(5, user);
-  auto one = carveVisualHull(rig.views, userVolume(96));
+  CarveStats oneStats;
+  auto one = carveVisualHull(rig.views, userVolume(96), &oneStats, 1);
   ASSERT_TRUE(one);
   const std::vector<float> sdf = signedDistanceField(*one, 1);
   const TriangleMesh mesh = meshHull(*one, sdf);
   for (int threads : {2, 3, 8}) {
+    CarveStats stats;
+    auto hull = carveVisualHull(rig.views, userVolume(96), &stats, threads);
+    ASSERT_TRUE(hull);
+    EXPECT_EQ(hull->occupied, one->occupied) << threads << " threads";
+    EXPECT_EQ(stats.blocksDecided, oneStats.blocksDecided) << threads << " threads";
+    EXPECT_EQ(stats.voxelsTested, oneStats.voxelsTested) << threads << " threads";
     EXPECT_TRUE(sameBits(signedDistanceField(*one, threads), sdf)) << threads << " threads";
     EXPECT_TRUE(sameBits(squaredDistanceTo(*one, 0, threads), squaredDistanceTo(*one, 0, 1)))
         << threads << " threads";

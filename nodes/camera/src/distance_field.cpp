@@ -1,8 +1,10 @@
 #include "vrflow/camera/distance_field.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "parallel_parts.hpp"
 
@@ -16,54 +18,42 @@ constexpr Squared kFar = std::numeric_limits<Squared>::max();
 
 // One line of the transform in place over n contiguous samples: d[q] = min_v f[v] + (q - v)^2
 // (Felzenszwalb and Huttenlocher's lower envelope of the parabolas rooted at the finite samples).
-// The scratch is sized once per part, never per line.
+// The intersections are compared by cross-multiplying integers, without a division: the
+// envelope is the one the rational intersections give. The scratch is sized once per part.
 class LineEnvelope {
  public:
-  explicit LineEnvelope(int n)
-      : f_(static_cast<std::size_t>(n)),
-        v_(static_cast<std::size_t>(n)),
-        z_(static_cast<std::size_t>(n) + 1) {}
+  explicit LineEnvelope(int n) : v_(static_cast<std::size_t>(n)), f_(static_cast<std::size_t>(n)) {}
 
   void operator()(Squared* data, int n) {
-    // z_[k] is where the k-th parabola starts to be the lowest.
+    // v_[0..k]: the roots of the envelope's parabolas, left to right; f_: their f + v^2.
     int k = -1;
     for (int q = 0; q < n; ++q) {
-      const Squared value = data[q];
-      f_[q] = value;
-      if (value == kFar) continue;
-      if (k < 0) {
-        k = 0;
-        v_[0] = q;
-        z_[0] = -1e30;
-        z_[1] = 1e30;
-        continue;
-      }
-      double s = intersection(v_[k], q);
-      while (s <= z_[k]) s = intersection(v_[--k], q);
+      if (data[q] == kFar) continue;
+      const std::int64_t fq = std::int64_t{data[q]} + std::int64_t{q} * q;
+      // Parabola k is hidden when q's intersection with it is not right of its own with k - 1.
+      while (k > 0 && (fq - f_[k]) * (v_[k] - v_[k - 1]) <= (f_[k] - f_[k - 1]) * (q - v_[k])) --k;
       ++k;
       v_[k] = q;
-      z_[k] = s;
-      z_[k + 1] = 1e30;
+      f_[k] = fq;
     }
     if (k < 0) return;  // nothing to spread along this line
+    const int last = k;
     k = 0;
     for (int q = 0; q < n; ++q) {
-      while (z_[k + 1] < q) ++k;
-      const Squared d = q - v_[k];
-      data[q] = f_[v_[k]] + d * d;
+      // The next parabola takes over where it is as low as the current one.
+      while (k < last && value(k + 1, q) <= value(k, q)) ++k;
+      data[q] = static_cast<Squared>(value(k, q));
     }
   }
 
  private:
-  double intersection(int p, int q) const {
-    return (static_cast<double>(f_[q]) + double(q) * q -
-            (static_cast<double>(f_[p]) + double(p) * p)) /
-           (2.0 * (q - p));
+  std::int64_t value(int k, int q) const {
+    const std::int64_t d = q - v_[k];
+    return f_[k] - std::int64_t{v_[k]} * v_[k] + d * d;
   }
 
-  std::vector<Squared> f_;
-  std::vector<int> v_;
-  std::vector<double> z_;
+  std::vector<std::int64_t> v_;
+  std::vector<std::int64_t> f_;
 };
 
 // The box [lo, hi) of a grid whose transform is computed, and the output's layout over it.
@@ -76,78 +66,84 @@ struct Box {
   std::size_t count() const { return slice() * nz(); }
 };
 
-// Along x by two scans (exact in 1D), then along y by the envelope over each column, one z
-// slice at a time: the slice is transposed into the scratch so that every line is contiguous.
-// Returns whether the slice holds a target voxel.
-bool transformSlice(const VoxelGrid& grid, const Box& box, std::uint8_t target, int k,
-                    Squared* slice, std::vector<Squared>& transposed, LineEnvelope& alongY) {
-  const GridSpec& s = grid.spec;
-  const int nx = box.nx(), ny = box.ny();
-  bool any = false;
-  for (int j = 0; j < ny; ++j) {
-    const std::uint8_t* occupied = &grid.occupied[s.index(box.lo[0], box.lo[1] + j, k)];
-    Squared* row = slice + static_cast<std::size_t>(j) * nx;
-    Squared gap = kFar;
-    for (int i = 0; i < nx; ++i) {
-      gap = occupied[i] == target ? 0 : (gap == kFar ? kFar : gap + 1);
-      row[i] = gap;
-    }
-    if (gap == kFar) continue;  // no target on the row: it stays far
-    any = true;
-    gap = kFar;
-    for (int i = nx - 1; i >= 0; --i) {
-      gap = occupied[i] == target ? 0 : (gap == kFar ? kFar : gap + 1);
-      row[i] = std::min(row[i], gap);
-    }
-    for (int i = 0; i < nx; ++i) row[i] *= row[i];
-  }
-  if (!any) return false;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i)
-      transposed[static_cast<std::size_t>(i) * ny + j] =
-          slice[static_cast<std::size_t>(j) * nx + i];
-  for (int i = 0; i < nx; ++i) alongY(&transposed[static_cast<std::size_t>(i) * ny], ny);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i)
-      slice[static_cast<std::size_t>(j) * nx + i] =
-          transposed[static_cast<std::size_t>(i) * ny + j];
-  return true;
-}
+// The 1D distance along z (in voxels) from every voxel of the box to the nearest target voxel
+// of its column, by a forward and a backward scan over whole rows of columns at once (slices in
+// order: contiguous and vectorisable); kFarGap where the column has no target.
+using Gap = std::uint16_t;
+constexpr Gap kFarGap = std::numeric_limits<Gap>::max();
 
-// The squared distance from every voxel of `box` to the nearest voxel of the box whose occupancy
-// is `target`, laid out over the box (x fastest). Slices of z, then planes of y, split in parts.
-std::vector<Squared> transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target,
-                                  int threads) {
-  std::vector<Squared> d(box.count());
+void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap* gaps,
+                int threads) {
+  const GridSpec& s = grid.spec;
   const int nx = box.nx(), ny = box.ny(), nz = box.nz();
   const std::size_t sliceSize = box.slice();
-  std::vector<std::uint8_t> sliceHasTarget(static_cast<std::size_t>(nz), 0);
-  forParts(threads, static_cast<std::size_t>(nz), [&](std::size_t begin, std::size_t end) {
-    std::vector<Squared> transposed(sliceSize);
-    LineEnvelope alongY(ny);
-    for (std::size_t k = begin; k < end; ++k)
-      sliceHasTarget[k] = transformSlice(grid, box, target, box.lo[2] + static_cast<int>(k),
-                                         &d[k * sliceSize], transposed, alongY);
+  forParts(threads, static_cast<std::size_t>(ny), [&](std::size_t jBegin, std::size_t jEnd) {
+    const std::size_t rows = jEnd - jBegin;
+    std::vector<Gap> run(rows * nx);
+    auto scan = [&](int k, bool backward) {
+      for (std::size_t j = jBegin; j < jEnd; ++j) {
+        const std::uint8_t* occupied =
+            &grid.occupied[s.index(box.lo[0], box.lo[1] + static_cast<int>(j), box.lo[2] + k)];
+        Gap* gap = &run[(j - jBegin) * nx];
+        Gap* out = &gaps[static_cast<std::size_t>(k) * sliceSize + j * nx];
+        for (int i = 0; i < nx; ++i) {
+          const Gap next = static_cast<Gap>(gap[i] + (gap[i] != kFarGap));
+          gap[i] = occupied[i] == target ? Gap{0} : next;
+          out[i] = backward ? std::min(out[i], gap[i]) : gap[i];
+        }
+      }
+    };
+    std::fill(run.begin(), run.end(), kFarGap);
+    for (int k = 0; k < nz; ++k) scan(k, false);
+    std::fill(run.begin(), run.end(), kFarGap);
+    for (int k = nz - 1; k >= 0; --k) scan(k, true);
   });
-  if (std::none_of(sliceHasTarget.begin(), sliceHasTarget.end(), [](auto b) { return b != 0; }))
-    return d;  // no target at all: far everywhere
-  // Along z: the plane of one y gathered as nx contiguous lines of nz.
-  forParts(threads, static_cast<std::size_t>(ny), [&](std::size_t begin, std::size_t end) {
-    std::vector<Squared> lines(static_cast<std::size_t>(nx) * nz);
-    LineEnvelope alongZ(nz);
-    for (std::size_t j = begin; j < end; ++j) {
-      for (int k = 0; k < nz; ++k) {
-        const Squared* row = &d[static_cast<std::size_t>(k) * sliceSize + j * nx];
-        for (int i = 0; i < nx; ++i) lines[static_cast<std::size_t>(i) * nz + k] = row[i];
+}
+
+// The exact squared distance over the box to the nearest target voxel of the box: the gaps
+// along z, then per z slice the envelope along x (contiguous rows) and along y (the slice
+// transposed into the scratch). Each finished row (j, k) of the box goes to emit(j, k, row).
+template <typename Emit>
+void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, int threads,
+                  Emit&& emit) {
+  const int nx = box.nx(), ny = box.ny(), nz = box.nz();
+  const std::size_t sliceSize = box.slice();
+  assert(nz < kFarGap);
+  std::unique_ptr<Gap[]> gaps(new Gap[box.count()]);  // every element written before it is read
+  gapsAlongZ(grid, box, target, gaps.get(), threads);
+  forParts(threads, static_cast<std::size_t>(nz), [&](std::size_t kBegin, std::size_t kEnd) {
+    std::vector<Squared> slice(sliceSize), transposed(sliceSize);
+    LineEnvelope alongX(nx), alongY(ny);
+    for (std::size_t k = kBegin; k < kEnd; ++k) {
+      const Gap* gap = &gaps[k * sliceSize];
+      bool any = false;
+      for (int j = 0; j < ny; ++j) {
+        Squared* row = &slice[static_cast<std::size_t>(j) * nx];
+        const Gap* rowGap = gap + static_cast<std::size_t>(j) * nx;
+        bool rowAny = false;
+        for (int i = 0; i < nx; ++i) {
+          const Squared g = rowGap[i];
+          rowAny |= g != kFarGap;
+          row[i] = g == kFarGap ? kFar : g * g;
+        }
+        if (rowAny) alongX(row, nx);
+        any |= rowAny;
       }
-      for (int i = 0; i < nx; ++i) alongZ(&lines[static_cast<std::size_t>(i) * nz], nz);
-      for (int k = 0; k < nz; ++k) {
-        Squared* row = &d[static_cast<std::size_t>(k) * sliceSize + j * nx];
-        for (int i = 0; i < nx; ++i) row[i] = lines[static_cast<std::size_t>(i) * nz + k];
+      if (any) {
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i)
+            transposed[static_cast<std::size_t>(i) * ny + j] =
+                slice[static_cast<std::size_t>(j) * nx + i];
+        for (int i = 0; i < nx; ++i) alongY(&transposed[static_cast<std::size_t>(i) * ny], ny);
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i)
+            slice[static_cast<std::size_t>(j) * nx + i] =
+                transposed[static_cast<std::size_t>(i) * ny + j];
       }
+      for (int j = 0; j < ny; ++j)
+        emit(j, static_cast<int>(k), &slice[static_cast<std::size_t>(j) * nx]);
     }
   });
-  return d;
 }
 
 Box wholeGrid(const GridSpec& s) {
@@ -182,42 +178,40 @@ float toFloat(Squared squared) {
 }  // namespace
 
 std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target, int threads) {
-  const std::vector<Squared> squared = transformBox(grid, wholeGrid(grid.spec), target, threads);
-  std::vector<float> d(squared.size());
-  std::transform(squared.begin(), squared.end(), d.begin(), toFloat);
+  const GridSpec& s = grid.spec;
+  std::vector<float> d(s.count());
+  transformBox(grid, wholeGrid(s), target, threads, [&](int j, int k, const Squared* row) {
+    std::transform(row, row + s.nx, &d[s.index(0, j, k)], toFloat);
+  });
   return d;
 }
 
 std::vector<float> signedDistanceField(const VoxelGrid& grid, int threads) {
   const GridSpec& s = grid.spec;
-  const std::vector<Squared> toInside = transformBox(grid, wholeGrid(s), 1, threads);
   const auto h = static_cast<float>(s.voxelSize);
   std::vector<float> field(s.count());
-  forParts(threads, field.size(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t n = begin; n < end; ++n)
-      field[n] =
-          toInside[n] == kFar ? kNoVoxel : (std::sqrt(static_cast<float>(toInside[n])) - 0.5f) * h;
+  transformBox(grid, wholeGrid(s), 1, threads, [&](int j, int k, const Squared* row) {
+    float* out = &field[s.index(0, j, k)];
+    for (int i = 0; i < s.nx; ++i)
+      out[i] = row[i] == kFar ? kNoVoxel : (std::sqrt(static_cast<float>(row[i])) - 0.5f) * h;
   });
   // Only inside voxels need their distance to the outside, and each has a nearest outside voxel
   // in the occupied bounding box grown by one voxel (clamping any other onto that box's border
   // layer, which is outside, brings it no farther): the transform runs on that box alone.
   const Box box = occupiedBox(grid);
   if (box.count() == 0) return field;  // nothing inside
-  const std::vector<Squared> toOutside = transformBox(grid, box, 0, threads);
-  // Beyond the grid counts as outside: an inside voxel is at most its distance to the border
-  // plus one from an outside centre.
-  for (int k = box.lo[2]; k < box.hi[2]; ++k)
-    for (int j = box.lo[1]; j < box.hi[1]; ++j) {
-      const std::size_t boxRow = static_cast<std::size_t>(k - box.lo[2]) * box.slice() +
-                                 static_cast<std::size_t>(j - box.lo[1]) * box.nx() - box.lo[0];
-      for (int i = box.lo[0]; i < box.hi[0]; ++i) {
-        const std::size_t n = s.index(i, j, k);
-        if (!grid.occupied[n]) continue;
-        const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
-        const auto squared = static_cast<float>(toOutside[boxRow + i]);
-        field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
-      }
+  transformBox(grid, box, 0, threads, [&](int boxJ, int boxK, const Squared* row) {
+    const int j = box.lo[1] + boxJ, k = box.lo[2] + boxK;
+    for (int i = box.lo[0]; i < box.hi[0]; ++i) {
+      const std::size_t n = s.index(i, j, k);
+      if (!grid.occupied[n]) continue;
+      // Beyond the grid counts as outside: an inside voxel is at most its distance to the
+      // border plus one from an outside centre.
+      const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
+      const auto squared = static_cast<float>(row[i - box.lo[0]]);
+      field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
     }
+  });
   return field;
 }
 
