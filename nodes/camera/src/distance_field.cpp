@@ -37,21 +37,23 @@ class LineEnvelope {
       f_[k] = fq;
     }
     if (k < 0) return;  // nothing to spread along this line
-    const int last = k;
-    k = 0;
-    for (int q = 0; q < n; ++q) {
-      // The next parabola takes over where it is as low as the current one.
-      while (k < last && value(k + 1, q) <= value(k, q)) ++k;
-      data[q] = static_cast<Squared>(value(k, q));
+    // Parabola m is the lowest from its intersection with m - 1 to its intersection with m + 1:
+    // the samples between take its value. A rational intersection's double rounds to no other
+    // integer ceiling (an integer quotient is exact, any other is over 1 / (2n) from one).
+    int q = 0;
+    for (int m = 0; m <= k; ++m) {
+      int end = n;
+      if (m < k) {
+        const double s =
+            static_cast<double>(f_[m + 1] - f_[m]) / static_cast<double>(2 * (v_[m + 1] - v_[m]));
+        end = static_cast<int>(std::ceil(std::clamp(s, 0.0, static_cast<double>(n))));
+      }
+      const std::int64_t root = v_[m], lowest = f_[m] - root * root;
+      for (; q < end; ++q) data[q] = static_cast<Squared>(lowest + (q - root) * (q - root));
     }
   }
 
  private:
-  std::int64_t value(int k, int q) const {
-    const std::int64_t d = q - v_[k];
-    return f_[k] - std::int64_t{v_[k]} * v_[k] + d * d;
-  }
-
   std::vector<std::int64_t> v_;
   std::vector<std::int64_t> f_;
 };
