@@ -74,6 +74,23 @@ double msPerFrame(int frames, int repeats, const std::function<void(int)>& work)
   return best;
 }
 
+// Best ms per frame of each of `variants` alternatives: `repeats` passes, each running every
+// variant over every frame in turn (after one warm-up frame each).
+std::vector<double> bestOfAlternating(std::size_t variants, int frames, int repeats,
+                                      const std::function<void(std::size_t, int)>& work) {
+  for (std::size_t v = 0; v < variants; ++v) work(v, 0);
+  std::vector<double> best(variants, 1e30);
+  for (int r = 0; r < repeats; ++r)
+    for (std::size_t v = 0; v < variants; ++v) {
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int n = 0; n < frames; ++n) work(v, n);
+      const auto t1 = std::chrono::steady_clock::now();
+      best[v] =
+          std::min(best[v], std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
+    }
+  return best;
+}
+
 // The one-minute load average when the case started: the machine is shared.
 double loadAverage() {
   double load = -1;
@@ -153,49 +170,45 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
       sum += intersectionOverUnion(at(out.hulls, n), at(input, n).exact);
     return sum / frames;
   };
-  // The stages before the speed round, one thread.
-  StageOutputs before = newOutputs();
-  {
-    auto hull = [&](int n) { reference::carveVisualHull(at(views, n), at(before.hulls, n)); };
-    auto field = [&](int n) {
-      at(before.fields, n) = reference::signedDistanceField(at(before.hulls, n));
-    };
-    auto mesh = [&](int n) {
-      at(before.meshes, n) = reference::meshHull(at(before.hulls, n), at(before.fields, n));
-    };
-    const double tHull = msPerFrame(frames, repeats, hull);
-    const double tField = msPerFrame(frames, repeats, field);
-    const double tMesh = msPerFrame(frames, repeats, mesh);
-    const double tChain = msPerFrame(frames, repeats, [&](int n) {
-      silhouettes(n);
-      hull(n);
-      field(n);
-      mesh(n);
-    });
-    line.print("reference_hull", "reference", 1, tHull, meanIoU(before));
-    line.print("reference_distance_field", "reference", 1, tField, -1);
-    line.print("reference_mesh", "reference", 1, tMesh, -1);
-    line.print("reference_chain", "reference", 1, tChain, meanIoU(before));
-  }
-  // The library's stages on one thread and on `threads`.
-  for (int t : threads > 1 ? std::vector<int>{1, threads} : std::vector<int>{1}) {
-    StageOutputs after = newOutputs();
-    auto hull = [&](int n) {
-      (void)carveVisualHull(at(views, n), 0, spec.nz, at(after.hulls, n), nullptr, t);
-    };
-    auto field = [&](int n) { at(after.fields, n) = signedDistanceField(at(after.hulls, n), t); };
-    auto mesh = [&](int n) {
-      at(after.meshes, n) = meshHull(at(after.hulls, n), at(after.fields, n));
-    };
-    const double tHull = msPerFrame(frames, repeats, hull);
-    const double tField = msPerFrame(frames, repeats, field);
-    const double tMesh = msPerFrame(frames, repeats, mesh);
-    const double tChain = msPerFrame(frames, repeats, [&](int n) {
-      silhouettes(n);
-      hull(n);
-      field(n);
-      mesh(n);
-    });
+  // The variants side by side: the stages before the speed round (one thread), then the
+  // library's on 1 and on `threads` threads. Each stage is timed in passes that alternate the
+  // variants, the best pass kept for each, so a load that changes during the run (the machine is
+  // shared) weighs on all of them alike.
+  std::vector<int> threadCounts{1};
+  if (threads > 1) threadCounts.push_back(threads);
+  const std::size_t variants = 1 + threadCounts.size();
+  std::vector<StageOutputs> out;
+  for (std::size_t v = 0; v < variants; ++v) out.push_back(newOutputs());
+  auto hull = [&](std::size_t v, int n) {
+    if (v == 0) return reference::carveVisualHull(at(views, n), at(out[0].hulls, n));
+    (void)carveVisualHull(at(views, n), 0, spec.nz, at(out[v].hulls, n), nullptr,
+                          threadCounts[v - 1]);
+  };
+  auto field = [&](std::size_t v, int n) {
+    at(out[v].fields, n) = v == 0 ? reference::signedDistanceField(at(out[0].hulls, n))
+                                  : signedDistanceField(at(out[v].hulls, n), threadCounts[v - 1]);
+  };
+  auto mesh = [&](std::size_t v, int n) {
+    at(out[v].meshes, n) = v == 0 ? reference::meshHull(at(out[0].hulls, n), at(out[0].fields, n))
+                                  : meshHull(at(out[v].hulls, n), at(out[v].fields, n));
+  };
+  auto chain = [&](std::size_t v, int n) {
+    silhouettes(n);
+    hull(v, n);
+    field(v, n);
+    mesh(v, n);
+  };
+  const std::vector<double> tHull = bestOfAlternating(variants, frames, repeats, hull);
+  const std::vector<double> tField = bestOfAlternating(variants, frames, repeats, field);
+  const std::vector<double> tMesh = bestOfAlternating(variants, frames, repeats, mesh);
+  const std::vector<double> tChain = bestOfAlternating(variants, frames, repeats, chain);
+  line.print("reference_hull", "reference", 1, tHull[0], meanIoU(out[0]));
+  line.print("reference_distance_field", "reference", 1, tField[0], -1);
+  line.print("reference_mesh", "reference", 1, tMesh[0], -1);
+  line.print("reference_chain", "reference", 1, tChain[0], meanIoU(out[0]));
+  const StageOutputs& before = out[0];
+  for (std::size_t v = 1; v < variants; ++v) {
+    const StageOutputs& after = out[v];
     bool sameHulls = true, sameFields = true, sameMeshes = true;
     for (int n = 0; n < frames; ++n) {
       sameHulls = sameHulls && at(after.hulls, n).occupied == at(before.hulls, n).occupied;
@@ -205,10 +218,12 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
       sameMeshes = sameMeshes && at(after.meshes, n).vertices == at(before.meshes, n).vertices &&
                    at(after.meshes, n).triangles == at(before.meshes, n).triangles;
     }
-    line.print("hull", "fast", t, tHull, meanIoU(after), sameHulls);
-    line.print("distance_field", "fast", t, tField, -1, sameFields);
-    line.print("mesh", "fast", t, tMesh, -1, sameMeshes);
-    line.print("chain", "fast", t, tChain, meanIoU(after), sameHulls && sameFields && sameMeshes);
+    const int t = threadCounts[v - 1];
+    line.print("hull", "fast", t, tHull[v], meanIoU(after), sameHulls);
+    line.print("distance_field", "fast", t, tField[v], -1, sameFields);
+    line.print("mesh", "fast", t, tMesh[v], -1, sameMeshes);
+    line.print("chain", "fast", t, tChain[v], meanIoU(after),
+               sameHulls && sameFields && sameMeshes);
   }
   if (baseline) {
     double sum = 0;
@@ -270,7 +285,7 @@ int main(int argc, char** argv) {
                  "and >= 2 voxels\n");
     return 2;
   }
-  const int frames = quick ? 2 : 10, repeats = quick ? 1 : 3;
+  const int frames = quick ? 2 : 10, repeats = quick ? 1 : 5;
   if (quick) {
     runCase(5, {320, 240}, 32, frames, repeats, true, threads, host);
     if (modules) runModules(5, {320, 240}, 32, 8, host);
