@@ -160,10 +160,11 @@ Box occupiedBox(const VoxelGrid& grid) {
   for (int k = 0; k < s.nz; ++k)
     for (int j = 0; j < s.ny; ++j) {
       const std::uint8_t* row = &grid.occupied[s.index(0, j, k)];
-      const std::uint8_t* first = std::find(row, row + s.nx, std::uint8_t{1});
+      const auto occupied = [](std::uint8_t v) { return v != 0; };
+      const std::uint8_t* first = std::find_if(row, row + s.nx, occupied);
       if (first == row + s.nx) continue;
-      const auto last = std::find(std::make_reverse_iterator(row + s.nx),
-                                  std::make_reverse_iterator(row), std::uint8_t{1});
+      const auto last = std::find_if(std::make_reverse_iterator(row + s.nx),
+                                     std::make_reverse_iterator(row), occupied);
       lo = {std::min(lo[0], static_cast<int>(first - row)), std::min(lo[1], j), std::min(lo[2], k)};
       hi = {std::max(hi[0], static_cast<int>(last.base() - row)), std::max(hi[1], j + 1),
             std::max(hi[2], k + 1)};
