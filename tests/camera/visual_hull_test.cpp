@@ -102,6 +102,18 @@ TEST(VisualHull, MasksOfTheWrongSizeOrABadSlabAreErrors) {
             "slab [30, 40) is not a non-empty range of the grid's 32 z layers");
 }
 
+TEST(VisualHull, MoreThanSixtyFourCamerasAreAnError) {
+  const std::vector<CameraCalibration> cameras = cameraRing(65, {32, 24});
+  std::vector<MaskView> views;
+  for (const CameraCalibration& camera : cameras)
+    views.push_back({&camera, cv::Mat(24, 32, CV_8UC1, cv::Scalar(255))});
+  auto hull = carveVisualHull(views, userVolume(8));
+  ASSERT_FALSE(hull);
+  EXPECT_EQ(hull.error().message, "65 cameras: the visual hull takes at most 64");
+  views.pop_back();
+  EXPECT_TRUE(carveVisualHull(views, userVolume(8)));
+}
+
 TEST(HullMesh, IsClosedAndEnclosesTheVoxelVolume) {
   const SyntheticUser user(standingPose());
   const Rig rig(5, user);

@@ -1,20 +1,27 @@
 // vrflow-bench-camera: ms per frame of each stage of the camera chain (silhouettes of every
 // camera, hierarchical visual hull, signed distance field, mesh) and of the whole chain, on
-// synthetic frames of the moving user, with the straightforward carving (cv::projectPoints of every
-// voxel into every mask) measured in the same run as the baseline. One JSON line per case:
-// {cameras, width, height, voxels, stage, ms_per_frame, iou, machine}. `--quick`: a smoke run.
-// The stages `modules_*` run the chain as modules (capture, silhouette, hull) through `vrflow run`.
+// synthetic frames of the moving user, in one run: the library's stages on 1 thread and on
+// --threads (default: the cores), the same stages as they were before the speed round
+// (reference_chain.hpp, stages reference_*), and the straightforward carving (cv::projectPoints
+// of every voxel into every mask, stage baseline). One JSON line per stage: {cameras, width,
+// height, voxels, stage, code, threads, ms_per_frame, iou, same_bits_as_reference, load,
+// machine}. `--quick`: a smoke run; `--case C V`: C cameras, V^3 only; `--no-modules`. The
+// stages `modules_*` run the chain as modules (capture, silhouette, hull, user animator) through
+// `vrflow run`.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "modules_stage.hpp"
+#include "reference_chain.hpp"
 #include "vrflow/camera/distance_field.hpp"
 #include "vrflow/camera/hull_mesh.hpp"
 #include "vrflow/camera/silhouette.hpp"
@@ -67,18 +74,62 @@ double msPerFrame(int frames, int repeats, const std::function<void(int)>& work)
   return best;
 }
 
-void print(int cameras, cv::Size size, int voxels, const char* stage, double ms, double iou,
-           const std::string& host) {
-  std::printf(
-      "{\"cameras\": %d, \"width\": %d, \"height\": %d, \"voxels\": %d, \"stage\": \"%s\", "
-      "\"ms_per_frame\": %.3f, \"iou\": %s, \"machine\": \"%s\"}\n",
-      cameras, size.width, size.height, voxels, stage, ms,
-      iou < 0 ? "null" : std::to_string(iou).c_str(), host.c_str());
-  std::fflush(stdout);
+// Best ms per frame of each of `variants` alternatives: `repeats` passes, each running every
+// variant over every frame in turn (after one warm-up frame each).
+std::vector<double> bestOfAlternating(std::size_t variants, int frames, int repeats,
+                                      const std::function<void(std::size_t, int)>& work) {
+  for (std::size_t v = 0; v < variants; ++v) work(v, 0);
+  std::vector<double> best(variants, 1e30);
+  for (int r = 0; r < repeats; ++r)
+    for (std::size_t v = 0; v < variants; ++v) {
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int n = 0; n < frames; ++n) work(v, n);
+      const auto t1 = std::chrono::steady_clock::now();
+      best[v] =
+          std::min(best[v], std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
+    }
+  return best;
 }
 
+// The one-minute load average when the case started: the machine is shared.
+double loadAverage() {
+  double load = -1;
+  std::ifstream("/proc/loadavg") >> load;
+  return load;
+}
+
+// One JSON line; `code` is "fast" (the library), "reference" (the stages before the speed round,
+// reference_chain.hpp) or "baseline"; `same` whether the fast output equals the reference's bits.
+struct Line {
+  int cameras;
+  cv::Size size;
+  int voxels;
+  const std::string& host;
+  double load;
+
+  void print(const std::string& stage, const char* code, int threads, double ms, double iou,
+             int same = -1) const {
+    std::printf(
+        "{\"cameras\": %d, \"width\": %d, \"height\": %d, \"voxels\": %d, \"stage\": \"%s\", "
+        "\"code\": \"%s\", \"threads\": %d, \"ms_per_frame\": %.3f, \"iou\": %s, "
+        "\"same_bits_as_reference\": %s, \"load\": %.2f, \"machine\": \"%s\"}\n",
+        cameras, size.width, size.height, voxels, stage.c_str(), code, threads, ms,
+        iou < 0 ? "null" : std::to_string(iou).c_str(),
+        same < 0 ? "null" : (same ? "true" : "false"), load, host.c_str());
+    std::fflush(stdout);
+  }
+};
+
+// Each stage's output per frame, so that the next stage is timed alone.
+struct StageOutputs {
+  std::vector<VoxelGrid> hulls;
+  std::vector<std::vector<float>> fields;
+  std::vector<TriangleMesh> meshes;
+};
+
 void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats, bool baseline,
-             const std::string& host) {
+             int threads, const std::string& host) {
+  const Line line{cameraCount, size, voxels, host, loadAverage()};
   const std::vector<CameraCalibration> cameras = cameraRing(cameraCount, size);
   const GridSpec spec = userVolume(voxels);
   std::vector<SilhouetteExtractor> extractors;
@@ -96,60 +147,92 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
                                              1000 + static_cast<std::uint64_t>(n)));
     input.push_back(std::move(frame));
   }
-  // Each stage's output, kept per frame so the next stage is timed alone.
+  const auto at = [](auto& vector, int n) -> auto& {
+    return vector[static_cast<std::size_t>(n)];
+  };
   std::vector<std::vector<MaskView>> views(static_cast<std::size_t>(frames));
-  std::vector<VoxelGrid> hulls(static_cast<std::size_t>(frames), VoxelGrid(spec));
-  std::vector<std::vector<float>> fields(static_cast<std::size_t>(frames));
   auto silhouettes = [&](int n) {
-    auto& v = views[static_cast<std::size_t>(n)];
+    auto& v = at(views, n);
     v.clear();
     for (int c = 0; c < cameraCount; ++c)
-      v.push_back({&cameras[static_cast<std::size_t>(c)],
-                   *extractors[static_cast<std::size_t>(c)].extract(
-                       input[static_cast<std::size_t>(n)].images[static_cast<std::size_t>(c)])});
-  };
-  auto hull = [&](int n) {
-    (void)carveVisualHull(views[static_cast<std::size_t>(n)], 0, spec.nz,
-                          hulls[static_cast<std::size_t>(n)]);
-  };
-  auto field = [&](int n) {
-    fields[static_cast<std::size_t>(n)] = signedDistanceField(hulls[static_cast<std::size_t>(n)]);
-  };
-  std::size_t triangles = 0;
-  auto mesh = [&](int n) {
-    triangles += meshHull(hulls[static_cast<std::size_t>(n)], fields[static_cast<std::size_t>(n)])
-                     .triangles.size();
-  };
-  auto meanIoU = [&] {
-    double sum = 0;
-    for (int n = 0; n < frames; ++n)
-      sum += intersectionOverUnion(hulls[static_cast<std::size_t>(n)],
-                                   input[static_cast<std::size_t>(n)].exact);
-    return sum / frames;
+      v.push_back({&at(cameras, c), *at(extractors, c).extract(at(at(input, n).images, c))});
   };
   const double tSilhouette = msPerFrame(frames, repeats, silhouettes);
-  const double tHull = msPerFrame(frames, repeats, hull);
-  const double iou = meanIoU();
-  const double tField = msPerFrame(frames, repeats, field);
-  const double tMesh = msPerFrame(frames, repeats, mesh);
-  const double tChain = msPerFrame(frames, repeats, [&](int n) {
+  line.print("silhouette", "fast", 1, tSilhouette, -1);
+  auto newOutputs = [&] {
+    return StageOutputs{std::vector<VoxelGrid>(static_cast<std::size_t>(frames), VoxelGrid(spec)),
+                        std::vector<std::vector<float>>(static_cast<std::size_t>(frames)),
+                        std::vector<TriangleMesh>(static_cast<std::size_t>(frames))};
+  };
+  auto meanIoU = [&](const StageOutputs& out) {
+    double sum = 0;
+    for (int n = 0; n < frames; ++n)
+      sum += intersectionOverUnion(at(out.hulls, n), at(input, n).exact);
+    return sum / frames;
+  };
+  // The variants side by side: the stages before the speed round (one thread), then the
+  // library's on 1 and on `threads` threads. Each stage is timed in passes that alternate the
+  // variants, the best pass kept for each, so a load that changes during the run (the machine is
+  // shared) weighs on all of them alike.
+  std::vector<int> threadCounts{1};
+  if (threads > 1) threadCounts.push_back(threads);
+  const std::size_t variants = 1 + threadCounts.size();
+  std::vector<StageOutputs> out;
+  for (std::size_t v = 0; v < variants; ++v) out.push_back(newOutputs());
+  auto hull = [&](std::size_t v, int n) {
+    if (v == 0) return reference::carveVisualHull(at(views, n), at(out[0].hulls, n));
+    (void)carveVisualHull(at(views, n), 0, spec.nz, at(out[v].hulls, n), nullptr,
+                          threadCounts[v - 1]);
+  };
+  auto field = [&](std::size_t v, int n) {
+    at(out[v].fields, n) = v == 0 ? reference::signedDistanceField(at(out[0].hulls, n))
+                                  : signedDistanceField(at(out[v].hulls, n), threadCounts[v - 1]);
+  };
+  auto mesh = [&](std::size_t v, int n) {
+    at(out[v].meshes, n) = v == 0 ? reference::meshHull(at(out[0].hulls, n), at(out[0].fields, n))
+                                  : meshHull(at(out[v].hulls, n), at(out[v].fields, n));
+  };
+  auto chain = [&](std::size_t v, int n) {
     silhouettes(n);
-    hull(n);
-    field(n);
-    mesh(n);
-  });
-  print(cameraCount, size, voxels, "silhouette", tSilhouette, -1, host);
-  print(cameraCount, size, voxels, "hull", tHull, iou, host);
-  print(cameraCount, size, voxels, "distance_field", tField, -1, host);
-  print(cameraCount, size, voxels, "mesh", tMesh, -1, host);
-  print(cameraCount, size, voxels, "chain", tChain, meanIoU(), host);
+    hull(v, n);
+    field(v, n);
+    mesh(v, n);
+  };
+  const std::vector<double> tHull = bestOfAlternating(variants, frames, repeats, hull);
+  const std::vector<double> tField = bestOfAlternating(variants, frames, repeats, field);
+  const std::vector<double> tMesh = bestOfAlternating(variants, frames, repeats, mesh);
+  const std::vector<double> tChain = bestOfAlternating(variants, frames, repeats, chain);
+  line.print("reference_hull", "reference", 1, tHull[0], meanIoU(out[0]));
+  line.print("reference_distance_field", "reference", 1, tField[0], -1);
+  line.print("reference_mesh", "reference", 1, tMesh[0], -1);
+  line.print("reference_chain", "reference", 1, tChain[0], meanIoU(out[0]));
+  const StageOutputs& before = out[0];
+  for (std::size_t v = 1; v < variants; ++v) {
+    const StageOutputs& after = out[v];
+    bool sameHulls = true, sameFields = true, sameMeshes = true;
+    for (int n = 0; n < frames; ++n) {
+      sameHulls = sameHulls && at(after.hulls, n).occupied == at(before.hulls, n).occupied;
+      sameFields = sameFields && at(after.fields, n).size() == at(before.fields, n).size() &&
+                   std::memcmp(at(after.fields, n).data(), at(before.fields, n).data(),
+                               at(after.fields, n).size() * sizeof(float)) == 0;
+      sameMeshes = sameMeshes && at(after.meshes, n).vertices == at(before.meshes, n).vertices &&
+                   at(after.meshes, n).triangles == at(before.meshes, n).triangles;
+    }
+    const int t = threadCounts[v - 1];
+    line.print("hull", "fast", t, tHull[v], meanIoU(after), sameHulls);
+    line.print("distance_field", "fast", t, tField[v], -1, sameFields);
+    line.print("mesh", "fast", t, tMesh[v], -1, sameMeshes);
+    line.print("chain", "fast", t, tChain[v], meanIoU(after),
+               sameHulls && sameFields && sameMeshes);
+  }
   if (baseline) {
     double sum = 0;
-    const double tBaseline = msPerFrame(std::min(frames, 3), 1, [&](int n) {
-      auto carved = carveVisualHullBaseline(views[static_cast<std::size_t>(n)], spec);
-      sum += intersectionOverUnion(*carved, input[static_cast<std::size_t>(n)].exact);
+    const int baselineFrames = std::min(frames, 3);
+    const double tBaseline = msPerFrame(baselineFrames, 1, [&](int n) {
+      auto carved = carveVisualHullBaseline(at(views, n), spec);
+      sum += intersectionOverUnion(*carved, at(input, n).exact);
     });
-    print(cameraCount, size, voxels, "baseline", tBaseline, sum / (std::min(frames, 3) + 1), host);
+    line.print("baseline", "baseline", 1, tBaseline, sum / (baselineFrames + 1));
   }
 }
 
@@ -162,27 +245,60 @@ void runModules(int cameraCount, cv::Size size, int voxels, int iterations,
     std::fprintf(stderr, "vrflow-bench-camera: %s\n", times.error.c_str());
     return;
   }
-  print(cameraCount, size, voxels, "modules_capture", times.captureMs, -1, host);
-  print(cameraCount, size, voxels, "modules_silhouette", times.silhouetteMs, -1, host);
-  print(cameraCount, size, voxels, "modules_hull", times.hullMs, -1, host);
-  print(cameraCount, size, voxels, "modules_wall", times.wallMsPerFrame, -1, host);
+  const Line line{cameraCount, size, voxels, host, loadAverage()};
+  line.print("modules_capture", "fast", 1, times.captureMs, -1);
+  line.print("modules_silhouette", "fast", 1, times.silhouetteMs, -1);
+  line.print("modules_hull", "fast", 1, times.hullMs, -1);
+  line.print("modules_animator", "fast", 1, times.animatorMs, -1);
+  line.print("modules_wall", "fast", 1, times.wallMsPerFrame, -1);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
   const std::string host = machine();
-  const int frames = quick ? 2 : 10, repeats = quick ? 1 : 3;
+  bool quick = false, modules = true;
+  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int onlyCameras = 0, onlyVoxels = 0;
+  for (int a = 1; a < argc; ++a) {
+    const std::string arg = argv[a];
+    if (arg == "--quick") {
+      quick = true;
+    } else if (arg == "--no-modules") {
+      modules = false;
+    } else if (arg == "--threads" && a + 1 < argc) {
+      threads = std::atoi(argv[++a]);
+    } else if (arg == "--case" && a + 2 < argc) {
+      onlyCameras = std::atoi(argv[++a]);
+      onlyVoxels = std::atoi(argv[++a]);
+    } else {
+      std::fprintf(stderr,
+                   "usage: vrflow-bench-camera [--quick] [--no-modules] [--threads N] "
+                   "[--case CAMERAS VOXELS]\n(unknown or incomplete argument '%s')\n",
+                   arg.c_str());
+      return 2;
+    }
+  }
+  if (threads < 1 || (onlyCameras != 0 && (onlyCameras < 1 || onlyVoxels < 2))) {
+    std::fprintf(stderr,
+                 "vrflow-bench-camera: --threads must be >= 1, --case needs >= 1 camera "
+                 "and >= 2 voxels\n");
+    return 2;
+  }
+  const int frames = quick ? 2 : 10, repeats = quick ? 1 : 5;
   if (quick) {
-    runCase(5, {320, 240}, 32, frames, repeats, true, host);
-    runModules(5, {320, 240}, 32, 8, host);
+    runCase(5, {320, 240}, 32, frames, repeats, true, threads, host);
+    if (modules) runModules(5, {320, 240}, 32, 8, host);
     return 0;
   }
-  runCase(5, {640, 480}, 128, frames, repeats, true, host);
-  runModules(5, {640, 480}, 128, 60, host);
-  runCase(5, {640, 480}, 64, frames, repeats, true, host);
-  runCase(4, {640, 480}, 128, frames, repeats, false, host);
-  runCase(3, {640, 480}, 128, frames, repeats, false, host);
+  if (onlyCameras != 0) {
+    runCase(onlyCameras, {640, 480}, onlyVoxels, frames, repeats, true, threads, host);
+    return 0;
+  }
+  runCase(5, {640, 480}, 128, frames, repeats, true, threads, host);
+  if (modules) runModules(5, {640, 480}, 128, 60, host);
+  runCase(5, {640, 480}, 64, frames, repeats, true, threads, host);
+  runCase(4, {640, 480}, 128, frames, repeats, false, threads, host);
+  runCase(3, {640, 480}, 128, frames, repeats, false, threads, host);
   return 0;
 }

@@ -50,7 +50,11 @@ std::string chainApplication(const std::filesystem::path& dir, int cameras, int 
   modules += "    <module id=\"hull\" package=\"camera\" type=\"hull\" host=\"local\">\n" +
              param("calibrations", calibrations) + param("cells", std::to_string(voxels)) +
              "    </module>\n";
+  modules +=
+      "    <module id=\"animator\" package=\"camera\" type=\"user-animator\" "
+      "host=\"local\"/>\n";
   connections += "    <connection from=\"masks.out\" to=\"hull.masks\"/>\n";
+  connections += "    <connection from=\"hull.hull\" to=\"animator.hull\"/>\n";
   return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<application name=\"bench-camera\" "
          "version=\"1\">\n  <hosts>\n    <host id=\"local\" address=\"127.0.0.1\"/>\n  </hosts>\n"
          "  <modules>\n" +
@@ -65,13 +69,13 @@ std::string chainApplication(const std::filesystem::path& dir, int cameras, int 
 ModuleChainTimes runModuleChain(int cameras, cv::Size size, int voxels, int iterations) {
   ModuleChainTimes times;
   std::string pattern = (std::filesystem::temp_directory_path() / "vrflow-bench-camera-XXXXXX");
-  if (!mkdtemp(pattern.data())) return {0, 0, 0, 0, "cannot create a temporary folder"};
+  if (!mkdtemp(pattern.data())) return {0, 0, 0, 0, 0, "cannot create a temporary folder"};
   const std::filesystem::path dir = pattern;
   const auto rig = cameraRing(cameras, size);
   for (int n = 0; n < cameras; ++n)
     if (!saveCalibration(rig[static_cast<std::size_t>(n)],
                          (dir / ("cam" + std::to_string(n) + ".yml")).string()))
-      return {0, 0, 0, 0, "cannot write a calibration in " + dir.string()};
+      return {0, 0, 0, 0, 0, "cannot write a calibration in " + dir.string()};
   std::ofstream(dir / "user.keys") << standingKeys();
   std::ofstream(dir / "chain.xml") << chainApplication(dir, cameras, voxels);
   const auto bin = std::filesystem::read_symlink("/proc/self/exe").parent_path();
@@ -95,6 +99,8 @@ ModuleChainTimes runModuleChain(int cameras, cv::Size size, int voxels, int iter
       times.silhouetteMs = std::max(times.silhouetteMs, computeMs);
     else if (id == "hull")
       times.hullMs = computeMs;
+    else if (id == "animator")
+      times.animatorMs = computeMs;
   }
   std::filesystem::remove_all(dir);
   return times;

@@ -11,11 +11,13 @@ struct ModuleChainTimes {
   double captureMs = 0;       ///< the slowest capture module's mean compute (its rendering)
   double silhouetteMs = 0;    ///< the slowest silhouette module's mean compute per iteration
   double hullMs = 0;          ///< the hull module's mean compute per iteration
+  double animatorMs = 0;      ///< the user animator's (distance field, mesh, velocity)
   std::string error;          ///< why the run failed, empty when it ran
 };
 
-/// Runs `cameras` synthetic captures -> silhouettes -> merge -> one hull module of `voxels`^3
-/// for `iterations` frames with the `vrflow` beside this program, in a temporary folder.
+/// Runs `cameras` synthetic captures -> silhouettes -> merge -> one hull module of `voxels`^3 ->
+/// the user animator for `iterations` frames with the `vrflow` beside this program, in a temporary
+/// folder.
 ModuleChainTimes runModuleChain(int cameras, cv::Size size, int voxels, int iterations);
 
 }  // namespace vrflow::camera

@@ -1,131 +1,220 @@
 #include "vrflow/camera/distance_field.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <limits>
+#include <memory>
+
+#include "parallel_parts.hpp"
 
 namespace vrflow::camera {
 
 namespace {
 
-// One line of the transform: d[q] = min_v f[v] + (q - v)^2 over n samples spaced `stride`
-// apart, in place (FH's algorithm, with v, z and a copy of f as scratch).
-struct LineTransform {
-  std::vector<float> f;
-  std::vector<int> v;
-  std::vector<double> z;
+// Squared distances in voxels^2 are integers: the transform runs on int32 and is exact.
+using Squared = std::int32_t;
+constexpr Squared kFar = std::numeric_limits<Squared>::max();
 
-  explicit LineTransform(int n)
-      : f(static_cast<std::size_t>(n)),
-        v(static_cast<std::size_t>(n)),
-        z(static_cast<std::size_t>(n) + 1) {}
+// One line of the transform in place over n contiguous samples: d[q] = min_v f[v] + (q - v)^2
+// (Felzenszwalb and Huttenlocher's lower envelope of the parabolas rooted at the finite samples).
+// The intersections are compared by cross-multiplying integers, without a division: the
+// envelope is the one the rational intersections give. The scratch is sized once per part.
+class LineEnvelope {
+ public:
+  explicit LineEnvelope(int n) : v_(static_cast<std::size_t>(n)), f_(static_cast<std::size_t>(n)) {}
 
-  void operator()(float* data, int n, std::size_t stride) {
-    for (int q = 0; q < n; ++q) f[q] = data[q * stride];
-    // The lower envelope of the parabolas rooted at the finite samples; z[k] is where the k-th
-    // one starts to be the lowest.
+  void operator()(Squared* data, int n) {
+    // v_[0..k]: the roots of the envelope's parabolas, left to right; f_: their f + v^2.
     int k = -1;
     for (int q = 0; q < n; ++q) {
-      if (f[q] >= kNoVoxel) continue;
-      if (k < 0) {
-        k = 0;
-        v[0] = q;
-        z[0] = -1e30;
-        z[1] = 1e30;
-        continue;
-      }
-      double s = intersection(v[k], q);
-      while (s <= z[k]) s = intersection(v[--k], q);
+      if (data[q] == kFar) continue;
+      const std::int64_t fq = std::int64_t{data[q]} + std::int64_t{q} * q;
+      // Parabola k is hidden when q's intersection with it is not right of its own with k - 1.
+      while (k > 0 && (fq - f_[k]) * (v_[k] - v_[k - 1]) <= (f_[k] - f_[k - 1]) * (q - v_[k])) --k;
       ++k;
-      v[k] = q;
-      z[k] = s;
-      z[k + 1] = 1e30;
+      v_[k] = q;
+      f_[k] = fq;
     }
     if (k < 0) return;  // nothing to spread along this line
-    k = 0;
-    for (int q = 0; q < n; ++q) {
-      while (z[k + 1] < q) ++k;
-      const double d = q - v[k];
-      data[q * stride] = static_cast<float>(f[v[k]] + d * d);
+    // Parabola m is the lowest from its intersection with m - 1 to its intersection with m + 1:
+    // the samples between take its value. A rational intersection's double rounds to no other
+    // integer ceiling (an integer quotient is exact, any other is over 1 / (2n) from one).
+    int q = 0;
+    for (int m = 0; m <= k; ++m) {
+      int end = n;
+      if (m < k) {
+        const double s =
+            static_cast<double>(f_[m + 1] - f_[m]) / static_cast<double>(2 * (v_[m + 1] - v_[m]));
+        end = static_cast<int>(std::ceil(std::clamp(s, 0.0, static_cast<double>(n))));
+      }
+      const std::int64_t root = v_[m], lowest = f_[m] - root * root;
+      for (; q < end; ++q) data[q] = static_cast<Squared>(lowest + (q - root) * (q - root));
     }
   }
 
-  double intersection(int p, int q) const {
-    return ((f[q] + double(q) * q) - (f[p] + double(p) * p)) / (2.0 * (q - p));
-  }
+ private:
+  std::vector<std::int64_t> v_;
+  std::vector<std::int64_t> f_;
 };
+
+// The box [lo, hi) of a grid whose transform is computed, and the output's layout over it.
+struct Box {
+  cv::Vec3i lo, hi;
+  int nx() const { return hi[0] - lo[0]; }
+  int ny() const { return hi[1] - lo[1]; }
+  int nz() const { return hi[2] - lo[2]; }
+  std::size_t slice() const { return static_cast<std::size_t>(nx()) * ny(); }
+  std::size_t count() const { return slice() * nz(); }
+};
+
+// The 1D distance along z (in voxels) from every voxel of the box to the nearest target voxel
+// of its column, by a forward and a backward scan over whole rows of columns at once (slices in
+// order: contiguous and vectorisable); kFarGap where the column has no target.
+using Gap = std::uint16_t;
+constexpr Gap kFarGap = std::numeric_limits<Gap>::max();
+
+void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap* gaps,
+                int threads) {
+  const GridSpec& s = grid.spec;
+  const int nx = box.nx(), ny = box.ny(), nz = box.nz();
+  const std::size_t sliceSize = box.slice();
+  forParts(threads, static_cast<std::size_t>(ny), [&](std::size_t jBegin, std::size_t jEnd) {
+    const std::size_t rows = jEnd - jBegin;
+    std::vector<Gap> run(rows * nx);
+    auto scan = [&](int k, bool backward) {
+      for (std::size_t j = jBegin; j < jEnd; ++j) {
+        const std::uint8_t* occupied =
+            &grid.occupied[s.index(box.lo[0], box.lo[1] + static_cast<int>(j), box.lo[2] + k)];
+        Gap* gap = &run[(j - jBegin) * nx];
+        Gap* out = &gaps[static_cast<std::size_t>(k) * sliceSize + j * nx];
+        for (int i = 0; i < nx; ++i) {
+          const Gap next = static_cast<Gap>(gap[i] + (gap[i] != kFarGap));
+          gap[i] = occupied[i] == target ? Gap{0} : next;
+          out[i] = backward ? std::min(out[i], gap[i]) : gap[i];
+        }
+      }
+    };
+    std::fill(run.begin(), run.end(), kFarGap);
+    for (int k = 0; k < nz; ++k) scan(k, false);
+    std::fill(run.begin(), run.end(), kFarGap);
+    for (int k = nz - 1; k >= 0; --k) scan(k, true);
+  });
+}
+
+// The exact squared distance over the box to the nearest target voxel of the box: the gaps
+// along z, then per z slice the envelope along x (contiguous rows) and along y (the slice
+// transposed into the scratch). Each finished row (j, k) of the box goes to emit(j, k, row).
+template <typename Emit>
+void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, int threads,
+                  Emit&& emit) {
+  const int nx = box.nx(), ny = box.ny(), nz = box.nz();
+  const std::size_t sliceSize = box.slice();
+  assert(nz < kFarGap);
+  std::unique_ptr<Gap[]> gaps(new Gap[box.count()]);  // every element written before it is read
+  gapsAlongZ(grid, box, target, gaps.get(), threads);
+  forParts(threads, static_cast<std::size_t>(nz), [&](std::size_t kBegin, std::size_t kEnd) {
+    std::vector<Squared> slice(sliceSize), transposed(sliceSize);
+    LineEnvelope alongX(nx), alongY(ny);
+    for (std::size_t k = kBegin; k < kEnd; ++k) {
+      const Gap* gap = &gaps[k * sliceSize];
+      bool any = false;
+      for (int j = 0; j < ny; ++j) {
+        Squared* row = &slice[static_cast<std::size_t>(j) * nx];
+        const Gap* rowGap = gap + static_cast<std::size_t>(j) * nx;
+        bool rowAny = false;
+        for (int i = 0; i < nx; ++i) {
+          const Squared g = rowGap[i];
+          rowAny |= g != kFarGap;
+          row[i] = g == kFarGap ? kFar : g * g;
+        }
+        if (rowAny) alongX(row, nx);
+        any |= rowAny;
+      }
+      if (any) {
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i)
+            transposed[static_cast<std::size_t>(i) * ny + j] =
+                slice[static_cast<std::size_t>(j) * nx + i];
+        for (int i = 0; i < nx; ++i) alongY(&transposed[static_cast<std::size_t>(i) * ny], ny);
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i)
+            slice[static_cast<std::size_t>(j) * nx + i] =
+                transposed[static_cast<std::size_t>(i) * ny + j];
+      }
+      for (int j = 0; j < ny; ++j)
+        emit(j, static_cast<int>(k), &slice[static_cast<std::size_t>(j) * nx]);
+    }
+  });
+}
+
+Box wholeGrid(const GridSpec& s) {
+  return {{0, 0, 0}, {s.nx, s.ny, s.nz}};
+}
+
+// The occupied voxels' bounding box grown by one voxel within the grid; empty (hi = lo) when
+// nothing is occupied.
+Box occupiedBox(const VoxelGrid& grid) {
+  const GridSpec& s = grid.spec;
+  cv::Vec3i lo(s.nx, s.ny, s.nz), hi(0, 0, 0);
+  for (int k = 0; k < s.nz; ++k)
+    for (int j = 0; j < s.ny; ++j) {
+      const std::uint8_t* row = &grid.occupied[s.index(0, j, k)];
+      const auto occupied = [](std::uint8_t v) { return v != 0; };
+      const std::uint8_t* first = std::find_if(row, row + s.nx, occupied);
+      if (first == row + s.nx) continue;
+      const auto last = std::find_if(std::make_reverse_iterator(row + s.nx),
+                                     std::make_reverse_iterator(row), occupied);
+      lo = {std::min(lo[0], static_cast<int>(first - row)), std::min(lo[1], j), std::min(lo[2], k)};
+      hi = {std::max(hi[0], static_cast<int>(last.base() - row)), std::max(hi[1], j + 1),
+            std::max(hi[2], k + 1)};
+    }
+  if (hi[0] == 0) return {{0, 0, 0}, {0, 0, 0}};
+  return {{std::max(lo[0] - 1, 0), std::max(lo[1] - 1, 0), std::max(lo[2] - 1, 0)},
+          {std::min(hi[0] + 1, s.nx), std::min(hi[1] + 1, s.ny), std::min(hi[2] + 1, s.nz)}};
+}
+
+float toFloat(Squared squared) {
+  return squared == kFar ? kNoVoxel : static_cast<float>(squared);
+}
 
 }  // namespace
 
-std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target) {
+std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target, int threads) {
   const GridSpec& s = grid.spec;
   std::vector<float> d(s.count());
-  // Along x: the distance to the nearest target on the line, by two scans (exact in 1D).
-  for (int k = 0; k < s.nz; ++k)
-    for (int j = 0; j < s.ny; ++j) {
-      const std::size_t row = s.index(0, j, k);
-      float gap = kNoVoxel;
-      for (int i = 0; i < s.nx; ++i) {
-        gap = grid.occupied[row + i] == target ? 0.0f : (gap >= kNoVoxel ? kNoVoxel : gap + 1);
-        d[row + i] = gap;
-      }
-      gap = kNoVoxel;
-      for (int i = s.nx - 1; i >= 0; --i) {
-        gap = grid.occupied[row + i] == target ? 0.0f : (gap >= kNoVoxel ? kNoVoxel : gap + 1);
-        if (gap < d[row + i]) d[row + i] = gap;
-      }
-      for (int i = 0; i < s.nx; ++i)
-        if (d[row + i] < kNoVoxel) d[row + i] *= d[row + i];
-    }
-  // Along y, then z: parabola envelopes.
-  LineTransform alongY(s.ny), alongZ(s.nz);
-  const std::size_t sliceSize = static_cast<std::size_t>(s.nx) * s.ny;
-  for (int k = 0; k < s.nz; ++k)
-    for (int i = 0; i < s.nx; ++i)
-      alongY(&d[s.index(i, 0, k)], s.ny, static_cast<std::size_t>(s.nx));
-  for (int j = 0; j < s.ny; ++j)
-    for (int i = 0; i < s.nx; ++i) alongZ(&d[s.index(i, j, 0)], s.nz, sliceSize);
+  transformBox(grid, wholeGrid(s), target, threads, [&](int j, int k, const Squared* row) {
+    std::transform(row, row + s.nx, &d[s.index(0, j, k)], toFloat);
+  });
   return d;
 }
 
-std::vector<float> signedDistanceField(const VoxelGrid& grid) {
+std::vector<float> signedDistanceField(const VoxelGrid& grid, int threads) {
   const GridSpec& s = grid.spec;
-  const std::vector<float> toInside = squaredDistanceTo(grid, 1);
+  const auto h = static_cast<float>(s.voxelSize);
+  std::vector<float> field(s.count());
+  transformBox(grid, wholeGrid(s), 1, threads, [&](int j, int k, const Squared* row) {
+    float* out = &field[s.index(0, j, k)];
+    for (int i = 0; i < s.nx; ++i)
+      out[i] = row[i] == kFar ? kNoVoxel : (std::sqrt(static_cast<float>(row[i])) - 0.5f) * h;
+  });
   // Only inside voxels need their distance to the outside, and each has a nearest outside voxel
   // in the occupied bounding box grown by one voxel (clamping any other onto that box's border
   // layer, which is outside, brings it no farther): the transform runs on that box alone.
-  cv::Vec3i lo(s.nx, s.ny, s.nz), hi(0, 0, 0);
-  for (int k = 0; k < s.nz; ++k)
-    for (int j = 0; j < s.ny; ++j)
-      for (int i = 0; i < s.nx; ++i)
-        if (grid.occupied[s.index(i, j, k)]) {
-          lo = {std::min(lo[0], i), std::min(lo[1], j), std::min(lo[2], k)};
-          hi = {std::max(hi[0], i + 1), std::max(hi[1], j + 1), std::max(hi[2], k + 1)};
-        }
-  const auto h = static_cast<float>(s.voxelSize);
-  std::vector<float> field(s.count());
-  for (std::size_t n = 0; n < field.size(); ++n)
-    field[n] = toInside[n] >= kNoVoxel ? kNoVoxel : (std::sqrt(toInside[n]) - 0.5f) * h;
-  if (hi[0] == 0) return field;  // nothing inside
-  lo = {std::max(lo[0] - 1, 0), std::max(lo[1] - 1, 0), std::max(lo[2] - 1, 0)};
-  hi = {std::min(hi[0] + 1, s.nx), std::min(hi[1] + 1, s.ny), std::min(hi[2] + 1, s.nz)};
-  VoxelGrid box(GridSpec{s.origin, s.voxelSize, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  for (int k = lo[2]; k < hi[2]; ++k)
-    for (int j = lo[1]; j < hi[1]; ++j)
-      for (int i = lo[0]; i < hi[0]; ++i)
-        box.occupied[box.spec.index(i - lo[0], j - lo[1], k - lo[2])] =
-            grid.occupied[s.index(i, j, k)];
-  const std::vector<float> toOutside = squaredDistanceTo(box, 0);
-  // Beyond the grid counts as outside: an inside voxel is at most its distance to the border
-  // plus one from an outside centre.
-  for (int k = lo[2]; k < hi[2]; ++k)
-    for (int j = lo[1]; j < hi[1]; ++j)
-      for (int i = lo[0]; i < hi[0]; ++i) {
-        const std::size_t n = s.index(i, j, k);
-        if (!grid.occupied[n]) continue;
-        const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
-        const float squared = toOutside[box.spec.index(i - lo[0], j - lo[1], k - lo[2])];
-        field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
-      }
+  const Box box = occupiedBox(grid);
+  if (box.count() == 0) return field;  // nothing inside
+  transformBox(grid, box, 0, threads, [&](int boxJ, int boxK, const Squared* row) {
+    const int j = box.lo[1] + boxJ, k = box.lo[2] + boxK;
+    for (int i = box.lo[0]; i < box.hi[0]; ++i) {
+      const std::size_t n = s.index(i, j, k);
+      if (!grid.occupied[n]) continue;
+      // Beyond the grid counts as outside: an inside voxel is at most its distance to the
+      // border plus one from an outside centre.
+      const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
+      const auto squared = static_cast<float>(row[i - box.lo[0]]);
+      field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
+    }
+  });
   return field;
 }
 

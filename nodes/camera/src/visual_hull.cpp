@@ -1,36 +1,80 @@
 #include "vrflow/camera/visual_hull.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "parallel_parts.hpp"
+
 namespace vrflow::camera {
 
 namespace {
 
-constexpr int kTopBlock = 16;  // voxels per edge of the coarsest blocks
+constexpr int kTopBlock = 16;    // voxels per edge of the coarsest blocks
+constexpr int kMaxCameras = 64;  // the cameras still undecided in a block are bits of a word
+// Projected block corners are widened by this (pixels) so that the rounding of a centre's own
+// projection, computed another way, can never fall outside the rectangle.
+constexpr double kCornerSlack = 1e-6;
 
-// One camera prepared for a frame: its projection and the integral image of its mask.
+using CameraSet = std::uint64_t;
+
+// One camera prepared for a frame: the terms of its projection along each grid axis, and its
+// mask and the mask's integral image. The projection of a voxel centre is affine along each axis
+// before the perspective divide: row r of P (x, y, z, 1) is ((a[r][i] + b[r][j]) + c[r][k]) +
+// d[r], summed in the order of cv::Matx's product so that every voxel rounds as it always did.
 struct PreparedView {
-  cv::Matx34d projection;
+  std::array<std::vector<double>, 3> a, b, c;
+  std::array<double, 3> d{};
   cv::Mat mask;      // CV_8UC1, 0 or 1
   cv::Mat integral;  // CV_32S, (rows+1) x (cols+1)
 
-  // Rounded pixel of a world point, or false when it is behind the camera.
-  bool pixel(const cv::Vec3d& p, double& u, double& v) const {
-    const cv::Vec4d h(p[0], p[1], p[2], 1.0);
-    const cv::Vec3d q = projection * h;
-    if (q[2] <= 0) return false;
-    u = q[0] / q[2];
-    v = q[1] / q[2];
-    return true;
+  PreparedView(const MaskView& view, const GridSpec& spec) {
+    const cv::Matx34d projection = view.camera->projection();
+    for (int r = 0; r < 3; ++r) {
+      const auto row = static_cast<std::size_t>(r);
+      a[row].resize(static_cast<std::size_t>(spec.nx));
+      b[row].resize(static_cast<std::size_t>(spec.ny));
+      c[row].resize(static_cast<std::size_t>(spec.nz));
+      for (int i = 0; i < spec.nx; ++i)
+        a[row][static_cast<std::size_t>(i)] =
+            projection(r, 0) * (spec.origin[0] + (i + 0.5) * spec.voxelSize);
+      for (int j = 0; j < spec.ny; ++j)
+        b[row][static_cast<std::size_t>(j)] =
+            projection(r, 1) * (spec.origin[1] + (j + 0.5) * spec.voxelSize);
+      for (int k = 0; k < spec.nz; ++k)
+        c[row][static_cast<std::size_t>(k)] =
+            projection(r, 2) * (spec.origin[2] + (k + 0.5) * spec.voxelSize);
+      d[row] = projection(r, 3) * 1.0;
+    }
+    cv::threshold(view.mask, mask, 0, 1, cv::THRESH_BINARY);
+    cv::integral(mask, integral, CV_32S);
+  }
+
+  double term(std::size_t r, int i, int j, int k) const {
+    return ((a[r][static_cast<std::size_t>(i)] + b[r][static_cast<std::size_t>(j)]) +
+            c[r][static_cast<std::size_t>(k)]) +
+           d[r];
+  }
+
+  // Whether voxel (i, j, k)'s centre rounds to a mask pixel (in front of the camera).
+  bool sees(int i, int j, int k) const {
+    const double q2 = term(2, i, j, k);
+    if (q2 <= 0) return false;
+    const long x = std::lround(term(0, i, j, k) / q2), y = std::lround(term(1, i, j, k) / q2);
+    if (x < 0 || y < 0 || x >= mask.cols || y >= mask.rows) return false;
+    return mask.at<std::uint8_t>(static_cast<int>(y), static_cast<int>(x)) != 0;
   }
 };
 
 enum class Decision { kOutside, kInside, kMixed };
 
+// Carves the blocks of one range of z: a block is split in 8 until it is decided whole or is
+// one voxel. Each block carries the cameras that have not yet seen all of it inside their mask:
+// a camera whose mask is full over the block's footprint is not asked again below it.
 class Carver {
  public:
   Carver(const std::vector<PreparedView>& views, VoxelGrid& hull, int zBegin, int zEnd,
@@ -38,23 +82,27 @@ class Carver {
       : views_(views), hull_(hull), spec_(hull.spec), zBegin_(zBegin), zEnd_(zEnd), stats_(stats) {}
 
   void run() {
+    const CameraSet all =
+        views_.size() == kMaxCameras ? ~CameraSet{0} : (CameraSet{1} << views_.size()) - 1;
     for (int k = zBegin_; k < zEnd_; k += kTopBlock)
       for (int j = 0; j < spec_.ny; j += kTopBlock)
         for (int i = 0; i < spec_.nx; i += kTopBlock)
-          visit({i, j, k}, {std::min(i + kTopBlock, spec_.nx), std::min(j + kTopBlock, spec_.ny),
-                            std::min(k + kTopBlock, zEnd_)});
+          visit({i, j, k},
+                {std::min(i + kTopBlock, spec_.nx), std::min(j + kTopBlock, spec_.ny),
+                 std::min(k + kTopBlock, zEnd_)},
+                all);
   }
 
  private:
   // Blocks [lo, hi) of voxels; voxel by voxel at the finest level.
-  void visit(const cv::Vec3i& lo, const cv::Vec3i& hi) {
+  void visit(const cv::Vec3i& lo, const cv::Vec3i& hi, CameraSet active) {
     const cv::Vec3i extent = hi - lo;
     if (extent[0] * extent[1] * extent[2] == 1) {
       ++stats_.voxelsTested;
-      hull_.occupied[spec_.index(lo[0], lo[1], lo[2])] = voxelInside(lo) ? 1 : 0;
+      hull_.occupied[spec_.index(lo[0], lo[1], lo[2])] = voxelInside(lo, active) ? 1 : 0;
       return;
     }
-    const Decision decision = classify(lo, hi);
+    const Decision decision = classify(lo, hi, active);
     if (decision != Decision::kMixed) {
       ++stats_.blocksDecided;
       fill(lo, hi, decision == Decision::kInside ? 1 : 0);
@@ -71,42 +119,48 @@ class Carver {
         a[axis] = upper ? mid[axis] : lo[axis];
         b[axis] = (upper || extent[axis] == 1) ? hi[axis] : mid[axis];
       }
-      if (!empty) visit(a, b);
+      if (!empty) visit(a, b, active);
     }
   }
 
-  bool voxelInside(const cv::Vec3i& v) const {
-    const cv::Vec3d p = spec_.centre(v[0], v[1], v[2]);
-    for (const PreparedView& view : views_) {
-      double u = 0, w = 0;
-      if (!view.pixel(p, u, w)) return false;
-      const long x = std::lround(u), y = std::lround(w);
-      if (x < 0 || y < 0 || x >= view.mask.cols || y >= view.mask.rows) return false;
-      if (!view.mask.at<std::uint8_t>(static_cast<int>(y), static_cast<int>(x))) return false;
-    }
+  bool voxelInside(const cv::Vec3i& v, CameraSet active) const {
+    for (; active; active &= active - 1)
+      if (!views_[static_cast<std::size_t>(std::countr_zero(active))].sees(v[0], v[1], v[2]))
+        return false;
     return true;
   }
 
   // The block's voxel centres span a box; its 8 corners' projections bound theirs (a pinhole
-  // camera maps the box to the convex hull of the projected corners).
-  Decision classify(const cv::Vec3i& lo, const cv::Vec3i& hi) const {
-    const cv::Vec3d minimum = spec_.centre(lo[0], lo[1], lo[2]);
-    const cv::Vec3d maximum = spec_.centre(hi[0] - 1, hi[1] - 1, hi[2] - 1);
-    bool insideAll = true;
-    for (const PreparedView& view : views_) {
+  // camera maps the box to the convex hull of the projected corners). Cameras whose mask is
+  // full over the rectangle leave `active`.
+  Decision classify(const cv::Vec3i& lo, const cv::Vec3i& hi, CameraSet& active) const {
+    const int corner[2][3] = {{lo[0], lo[1], lo[2]}, {hi[0] - 1, hi[1] - 1, hi[2] - 1}};
+    CameraSet full = 0;
+    for (CameraSet rest = active; rest; rest &= rest - 1) {
+      const int index = std::countr_zero(rest);
+      const PreparedView& view = views_[static_cast<std::size_t>(index)];
       double minU = 1e30, minV = 1e30, maxU = -1e30, maxV = -1e30;
+      bool behind = false;
       for (int c = 0; c < 8; ++c) {
-        const cv::Vec3d p((c & 1) ? maximum[0] : minimum[0], (c & 2) ? maximum[1] : minimum[1],
-                          (c & 4) ? maximum[2] : minimum[2]);
-        double u = 0, v = 0;
-        if (!view.pixel(p, u, v)) return Decision::kMixed;
+        const int i = corner[c & 1][0], j = corner[(c >> 1) & 1][1], k = corner[(c >> 2) & 1][2];
+        const double q2 = view.term(2, i, j, k);
+        if (q2 <= 0) {
+          behind = true;
+          break;
+        }
+        const double inverse = 1.0 / q2;
+        const double u = view.term(0, i, j, k) * inverse, v = view.term(1, i, j, k) * inverse;
         minU = std::min(minU, u), maxU = std::max(maxU, u);
         minV = std::min(minV, v), maxV = std::max(maxV, v);
       }
+      if (behind) continue;  // this camera cannot decide the block
       // Pixels the centres can round to: [round(min), round(max)], inclusive.
-      const double x0 = std::floor(minU + 0.5), x1 = std::floor(maxU + 0.5);
-      const double y0 = std::floor(minV + 0.5), y1 = std::floor(maxV + 0.5);
-      const bool whollyInImage = x0 >= 0 && y0 >= 0 && x1 < view.mask.cols && y1 < view.mask.rows;
+      const double x0 = std::floor(minU + 0.5 - kCornerSlack);
+      const double x1 = std::floor(maxU + 0.5 + kCornerSlack);
+      const double y0 = std::floor(minV + 0.5 - kCornerSlack);
+      const double y1 = std::floor(maxV + 0.5 + kCornerSlack);
+      const bool whollyInImage = minU - kCornerSlack > 0.5 && minV - kCornerSlack > 0.5 &&
+                                 x1 < view.mask.cols && y1 < view.mask.rows;
       const int cx0 = static_cast<int>(std::clamp(x0, 0.0, double(view.mask.cols)));
       const int cx1 = static_cast<int>(std::clamp(x1 + 1, 0.0, double(view.mask.cols)));
       const int cy0 = static_cast<int>(std::clamp(y0, 0.0, double(view.mask.rows)));
@@ -115,9 +169,10 @@ class Carver {
       const int count = view.integral.at<int>(cy1, cx1) - view.integral.at<int>(cy0, cx1) -
                         view.integral.at<int>(cy1, cx0) + view.integral.at<int>(cy0, cx0);
       if (count == 0) return Decision::kOutside;
-      if (!whollyInImage || count != (cx1 - cx0) * (cy1 - cy0)) insideAll = false;
+      if (whollyInImage && count == (cx1 - cx0) * (cy1 - cy0)) full |= CameraSet{1} << index;
     }
-    return insideAll ? Decision::kInside : Decision::kMixed;
+    active &= ~full;
+    return active == 0 ? Decision::kInside : Decision::kMixed;
   }
 
   void fill(const cv::Vec3i& lo, const cv::Vec3i& hi, std::uint8_t value) {
@@ -137,6 +192,9 @@ class Carver {
 
 Status checkViews(const std::vector<MaskView>& views) {
   if (views.empty()) return makeError("no camera to carve the visual hull with");
+  if (views.size() > kMaxCameras)
+    return makeError(std::to_string(views.size()) + " cameras: the visual hull takes at most " +
+                     std::to_string(kMaxCameras));
   for (std::size_t i = 0; i < views.size(); ++i) {
     const MaskView& view = views[i];
     if (view.mask.type() != CV_8UC1 || view.mask.size() != view.camera->imageSize)
@@ -152,27 +210,36 @@ Status checkViews(const std::vector<MaskView>& views) {
 }  // namespace
 
 Status carveVisualHull(const std::vector<MaskView>& views, int zBegin, int zEnd, VoxelGrid& hull,
-                       CarveStats* stats) {
+                       CarveStats* stats, int threads) {
   if (auto status = checkViews(views); !status) return status;
   if (zBegin < 0 || zEnd > hull.spec.nz || zBegin >= zEnd)
     return makeError("slab [" + std::to_string(zBegin) + ", " + std::to_string(zEnd) +
                      ") is not a non-empty range of the grid's " + std::to_string(hull.spec.nz) +
                      " z layers");
-  std::vector<PreparedView> prepared(views.size());
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    prepared[i].projection = views[i].camera->projection();
-    cv::threshold(views[i].mask, prepared[i].mask, 0, 1, cv::THRESH_BINARY);
-    cv::integral(prepared[i].mask, prepared[i].integral, CV_32S);
-  }
-  CarveStats local;
-  Carver(prepared, hull, zBegin, zEnd, stats ? *stats : local).run();
+  std::vector<PreparedView> prepared;
+  prepared.reserve(views.size());
+  for (const MaskView& view : views) prepared.emplace_back(view, hull.spec);
+  // Parts are whole layers of top blocks, each carved alone; the counts are summed in order.
+  const auto layers = static_cast<std::size_t>((zEnd - zBegin + kTopBlock - 1) / kTopBlock);
+  std::vector<CarveStats> partStats(layers);
+  forParts(threads, layers, [&](std::size_t begin, std::size_t end) {
+    const int z0 = zBegin + static_cast<int>(begin) * kTopBlock;
+    const int z1 = std::min(zEnd, zBegin + static_cast<int>(end) * kTopBlock);
+    Carver(prepared, hull, z0, z1, partStats[begin]).run();
+  });
+  if (stats)
+    for (const CarveStats& part : partStats) {
+      stats->blocksDecided += part.blocksDecided;
+      stats->voxelsTested += part.voxelsTested;
+    }
   return {};
 }
 
 Result<VoxelGrid> carveVisualHull(const std::vector<MaskView>& views, const GridSpec& spec,
-                                  CarveStats* stats) {
+                                  CarveStats* stats, int threads) {
   VoxelGrid hull(spec);
-  if (auto status = carveVisualHull(views, 0, spec.nz, hull, stats); !status) return status.error();
+  if (auto status = carveVisualHull(views, 0, spec.nz, hull, stats, threads); !status)
+    return status.error();
   return hull;
 }
 

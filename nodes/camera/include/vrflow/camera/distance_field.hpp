@@ -1,7 +1,8 @@
 #pragma once
 // The signed distance field of a voxel model: an exact Euclidean distance transform, separable
 // and linear in the voxel count (Felzenszwalb and Huttenlocher, "Distance transforms of sampled
-// functions", 2012: the lower envelope of parabolas along each axis in turn).
+// functions", 2012: the lower envelope of parabolas along each axis in turn), on integer squared
+// distances, each strided axis gathered into contiguous lines (a transposed slice or plane).
 
 #include <cstdint>
 #include <vector>
@@ -11,8 +12,9 @@
 namespace vrflow::camera {
 
 /// Squared distance (in voxels^2) from every voxel centre to the nearest centre of a voxel whose
-/// occupancy equals `target`; kNoVoxel where the grid has none.
-std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target);
+/// occupancy equals `target`; kNoVoxel where the grid has none. `threads` > 1 runs the passes
+/// on that many oneTBB threads; every line is computed alone, so the result does not depend on it.
+std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target, int threads = 1);
 
 /// The value squaredDistanceTo gives when no voxel has the target occupancy.
 inline constexpr float kNoVoxel = 1e20f;
@@ -20,7 +22,7 @@ inline constexpr float kNoVoxel = 1e20f;
 /// Signed distance (metres) of every voxel centre to the model's surface, negative inside: for a
 /// voxel outside, the distance to the nearest inside centre less half a voxel; inside, minus the
 /// distance to the nearest outside centre less half a voxel (the surface lies half-way between
-/// an inside and an outside centre). Voxels beyond the grid count as outside.
-std::vector<float> signedDistanceField(const VoxelGrid& grid);
+/// an inside and an outside centre). Voxels beyond the grid count as outside. `threads`: as above.
+std::vector<float> signedDistanceField(const VoxelGrid& grid, int threads = 1);
 
 }  // namespace vrflow::camera
