@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "vrflow/massspring/solver.hpp"
 #include "vrflow/message/eigen.hpp"
@@ -184,18 +185,23 @@ ContactImpulses solveRigidNetContacts(const std::map<std::uint64_t, Net>& nets,
         solveSpring(net, rows[iteration % 2 == 0 ? index : count - 1 - index], p.dt);
     }
   }
-  // A taut net is locked: with every row and column straight at its limit, a transverse push
+  // A taut net is locked: with its rows and columns straight at their limits, a transverse push
   // meets limits whose directions it barely changes, so these sweeps (at the end-of-step
-  // positions) let the nodes give way while the animator's projection cannot meet the limits
-  // and cuts the motion short. So the nets' motion is taken only as far along as every limit
-  // holds (feasibleFraction, as the animator backs off), and the rigids take the rest: further
-  // impulses against the nets' nodes moving so, as if infinitely heavy. Those do not go to the
-  // nets: what a locked net would receive, its limits hand on to its pins.
+  // positions) let the nodes give way while the animator's projection cannot meet the limits and
+  // cuts the motion short (the net stays put). So the nets' motion is taken only as far along as
+  // every limit holds (feasibleFraction, as the animator backs off), and on a net with limits
+  // the rigids take the rest: further impulses against its nodes moving so, as if infinitely
+  // heavy. Those do not go to the net: its limits hand them on to its pins. (On a net without
+  // limits every impulse acts on both sides: momentum is exchanged exactly.)
+  std::set<std::uint64_t> limited;
   for (auto& [id, state] : states) {
     std::vector<double> end = state.net->positions;
     for (std::size_t k = 0; k < end.size(); ++k) end[k] += p.dt * state.v[k];
     const double t = std::clamp(feasibleFraction(*state.net, state.net->positions, end), 0.0, 1.0);
     for (auto& v : state.v) v *= t;
+    if (std::any_of(state.net->springs.begin(), state.net->springs.end(),
+                    [](const Spring& spring) { return spring.maxStretch > 0; }))
+      limited.insert(id);
   }
   std::vector<double> rigidMass(contacts.size(), 0.0), extra(contacts.size(), 0.0);
   for (std::size_t i = 0; i < contacts.size(); ++i) {
@@ -207,7 +213,7 @@ ContactImpulses solveRigidNetContacts(const std::map<std::uint64_t, Net>& nets,
   }
   for (int iteration = 0; iteration < p.iterations; ++iteration) {
     for (std::size_t i = 0; i < contacts.size(); ++i) {
-      if (rigidMass[i] == 0) continue;
+      if (rigidMass[i] == 0 || !limited.count(contacts[i].netId)) continue;
       const auto& c = contacts[i];
       auto& body = bodies.at(c.rigidId);
       const auto& net = states.at(c.netId);
