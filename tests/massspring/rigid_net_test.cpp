@@ -66,22 +66,6 @@ Trial simulate(const GridParams& grid, Box body, int steps, bool collide,
   return r;
 }
 
-// The height of the net's surface under (x, z): the triangle whose x-z projection holds it,
-// interpolated (nan outside the net).
-double surfaceHeight(const Net& net, double x, double z) {
-  for (std::size_t t = 0; t + 2 < net.surface.size(); t += 3) {
-    const auto a = net.position(net.surface[t]), b = net.position(net.surface[t + 1]),
-               c = net.position(net.surface[t + 2]);
-    const double det = (b[0] - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (b[2] - a[2]);
-    if (std::abs(det) < 1e-15) continue;
-    const double u = ((x - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (z - a[2])) / det;
-    const double v = ((b[0] - a[0]) * (z - a[2]) - (x - a[0]) * (b[2] - a[2])) / det;
-    if (u < -1e-12 || v < -1e-12 || u + v > 1 + 1e-12) continue;
-    return a[1] + u * (b[1] - a[1]) + v * (c[1] - a[1]);
-  }
-  return std::nan("");
-}
-
 double speedOf(const RigidBody& body) {
   const auto& v = body.linearVelocity;
   return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
