@@ -70,10 +70,9 @@ inline double lowestCorner(const Box& box) {
   return lowest;
 }
 
-inline  // The height of the net's surface under (x, z): the triangle whose x-z projection holds it,
-    // interpolated (nan outside the net).
-    double
-    surfaceHeight(const Net& net, double x, double z) {
+// The height of the net's surface under (x, z): the triangle whose x-z projection holds it,
+// interpolated (nan outside the net).
+inline double surfaceHeight(const Net& net, double x, double z) {
   for (std::size_t t = 0; t + 2 < net.surface.size(); t += 3) {
     const auto a = net.position(net.surface[t]), b = net.position(net.surface[t + 1]),
                c = net.position(net.surface[t + 2]);
