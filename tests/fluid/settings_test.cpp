@@ -77,11 +77,11 @@ TEST(FluidSettings, PreconditionersAreReadByNameAndOthersAreRefused) {
     ASSERT_TRUE(parsePreconditioner(preconditionerName(p), read));
     EXPECT_EQ(read, p);
   }
-  EXPECT_EQ(FluidSettings{}.preconditioner, FluidPreconditioner::kMultigrid);
-  FluidPreconditioner read = FluidPreconditioner::kMic0;
+  EXPECT_EQ(FluidSettings{}.preconditioner, FluidPreconditioner::kMic0);
+  FluidPreconditioner read = FluidPreconditioner::kMultigrid;
   for (const char* bad : {"", "MIC0", "jacobi", "multigrid "}) {
     EXPECT_FALSE(parsePreconditioner(bad, read)) << bad;
-    EXPECT_EQ(read, FluidPreconditioner::kMic0) << bad;
+    EXPECT_EQ(read, FluidPreconditioner::kMultigrid) << bad;
   }
   auto s = smallTank(8, 8, 8);
   s.preconditioner = static_cast<FluidPreconditioner>(7);
