@@ -269,11 +269,20 @@ std::optional<run::RunOutcome> ControlLink::poll() {
   return std::nullopt;
 }
 
+void ControlLink::failing(const run::RunOutcome& outcome) {
+  // The cause goes to the launcher now, before the modules are stopped; their last lines and
+  // this host's report follow as usual.
+  send(net::ControlEvent::finished(outcome.exitCode, outcome.status, outcome.error));
+  finishedSent_ = true;
+}
+
 std::vector<std::string> ControlLink::drain(const run::RunOutcome& outcome) {
   // The modules' last lines were sent (the supervisor read their pipes to the end): what was
   // dropped of them is said before this host's end.
   for (const auto& dropped : takeDropped()) send(dropped);
-  send(net::ControlEvent::finished(outcome.exitCode, outcome.status, outcome.error));
+  if (!finishedSent_) {
+    send(net::ControlEvent::finished(outcome.exitCode, outcome.status, outcome.error));
+  }
   std::vector<std::string> warnings;
   // Keep routing (messages for the other hosts) until the launcher says every host is done.
   while (!stopped_) {

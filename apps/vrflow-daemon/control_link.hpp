@@ -41,6 +41,7 @@ class ControlLink final : public run::HostLink {
   Status ready() override;
   std::optional<run::RunOutcome> poll() override;
   std::vector<std::string> drain(const run::RunOutcome& outcome) override;
+  void failing(const run::RunOutcome& outcome) override;
   void report(const std::string& json) override;
   void trace(const std::string& json) override;
   void stats(const std::string& json) override;
@@ -81,6 +82,7 @@ class ControlLink final : public run::HostLink {
   std::string host_;
   int selfIndex_ = 0;
   bool stopped_ = false;  ///< the launcher said stop (or went away)
+  bool finishedSent_ = false;  ///< failing() said this host's end before drain()
   std::unique_ptr<net::Transport> transport_;
   std::vector<net::RemoteConnection> remote_;
   std::vector<uint32_t> localChannels_;

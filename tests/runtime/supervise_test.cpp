@@ -88,6 +88,24 @@ TEST_F(SuperviseTest, AStoppedModuleIsNamedAsNotRespondingNotCalledADeadlock) {
   EXPECT_EQ(nlohmann::json::parse(readFile(report))["status"], "stalled");
 }
 
+TEST_F(SuperviseTest, AModuleStoppedWhileItExitsIsNoStallButOneThatLingers) {
+  // `mid` ends with the run and stops itself before it exits (as ASan's leak check holds an
+  // exiting process under its tracer, state t): its slot says finished, so the run is not
+  // called stalled; it ends as a module that finished but did not exit, stopped by the run.
+  const auto file = dir.write(
+      "app.xml",
+      application(module("src", "core/source") +
+                      module("mid", "testing/slow", param("stop-at-exit", "true")) +
+                      module("rec", "core/recorder", param("file", dir.file("x.csv"))),
+                  connect("src.out", "mid.in") + connect("mid.out", "rec.in")));
+  const auto result = runVrflow({"run", file, "-n", "5", "--deadlock-timeout", "1"}, 90);
+  EXPECT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(result.err.find("stalled"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("module(s) 'mid' finished but did not exit; stopping them"),
+            std::string::npos)
+      << result.err;
+}
+
 TEST_F(SuperviseTest, ATrueDeadlockIsStillCalledOne) {
   // mute receives but never sends: the cycle through it blocks every module in wait().
   const auto file = dir.write(

@@ -199,7 +199,10 @@ std::optional<RunOutcome> Supervisor::noProgress() {
     const double cpu = process.known && process.cpuNs >= stallCpuNs_[i]
                            ? static_cast<double>(process.cpuNs - stallCpuNs_[i]) / 1e9 / sampled
                            : 0.0;
-    std::string why = notRunningReason(process.state);
+    // A module that finished is exiting: a sanitizer's leak check stops it under a tracer
+    // (state t) for a while, which is no stall of the run.
+    std::string why =
+        state == ipc::ModuleState::Finished ? std::string() : notRunningReason(process.state);
     if (why.empty() && inWait && cpu > 0.5) {
       char text[96];
       std::snprintf(text, sizeof text, "spinning (%.0f%% CPU, process state %c) instead of waiting",

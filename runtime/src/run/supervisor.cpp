@@ -321,6 +321,10 @@ RunOutcome Supervisor::run() {
     }
   }
   showProgress(&outcome);
+  if (options_.hostLink != nullptr && outcome.exitCode != kExitOk &&
+      outcome.exitCode != kExitInterrupted) {
+    options_.hostLink->failing(outcome);
+  }
   stopAll();
   // Every process ended: what they printed last is read to the end of their pipes (a process
   // they left behind holding one open is waited for briefly).

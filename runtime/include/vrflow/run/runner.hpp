@@ -95,6 +95,11 @@ class HostLink {
   /// After this host's modules ended: keeps routing until every host is done and every
   /// connection crossing hosts is over. Returns warnings for the report.
   virtual std::vector<std::string> drain(const RunOutcome& outcome) = 0;
+  /// This host's run failed (a stall, a failed module, a time-out), said before its modules
+  /// are stopped: stopping them takes a while (seconds under a sanitizer), and what their end
+  /// does to the other hosts (a closed connection, a module ending) must not be reported there
+  /// before the cause. drain() then does not repeat it. Ignored by default.
+  virtual void failing(const RunOutcome& outcome) { (void)outcome; }
   /// This host's share of the run report (JSON text).
   virtual void report(const std::string& json) = 0;
   /// This host's trace events (run::hostTraceToJson), when the run is traced.
