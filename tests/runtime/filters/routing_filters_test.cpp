@@ -173,6 +173,53 @@ TEST(RouteFilter, SendsEachReceiverTheObjectsItsVolumeMeets) {
   EXPECT_EQ(far[0].view()->stamps().iteration, 3u);
 }
 
+// lockstep: message k of `in` waits for k interest messages from each receiver whose input is
+// open, so a receiver's answer to message k-1 applies to message k even when it arrives after
+// message k (another host's path); without lockstep message k is routed with what has come.
+TEST(RouteFilter, LockstepRoutesMessageKWithEachReceiversAnswerToMessageKMinusOne) {
+  for (const bool lockstep : {false, true}) {
+    SCOPED_TRACE(lockstep ? "lockstep" : "latest volume");
+    auto h = harness("route", {{"outputs", "2"}, {"lockstep", lockstep ? "true" : "false"}});
+    ASSERT_TRUE(h);
+    const auto interest = [&](const char* volume) {
+      return h->message([&](msg::MessageBuilder& b) { b.addStringStamp("interest", volume); });
+    };
+    h->push("in", pointsAt(*h, 0, {0.5, 5}));  // message 0: no volume yet, nothing to wait for
+    h->step();
+    ASSERT_EQ(h->take("out0").size(), 1u);
+    ASSERT_EQ(h->take("out1").size(), 1u);
+    h->push("in", pointsAt(*h, 1, {0.5, 5}));  // message 1 comes before the answers to 0
+    h->push("interest1", interest("4 4 4 6 6 6"));
+    h->step();
+    auto near = h->take("out0");
+    auto far = h->take("out1");
+    if (!lockstep) {
+      ASSERT_EQ(near.size(), 1u);
+      EXPECT_TRUE(idsOf(near[0]).empty());  // receiver 0's volume was still on its way
+      continue;
+    }
+    EXPECT_TRUE(near.empty());  // waits for receiver 0's answer
+    EXPECT_TRUE(far.empty());
+    h->push("interest0", interest("-1 -1 -1 1 1 1"));
+    h->step();
+    near = h->take("out0");
+    far = h->take("out1");
+    ASSERT_EQ(near.size(), 1u);
+    ASSERT_EQ(far.size(), 1u);
+    EXPECT_EQ(idsOf(near[0]), (std::vector<uint64_t>{100}));
+    EXPECT_EQ(idsOf(far[0]), (std::vector<uint64_t>{101}));
+    // A receiver whose interest input ended is not waited for: its volume stays.
+    h->close("interest1");
+    h->push("in", pointsAt(*h, 2, {0.5, 5}));
+    h->push("interest0", interest("-1 -1 -1 1 1 1"));
+    h->step();
+    far = h->take("out1");
+    ASSERT_EQ(h->take("out0").size(), 1u);
+    ASSERT_EQ(far.size(), 1u);
+    EXPECT_EQ(idsOf(far[0]), (std::vector<uint64_t>{101}));
+  }
+}
+
 TEST(RouteFilter, RefusesAnEmptyStampName) {
   EXPECT_NE(refusal("route", {{"stamp", ""}}).find("must name a user stamp"), std::string::npos);
   EXPECT_NE(refusal("route", {{"initially", "some"}}), "");

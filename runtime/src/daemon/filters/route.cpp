@@ -81,12 +81,16 @@ struct Receiver {
   std::unordered_set<uint64_t> resources;  // resources it was sent
   std::unordered_set<uint64_t> wanted;     // resources its objects refer to, not seen yet
   std::vector<Action> actions;
+  uint64_t interestsRead = 0;  // messages taken from interest{k} (lockstep)
 };
 
 class RouteFilter final : public Filter {
  public:
-  RouteFilter(std::string stamp, bool initiallyAll, bool unboundedToAll)
-      : stamp_(std::move(stamp)), initiallyAll_(initiallyAll), unboundedToAll_(unboundedToAll) {}
+  RouteFilter(std::string stamp, bool initiallyAll, bool unboundedToAll, bool lockstep)
+      : stamp_(std::move(stamp)),
+        initiallyAll_(initiallyAll),
+        unboundedToAll_(unboundedToAll),
+        lockstep_(lockstep) {}
 
   Status start(FilterContext& context) override {
     receivers_.resize(context.outputCount());
@@ -100,11 +104,13 @@ class RouteFilter final : public Filter {
     auto& in = context.input(kIn);
     for (std::size_t r = 0; r < receivers_.size(); ++r) readInterest(context, r);
     while (!in.empty()) {
+      if (lockstep_ && !interestsCaughtUp(context)) return;
       for (std::size_t o = 0; o < context.outputCount(); ++o) {
         if (!context.canEmit(o)) return;  // every receiver's part leaves together
       }
       MessageRef message = std::move(in.front());
       in.pop_front();
+      ++taken_;
       const auto view = viewOrWarn(context, message);
       if (!view) continue;
       route(context, message, *view);
@@ -122,12 +128,24 @@ class RouteFilter final : public Filter {
     return Box{{-inf, -inf, -inf}, {inf, inf, inf}};
   }
 
+  // lockstep: message k of `in` (from 0) waits for k messages on every interest input that
+  // may still bring one, so that each receiver's answer to message k-1 applies to message k
+  // whatever the order in which the two paths deliver (another host, a slower link).
+  bool interestsCaughtUp(FilterContext& context) {
+    for (std::size_t r = 0; r < receivers_.size(); ++r) {
+      readInterest(context, r);
+      if (receivers_[r].interestsRead < taken_ && !context.inputClosed(1 + r)) return false;
+    }
+    return true;
+  }
+
   // Applies the control messages pending on interest{r}: the last one that names a volume wins.
   void readInterest(FilterContext& context, std::size_t r) {
     auto& queue = context.input(1 + r);
     while (!queue.empty()) {
       MessageRef message = std::move(queue.front());
       queue.pop_front();
+      ++receivers_[r].interestsRead;
       const auto view = viewOrWarn(context, message);
       if (!view) continue;
       for (const auto stamp : view->stamps().user) {
@@ -400,6 +418,8 @@ class RouteFilter final : public Filter {
   std::string stamp_;
   bool initiallyAll_;
   bool unboundedToAll_;
+  bool lockstep_;
+  uint64_t taken_ = 0;  // messages of `in` routed so far
   std::vector<Receiver> receivers_;
   std::unordered_map<uint64_t, ObjectState> objects_;
   std::unordered_map<uint64_t, Bytes> resources_;  // latest chunk of every resource, verbatim
@@ -424,6 +444,10 @@ app::FilterType routeType() {
   type.params.push_back(enumParam("unbounded", {"all", "drop"},
                                   "objects whose bounds are unknown: to every receiver that has "
                                   "a volume, or to none"));
+  type.params.push_back(boolParam("lockstep", "false",
+                                  "message k of `in` waits for k messages on every open "
+                                  "interest input: each receiver's answer to the sender's "
+                                  "previous message applies, on any host layout"));
   type.ports = [outputCount](const std::vector<Param>& params) {
     const long long n = clampedInt(outputCount, params);
     std::vector<PortSpec> ports{filterPort("in", true, "the sender's messages")};
@@ -460,7 +484,8 @@ void registerRoute(FilterRegistry& registry) {
            return makeError("filter '" + context.name() + "': unbounded must be all or drop");
          }
          return std::unique_ptr<Filter>(std::make_unique<RouteFilter>(
-             context.params().getString("stamp"), initially == "all", unbounded == "all"));
+             context.params().getString("stamp"), initially == "all", unbounded == "all",
+             context.params().getBool("lockstep")));
        }});
 }
 
