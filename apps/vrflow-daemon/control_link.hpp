@@ -81,7 +81,7 @@ class ControlLink final : public run::HostLink {
   int in_, out_;
   std::string host_;
   int selfIndex_ = 0;
-  bool stopped_ = false;  ///< the launcher said stop (or went away)
+  bool stopped_ = false;       ///< the launcher said stop (or went away)
   bool finishedSent_ = false;  ///< failing() said this host's end before drain()
   std::unique_ptr<net::Transport> transport_;
   std::vector<net::RemoteConnection> remote_;

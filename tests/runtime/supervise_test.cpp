@@ -93,11 +93,10 @@ TEST_F(SuperviseTest, AModuleStoppedWhileItExitsIsNoStallButOneThatLingers) {
   // exiting process under its tracer, state t): its slot says finished, so the run is not
   // called stalled; it ends as a module that finished but did not exit, stopped by the run.
   const auto file = dir.write(
-      "app.xml",
-      application(module("src", "core/source") +
-                      module("mid", "testing/slow", param("stop-at-exit", "true")) +
-                      module("rec", "core/recorder", param("file", dir.file("x.csv"))),
-                  connect("src.out", "mid.in") + connect("mid.out", "rec.in")));
+      "app.xml", application(module("src", "core/source") +
+                                 module("mid", "testing/slow", param("stop-at-exit", "true")) +
+                                 module("rec", "core/recorder", param("file", dir.file("x.csv"))),
+                             connect("src.out", "mid.in") + connect("mid.out", "rec.in")));
   const auto result = runVrflow({"run", file, "-n", "5", "--deadlock-timeout", "1"}, 90);
   EXPECT_EQ(result.exitCode, 0) << result.err;
   EXPECT_EQ(result.err.find("stalled"), std::string::npos) << result.err;
