@@ -93,6 +93,11 @@ TEST_F(OnScreen, PointerAndKeysOfTheWindowComeOutAsEventsInWindowPixels) {
   ASSERT_TRUE(renderer.ok());
   window->swap();
   (void)window->poll();
+  // GLFW waits a tenth of a second at most for the window to be mapped: on a loaded machine
+  // the clicks could otherwise land on the root window.
+  ASSERT_EQ(testing::xdotool(server_->display(1),
+                             {"search", "--sync", "--onlyvisible", "--name", "window-test"}),
+            0);
   ASSERT_EQ(
       testing::xdotool(server_->display(1), {"mousemove", "--screen", "1", "--sync", "80", "65",
                                              "mousedown", "1", "mouseup", "1", "key", "a"}),
