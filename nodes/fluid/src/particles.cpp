@@ -36,12 +36,9 @@ void FluidSolver::Impl::migrate() {
   pos.resize(3 * keep);
   vel.resize(3 * keep);
   const auto in = comm->exchange(out, kParticleRecord);
-  // Records travel as doubles: a float goes there and back exactly.
   for (std::size_t r = 0; r + kParticleRecord <= in.size(); r += kParticleRecord) {
-    for (std::size_t d = 0; d < 3; ++d) {
-      pos.push_back(static_cast<float>(in[r + d]));
-      vel.push_back(static_cast<float>(in[r + 3 + d]));
-    }
+    pos.insert(pos.end(), &in[r], &in[r] + 3);
+    vel.insert(vel.end(), &in[r + 3], &in[r + 3] + 3);
   }
 }
 
@@ -116,19 +113,16 @@ void FluidSolver::Impl::pushParticlesOut(const std::vector<PreparedBody>& bodies
   }
   const std::size_t count = pos.size() / 3;
   for (std::size_t p = 0; p < count; ++p) {
-    float* stored = &pos[3 * p];
+    double* x = &pos[3 * p];
     std::size_t c;
     if (cellsKnown) {
       c = sortCell[p];
     } else {
       int i, j, k;
-      if (!cellOf(stored, i, j, k)) continue;
+      if (!cellOf(x, i, j, k)) continue;
       c = grid.cell(i, j, k);
     }
     if (bodiesAt[c] == bodiesAt[c + 1]) continue;
-    // The pushes work in double (bodies.hpp); the result is stored back in single precision.
-    double x[3] = {stored[0], stored[1], stored[2]};
-    bool pushed = false;
     // Every body whose bounds hold a point of cell c is on c's list. A push that carries the
     // particle out of c ends the list: the bodies after the one that pushed are then all tested.
     for (std::uint32_t e = bodiesAt[c]; e < bodiesAt[c + 1]; ++e) {
@@ -136,7 +130,6 @@ void FluidSolver::Impl::pushParticlesOut(const std::vector<PreparedBody>& bodies
       if (!detail::inBounds(bodies[b].bounds, x)) continue;
       detail::pushOut(bodies[b], x, 0.25 * grid.h);
       clampToDomain(x);
-      pushed = true;
       if (clampedCell(x) == c) continue;
       for (std::size_t rest = b + 1; rest < bodies.size(); ++rest) {
         if (!detail::inBounds(bodies[rest].bounds, x)) continue;
@@ -145,10 +138,7 @@ void FluidSolver::Impl::pushParticlesOut(const std::vector<PreparedBody>& bodies
       }
       break;
     }
-    if (!pushed) continue;
-    for (int d = 0; d < 3; ++d) stored[d] = static_cast<float>(x[d]);
-    clampToDomain(stored);
-    if (cellsKnown) sortCell[p] = clampedCell(stored);
+    if (cellsKnown) sortCell[p] = clampedCell(x);
   }
 }
 
@@ -221,12 +211,11 @@ VRFLOW_FLUID_HOT void FluidSolver::Impl::splatRange(std::size_t p0, std::size_t 
                                                     int planeHi) {
   const detail::Lattice lattice(grid);
   double* sums[3] = {acc[0].data(), acc[1].data(), acc[2].data()};
-  const float* x = pos.data() + 3 * p0;
-  const float* v = vel.data() + 3 * p0;
+  const double* x = pos.data() + 3 * p0;
+  const double* v = vel.data() + 3 * p0;
   for (std::size_t p = p0; p < p1; ++p, x += 3, v += 3) {
     detail::Located c;
-    const double xd[3] = {x[0], x[1], x[2]};
-    detail::locate(lattice, xd, c);
+    detail::locate(lattice, x, c);
     const int zc = c.centreBase[2] - planeLo, zf = c.faceBase[2] - planeLo;
     const int span = planeHi - planeLo;
     detail::splat(sums[0], detail::stencilOf(lattice, 0, c), v[0], zc, span);
@@ -290,38 +279,34 @@ VRFLOW_FLUID_HOT void FluidSolver::Impl::sampleAndAdvectRange(double dt, std::si
   // Two passes (velocities and midpoints, then positions) rather than one: within a particle
   // the second interpolation waits for the first, and a pass of short independent chains
   // keeps more particles in flight.
-  // Particles are stored in single precision and updated in double.
-  float* midpoints = posScratch.data();
+  double* midpoints = posScratch.data();
   for (std::size_t p = p0; p < p1; ++p) {
-    const double x[3] = {pos[3 * p], pos[3 * p + 1], pos[3 * p + 2]};
-    float* v = &vel[3 * p];
+    const double* x = &pos[3 * p];
+    double* v = &vel[3 * p];
     detail::Located c;
     detail::locate(lattice, x, c);
     const detail::Pair g0 = detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c));
     const detail::Pair g1 = detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c));
     const detail::Pair g2 = detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c));
-    v[0] = static_cast<float>(flip * (v[0] + g0[1]) + pic * g0[0]);
-    v[1] = static_cast<float>(flip * (v[1] + g1[1]) + pic * g1[0]);
-    v[2] = static_cast<float>(flip * (v[2] + g2[1]) + pic * g2[0]);
+    v[0] = flip * (v[0] + g0[1]) + pic * g0[0];
+    v[1] = flip * (v[1] + g1[1]) + pic * g1[0];
+    v[2] = flip * (v[2] + g2[1]) + pic * g2[0];
     // Midpoint (RK2) through the divergence-free grid velocity.
-    double mid[3] = {x[0] + halfDt * g0[0], x[1] + halfDt * g1[0], x[2] + halfDt * g2[0]};
+    double* mid = midpoints + 3 * p;
+    mid[0] = x[0] + halfDt * g0[0];
+    mid[1] = x[1] + halfDt * g1[0];
+    mid[2] = x[2] + halfDt * g2[0];
     clamp(mid);
-    for (int d = 0; d < 3; ++d)
-      midpoints[3 * p + static_cast<std::size_t>(d)] = static_cast<float>(mid[d]);
   }
   for (std::size_t p = p0; p < p1; ++p) {
-    float* stored = &pos[3 * p];
-    const float* m = midpoints + 3 * p;
-    const double mid[3] = {m[0], m[1], m[2]};
+    double* x = &pos[3 * p];
     detail::Located c;
-    detail::locate(lattice, mid, c);
-    double x[3] = {
-        stored[0] + dt * detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c))[0],
-        stored[1] + dt * detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c))[0],
-        stored[2] + dt * detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c))[0]};
+    detail::locate(lattice, midpoints + 3 * p, c);
+    x[0] += dt * detail::gatherPair(pairs[0], detail::stencilOf(lattice, 0, c))[0];
+    x[1] += dt * detail::gatherPair(pairs[1], detail::stencilOf(lattice, 1, c))[0];
+    x[2] += dt * detail::gatherPair(pairs[2], detail::stencilOf(lattice, 2, c))[0];
     clamp(x);
-    for (int d = 0; d < 3; ++d) stored[d] = static_cast<float>(x[d]);
-    if (storeCells) sortCell[p] = clampedCell(stored);
+    if (storeCells) sortCell[p] = clampedCell(x);
   }
 }
 

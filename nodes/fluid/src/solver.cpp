@@ -183,13 +183,14 @@ Status FluidSolver::addLiquidBox(const msg::Aabb& box) {
             x[d] = o[d] + (idx[d] + sub) * g.h;
           }
           if (!mine) continue;
-          for (const double xd : x) m.pos.push_back(static_cast<float>(xd));
+          m.pos.insert(m.pos.end(), x, x + 3);
           m.cellsKnown = false;
-          m.vel.insert(m.vel.end(), 3, 0.0f);
+          m.vel.insert(m.vel.end(), 3, 0.0);
         }
       }
     }
   }
+  m.refreshOutput();
   return {};
 }
 
@@ -259,6 +260,7 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   m.zeroWalls(m.u);
   m.gridToParticlesAndAdvect(dt);
   m.migrate();
+  m.refreshOutput();
   return forces;
 }
 
@@ -269,11 +271,11 @@ const StepStats& FluidSolver::lastStats() const {
   return impl_->stats;
 }
 const std::vector<float>& FluidSolver::particlePositions() const {
-  return impl_->pos;
+  return impl_->posOut;
 }
 
 std::vector<float> FluidSolver::gatherParticlePositions() const {
-  return impl_->comm ? impl_->comm->gatherToRoot(impl_->pos) : impl_->pos;
+  return impl_->comm ? impl_->comm->gatherToRoot(impl_->posOut) : impl_->posOut;
 }
 
 std::size_t FluidSolver::particleCount() const {
@@ -294,8 +296,8 @@ double FluidSolver::maxParticleSpeed() const {
   auto& m = *impl_;
   double best = 0.0;
   for (std::size_t p = 0; p + 2 < m.vel.size(); p += 3) {
-    const double v[3] = {m.vel[p], m.vel[p + 1], m.vel[p + 2]};
-    best = std::max(best, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    best = std::max(best, std::sqrt(m.vel[p] * m.vel[p] + m.vel[p + 1] * m.vel[p + 1] +
+                                    m.vel[p + 2] * m.vel[p + 2]));
   }
   return m.max(best);
 }
@@ -308,7 +310,7 @@ double FluidSolver::surfaceHeightAt(double x, double z) const {
   for (std::size_t p = 0; p + 2 < m.pos.size(); p += 3) {
     const int i = static_cast<int>(std::floor((m.pos[p] - m.grid.ox) * m.invH));
     const int k = static_cast<int>(std::floor((m.pos[p + 2] - m.grid.oz) * m.invH));
-    if (i == ci && k == ck) top = std::max(top, static_cast<double>(m.pos[p + 1]));
+    if (i == ci && k == ck) top = std::max(top, m.pos[p + 1]);
   }
   return m.max(top);
 }

@@ -30,12 +30,10 @@ struct FluidSolver::Impl {
   std::unique_ptr<detail::Workers> workers;  ///< settings.threads threads
   Grid grid;
   double invH = 1.0;
-  int k0 = 0, k1 = 0;  // this block's cell planes
-  // xyz per particle (this block's), in single precision: the particle loops stream half the
-  // bytes, and the positions are the output as they are (particlePositions()). Arithmetic on
-  // them is done in double.
-  std::vector<float> pos;
-  std::vector<float> vel;
+  int k0 = 0, k1 = 0;       // this block's cell planes
+  std::vector<double> pos;  // xyz per particle (this block's)
+  std::vector<double> vel;
+  std::vector<float> posOut;
   std::vector<double> u[3], uOld[3];
   std::vector<double> acc[3];  // particle-to-grid sums: (weighted velocity, weight) per face
   std::vector<unsigned char> valid[3];
@@ -107,19 +105,14 @@ struct FluidSolver::Impl {
     return x;
   }
 
-  template <typename T>
-  void clampToDomain(T* x) const {
+  void clampToDomain(double* x) const {
     const double eps = 1e-3 * grid.h;
     const double lo[3] = {grid.ox, grid.oy, grid.oz};
     const int n[3] = {grid.nx, grid.ny, grid.nz};
-    for (int d = 0; d < 3; ++d) {
-      x[d] = static_cast<T>(
-          std::clamp(static_cast<double>(x[d]), lo[d] + eps, lo[d] + n[d] * grid.h - eps));
-    }
+    for (int d = 0; d < 3; ++d) x[d] = std::clamp(x[d], lo[d] + eps, lo[d] + n[d] * grid.h - eps);
   }
 
-  template <typename T>
-  bool cellOf(const T* x, int& i, int& j, int& k) const {
+  bool cellOf(const double* x, int& i, int& j, int& k) const {
     i = static_cast<int>(std::floor((x[0] - grid.ox) * invH));
     j = static_cast<int>(std::floor((x[1] - grid.oy) * invH));
     k = static_cast<int>(std::floor((x[2] - grid.oz) * invH));
@@ -133,7 +126,7 @@ struct FluidSolver::Impl {
     return i < n ? i : n - 1;
   }
 
-  int planeOf(const float* x) const { return clampedIndex((x[2] - grid.oz) * invH, grid.nz); }
+  int planeOf(const double* x) const { return clampedIndex((x[2] - grid.oz) * invH, grid.nz); }
 
   // Loops over this block's faces of component a (with the along-axis index).
   template <typename F>
@@ -207,8 +200,7 @@ struct FluidSolver::Impl {
   // out of bodies and sorting need not locate every particle again; `cellsKnown` says so.
   std::vector<std::uint32_t> sortCell;
   bool cellsKnown = false;
-  template <typename T>
-  std::uint32_t clampedCell(const T* x) const {
+  std::uint32_t clampedCell(const double* x) const {
     const int i = clampedIndex((x[0] - grid.ox) * invH, grid.nx);
     const int j = clampedIndex((x[1] - grid.oy) * invH, grid.ny);
     const int k = clampedIndex((x[2] - grid.oz) * invH, grid.nz);
@@ -216,7 +208,7 @@ struct FluidSolver::Impl {
   }
   std::vector<std::size_t> sortStart;
   std::vector<std::size_t> planeStart;  ///< after sorting: first particle of each plane k0..k1
-  std::vector<float> posScratch, velScratch;
+  std::vector<double> posScratch, velScratch;
   // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
   // and an order that does not depend on history.
   void sortParticles();
@@ -283,6 +275,11 @@ struct FluidSolver::Impl {
   void markProjectedFaces();
 
   void gridToParticlesAndAdvect(double dt);
+
+  void refreshOutput() {
+    posOut.resize(pos.size());
+    for (std::size_t q = 0; q < pos.size(); ++q) posOut[q] = static_cast<float>(pos[q]);
+  }
 };
 
 }  // namespace vrflow::fluid
