@@ -15,9 +15,14 @@ void FluidSolver::Impl::project(double dt) {
       static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::max(0, k0 - 1)));
   const auto cTo =
       static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1)));
+  // The block's planes are written below, every cell (zero where no unknown); the plane beyond
+  // each side is cleared here.
+  const auto own0 = static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(k0));
+  const auto own1 = static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(k1));
   for (auto* v : {&A.diag, &A.ax, &A.ay, &A.az, &rhs}) {
     v->resize(n);
-    std::fill(v->begin() + cFrom, v->begin() + cTo, 0.0);
+    std::fill(v->begin() + cFrom, v->begin() + own0, 0.0);
+    std::fill(v->begin() + own1, v->begin() + cTo, 0.0);
   }
   const double h = grid.h;
   lastDt = dt;
@@ -29,7 +34,11 @@ void FluidSolver::Impl::project(double dt) {
     for (int j = 0; j < grid.ny; ++j) {
       for (int i = 0; i < grid.nx; ++i) {
         const std::size_t c = grid.cell(i, j, k);
-        if (!unknown(c)) continue;
+        double diag = 0.0, off[3] = {0.0, 0.0, 0.0};
+        if (!unknown(c)) {
+          A.diag[c] = A.ax[c] = A.ay[c] = A.az[c] = rhs[c] = 0.0;
+          continue;
+        }
         rhs[c] = -((u[0][grid.face(0, i + 1, j, k)] - u[0][grid.face(0, i, j, k)]) +
                    (u[1][grid.face(1, i, j + 1, k)] - u[1][grid.face(1, i, j, k)]) +
                    (u[2][grid.face(2, i, j, k + 1)] - u[2][grid.face(2, i, j, k)])) /
@@ -45,10 +54,14 @@ void FluidSolver::Impl::project(double dt) {
             const double rho =
                 unknown(nbr) ? 0.5 * (cellDensity[c] + cellDensity[nbr]) : cellDensity[c];
             const double beta = dt / (rho * h * h);
-            A.diag[c] += unknown(nbr) ? beta : beta / theta[c];
-            if (side > 0 && unknown(nbr)) (a == 0 ? A.ax : a == 1 ? A.ay : A.az)[c] = -beta;
+            diag += unknown(nbr) ? beta : beta / theta[c];
+            if (side > 0 && unknown(nbr)) off[a] = -beta;
           }
         }
+        A.diag[c] = diag;
+        A.ax[c] = off[0];
+        A.ay[c] = off[1];
+        A.az[c] = off[2];
       }
     }
   });
