@@ -1,6 +1,8 @@
 #include "vrflow/rigid/contact_solver.hpp"
 
 #include <BulletCollision/CollisionShapes/btConvexHullShape.h>
+#include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
+#include <BulletCollision/Gimpact/btGImpactShape.h>
 #include <btBulletCollisionCommon.h>
 
 #include <algorithm>
@@ -8,6 +10,7 @@
 #include <cmath>
 #include <string>
 
+#include "vrflow/rigid/mesh.hpp"
 #include "vrflow/rigid/user_contacts.hpp"
 
 namespace vrflow::rigid {
@@ -88,6 +91,26 @@ struct RigidContactSolver::Impl {
     // One contact distance for every shape (gContactBreakingThreshold, set around each query),
     // not Bullet's default that shrinks it with the shape's size.
     dispatcher.setDispatcherFlags(0);
+    // Moving triangle meshes (btGImpactMeshShape) against anything.
+    btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
+  }
+
+  // Bullet's view of a triangle mesh body's vertices and triangles (kept in the entry).
+  static btTriangleIndexVertexArray* meshInterface(Entry& e) {
+    const msg::Shape& s = e.body.shape;
+    e.vertices.clear();
+    for (double v : s.vertices) e.vertices.push_back(static_cast<btScalar>(v));
+    e.indices.assign(s.indices.begin(), s.indices.end());
+    btIndexedMesh mesh;
+    mesh.m_numTriangles = static_cast<int>(e.indices.size() / 3);
+    mesh.m_triangleIndexBase = reinterpret_cast<const unsigned char*>(e.indices.data());
+    mesh.m_triangleIndexStride = 3 * static_cast<int>(sizeof(int));
+    mesh.m_numVertices = static_cast<int>(e.vertices.size() / 3);
+    mesh.m_vertexBase = reinterpret_cast<const unsigned char*>(e.vertices.data());
+    mesh.m_vertexStride = 3 * static_cast<int>(sizeof(btScalar));
+    e.meshData = std::make_unique<btTriangleIndexVertexArray>();
+    e.meshData->addIndexedMesh(mesh, PHY_INTEGER);
+    return e.meshData.get();
   }
   ~Impl() {
     for (auto& [id, entry] : entries) world.removeCollisionObject(entry->object.get());
@@ -96,10 +119,7 @@ struct RigidContactSolver::Impl {
   Status build(Entry& e) {
     const msg::Shape& s = e.body.shape;
     if (auto status = msg::validateShape(s); !status) return status;
-    const bool concave = s.kind == msg::ShapeKind::TriangleMesh && e.body.kinematic;
-    if (s.kind == msg::ShapeKind::ConvexHull ||
-        (s.kind == msg::ShapeKind::TriangleMesh && !concave)) {
-      // Moving triangle meshes collide as their convex hull (documented approximation).
+    if (s.kind == msg::ShapeKind::ConvexHull) {
       auto hull = std::make_unique<btConvexHullShape>();
       for (std::size_t i = 0; i + 2 < s.vertices.size(); i += 3)
         hull->addPoint(btVector3(static_cast<btScalar>(s.vertices[i]),
@@ -110,20 +130,18 @@ struct RigidContactSolver::Impl {
       hull->setMargin(static_cast<btScalar>(margin_));
       hull->initializePolyhedralFeatures();
       e.shape = std::move(hull);
-    } else if (concave) {
-      e.vertices.clear();
-      for (double v : s.vertices) e.vertices.push_back(static_cast<btScalar>(v));
-      e.indices.assign(s.indices.begin(), s.indices.end());
-      btIndexedMesh mesh;
-      mesh.m_numTriangles = static_cast<int>(e.indices.size() / 3);
-      mesh.m_triangleIndexBase = reinterpret_cast<const unsigned char*>(e.indices.data());
-      mesh.m_triangleIndexStride = 3 * static_cast<int>(sizeof(int));
-      mesh.m_numVertices = static_cast<int>(e.vertices.size() / 3);
-      mesh.m_vertexBase = reinterpret_cast<const unsigned char*>(e.vertices.data());
-      mesh.m_vertexStride = 3 * static_cast<int>(sizeof(btScalar));
-      e.meshData = std::make_unique<btTriangleIndexVertexArray>();
-      e.meshData->addIndexedMesh(mesh, PHY_INTEGER);
-      e.shape = std::make_unique<btBvhTriangleMeshShape>(e.meshData.get(), true);
+    } else if (s.kind == msg::ShapeKind::TriangleMesh && e.body.kinematic) {
+      // Static, possibly open and concave: Bullet's BVH of triangles.
+      e.shape = std::make_unique<btBvhTriangleMeshShape>(meshInterface(e), true);
+    } else if (s.kind == msg::ShapeKind::TriangleMesh) {
+      // Moving and possibly concave: GImpact (its triangles' tree is in the body frame, so a pose
+      // change needs no update). The mesh must enclose its volume, which its inertia came from.
+      if (auto closed = checkClosedMesh(s); !closed)
+        return makeError("dynamic triangle mesh: " + closed.error().message);
+      auto mesh = std::make_unique<btGImpactMeshShape>(meshInterface(e));
+      mesh->setMargin(static_cast<btScalar>(margin_));
+      mesh->updateBound();
+      e.shape = std::move(mesh);
     } else if (s.kind == msg::ShapeKind::Sphere) {
       e.shape = std::make_unique<btSphereShape>(static_cast<btScalar>(s.radius));
     } else if (s.kind == msg::ShapeKind::Box) {
