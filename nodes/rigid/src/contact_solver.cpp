@@ -170,7 +170,55 @@ struct RigidContactSolver::Impl {
     return {};
   }
 
+  // GImpact (a moving mesh's pairs) makes a new manifold at every query: a flat face would get one
+  // point per pair of triangles per step and nothing to warm start from. So the points of the last
+  // solve are kept per pair and offered to the new manifold, where Bullet's own matching and
+  // refresh keep those still in contact, as a persistent manifold does for the other pairs.
+  static bool remadeEachQuery(const btPersistentManifold& m) {
+    return m.getBody0()->getCollisionShape()->getShapeType() == GIMPACT_SHAPE_PROXYTYPE ||
+           m.getBody1()->getCollisionShape()->getShapeType() == GIMPACT_SHAPE_PROXYTYPE;
+  }
+  static std::pair<std::uint64_t, std::uint64_t> idsOf(const btPersistentManifold& m) {
+    return {static_cast<const Entry*>(m.getBody0()->getUserPointer())->body.id,
+            static_cast<const Entry*>(m.getBody1()->getUserPointer())->body.id};
+  }
+  // After the query: the kept points join the new manifolds (a new point matching a kept one
+  // takes its impulses), then every point is re-measured at the current poses.
+  void restoreMeshPoints() {
+    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+      btPersistentManifold& manifold = *dispatcher.getManifoldByIndexInternal(m);
+      if (!remadeEachQuery(manifold)) continue;
+      const auto it = meshPoints.find(idsOf(manifold));
+      if (it == meshPoints.end()) continue;
+      for (const btManifoldPoint& old : it->second) {
+        const int match = manifold.getCacheEntry(old);
+        if (match < 0) {
+          manifold.addManifoldPoint(old);
+          continue;
+        }
+        btManifoldPoint& fresh = manifold.getContactPoint(match);
+        fresh.m_appliedImpulse = old.m_appliedImpulse;
+        fresh.m_appliedImpulseLateral1 = old.m_appliedImpulseLateral1;
+        fresh.m_appliedImpulseLateral2 = old.m_appliedImpulseLateral2;
+      }
+      manifold.refreshContactPoints(manifold.getBody0()->getWorldTransform(),
+                                    manifold.getBody1()->getWorldTransform());
+    }
+    meshPoints.clear();
+  }
+  // After the solve (impulses written back): keep the moving meshes' points for the next query.
+  void keepMeshPoints() {
+    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+      const btPersistentManifold& manifold = *dispatcher.getManifoldByIndexInternal(m);
+      if (!remadeEachQuery(manifold) || manifold.getNumContacts() == 0) continue;
+      auto& points = meshPoints[idsOf(manifold)];
+      for (int i = 0; i < manifold.getNumContacts(); ++i)
+        points.push_back(manifold.getContactPoint(i));
+    }
+  }
+
   double margin_;
+  std::map<std::pair<std::uint64_t, std::uint64_t>, std::vector<btManifoldPoint>> meshPoints;
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher{&config};
   btDbvtBroadphase broadphase;
@@ -218,6 +266,9 @@ void RigidContactSolver::removeBody(std::uint64_t id) {
   if (it == impl_->entries.end()) return;
   impl_->world.removeCollisionObject(it->second->object.get());
   impl_->entries.erase(it);
+  std::erase_if(impl_->meshPoints, [id](const auto& kept) {
+    return kept.first.first == id || kept.first.second == id;
+  });
 }
 
 bool RigidContactSolver::contains(std::uint64_t id) const {
@@ -262,6 +313,7 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     impl_->world.performDiscreteCollisionDetection();
     gContactBreakingThreshold = saved;
   }
+  impl_->restoreMeshPoints();
 
   // Axis 0 is the normal (from b to a), 1 and 2 the friction tangents. For each axis the
   // Jacobian's angular parts r x d and their images through the inverse inertia are precomputed.
@@ -465,6 +517,8 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     angular[c.a] += c.ra.cross(impulse) + c.accRoll;
     angular[c.b] -= c.rb.cross(impulse) + c.accRoll;
   }
+
+  impl_->keepMeshPoints();
 
   for (std::size_t k = 0; k < n; ++k) {
     const Body& b = bodies[k]->body;
