@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -261,6 +262,40 @@ TEST(RigidMesh, CubeMeshRestsInABowlStandingOnAStaticMeshFloor) {
   EXPECT_LT(cubeBox.max[1], height);
   EXPECT_LT(asEigen(c.linearVelocity).norm(), 0.02);
   EXPECT_LT(asEigen(bw.linearVelocity).norm(), 0.02);
+}
+
+// A moving mesh's contacts start as far away as the other shapes' (the speculative distance,
+// 4 cm): a ball above the bowl's floor and a bowl above a static mesh floor get a contact whose
+// distance is the gap, as a ball above a box does.
+TEST(RigidMesh, MovingMeshGetsSpeculativeContactsAsFarAsOtherShapes) {
+  const auto floor =
+      msg::Shape::triangleMesh({-3, 0, -3, 3, 0, -3, 3, 0, 3, -3, 0, 3}, {0, 2, 1, 0, 3, 2});
+  for (double gap : {0.008, 0.02, 0.035}) {
+    SCOPED_TRACE(gap);
+    RigidContactSolver solver(ContactParams{});
+    const Body bowl = meshBody(1, bowlMesh(0.3, 0.3, 0.05), 500, {0, gap, 0});
+    ASSERT_TRUE(solver.setBody(bowl));
+    ASSERT_TRUE(solver.setBody(makeKinematic(2, floor, {0, 0, 0})));
+    ASSERT_TRUE(solver.setBody(
+        makeBody(3, msg::Shape::sphere(0.08), 1.0, {0, gap + 0.05 + 0.08 + gap, 0})));
+    ASSERT_TRUE(solver.setBody(makeKinematic(4, msg::Shape::box({0.1, 0.1, 0.1}), {2, 0, 0})));
+    ASSERT_TRUE(
+        solver.setBody(makeBody(5, msg::Shape::sphere(0.08), 1.0, {2, 0.1 + 0.08 + gap, 0})));
+    solver.solve(kDt);
+    bool ballInBowl = false, bowlOnFloor = false, ballOnBox = false;
+    for (const auto& c : solver.contacts()) {
+      const auto pair = std::minmax(c.a, c.b);
+      // Bullet's distances are floats; the bowl's triangles carry the 5 mm margin.
+      if (pair == std::minmax<std::uint64_t>(1, 3))
+        ballInBowl |= std::abs(c.distance - gap) < 1e-4 + 0.005;
+      if (pair == std::minmax<std::uint64_t>(1, 2))
+        bowlOnFloor |= std::abs(c.distance - gap) < 1e-4 + 0.005;
+      if (pair == std::minmax<std::uint64_t>(4, 5)) ballOnBox |= std::abs(c.distance - gap) < 1e-4;
+    }
+    EXPECT_TRUE(ballOnBox);
+    EXPECT_TRUE(ballInBowl);
+    EXPECT_TRUE(bowlOnFloor);
+  }
 }
 
 std::string errorOf(const Result<std::vector<Body>>& result) {

@@ -84,7 +84,7 @@ struct RigidContactSolver::Impl {
     std::size_t dense = 0;  // index in the solve's arrays
   };
 
-  explicit Impl(double margin) : margin_(margin) {
+  Impl(double margin, double speculative) : margin_(margin), speculative_(speculative) {
     // No perturbation iterations: their extra points carry distances of the perturbed pose (off
     // by millimetres, which breaks speculative contacts); boxes and hulls get full manifolds from
     // polyhedral clipping instead, other pairs build theirs over steps (persistent manifolds).
@@ -138,9 +138,15 @@ struct RigidContactSolver::Impl {
       // change needs no update). The mesh must enclose its volume, which its inertia came from.
       if (auto closed = checkClosedMesh(s); !closed)
         return makeError("dynamic triangle mesh: " + closed.error().message);
+      // GImpact tests the triangles whose boxes meet the other shape's, and grows those boxes by
+      // the margin only: built with margin + speculative distance, they let the triangles (whose
+      // margin is then set back) give speculative points as far as the other pairs do.
       auto mesh = std::make_unique<btGImpactMeshShape>(meshInterface(e));
-      mesh->setMargin(static_cast<btScalar>(margin_));
+      mesh->setMargin(static_cast<btScalar>(margin_ + speculative_));
       mesh->updateBound();
+      for (int part = 0; part < mesh->getMeshPartCount(); ++part)
+        mesh->getMeshPart(part)->getTrimeshPrimitiveManager()->m_margin =
+            static_cast<btScalar>(margin_);
       e.shape = std::move(mesh);
     } else if (s.kind == msg::ShapeKind::Sphere) {
       e.shape = std::make_unique<btSphereShape>(static_cast<btScalar>(s.radius));
@@ -218,6 +224,7 @@ struct RigidContactSolver::Impl {
   }
 
   double margin_;
+  double speculative_;
   std::map<std::pair<std::uint64_t, std::uint64_t>, std::vector<btManifoldPoint>> meshPoints;
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher{&config};
@@ -227,7 +234,7 @@ struct RigidContactSolver::Impl {
 };
 
 RigidContactSolver::RigidContactSolver(ContactParams params)
-    : impl_(std::make_unique<Impl>(params.margin)), params_(params) {}
+    : impl_(std::make_unique<Impl>(params.margin, params.speculativeDistance)), params_(params) {}
 
 RigidContactSolver::~RigidContactSolver() = default;
 
