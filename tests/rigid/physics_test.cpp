@@ -305,7 +305,7 @@ TEST(RigidPhysics, TwentyMixedObjectsComeToRestInTheBox) {
 }
 
 // A concave static triangle mesh (a V-shaped trough) catches a sphere, a box and a moving
-// triangle-mesh body (which collides as its convex hull); they settle in the trough's valley.
+// triangle-mesh body (a closed tetrahedron, through GImpact); they settle in the trough's valley.
 TEST(RigidPhysics, StaticTriangleMeshCatchesConvexAndMeshBodies) {
   // Two planes meeting along the z axis at y = 0, sloping up to y = 1 at x = +-2.
   std::vector<double> v{-2, 1, -2, -2, 1, 2, 0, 0, -2, 0, 0, 2, 2, 1, -2, 2, 1, 2};

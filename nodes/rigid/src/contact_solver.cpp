@@ -1,6 +1,8 @@
 #include "vrflow/rigid/contact_solver.hpp"
 
 #include <BulletCollision/CollisionShapes/btConvexHullShape.h>
+#include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
+#include <BulletCollision/Gimpact/btGImpactShape.h>
 #include <btBulletCollisionCommon.h>
 
 #include <algorithm>
@@ -8,6 +10,7 @@
 #include <cmath>
 #include <string>
 
+#include "vrflow/rigid/mesh.hpp"
 #include "vrflow/rigid/user_contacts.hpp"
 
 namespace vrflow::rigid {
@@ -81,13 +84,33 @@ struct RigidContactSolver::Impl {
     std::size_t dense = 0;  // index in the solve's arrays
   };
 
-  explicit Impl(double margin) : margin_(margin) {
+  Impl(double margin, double speculative) : margin_(margin), speculative_(speculative) {
     // No perturbation iterations: their extra points carry distances of the perturbed pose (off
     // by millimetres, which breaks speculative contacts); boxes and hulls get full manifolds from
     // polyhedral clipping instead, other pairs build theirs over steps (persistent manifolds).
     // One contact distance for every shape (gContactBreakingThreshold, set around each query),
     // not Bullet's default that shrinks it with the shape's size.
     dispatcher.setDispatcherFlags(0);
+    // Moving triangle meshes (btGImpactMeshShape) against anything.
+    btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
+  }
+
+  // Bullet's view of a triangle mesh body's vertices and triangles (kept in the entry).
+  static btTriangleIndexVertexArray* meshInterface(Entry& e) {
+    const msg::Shape& s = e.body.shape;
+    e.vertices.clear();
+    for (double v : s.vertices) e.vertices.push_back(static_cast<btScalar>(v));
+    e.indices.assign(s.indices.begin(), s.indices.end());
+    btIndexedMesh mesh;
+    mesh.m_numTriangles = static_cast<int>(e.indices.size() / 3);
+    mesh.m_triangleIndexBase = reinterpret_cast<const unsigned char*>(e.indices.data());
+    mesh.m_triangleIndexStride = 3 * static_cast<int>(sizeof(int));
+    mesh.m_numVertices = static_cast<int>(e.vertices.size() / 3);
+    mesh.m_vertexBase = reinterpret_cast<const unsigned char*>(e.vertices.data());
+    mesh.m_vertexStride = 3 * static_cast<int>(sizeof(btScalar));
+    e.meshData = std::make_unique<btTriangleIndexVertexArray>();
+    e.meshData->addIndexedMesh(mesh, PHY_INTEGER);
+    return e.meshData.get();
   }
   ~Impl() {
     for (auto& [id, entry] : entries) world.removeCollisionObject(entry->object.get());
@@ -96,10 +119,7 @@ struct RigidContactSolver::Impl {
   Status build(Entry& e) {
     const msg::Shape& s = e.body.shape;
     if (auto status = msg::validateShape(s); !status) return status;
-    const bool concave = s.kind == msg::ShapeKind::TriangleMesh && e.body.kinematic;
-    if (s.kind == msg::ShapeKind::ConvexHull ||
-        (s.kind == msg::ShapeKind::TriangleMesh && !concave)) {
-      // Moving triangle meshes collide as their convex hull (documented approximation).
+    if (s.kind == msg::ShapeKind::ConvexHull) {
       auto hull = std::make_unique<btConvexHullShape>();
       for (std::size_t i = 0; i + 2 < s.vertices.size(); i += 3)
         hull->addPoint(btVector3(static_cast<btScalar>(s.vertices[i]),
@@ -110,20 +130,24 @@ struct RigidContactSolver::Impl {
       hull->setMargin(static_cast<btScalar>(margin_));
       hull->initializePolyhedralFeatures();
       e.shape = std::move(hull);
-    } else if (concave) {
-      e.vertices.clear();
-      for (double v : s.vertices) e.vertices.push_back(static_cast<btScalar>(v));
-      e.indices.assign(s.indices.begin(), s.indices.end());
-      btIndexedMesh mesh;
-      mesh.m_numTriangles = static_cast<int>(e.indices.size() / 3);
-      mesh.m_triangleIndexBase = reinterpret_cast<const unsigned char*>(e.indices.data());
-      mesh.m_triangleIndexStride = 3 * static_cast<int>(sizeof(int));
-      mesh.m_numVertices = static_cast<int>(e.vertices.size() / 3);
-      mesh.m_vertexBase = reinterpret_cast<const unsigned char*>(e.vertices.data());
-      mesh.m_vertexStride = 3 * static_cast<int>(sizeof(btScalar));
-      e.meshData = std::make_unique<btTriangleIndexVertexArray>();
-      e.meshData->addIndexedMesh(mesh, PHY_INTEGER);
-      e.shape = std::make_unique<btBvhTriangleMeshShape>(e.meshData.get(), true);
+    } else if (s.kind == msg::ShapeKind::TriangleMesh && e.body.kinematic) {
+      // Static, possibly open and concave: Bullet's BVH of triangles.
+      e.shape = std::make_unique<btBvhTriangleMeshShape>(meshInterface(e), true);
+    } else if (s.kind == msg::ShapeKind::TriangleMesh) {
+      // Moving and possibly concave: GImpact (its triangles' tree is in the body frame, so a pose
+      // change needs no update). The mesh must enclose its volume, which its inertia came from.
+      if (auto closed = checkClosedMesh(s); !closed)
+        return makeError("dynamic triangle mesh: " + closed.error().message);
+      // GImpact tests the triangles whose boxes meet the other shape's, and grows those boxes by
+      // the margin only: built with margin + speculative distance, they let the triangles (whose
+      // margin is then set back) give speculative points as far as the other pairs do.
+      auto mesh = std::make_unique<btGImpactMeshShape>(meshInterface(e));
+      mesh->setMargin(static_cast<btScalar>(margin_ + speculative_));
+      mesh->updateBound();
+      for (int part = 0; part < mesh->getMeshPartCount(); ++part)
+        mesh->getMeshPart(part)->getTrimeshPrimitiveManager()->m_margin =
+            static_cast<btScalar>(margin_);
+      e.shape = std::move(mesh);
     } else if (s.kind == msg::ShapeKind::Sphere) {
       e.shape = std::make_unique<btSphereShape>(static_cast<btScalar>(s.radius));
     } else if (s.kind == msg::ShapeKind::Box) {
@@ -152,7 +176,56 @@ struct RigidContactSolver::Impl {
     return {};
   }
 
+  // GImpact (a moving mesh's pairs) makes a new manifold at every query: a flat face would get one
+  // point per pair of triangles per step and nothing to warm start from. So the points of the last
+  // solve are kept per pair and offered to the new manifold, where Bullet's own matching and
+  // refresh keep those still in contact, as a persistent manifold does for the other pairs.
+  static bool remadeEachQuery(const btPersistentManifold& m) {
+    return m.getBody0()->getCollisionShape()->getShapeType() == GIMPACT_SHAPE_PROXYTYPE ||
+           m.getBody1()->getCollisionShape()->getShapeType() == GIMPACT_SHAPE_PROXYTYPE;
+  }
+  static std::pair<std::uint64_t, std::uint64_t> idsOf(const btPersistentManifold& m) {
+    return {static_cast<const Entry*>(m.getBody0()->getUserPointer())->body.id,
+            static_cast<const Entry*>(m.getBody1()->getUserPointer())->body.id};
+  }
+  // After the query: the kept points join the new manifolds (a new point matching a kept one
+  // takes its impulses), then every point is re-measured at the current poses.
+  void restoreMeshPoints() {
+    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+      btPersistentManifold& manifold = *dispatcher.getManifoldByIndexInternal(m);
+      if (!remadeEachQuery(manifold)) continue;
+      const auto it = meshPoints.find(idsOf(manifold));
+      if (it == meshPoints.end()) continue;
+      for (const btManifoldPoint& old : it->second) {
+        const int match = manifold.getCacheEntry(old);
+        if (match < 0) {
+          manifold.addManifoldPoint(old);
+          continue;
+        }
+        btManifoldPoint& fresh = manifold.getContactPoint(match);
+        fresh.m_appliedImpulse = old.m_appliedImpulse;
+        fresh.m_appliedImpulseLateral1 = old.m_appliedImpulseLateral1;
+        fresh.m_appliedImpulseLateral2 = old.m_appliedImpulseLateral2;
+      }
+      manifold.refreshContactPoints(manifold.getBody0()->getWorldTransform(),
+                                    manifold.getBody1()->getWorldTransform());
+    }
+    meshPoints.clear();
+  }
+  // After the solve (impulses written back): keep the moving meshes' points for the next query.
+  void keepMeshPoints() {
+    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+      const btPersistentManifold& manifold = *dispatcher.getManifoldByIndexInternal(m);
+      if (!remadeEachQuery(manifold) || manifold.getNumContacts() == 0) continue;
+      auto& points = meshPoints[idsOf(manifold)];
+      for (int i = 0; i < manifold.getNumContacts(); ++i)
+        points.push_back(manifold.getContactPoint(i));
+    }
+  }
+
   double margin_;
+  double speculative_;
+  std::map<std::pair<std::uint64_t, std::uint64_t>, std::vector<btManifoldPoint>> meshPoints;
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher{&config};
   btDbvtBroadphase broadphase;
@@ -161,7 +234,7 @@ struct RigidContactSolver::Impl {
 };
 
 RigidContactSolver::RigidContactSolver(ContactParams params)
-    : impl_(std::make_unique<Impl>(params.margin)), params_(params) {}
+    : impl_(std::make_unique<Impl>(params.margin, params.speculativeDistance)), params_(params) {}
 
 RigidContactSolver::~RigidContactSolver() = default;
 
@@ -200,6 +273,9 @@ void RigidContactSolver::removeBody(std::uint64_t id) {
   if (it == impl_->entries.end()) return;
   impl_->world.removeCollisionObject(it->second->object.get());
   impl_->entries.erase(it);
+  std::erase_if(impl_->meshPoints, [id](const auto& kept) {
+    return kept.first.first == id || kept.first.second == id;
+  });
 }
 
 bool RigidContactSolver::contains(std::uint64_t id) const {
@@ -244,6 +320,7 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     impl_->world.performDiscreteCollisionDetection();
     gContactBreakingThreshold = saved;
   }
+  impl_->restoreMeshPoints();
 
   // Axis 0 is the normal (from b to a), 1 and 2 the friction tangents. For each axis the
   // Jacobian's angular parts r x d and their images through the inverse inertia are precomputed.
@@ -447,6 +524,8 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
     angular[c.a] += c.ra.cross(impulse) + c.accRoll;
     angular[c.b] -= c.rb.cross(impulse) + c.accRoll;
   }
+
+  impl_->keepMeshPoints();
 
   for (std::size_t k = 0; k < n; ++k) {
     const Body& b = bodies[k]->body;

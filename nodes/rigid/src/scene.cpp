@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "vrflow/base/file_access.hpp"
+#include "vrflow/rigid/mesh.hpp"
 
 namespace vrflow::rigid {
 namespace {
@@ -118,7 +119,7 @@ Body parseBody(const json& j, std::uint64_t id) {
            "");
   if (!j.contains("shape")) throw BodyError{"missing 'shape'"};
   Vec3 offset{};
-  const msg::Shape shape = parseShape(j["shape"], offset);
+  msg::Shape shape = parseShape(j["shape"], offset);
   const bool kinematic = j.value("kinematic", false);
   Vec3 position = j.contains("position") ? vector<3>(j["position"], "position") : Vec3{};
   Quat orientation =
@@ -127,7 +128,14 @@ Body parseBody(const json& j, std::uint64_t id) {
                                 orientation[2] * orientation[2] + orientation[3] * orientation[3]);
   if (!(norm > 1e-9)) throw BodyError{"'orientation' must be a non-zero quaternion [x, y, z, w]"};
   for (auto& c : orientation) c /= norm;
-  // A recentred hull keeps its points where the file put them.
+  if (shape.kind == msg::ShapeKind::TriangleMesh && !kinematic) {
+    // A moving mesh collides as itself and weighs what it encloses: it must be closed, and its
+    // body frame is centred on its volume centroid like a hull's.
+    auto centred = centredMesh(shape, &offset);
+    if (!centred) throw BodyError{"dynamic triangle mesh: " + centred.error().message};
+    shape = std::move(centred.value());
+  }
+  // A recentred hull or mesh keeps its points where the file put them.
   asEigen(position) += asEigen(orientation) * asEigen(offset);
   Body body;
   if (kinematic) {
@@ -238,18 +246,9 @@ Result<msg::Shape> convexHullFromPoints(const std::vector<Vec3>& input, Vec3* ce
       for (int i : t) triangles.push_back(static_cast<std::uint32_t>(i));
     }
   }
-  // Volume centroid from the signed tetrahedra with `mean`.
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  double volume = 0;
-  for (std::size_t t = 0; t < triangles.size(); t += 3) {
-    const Eigen::Vector3d a = vertices[triangles[t]] - mean, b = vertices[triangles[t + 1]] - mean,
-                          d = vertices[triangles[t + 2]] - mean;
-    const double v6 = a.dot(b.cross(d));
-    volume += v6;
-    c += (a + b + d) * (v6 / 4.0);
-  }
-  if (!(volume > 0)) return makeError("the convex hull has no volume");
-  const Eigen::Vector3d shift = mean + c * (1.0 / volume);
+  auto centre = volumeCentroid(vertices, triangles);
+  if (!centre) return makeError("the convex hull has no volume");
+  const Eigen::Vector3d shift = *centre;
   std::vector<double> xyz;
   for (const auto& v : vertices) {
     const Eigen::Vector3d r = v - shift;
@@ -319,7 +318,7 @@ Result<std::vector<Body>> generateScene(std::string_view spec) {
   const auto colon = spec.find(':');
   if (colon == std::string_view::npos)
     return makeError("generator '" + std::string(spec) +
-                     "': expected KIND:N (boxes:N, mixed:N, stack:N)");
+                     "': expected KIND:N (boxes:N, mixed:N, stack:N, bowls:N)");
   const std::string_view kind = spec.substr(0, colon), countText = spec.substr(colon + 1);
   std::int64_t count = 0;
   const auto [end, ec] =
@@ -392,9 +391,27 @@ Result<std::vector<Body>> generateScene(std::string_view spec) {
       bodies.push_back(
           makeBody(id++, shape, density * msg::massProperties(shape, 1.0).volume, position, q));
     }
+  } else if (kind == "bowls") {
+    // Bowls (dynamic concave meshes) in a row on the ground, each catching a sphere and a box.
+    const double spacing = 1.0, half = 0.5 * spacing * static_cast<double>(n) + 1.0;
+    bodies.push_back(makeKinematic(id++, msg::Shape::box({half, 0.5, 1.5}), {0, -0.5, 0}));
+    Vec3 centroid{};
+    auto bowl = centredMesh(bowlMesh(0.3, 0.3, 0.05), &centroid);
+    if (!bowl) return bowl.error();
+    const double density = 500;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x = (static_cast<double>(i) - 0.5 * static_cast<double>(n - 1)) * spacing;
+      bodies.push_back(makeBody(id++, bowl.value(),
+                                density * msg::massProperties(bowl.value(), 1.0).volume,
+                                {x + centroid[0], centroid[1], centroid[2]}));
+      bodies.push_back(makeBody(id++, msg::Shape::sphere(0.08), 1.0,
+                                {x + 0.1 * (random.next() - 0.5), 0.6, 0.05}));
+      bodies.push_back(makeBody(id++, msg::Shape::box({0.06, 0.06, 0.06}), 0.5,
+                                {x + 0.1 * (random.next() - 0.5), 0.9, -0.08}));
+    }
   } else {
     return makeError("generator '" + std::string(spec) + "': unknown kind '" + std::string(kind) +
-                     "' (boxes, mixed, stack)");
+                     "' (boxes, mixed, stack, bowls)");
   }
   return bodies;
 }

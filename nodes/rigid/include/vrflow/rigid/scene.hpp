@@ -22,7 +22,9 @@ Result<std::vector<Body>> parseScene(std::string_view text, const std::string& o
 ///  - `boxes:N`  N unit-density 0.4 m boxes in a jittered grid above a static ground (bench);
 ///  - `mixed:N`  N spheres, boxes, capsules and convex hulls dropped into a 2 m x 2 m box
 ///               (static ground and four walls): the demo scene's rigid objects;
-///  - `stack:N`  N 0.5 m boxes stacked on the ground.
+///  - `stack:N`  N 0.5 m boxes stacked on the ground;
+///  - `bowls:N`  N bowls (moving concave triangle meshes, bowlMesh(0.3, 0.3, 0.05), density
+///               500) in a row on the ground, a sphere and a box dropped into each (bench).
 /// Static bodies (ground, walls) come first.
 Result<std::vector<Body>> generateScene(std::string_view spec);
 
