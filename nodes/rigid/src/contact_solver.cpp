@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "vrflow/rigid/user_contacts.hpp"
@@ -273,10 +274,12 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   };
 
   // The Jacobian of contact c at `middle` along `normal` (from b to a), its effective masses and
-  // its target normal velocity (speculative below a gap, restitution, Baumgarte beyond slop).
+  // its target normal velocity (speculative below a gap, restitution, Baumgarte beyond slop, the
+  // latter at most maxPushOut).
   auto setUp = [&](Constraint& c, const Eigen::Vector3d& middle, const Eigen::Vector3d& positionA,
                    const Eigen::Vector3d& positionB, const Eigen::Vector3d& normal, double distance,
-                   bool kinematicA, bool kinematicB, double restitution) {
+                   bool kinematicA, bool kinematicB, double restitution,
+                   double maxPushOut = std::numeric_limits<double>::infinity()) {
     c.ra = middle - positionA;
     c.rb = middle - positionB;
     c.dir[0] = normal;
@@ -305,8 +308,9 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       c.target = -distance / dt;
       if (bounce && vn * dt < -distance) c.target = std::max(c.target, rebound(distance));
     } else {
-      c.target = std::max(bounce ? rebound(distance) : 0.0,
-                          p.baumgarte / dt * std::max(-distance - p.slop, 0.0));
+      c.target =
+          std::max(bounce ? rebound(distance) : 0.0,
+                   std::min(p.baumgarte / dt * std::max(-distance - p.slop, 0.0), maxPushOut));
     }
   };
 
@@ -386,12 +390,14 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       c.point = nullptr;
       c.accRoll.setZero();
       c.rolls = false;
-      c.surface = asEigen(s.surfaceVelocity);
+      const Eigen::Vector3d normal = asEigen(s.normal);
+      c.surface = normal * std::clamp(asEigen(s.surfaceVelocity).dot(normal), -p.userSurfaceSpeed,
+                                      p.userSurfaceSpeed);
       // The user has the interactor's friction and restitution (its own are unset: -1).
       const Body& body = bodies[c.a]->body;
       c.friction = combinedFriction(body.friction, -1, p.friction);
-      setUp(c, asEigen(s.point), asEigen(body.position), asEigen(s.point), asEigen(s.normal),
-            s.distance, false, true, combinedRestitution(body.restitution, -1, p.restitution));
+      setUp(c, asEigen(s.point), asEigen(body.position), asEigen(s.point), normal, s.distance,
+            false, true, combinedRestitution(body.restitution, -1, p.restitution), p.userPushOut);
       constraints.push_back(c);
       contacts_.push_back({s.body, s.surface, s.point, s.normal, s.distance});
     }
