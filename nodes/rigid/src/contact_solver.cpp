@@ -391,8 +391,13 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       c.accRoll.setZero();
       c.rolls = false;
       const Eigen::Vector3d normal = asEigen(s.normal);
-      c.surface = normal * std::clamp(asEigen(s.surfaceVelocity).dot(normal), -p.userSurfaceSpeed,
-                                      p.userSurfaceSpeed);
+      // The user's surface velocity, at most userSurfaceSpeed. Not only its normal part: the
+      // field, smoothed over voxels, carries the motion of the user's surface near the sample
+      // better than one sample's normal does (a hand pushing a crate along a table drives it
+      // along the hand's motion through friction, not up along the tilted normals of its edge).
+      c.surface = asEigen(s.surfaceVelocity);
+      if (const double speed = c.surface.norm(); speed > p.userSurfaceSpeed)
+        c.surface *= p.userSurfaceSpeed / speed;
       // The user has the interactor's friction and restitution (its own are unset: -1).
       const Body& body = bodies[c.a]->body;
       c.friction = combinedFriction(body.friction, -1, p.friction);

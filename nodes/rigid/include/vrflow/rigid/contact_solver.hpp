@@ -55,8 +55,8 @@ struct ContactParams {
   /// (m/s; Box2D's maximum linear correction as a speed): a body found inside is moved out gently
   /// over a few steps, not launched.
   double userPushOut = 0.5;
-  /// The user's surface velocity is taken along the contact normal only (the component a distance
-  /// field can show), at most this fast (m/s): a human hand, not a voxel step per frame.
+  /// The user's surface velocity at a contact is taken at most this fast (m/s): a human hand, not
+  /// a voxel step per frame.
   double userSurfaceSpeed = 3.0;
 };
 
