@@ -133,6 +133,78 @@ TEST(SurfaceVelocity, StillUserAndEmptyFramesGiveZero) {
   EXPECT_EQ(surfaceVelocity(spec, sdf, sdf, 0.01).size(), 3 * spec.count());
 }
 
+TEST(SurfaceVelocity, OnlyTheBandIsComputedWithTheWholeGridsValues) {
+  // The velocity is computed in the band's box only: inside the band it must equal what the
+  // whole grid gives (a band wider than the grid), and be zero outside it.
+  const GridSpec spec = GridSpec::cube({-0.7, -0.7, -0.7}, 1.4, 48);
+  const cv::Vec3d v(0.4, 0.1, -0.2);
+  auto sphereAt = [](cv::Vec3d c) {
+    return [c](const cv::Vec3d& x) { return cv::norm(x - c) - 0.25; };
+  };
+  const auto before = signedDistanceField(voxelize(spec, sphereAt({0.1, 0, 0})));
+  const auto now = signedDistanceField(voxelize(spec, sphereAt(cv::Vec3d(0.1, 0, 0) + v * 0.05)));
+  SurfaceVelocitySettings band, whole;
+  band.band = 0.08;
+  whole.band = 1e9;
+  const auto inBand = surfaceVelocity(spec, before, now, 0.05, band);
+  const auto everywhere = surfaceVelocity(spec, before, now, 0.05, whole);
+  int moving = 0;
+  for (std::size_t c = 0; c < spec.count(); ++c)
+    for (std::size_t a = 0; a < 3; ++a) {
+      const float expected = std::abs(now[c]) <= band.band ? everywhere[3 * c + a] : 0.0f;
+      ASSERT_EQ(inBand[3 * c + a], expected) << "cell " << c;
+      if (a == 0 && expected != 0) ++moving;
+    }
+  EXPECT_GT(moving, 1000);
+}
+
+TEST(SurfaceVelocity, ATimeAverageReadsASlowSurfacesVoxelStepsAsItsSpeed) {
+  // A sphere moving 0.2 voxels a frame: its voxel model steps a whole voxel every 5 frames. One
+  // frame's change reads the step as a voxel per frame (5x its speed) and the frames between as
+  // still; averaged over 10 frames the estimate stays near the true speed.
+  const GridSpec spec = GridSpec::cube({-0.7, -0.7, -0.7}, 1.4, 56);  // 2.5 cm voxels
+  const double dt = 0.01, speed = 0.2 * spec.voxelSize / dt;          // 0.5 m/s
+  auto sdfAt = [&](int frame) {
+    const cv::Vec3d c(-0.1 + speed * dt * frame, 0.013, -0.007);
+    return signedDistanceField(
+        voxelize(spec, [c](const cv::Vec3d& x) { return cv::norm(x - c) - 0.3; }));
+  };
+  // The estimated speed along +x at the sphere's leading point, frame by frame.
+  auto leadingSpeed = [&](const std::vector<float>& velocity, int frame) {
+    const cv::Vec3d lead(-0.1 + speed * dt * frame + 0.3, 0.013, -0.007);
+    const int i = static_cast<int>(std::lround((lead[0] - spec.origin[0]) / spec.voxelSize - 0.5));
+    const int j = static_cast<int>(std::lround((lead[1] - spec.origin[1]) / spec.voxelSize - 0.5));
+    const int k = static_cast<int>(std::lround((lead[2] - spec.origin[2]) / spec.voxelSize - 0.5));
+    return static_cast<double>(velocity[3 * spec.index(i, j, k)]);
+  };
+  SurfaceVelocitySettings one, ten;
+  ten.frames = 10;
+  SurfaceChangeHistory history;
+  double peakOne = 0, peakTen = 0, meanTen = 0;
+  int counted = 0;
+  std::vector<float> before = sdfAt(0);
+  for (int frame = 1; frame <= 40; ++frame) {
+    const std::vector<float> now = sdfAt(frame);
+    const double a = leadingSpeed(surfaceVelocity(spec, before, now, dt, one), frame);
+    const double b = leadingSpeed(surfaceVelocity(spec, before, now, dt, ten, &history), frame);
+    before = now;
+    if (frame <= 20) continue;  // the average has settled
+    peakOne = std::max(peakOne, a);
+    peakTen = std::max(peakTen, b);
+    meanTen += b;
+    ++counted;
+  }
+  meanTen /= counted;
+  std::printf(
+      "sphere at %.2f m/s (0.2 voxels a frame): peak estimate %.2f m/s from one frame, %.2f "
+      "m/s averaged over 10 (mean %.2f)\n",
+      speed, peakOne, peakTen, meanTen);
+  EXPECT_GT(peakOne, 2.5 * speed) << "one frame reads a voxel step";
+  EXPECT_LT(peakTen, 2.0 * speed);
+  EXPECT_GT(meanTen, 0.5 * speed);
+  EXPECT_LT(meanTen, 1.5 * speed);
+}
+
 msg::MessageView finish(msg::MessageBuilder& builder) {
   const std::size_t size = builder.finish();
   EXPECT_GT(size, 0u);

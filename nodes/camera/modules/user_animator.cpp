@@ -59,6 +59,8 @@ int main() {
   camera::SurfaceVelocitySettings velocitySettings;
   velocitySettings.smoothing = static_cast<int>(params.getInt("velocity-smoothing"));
   velocitySettings.band = params.getFloat("velocity-band");
+  velocitySettings.frames = static_cast<int>(params.getInt("velocity-frames"));
+  camera::SurfaceChangeHistory history;
   camera::UserIds ids{module.newId(), module.newId(), module.newId(), module.newId()};
   std::optional<camera::UserFrame> previous;
   double previousTime = 0;
@@ -80,8 +82,9 @@ int main() {
           previous->spec.nz == frame.spec.nz && previous->spec.origin == frame.spec.origin &&
           previous->spec.voxelSize == frame.spec.voxelSize;
       const double dt = time > previousTime ? time - previousTime : fallbackDt;
+      if (!sameGrid) history.clear();
       frame.velocity = sameGrid ? camera::surfaceVelocity(frame.spec, previous->sdf, frame.sdf, dt,
-                                                          velocitySettings)
+                                                          velocitySettings, &history)
                                 : std::vector<float>(3 * frame.spec.count(), 0.0f);
     }
     const std::size_t bytes = 4 * frame.sdf.size() + 4 * frame.velocity.size() +

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "vrflow/rigid/mesh.hpp"
@@ -350,10 +351,12 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   };
 
   // The Jacobian of contact c at `middle` along `normal` (from b to a), its effective masses and
-  // its target normal velocity (speculative below a gap, restitution, Baumgarte beyond slop).
+  // its target normal velocity (speculative below a gap, restitution, Baumgarte beyond slop, the
+  // latter at most maxPushOut).
   auto setUp = [&](Constraint& c, const Eigen::Vector3d& middle, const Eigen::Vector3d& positionA,
                    const Eigen::Vector3d& positionB, const Eigen::Vector3d& normal, double distance,
-                   bool kinematicA, bool kinematicB, double restitution) {
+                   bool kinematicA, bool kinematicB, double restitution,
+                   double maxPushOut = std::numeric_limits<double>::infinity()) {
     c.ra = middle - positionA;
     c.rb = middle - positionB;
     c.dir[0] = normal;
@@ -382,8 +385,9 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       c.target = -distance / dt;
       if (bounce && vn * dt < -distance) c.target = std::max(c.target, rebound(distance));
     } else {
-      c.target = std::max(bounce ? rebound(distance) : 0.0,
-                          p.baumgarte / dt * std::max(-distance - p.slop, 0.0));
+      c.target =
+          std::max(bounce ? rebound(distance) : 0.0,
+                   std::min(p.baumgarte / dt * std::max(-distance - p.slop, 0.0), maxPushOut));
     }
   };
 
@@ -463,12 +467,19 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
       c.point = nullptr;
       c.accRoll.setZero();
       c.rolls = false;
+      const Eigen::Vector3d normal = asEigen(s.normal);
+      // The user's surface velocity, at most userSurfaceSpeed. Not only its normal part: the
+      // field, smoothed over voxels, carries the motion of the user's surface near the sample
+      // better than one sample's normal does (a hand pushing a crate along a table drives it
+      // along the hand's motion through friction, not up along the tilted normals of its edge).
       c.surface = asEigen(s.surfaceVelocity);
+      if (const double speed = c.surface.norm(); speed > p.userSurfaceSpeed)
+        c.surface *= p.userSurfaceSpeed / speed;
       // The user has the interactor's friction and restitution (its own are unset: -1).
       const Body& body = bodies[c.a]->body;
       c.friction = combinedFriction(body.friction, -1, p.friction);
-      setUp(c, asEigen(s.point), asEigen(body.position), asEigen(s.point), asEigen(s.normal),
-            s.distance, false, true, combinedRestitution(body.restitution, -1, p.restitution));
+      setUp(c, asEigen(s.point), asEigen(body.position), asEigen(s.point), normal, s.distance,
+            false, true, combinedRestitution(body.restitution, -1, p.restitution), p.userPushOut);
       constraints.push_back(c);
       contacts_.push_back({s.body, s.surface, s.point, s.normal, s.distance});
     }

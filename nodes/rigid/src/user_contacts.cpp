@@ -20,6 +20,28 @@ bool isRound(const msg::Shape& shape) {
   return shape.kind == msg::ShapeKind::Sphere || shape.kind == msg::ShapeKind::Capsule;
 }
 
+// The contacts out[first..] of one body with one user, made to push one way: a contact whose
+// normal is more than 60 degrees from their mean direction (each weighted by how far inside
+// `reach` it is) takes that direction. A body that the user's field partly swallows has samples
+// whose nearest surface lies on opposite sides (above and below a hand): their normals oppose, no
+// velocity meets both pushes, and the solver's impulses grow until the body is thrown. Normals
+// within 60 degrees of one direction are all met by a velocity along it at most twice the
+// largest target, and the swallowed part is pushed out the way most of the body sees the surface.
+void pushOneWay(std::vector<SurfaceContact>& out, std::size_t first, double reach) {
+  Vec3 mean{};
+  for (std::size_t i = first; i < out.size(); ++i) {
+    const double weight = reach - out[i].distance;
+    for (int a = 0; a < 3; ++a) mean[a] += weight * out[i].normal[a];
+  }
+  const double norm = std::sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
+  if (!(norm > 0)) return;
+  for (double& x : mean) x /= norm;
+  for (std::size_t i = first; i < out.size(); ++i) {
+    const Vec3& n = out[i].normal;
+    if (n[0] * mean[0] + n[1] * mean[1] + n[2] * mean[2] < 0.5) out[i].normal = mean;
+  }
+}
+
 }  // namespace
 
 std::vector<Vec3> surfaceSamples(const msg::Shape& shape, double spacing) {
@@ -75,6 +97,7 @@ void userContacts(const Body& body, double spacing,
   for (const auto& [id, user] : users) {
     if (!near(box, user->bounds, reach + user->spacing)) continue;
     if (samples.empty()) samples = surfaceSamples(body.shape, spacing);
+    const std::size_t first = out.size();
     for (const Vec3& local : samples) {
       const Vec3 centre = add(body.position, msg::rotate(body.orientation, local));
       const double distance = user->distance(centre) - radius;
@@ -85,6 +108,7 @@ void userContacts(const Body& body, double spacing,
                        centre[2] - radius * normal[2]};
       out.push_back({body.id, id, point, normal, distance, user->velocityAt(point)});
     }
+    pushOneWay(out, first, reach);
   }
 }
 

@@ -49,6 +49,15 @@ struct ContactParams {
   /// gap): catches objects moving up to about this far per step against each other.
   double speculativeDistance = 0.04;
   bool warmStart = true;
+  /// Contacts with a captured user (user_contacts.hpp). A visual hull is fatter than the body it
+  /// films and moves in whole-voxel steps, so a body can start inside it and its estimated surface
+  /// velocity is noisy. The position correction of a user contact pushes out at most this fast
+  /// (m/s; Box2D's maximum linear correction as a speed): a body found inside is moved out gently
+  /// over a few steps, not launched.
+  double userPushOut = 0.5;
+  /// The user's surface velocity at a contact is taken at most this fast (m/s): a human hand, not
+  /// a voxel step per frame.
+  double userSurfaceSpeed = 3.0;
 };
 
 /// The friction of a pair: the geometric mean sqrt(fa fb) of its bodies' (Box2D's and Bullet's

@@ -26,6 +26,8 @@ class RigidWorld {
   const RigidAnimatorState& state() const { return state_; }
   RigidAnimatorState& state() { return state_; }
   const RigidContactSolver& solver() const { return solver_; }
+  /// The contact solver, to hand it captured users (RigidContactSolver::setUsers).
+  RigidContactSolver& solver() { return solver_; }
   const ForceField& field() const { return field_; }
 
  private:
