@@ -56,6 +56,34 @@ void addSpringForces(const Net& net, std::span<double> forces) {
   addSpringForces(net, net.springs, forces);
 }
 
+double feasibleFraction(const Net& net, std::span<const double> from, std::span<const double> to) {
+  constexpr double kTolerance = 1e-9;
+  // Each spring's constraint holds on an interval of t that contains 0, so the smallest root over
+  // the springs is safe.
+  double t = 1.0;
+  for (const auto& s : net.springs) {
+    if (s.maxStretch <= 0) continue;
+    const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
+    const double limit = s.maxStretch * s.restLength * (1 - 0.5 * kTolerance);
+    double aa = 0, bb = 0, cc = -limit * limit, now = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double d = from[b + k] - from[a + k];
+      const double e = (to[b + k] - to[a + k]) - d;
+      aa += e * e;
+      bb += d * e;
+      cc += d * d;
+      now += (to[b + k] - to[a + k]) * (to[b + k] - to[a + k]);
+    }
+    if (now <= limit * limit || aa <= 0) continue;
+    if (cc >= 0) {
+      t = 0;  // the start was not inside this limit: stay there
+      continue;
+    }
+    t = std::min(t, (-bb + std::sqrt(std::max(0.0, bb * bb - aa * cc))) / aa);
+  }
+  return t;
+}
+
 double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible) {
   bool any = false;
   for (const auto& s : net.springs) any = any || s.maxStretch > 0;
@@ -94,29 +122,8 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
   }
   if (maxConstraintRatio(net) > 1.0 && feasible.size() == net.positions.size()) {
     // Not converged: back off along the segment from the feasible positions to these, to the
-    // largest fraction t at which every limited spring holds (each spring's constraint holds on
-    // an interval of t that contains 0, so the smallest root over the springs is safe).
-    double t = 1.0;
-    for (const auto& s : net.springs) {
-      if (s.maxStretch <= 0) continue;
-      const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
-      const double limit = s.maxStretch * s.restLength * (1 - 0.5 * kTolerance);
-      double aa = 0, bb = 0, cc = -limit * limit, now = 0;
-      for (int k = 0; k < 3; ++k) {
-        const double d = feasible[b + k] - feasible[a + k];
-        const double e = (x[b + k] - x[a + k]) - d;
-        aa += e * e;
-        bb += d * e;
-        cc += d * d;
-        now += (x[b + k] - x[a + k]) * (x[b + k] - x[a + k]);
-      }
-      if (now <= limit * limit || aa <= 0) continue;
-      if (cc >= 0) {
-        t = 0;  // the start was not inside this limit: stay there
-        continue;
-      }
-      t = std::min(t, (-bb + std::sqrt(std::max(0.0, bb * bb - aa * cc))) / aa);
-    }
+    // largest fraction at which every limited spring holds.
+    double t = feasibleFraction(net, feasible, net.positions);
     t = std::max(0.0, t * (1 - 1e-12));
     for (std::size_t i = 0; i < net.positions.size(); ++i) {
       const double backed = feasible[i] + t * (x[i] - feasible[i]);

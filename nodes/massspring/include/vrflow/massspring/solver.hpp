@@ -41,6 +41,12 @@ void addSpringForces(const Net& net, std::span<const Spring> springs, std::span<
 double enforceMaxStretch(Net& net, double h, int maxIterations,
                          std::span<const double> feasible = {});
 
+/// The largest fraction t in [0, 1] such that every limited spring holds (length <= maxStretch *
+/// restLength, less 0.5e-9 of it) at from + t (to - from), the nodes moving on straight lines;
+/// 0 when a spring that `to` stretches beyond its limit is not inside it at `from` already.
+/// `from` and `to` hold xyz per node.
+double feasibleFraction(const Net& net, std::span<const double> from, std::span<const double> to);
+
 /// Advances the net by one outer step. `externalForces` holds xyz per node (or is empty).
 /// Returns the largest constraint ratio left (see enforceMaxStretch), 0 if no spring has a limit.
 double step(Net& net, std::span<const double> externalForces, const StepOptions& options);
