@@ -140,6 +140,32 @@ TEST(MassSpringPhysics, NetHangingAtItsLimitsStillMovesUnderAPush) {
   EXPECT_LE(worst, 1.0 + 1e-9);
 }
 
+// StepOptions::warmStart is state the caller can touch: a wrong count is replaced by zeros, and
+// values that are not finite and positive are dropped; large ones cost the step, not the limits.
+TEST(MassSpringPhysics, GarbageWarmStartNeitherBreaksTheLimitsNorPoisonsTheNet) {
+  GridParams grid;
+  grid.n = grid.m = 8;
+  grid.mass = 1.0;
+  grid.stiffness = 100.0;
+  auto net = generateGrid(grid);
+  ASSERT_TRUE(net);
+  StepOptions options;
+  options.gravity = {0, -9.81, 0};
+  for (int s = 0; s < 100; ++s) step(*net, {}, options);  // hanging at its limits
+  ASSERT_EQ(options.warmStart.size(), net->springs.size());
+  const double values[] = {std::nan(""), INFINITY, -INFINITY, -1.0, 1e6};
+  for (std::size_t i = 0; i < options.warmStart.size(); ++i) options.warmStart[i] = values[i % 5];
+  for (int s = 0; s < 20; ++s) {
+    step(*net, {}, options);
+    for (double x : net->positions) ASSERT_TRUE(std::isfinite(x)) << s;
+    ASSERT_LE(maxConstraintRatio(*net), 1.0 + 1e-9) << s;
+  }
+  options.warmStart.assign(3, 1.0);  // not one per spring: ignored
+  step(*net, {}, options);
+  EXPECT_EQ(options.warmStart.size(), net->springs.size());
+  EXPECT_LE(maxConstraintRatio(*net), 1.0 + 1e-9);
+}
+
 TEST(MassSpringPhysics, EnergyDoesNotGrowForAnUndampedNet) {
   GridParams grid;
   grid.n = grid.m = 10;

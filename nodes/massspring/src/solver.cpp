@@ -155,7 +155,7 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
   // again first (a net hanging at its limits needs about the same ones every sub-step).
   for (std::size_t index = 0; index < count; ++index) {
     const auto& s = net.springs[index];
-    if (s.maxStretch <= 0 || multipliers[index] <= 0) {
+    if (s.maxStretch <= 0 || !(multipliers[index] > 0) || !std::isfinite(multipliers[index])) {
       multipliers[index] = 0;
       continue;
     }
