@@ -77,7 +77,9 @@ testing::CommandResult run(const TempDir& dir, const std::string& text, int iter
 
 TEST(RigidNetNetwork, HeavyBoxAndFastBallAreCaughtByTheNet) {
   TempDir dir;
-  const auto result = run(dir, app(""), 300);  // 3 s
+  // 6 s: the net no longer freezes at its stretch limits (issue 26), so the bodies ride its
+  // decaying swing for longer (box 1.4e-1 m/s at 3 s, 5e-3 m/s at 4 s; ball 5e-2 at 4 s).
+  const auto result = run(dir, app(""), 600);
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto net = loadNet(dir.file("net.txt"));
   ASSERT_TRUE(net) << net.error().message;
@@ -92,7 +94,7 @@ TEST(RigidNetNetwork, HeavyBoxAndFastBallAreCaughtByTheNet) {
     const auto v = bodies[k].at("linearVelocity").get<std::vector<double>>();
     const double surface = surfaceHeight(*net, p[0], p[2]);
     const double speed = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    std::printf("%s: centre %.4f m above the net's surface, speed %.2e m/s after 3 s\n",
+    std::printf("%s: centre %.4f m above the net's surface, speed %.2e m/s after 6 s\n",
                 k == 0 ? "box" : "ball", p[1] - surface, speed);
     ASSERT_FALSE(std::isnan(surface)) << k << " is no longer over the net";
     EXPECT_GT(p[1] - surface, 0.5 * halfHeights[k]) << k;  // on the net, not through it
