@@ -243,6 +243,54 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
   return worst;
 }
 
+double fastestSpringFrequency(const Net& net, int iterations) {
+  const std::size_t n = net.nodeCount();
+  // Power iteration on A = M^-1/2 K M^-1/2 (symmetric, positive semi-definite), pinned nodes
+  // held at zero. The start vector is fixed and irregular so that it is orthogonal to no mode.
+  std::vector<double> scale(3 * n, 0.0), v(3 * n, 0.0), w(3 * n), z(3 * n);
+  std::uint64_t seed = 0x9e3779b97f4a7c15ULL;
+  for (std::size_t i = 0; i < 3 * n; ++i) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    if (net.pinned[i / 3]) continue;
+    scale[i] = 1.0 / std::sqrt(net.masses[i / 3]);
+    v[i] = static_cast<double>(seed >> 11) * 0x1.0p-53 - 0.5;
+  }
+  double best = 0.0;
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    double norm = 0;
+    for (double x : v) norm += x * x;
+    if (!(norm > 0) || !std::isfinite(norm)) break;
+    for (std::size_t i = 0; i < 3 * n; ++i) w[i] = v[i] * scale[i];
+    std::fill(z.begin(), z.end(), 0.0);
+    for (const auto& s : net.springs) {
+      const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
+      const double d0 = net.positions[b] - net.positions[a],
+                   d1 = net.positions[b + 1] - net.positions[a + 1],
+                   d2 = net.positions[b + 2] - net.positions[a + 2];
+      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+      if (length < 1e-12 || s.stiffness <= 0) continue;
+      const double u0 = d0 / length, u1 = d1 / length, u2 = d2 / length;
+      const double across = s.stiffness * std::max(0.0, 1.0 - s.restLength / length);
+      const double e0 = w[b] - w[a], e1 = w[b + 1] - w[a + 1], e2 = w[b + 2] - w[a + 2];
+      const double along = (s.stiffness - across) * (u0 * e0 + u1 * e1 + u2 * e2);
+      // K_s e = k u u^T e + across (I - u u^T) e = (k - across) (u.e) u + across e.
+      addOpposite(z.data(), b, a, 1.0, 1.0, along * u0 + across * e0, along * u1 + across * e1,
+                  along * u2 + across * e2);
+    }
+    double quotient = 0, next = 0;
+    for (std::size_t i = 0; i < 3 * n; ++i) {
+      z[i] *= scale[i];
+      quotient += v[i] * z[i];
+      next += z[i] * z[i];
+    }
+    best = std::max(best, quotient / norm);
+    if (!(next > 0)) break;
+    const double inv = 1.0 / std::sqrt(next);
+    for (std::size_t i = 0; i < 3 * n; ++i) v[i] = z[i] * inv;
+  }
+  return std::sqrt(best);
+}
+
 double kineticEnergy(const Net& net) {
   double e = 0;
   for (std::size_t i = 0; i < net.nodeCount(); ++i) {

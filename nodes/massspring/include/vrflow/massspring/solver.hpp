@@ -57,6 +57,15 @@ double enforceMaxStretch(Net& net, double h, int maxIterations,
 /// `from` and `to` hold xyz per node.
 double feasibleFraction(const Net& net, std::span<const double> from, std::span<const double> to);
 
+/// The fastest angular frequency (rad/s) of the net's springs about its present state: the square
+/// root of the largest eigenvalue of M^-1 K over the free nodes, K the springs' tangent stiffness
+/// (k u u^T along each spring, plus k (1 - L0 / L) across it while it is stretched), damping left
+/// out. Symplectic Euler integrates those springs stably with a step h only while omega h < 2
+/// (damping lowers that bound further). Estimated by `iterations` power iterations from a fixed
+/// start vector: the result (the largest Rayleigh quotient met) never exceeds the true value and
+/// approaches it from below. 0 when no free node has a spring with stiffness.
+double fastestSpringFrequency(const Net& net, int iterations = 300);
+
 /// Advances the net by one outer step. `externalForces` holds xyz per node (or is empty).
 /// Returns the largest constraint ratio left (see enforceMaxStretch), 0 if no spring has a limit.
 double step(Net& net, std::span<const double> externalForces, const StepOptions& options);
