@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "paper_net.hpp"
 #include "vrflow/massspring/solver.hpp"
 
 namespace vrflow::massspring {
@@ -99,14 +100,7 @@ TEST(MassSpringPhysics, MaximumStretchNeverExceededUnderHeavyLoad) {
 // back the whole net off to where it was. Hangs it 1.5 s, then pushes its middle node up with 3 N
 // for 0.3 s; `internal` springs in `substeps` sub-steps, or applied once per step from outside.
 void expectTheHangingNetMovesUnderAPush(bool internal, int substeps) {
-  GridParams grid;
-  grid.n = grid.m = 20;
-  grid.spacing = 0.1;
-  grid.mass = 8.0;
-  grid.stiffness = 300.0;
-  grid.damping = 0.2;
-  grid.maxStretch = 1.1;
-  auto net = generateGrid(grid);
+  auto net = generateGrid(paperSceneNet());
   ASSERT_TRUE(net) << net.error().message;
   StepOptions options;
   options.dt = 0.01;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "paper_net.hpp"
 #include "vrflow/massspring/solver.hpp"
 
 namespace vrflow::massspring {
@@ -26,16 +27,6 @@ Net chain(int count, double m, double k, double stretch) {
     net.springs.push_back(
         {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1), 0.1, k, 0.0, 0.0});
   return net;
-}
-
-GridParams paperNet() {
-  GridParams grid;
-  grid.n = grid.m = 20;
-  grid.spacing = 0.1;
-  grid.mass = 8.0;
-  grid.stiffness = 300.0;
-  grid.damping = 0.2;
-  return grid;
 }
 
 TEST(SpringStability, FastestFrequencyIsTheAnalyticOneOfChains) {
@@ -67,7 +58,7 @@ TEST(SpringStability, FastestFrequencyIsTheAnalyticOneOfChains) {
 // the explicit limit of 2 and it blows up; in the animator's 3 sub-steps (omega h = 1.0) it stays
 // bounded for 1,000 steps (10 s).
 TEST(SpringStability, ThePaperScenesNetStaysBoundedInSubStepsAndBlowsUpWithSpringsOnceAStep) {
-  auto grid = paperNet();
+  auto grid = paperSceneNet();
   grid.maxStretch = 0;
   const auto start = generateGrid(grid);
   ASSERT_TRUE(start) << start.error().message;
