@@ -46,6 +46,12 @@ TEST(SpringStability, FastestFrequencyIsTheAnalyticOneOfChains) {
   Net slack = rest;
   for (auto& s : slack.springs) s.stiffness = 0;
   EXPECT_EQ(fastestSpringFrequency(slack), 0.0);
+  // Bad input gives a number, never a crash: no iteration, no node, a position that is not finite.
+  EXPECT_EQ(fastestSpringFrequency(rest, 0), 0.0);
+  EXPECT_EQ(fastestSpringFrequency(Net{}), 0.0);
+  Net broken = rest;
+  broken.positions[3 * 5 + 1] = std::nan("");
+  EXPECT_TRUE(std::isfinite(fastestSpringFrequency(broken)));
   // Never above the true value, whatever the iteration count (a Rayleigh quotient).
   const Net longer = chain(40, m, k, 1.0);
   const double top = std::sqrt(4 * k / m) * std::sin(40 * std::numbers::pi / 82);
