@@ -67,8 +67,9 @@ int main() {
   for (std::size_t i = 0; i < net.nodeCount(); ++i) {
     if (!net.pinned[i]) totalFreeMass += net.masses[i];
   }
-  // Explicit springs beyond their stability limit (omega h >= 2; omega is a lower estimate, so
-  // this never warns wrongly): said once, with the numbers and the way out.
+  // Explicit springs beyond their stability limit (omega h >= 2 on the first state; omega is a
+  // lower estimate of that state's, so this never warns wrongly): said once, with the numbers
+  // and the way out.
   if (const double omega = fastestSpringFrequency(net); omega > 0) {
     const double h = options.internalSprings ? options.dt / options.substeps : options.dt;
     const int needed = static_cast<int>(std::floor(omega * options.dt / 2.0)) + 1;
