@@ -6,6 +6,8 @@
 //                  states one iteration old, as the demo ships (section 4.2 of the paper);
 //   "network-sequential" the same with every interactor after its animators, the loop's order;
 //   "monolithic"   the same solver classes called in one loop in one process;
+//   "monolithic-springs-once-a-step" (20 objects) the same loop with the net's springs applied
+//                  once per step from outside, as the demo did before issue 26 (unstable);
 //   "bullet-world" Bullet's own btDiscreteDynamicsWorld stepping the same rigid bodies (no net:
 //                  Bullet's soft bodies are another solver, so only the rigid part compares).
 // The scene of 20 objects is the demo's (rigid objects and the 20 x 20 net); 200 and 2000 are
@@ -180,7 +182,10 @@ Result<Rate> networkRate(const Context& ctx, const fs::path& bin, int objects, b
 // order (interactors see the state of the previous step, then the animators integrate).
 class Monolithic {
  public:
-  Status init(std::vector<rigid::Body> bodies, bool withNet) {
+  /// `springsOnceAStep`: the net's springs as the demo applied them until issue 26 (the spring
+  /// interactor's forces once per 10 ms step, one sub-step: unstable, omega dt 3.0) instead of
+  /// the animator's own springs in 3 sub-steps.
+  Status init(std::vector<rigid::Body> bodies, bool withNet, bool springsOnceAStep = false) {
     rigid::ContactParams contact;
     contact.gravity = kGravity;
     world_ = std::make_unique<rigid::RigidWorld>(
@@ -191,8 +196,8 @@ class Monolithic {
     if (!net) return net.error();
     nets_[kNetId] = std::move(net).value();
     options_.dt = kDt;
-    options_.substeps = 1;
-    options_.internalSprings = false;
+    options_.substeps = springsOnceAStep ? 1 : 3;
+    options_.internalSprings = !springsOnceAStep;
     options_.gravity = kGravity;
     collision_.thickness = 0.05;
     collision_.dt = kDt;
@@ -213,7 +218,7 @@ class Monolithic {
       }
       massspring::Net& net = nets_[kNetId];
       std::vector<double> forces(net.positions.size(), 0.0);
-      massspring::addSpringForces(net, forces);
+      if (!options_.internalSprings) massspring::addSpringForces(net, forces);
       const auto collisions = massspring::netCollisions(nets_, collision_, &collisionMemory_);
       const auto touches = massspring::rigidContacts(nets_, rigids, touch_, &touchMemory_);
       for (const auto* contact : {&collisions, &touches}) {
@@ -406,6 +411,21 @@ int main(int argc, char** argv) {
                     ",\"cpu_ms_per_iteration\":%.3f,\"round\":%d,\"load_average\":%.1f",
                     monoRate.cpuMsPerIteration, round, loadAverage());
       print("monolithic", objects, monoRate.perSecond, extra);
+      if (objects == 20) {
+        // Before issue 26's stable net, in the same round: the springs once per step.
+        Monolithic before;
+        if (auto ok = before.init(*bodies, true, true); !ok) {
+          std::fprintf(stderr, "vrflow-bench-scene: %s\n", ok.error().message.c_str());
+          return 2;
+        }
+        const Rate beforeRate = loopRate([&] { before.step(); }, warm, measured);
+        std::snprintf(extra, sizeof extra,
+                      ",\"cpu_ms_per_iteration\":%.3f,\"of_monolithic\":%.3f,\"round\":%d,"
+                      "\"load_average\":%.1f",
+                      beforeRate.cpuMsPerIteration, beforeRate.perSecond / monoRate.perSecond,
+                      round, loadAverage());
+        print("monolithic-springs-once-a-step", objects, beforeRate.perSecond, extra);
+      }
       for (const auto& variant : variants) {
         auto network = networkRate(ctx, variant.bin, objects, variant.sequential, warm, measured);
         if (!network) {

@@ -7,69 +7,13 @@
 #include <cmath>
 #include <cstdio>
 
+#include "rigid_harness.hpp"
 #include "vrflow/massspring/solver.hpp"
 
 namespace vrflow::massspring {
 namespace {
 
 using msg::Vec3;
-
-// A free rigid body integrated with semi-implicit Euler from ForceEvents (force at its centre of
-// mass plus torque) and gravity; orientation from the angular velocity (first order, normalised).
-struct Box {
-  RigidBody body;
-  Vec3 halfExtents{};
-  msg::Mat3 inertia{};
-};
-
-Box makeBox(const Vec3& half, double mass, const Vec3& position) {
-  Box box;
-  box.halfExtents = half;
-  box.body.shape = msg::Shape::box(half);
-  box.body.mass = mass;
-  box.body.position = position;
-  box.inertia = msg::massProperties(box.body.shape, mass).inertia;
-  return box;
-}
-
-void integrate(Box& box, const msg::ForceEvent* event, const Vec3& g, double dt) {
-  auto& b = box.body;
-  Vec3 torque{};
-  for (int k = 0; k < 3; ++k) {
-    const double f = (event ? event->force[k] : 0.0) + b.mass * g[k];
-    b.linearVelocity[k] += dt * f / b.mass;
-    b.position[k] += dt * b.linearVelocity[k];
-    torque[k] = event ? event->torque[k] : 0.0;
-  }
-  // World torque to body frame, divide by the (diagonal) body inertia, back to world.
-  const Vec3 local = msg::rotateInverse(b.orientation, torque);
-  const Vec3 alpha = msg::rotate(
-      b.orientation,
-      {local[0] / box.inertia[0], local[1] / box.inertia[4], local[2] / box.inertia[8]});
-  for (int k = 0; k < 3; ++k) b.angularVelocity[k] += dt * alpha[k];
-  const auto& w = b.angularVelocity;
-  auto& q = b.orientation;
-  const msg::Quat dq{0.5 * dt * (w[0] * q[3] + w[1] * q[2] - w[2] * q[1]),
-                     0.5 * dt * (w[1] * q[3] + w[2] * q[0] - w[0] * q[2]),
-                     0.5 * dt * (w[2] * q[3] + w[0] * q[1] - w[1] * q[0]),
-                     0.5 * dt * (-w[0] * q[0] - w[1] * q[1] - w[2] * q[2])};
-  double norm = 0;
-  for (int k = 0; k < 4; ++k) {
-    q[k] += dq[k];
-    norm += q[k] * q[k];
-  }
-  for (auto& c : q) c /= std::sqrt(norm);
-}
-
-double lowestCorner(const Box& box) {
-  double lowest = 1e300;
-  for (int c = 0; c < 8; ++c) {
-    const Vec3 local{(c & 1 ? 1 : -1) * box.halfExtents[0], (c & 2 ? 1 : -1) * box.halfExtents[1],
-                     (c & 4 ? 1 : -1) * box.halfExtents[2]};
-    lowest = std::min(lowest, box.body.position[1] + msg::rotate(box.body.orientation, local)[1]);
-  }
-  return lowest;
-}
 
 struct CatchResult {
   Net net;
@@ -102,6 +46,7 @@ CatchResult catchBox(int steps) {
   options.dt = 0.01;
   options.substeps = 40;
   options.gravity = g;
+  if (std::getenv("NC_SWEEPS")) options.constraintIterations = std::atoi(std::getenv("NC_SWEEPS"));
   ContactParams contact;
   contact.dt = options.dt;
   contact.thickness = 0.02;
@@ -146,10 +91,12 @@ TEST(MassSpringContact, FallingBoxIsCaughtByTheNetPinnedAtItsCorners) {
   EXPECT_GT(r.lowestBox, 0.5);             // never near the ground
   EXPECT_LT(r.box.body.position[1], 1.5);  // it did land in the net, below the pinned corners
   EXPECT_GT(r.box.body.position[1], 1.0);
-  EXPECT_LT(speed, 0.1);  // and (nearly) rests there
-  // Known weakness (README): the net sinks into the box, up to 0.19 m during the impact and
-  // 0.15 m at rest, but never through its 0.2 m half-size.
-  EXPECT_GT(r.deepest, -0.2);
+  // It rides the net's own oscillation (k 1000 N/m, 0.5 N s/m per spring): since the contact is
+  // solved with the net's springs (issue 26) it no longer damps that motion as the old fudge
+  // weight did (0.2 m/s left after 4 s, was < 0.1).
+  EXPECT_LT(speed, 0.3);
+  // The net no longer sinks into the box (it did by up to 0.19 m with the explicit contact).
+  EXPECT_GT(r.deepest, -0.05);
   // The nodes under the box stay under it: the box did not pass through the net.
   for (std::size_t i = 0; i < r.net.nodeCount(); ++i) {
     const double dx = r.net.positions[3 * i] - r.box.body.position[0];
@@ -181,6 +128,9 @@ TEST(MassSpringContact, RigidForcesAreOppositeToTheNodeForces) {
   GridParams grid;
   grid.n = grid.m = 5;
   grid.spacing = 0.1;
+  // Without maximum-stretch limits: a net with limits hands to its pins what it cannot take
+  // (rigidContacts), so only then does the rigid get more than the nodes' opposite.
+  grid.maxStretch = 0;
   auto net = generateGrid(grid);
   ASSERT_TRUE(net);
   RigidBody ball;
@@ -229,7 +179,9 @@ TEST(MassSpringContact, NetCollisionKeepsTwoNetsApart) {
     options.gravity = {0, -9.81, 0};
     ContactParams contact;
     contact.dt = options.dt;
-    contact.thickness = 0.05;  // at 0.03 up to 8 nodes get through for a while (they come back)
+    // At 0.03 up to 8 nodes get through for a while (they come back); at 0.05 one did once the
+    // lower net stopped freezing at its stretch limits (issue 26).
+    contact.thickness = 0.06;
     std::size_t contacts = 0;
     int below = 0, worst = 0;
     ContactMemory memory;

@@ -239,5 +239,54 @@ TEST(MassSpringNetwork, NetFileThatIsNotARegularFileIsRefusedBeforeTheRun) {
       << ran.err;
 }
 
+// The animator warns once, naming the module and the numbers, when its net's springs are
+// integrated explicitly beyond omega h < 2: the paper scene's net (20 x 20, 8 kg, 300 N/m) with
+// springs from the interactor once per 10 ms step (omega dt 2.99), or in too few sub-steps; not
+// in 3 sub-steps (omega h 1.0).
+TEST(MassSpringNetwork, AnimatorWarnsOnceWhenItsExplicitSpringsAreBeyondTheirStabilityLimit) {
+  auto app = [](const std::string& internal, int substeps) {
+    return std::string(kHeader) + R"(  <modules>
+    <module id="hammock" package="massspring" type="animator" host="local">
+      <param name="mass" value="8"/>
+      <param name="stiffness" value="300"/>
+      <param name="damping" value="0.2"/>
+      <param name="substeps" value=")" +
+           std::to_string(substeps) + R"("/>
+      <param name="internal-springs" value=")" +
+           internal + R"("/>
+      <input port="events" initial-messages="1"/>
+    </module>
+    <module id="springs" package="massspring" type="spring" host="local"/>
+  </modules>
+  <connections>
+    <connection from="hammock.objects" to="springs.objects"/>
+    <connection from="springs.forces" to="hammock.events"/>
+  </connections>
+</application>
+)";
+  };
+  auto count = [](const std::string& text, const std::string& what) {
+    int n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+  };
+  TempDir external, few, enough;
+  const auto once = run(external, app("false", 1), 5);
+  ASSERT_EQ(once.exitCode, 0) << once.err;
+  EXPECT_EQ(count(once.err, "module 'hammock': its springs come from an interactor"), 1)
+      << once.err;
+  EXPECT_NE(once.err.find("omega*h 2.99 with h 0.01 s"), std::string::npos) << once.err;
+  EXPECT_NE(once.err.find("substeps >= 2"), std::string::npos) << once.err;
+  // Internal springs: h = dt / substeps. (The interactor's forces then count twice: this run only
+  // looks at the warning.)
+  const auto one = run(few, app("true", 1), 5);
+  ASSERT_EQ(one.exitCode, 0) << one.err;
+  EXPECT_EQ(count(one.err, "module 'hammock': the net's fastest spring mode"), 1) << one.err;
+  EXPECT_NE(one.err.find("use substeps >= 2"), std::string::npos) << one.err;
+  const auto three = run(enough, app("true", 3), 5);
+  ASSERT_EQ(three.exitCode, 0) << three.err;
+  EXPECT_EQ(three.err.find("explicit limit"), std::string::npos) << three.err;
+}
+
 }  // namespace
 }  // namespace vrflow::massspring

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "paper_net.hpp"
 #include "vrflow/massspring/solver.hpp"
 
 namespace vrflow::massspring {
@@ -92,6 +93,84 @@ TEST(MassSpringPhysics, MaximumStretchNeverExceededUnderHeavyLoad) {
   ASSERT_TRUE(free);
   for (int s = 0; s < 300; ++s) step(*free, load, options);
   EXPECT_GT(maxStretchRatio(*free), 1.3);
+}
+
+// A net hanging at its stretch limits (the paper scene's net: 20 x 20, 8 kg, 300 N/m) must still
+// answer a push: the projection used to stall over the long chains of springs at their limits and
+// back the whole net off to where it was. Hangs it 1.5 s, then pushes its middle node up with 3 N
+// for 0.3 s; `internal` springs in `substeps` sub-steps, or applied once per step from outside.
+void expectTheHangingNetMovesUnderAPush(bool internal, int substeps) {
+  auto net = generateGrid(paperSceneNet());
+  ASSERT_TRUE(net) << net.error().message;
+  StepOptions options;
+  options.dt = 0.01;
+  options.substeps = substeps;
+  options.internalSprings = internal;
+  options.gravity = {0, -9.81, 0};
+  const std::size_t middle = 10 * 20 + 10;
+  double worst = 0;
+  int identical = 0, atLimit = 0;
+  auto advance = [&](double push) {
+    std::vector<double> forces(3 * net->nodeCount(), 0.0);
+    if (!internal) addSpringForces(*net, forces);
+    forces[3 * middle + 1] += push;
+    const std::vector<double> before = net->positions;
+    step(*net, forces, options);
+    worst = std::max(worst, maxConstraintRatio(*net));
+    if (net->positions == before) ++identical;
+  };
+  for (int s = 0; s < 150; ++s) {
+    advance(0.0);
+    if (s >= 100 && maxConstraintRatio(*net) > 1.0 - 1e-6) ++atLimit;
+  }
+  EXPECT_EQ(atLimit, 50);  // it hangs at its limits
+  const double hanging = net->positions[3 * middle + 1];
+  identical = 0;
+  for (int s = 0; s < 30; ++s) advance(3.0);
+  const double rise = net->positions[3 * middle + 1] - hanging;
+  std::printf(
+      "hanging net (%s springs, %d sub-steps): middle node rose %.4f m under 3 N in 0.3 s, "
+      "length/limit %.12f\n",
+      internal ? "internal" : "external", substeps, rise, worst);
+  EXPECT_GT(rise, 0.02);
+  EXPECT_EQ(identical, 0);  // never frozen bit for bit under the push
+  EXPECT_LE(worst, 1.0 + 1e-9);
+}
+
+// As the paper's spring interactor applies them: once per 10 ms step.
+TEST(MassSpringPhysics, NetHangingAtItsLimitsStillMovesUnderAPush) {
+  expectTheHangingNetMovesUnderAPush(false, 1);
+}
+
+// As every paper-scene copy now integrates them: in the animator, 3 sub-steps.
+TEST(MassSpringPhysics, NetHangingAtItsLimitsStillMovesUnderAPushWithItsSpringsInThreeSubSteps) {
+  expectTheHangingNetMovesUnderAPush(true, 3);
+}
+
+// StepOptions::warmStart is state the caller can touch: a wrong count is replaced by zeros, and
+// values that are not finite and positive are dropped; large ones cost the step, not the limits.
+TEST(MassSpringPhysics, GarbageWarmStartNeitherBreaksTheLimitsNorPoisonsTheNet) {
+  GridParams grid;
+  grid.n = grid.m = 8;
+  grid.mass = 1.0;
+  grid.stiffness = 100.0;
+  auto net = generateGrid(grid);
+  ASSERT_TRUE(net);
+  StepOptions options;
+  options.gravity = {0, -9.81, 0};
+  for (int s = 0; s < 100; ++s) step(*net, {}, options);  // hanging at its limits
+  ASSERT_EQ(options.warmStart.size(), net->springs.size());
+  const double values[] = {std::nan(""), INFINITY, -INFINITY, -1.0, 1e6};
+  for (std::size_t i = 0; i < options.warmStart.size(); ++i) options.warmStart[i] = values[i % 5];
+  for (int s = 0; s < 20; ++s) {
+    step(*net, {}, options);
+    for (double x : net->positions) ASSERT_TRUE(std::isfinite(x)) << s;
+    ASSERT_LE(maxConstraintRatio(*net), 1.0 + 1e-9) << s;
+  }
+  options.warmStart.assign(3, 1.0);  // not one per spring: ignored
+  step(*net, {}, options);
+  EXPECT_EQ(options.warmStart.size(), net->springs.size());
+  EXPECT_LE(maxConstraintRatio(*net), 1.0 + 1e-9);
 }
 
 TEST(MassSpringPhysics, EnergyDoesNotGrowForAnUndampedNet) {

@@ -167,7 +167,7 @@ TEST(RoutedWall, EachTileGetsFewerBytesAndDrawsTheSameFramesAndTheSimulationIsUn
 
   // Routing never changes what the simulation computes.
   const auto digests = simulationDigests(withRoute.report);
-  EXPECT_EQ(digests.size(), 7u);  // bodies.objects, net.objects and the 5 interactors' forces
+  EXPECT_EQ(digests.size(), 6u);  // bodies.objects, net.objects and the 4 interactors' forces
   EXPECT_TRUE(digests.contains("bodies.objects") && digests.contains("net.objects"));
   EXPECT_EQ(digests, simulationDigests(direct.report));
   EXPECT_EQ(withRoute.bodiesState, direct.bodiesState);

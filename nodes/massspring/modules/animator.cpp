@@ -67,6 +67,32 @@ int main() {
   for (std::size_t i = 0; i < net.nodeCount(); ++i) {
     if (!net.pinned[i]) totalFreeMass += net.masses[i];
   }
+  // Explicit springs beyond their stability limit (omega h >= 2 on the first state; omega is a
+  // lower estimate of that state's, so this never warns wrongly): said once, with the numbers
+  // and the way out.
+  if (const double omega = fastestSpringFrequency(net); omega > 0) {
+    const double h = options.internalSprings ? options.dt / options.substeps : options.dt;
+    const int needed = static_cast<int>(std::floor(omega * options.dt / 2.0)) + 1;
+    char numbers[160];
+    std::snprintf(numbers, sizeof numbers,
+                  "the net's fastest spring mode (omega %.4g rad/s) has omega*h %.3g with h %.4g s",
+                  omega, omega * h, h);
+    const std::string where = "module '" + module.id() + "': ";
+    if (omega * h >= 2.0 && !options.internalSprings) {
+      warnings.warn(where +
+                    "its springs come from an interactor (internal-springs=false), held "
+                    "over each outer step: " +
+                    numbers +
+                    ", beyond the explicit limit omega*h < 2, so the net can blow up; "
+                    "use internal-springs=true with substeps >= " +
+                    std::to_string(needed) + " and no spring interactor");
+    } else if (omega * h >= 2.0) {
+      warnings.warn(where + numbers +
+                    " (dt / substeps), beyond the explicit limit omega*h < 2, so the net can blow "
+                    "up; use substeps >= " +
+                    std::to_string(needed));
+    }
+  }
   double time = 0.0;
   bool warnedStretch = false;
   while (module.wait()) {

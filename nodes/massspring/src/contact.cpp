@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "rigid_solve.hpp"
 #include "vrflow/message/eigen.hpp"
 
 namespace vrflow::massspring {
@@ -55,10 +56,12 @@ struct PlaneHit {
   int side = 0;  ///< that side along the triangle's own normal (+1 / -1)
 };
 
-/// A point x moving at `relative` (point minus surface) against triangle abc.
+/// A point x moving at `relative` (point minus surface) against triangle abc. A ball of `radius`
+/// around x touches at distance (from its surface) below the thickness; `speculative`: also
+/// while it is farther, by no more than it approaches within the step.
 PlaneHit pointTriangle(const Vector3d& x, const Vector3d& relative, const Vector3d& a,
                        const Vector3d& b, const Vector3d& c, const ContactParams& p,
-                       int knownSide = 0) {
+                       int knownSide = 0, double radius = 0, bool speculative = false) {
   PlaneHit out;
   Vector3d n = (b - a).cross(c - a);
   const double length = n.norm();
@@ -71,13 +74,16 @@ PlaneHit pointTriangle(const Vector3d& x, const Vector3d& relative, const Vector
                       : before > 0   ? 1.0
                       : before < 0   ? -1.0
                                      : (s >= 0 ? 1.0 : -1.0);
-  const double distance = s * side;
-  const double deepest = std::abs(along) * p.dt + (knownSide != 0 ? 5.0 : 1.0) * p.thickness;
-  if (distance >= p.thickness || distance < -deepest) return out;
+  const double distance = s * side - radius;
+  const double deepest =
+      std::abs(along) * p.dt + (knownSide != 0 ? 5.0 : 1.0) * p.thickness + radius;
+  const double ahead = speculative ? std::max(0.0, -along * side) * p.dt : 0.0;
+  if (distance >= p.thickness + ahead || distance < -deepest) return out;
   const Vector3d onPlane = x - n * s;
   const auto closest =
       closestPointOnTriangle(msg::toVec3(onPlane), msg::toVec3(a), msg::toVec3(b), msg::toVec3(c));
-  if ((onPlane - asEigen(closest.point)).squaredNorm() > p.thickness * p.thickness) return out;
+  const double lateral = p.thickness + radius;
+  if ((onPlane - asEigen(closest.point)).squaredNorm() > lateral * lateral) return out;
   out.hit = true;
   out.distance = distance;
   out.gap = (x - asEigen(closest.point)).norm();
@@ -140,6 +146,8 @@ Status validateContactParams(const ContactParams& p) {
   if (!(p.dt > 0) || !std::isfinite(p.dt)) return makeError("contact: dt must be finite and > 0");
   if (!(p.springMassWeight >= 0) || !std::isfinite(p.springMassWeight))
     return makeError("contact: spring mass weight must be >= 0");
+  if (p.iterations < 1 || p.iterations > 10000)
+    return makeError("contact: iterations must be in [1, 10000]");
   return {};
 }
 
@@ -284,46 +292,36 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
                             const ContactParams& p, ContactMemory* memory) {
   ContactForces out;
   ContactMemory next;
-  std::map<std::uint64_t, Adjacency> adjacent;
-  for (const auto& [netId, net] : nets) adjacent[netId] = adjacency(net);
   std::map<std::uint64_t, msg::Aabb> netBoxes;
-  for (const auto& [netId, net] : nets) netBoxes[netId] = bounds(net);
+  std::map<std::uint64_t, double> netSpeeds;  // each net's fastest node (1-norm)
+  for (const auto& [netId, net] : nets) {
+    netBoxes[netId] = bounds(net);
+    double fastest = 0;
+    for (std::size_t i = 0; i < net.nodeCount(); ++i)
+      fastest = std::max(fastest, velocityOf(net, i).lpNorm<1>());
+    netSpeeds[netId] = fastest;
+  }
+  std::vector<detail::RigidNetContact> contacts;
   for (const auto& [rigidId, body] : rigids) {
-    auto box = msg::worldBounds(body.shape, body.position, body.orientation);
-    // Nets whose box (grown by the thickness and one step of the rigid's motion) misses the
+    const auto box = msg::worldBounds(body.shape, body.position, body.orientation);
+    // Nets whose box (grown by the thickness and one step of the relative motion) misses the
     // rigid's box are skipped.
-    const double speed = std::abs(body.linearVelocity[0]) + std::abs(body.linearVelocity[1]) +
-                         std::abs(body.linearVelocity[2]);
-    const double spin = std::abs(body.angularVelocity[0]) + std::abs(body.angularVelocity[1]) +
-                        std::abs(body.angularVelocity[2]);
+    const double speed = asEigen(body.linearVelocity).lpNorm<1>();
+    const double spin = asEigen(body.angularVelocity).lpNorm<1>();
     double radius = 0;
     for (int k = 0; k < 3; ++k) radius = std::max(radius, 0.5 * (box.max[k] - box.min[k]));
-    const double margin = p.thickness + (speed + spin * radius) * p.dt;
+    auto marginFor = [&](std::uint64_t netId) {
+      return p.thickness + (speed + spin * radius + netSpeeds[netId]) * p.dt;
+    };
     auto netNear = [&](std::uint64_t netId) {
       const auto& nb = netBoxes[netId];
+      const double margin = marginFor(netId);
       for (int k = 0; k < 3; ++k) {
         if (nb.min[k] > box.max[k] + margin || nb.max[k] < box.min[k] - margin) return false;
       }
       return true;
     };
     const bool kinematic = !(body.mass > 0) || !std::isfinite(body.mass);
-    const double invRigid = kinematic ? 0.0 : 1.0 / body.mass;
-    Vector3d totalForce = Vector3d::Zero(), totalTorque = Vector3d::Zero();
-    bool touched = false;
-    // Contacts are gathered first, then answered with the rigid's mass shared among them (each
-    // contact sees 1/count of it), so that many simultaneous contacts do not each push the
-    // rigid as if alone.
-    struct Candidate {
-      std::uint64_t netId;
-      const Net* net;
-      std::size_t nodes[3];
-      double w[3];
-      int count;
-      Vector3d normal;  // pushes the nodes along it (the rigid the other way)
-      double distance, vn, invNet;
-      Vector3d r;
-    };
-    std::vector<Candidate> candidates;
     auto pointVelocity = [&](const Vector3d& r) -> Vector3d {
       return asEigen(body.linearVelocity) + asEigen(body.angularVelocity).cross(r);
     };
@@ -331,10 +329,11 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
     // Nodes against the shape.
     for (const auto& [netId, net] : nets) {
       if (!netNear(netId)) continue;
+      const double margin = marginFor(netId);
       for (std::size_t i = 0; i < net.nodeCount(); ++i) {
         const Vector3d x = positionOf(net, i);
-        if (!inBox(x, box, p.thickness)) continue;
-        if (invMass(net, i) + invRigid == 0) continue;
+        if (!inBox(x, box, margin)) continue;
+        if (invMass(net, i) == 0 && kinematic) continue;
         const Vector3d r = x - asEigen(body.position);
         const Vector3d local = orientation.conjugate() * r;
         auto sd = msg::signedDistance(body.shape, msg::toVec3(local));
@@ -349,8 +348,10 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
           sd.normal = plane->normal;
           sd.distance = local.dot(asEigen(plane->normal)) - plane->offset;
         }
-        if (sd.distance >= p.thickness) continue;
         const Vector3d relative = velocityOf(net, i) - pointVelocity(r);
+        // Speculative: a node still apart is a contact if it closes the gap within the step.
+        const double ahead = std::max(0.0, -relative.dot(orientation * asEigen(sd.normal))) * p.dt;
+        if (sd.distance >= p.thickness + ahead) continue;
         if (!plane && sd.distance < 0) {
           // Inside: take the normal of where the node was one step before, if it was outside then.
           const Vector3d before = r - relative * p.dt;
@@ -358,42 +359,47 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
               msg::signedDistance(body.shape, msg::toVec3(orientation.conjugate() * before));
           if (sdBefore.distance > 0) sd.normal = sdBefore.normal;
         }
-        next.planes[key] =
-            plane ? *plane
-                  : ContactMemory::Plane{sd.normal, local.dot(asEigen(sd.normal)) - sd.distance};
-        const Vector3d normal = orientation * asEigen(sd.normal);
-        const double invNode = effectiveInvMass(net, adjacent[netId], i, normal, p);
-        candidates.push_back({netId,
-                              &net,
-                              {i, 0, 0},
-                              {1, 0, 0},
-                              1,
-                              normal,
-                              sd.distance,
-                              relative.dot(normal),
-                              invNode,
-                              r});
+        if (sd.distance < p.thickness) {
+          next.planes[key] =
+              plane ? *plane
+                    : ContactMemory::Plane{sd.normal, local.dot(asEigen(sd.normal)) - sd.distance};
+        }
+        detail::RigidNetContact c;
+        c.rigidId = rigidId;
+        c.netId = netId;
+        c.nodes[0] = i;
+        c.normal = orientation * asEigen(sd.normal);
+        c.r = r;
+        c.distance = sd.distance;
+        contacts.push_back(c);
       }
     }
-    // Corners of boxes, vertices of hulls and meshes against the nets' triangles.
-    std::vector<Vector3d> corners;
-    if (body.shape.kind == msg::ShapeKind::Box) {
-      const auto& h = body.shape.halfExtents;
+    // Corners of boxes, vertices of hulls and meshes, centres of spheres and capsule ends (with
+    // their radius) against the nets' triangles.
+    std::vector<std::pair<Vector3d, double>> corners;
+    const auto& shape = body.shape;
+    if (shape.kind == msg::ShapeKind::Box) {
+      const auto& h = shape.halfExtents;
       for (int c = 0; c < 8; ++c)
-        corners.emplace_back(c & 1 ? h[0] : -h[0], c & 2 ? h[1] : -h[1], c & 4 ? h[2] : -h[2]);
-    } else if (body.shape.kind == msg::ShapeKind::ConvexHull ||
-               body.shape.kind == msg::ShapeKind::TriangleMesh) {
-      for (std::size_t v = 0; v + 2 < body.shape.vertices.size(); v += 3) {
-        corners.emplace_back(msg::asVector3(&body.shape.vertices[v]));
-      }
+        corners.push_back(
+            {Vector3d(c & 1 ? h[0] : -h[0], c & 2 ? h[1] : -h[1], c & 4 ? h[2] : -h[2]), 0.0});
+    } else if (shape.kind == msg::ShapeKind::ConvexHull ||
+               shape.kind == msg::ShapeKind::TriangleMesh) {
+      for (std::size_t v = 0; v + 2 < shape.vertices.size(); v += 3)
+        corners.push_back({msg::asVector3(&shape.vertices[v]), 0.0});
+    } else if (shape.kind == msg::ShapeKind::Sphere) {
+      corners.push_back({Vector3d::Zero(), shape.radius});
+    } else if (shape.kind == msg::ShapeKind::Capsule) {
+      corners.push_back({Vector3d(0, shape.halfHeight, 0), shape.radius});
+      corners.push_back({Vector3d(0, -shape.halfHeight, 0), shape.radius});
     }
     for (const auto& [netId, net] : nets) {
       if (corners.empty() || net.surface.empty() || !netNear(netId)) continue;
-      for (const auto& corner : corners) {
+      for (const auto& [corner, ball] : corners) {
         const Vector3d r = orientation * corner;
         const Vector3d x = asEigen(body.position) + r;
         const Vector3d vx = pointVelocity(r);
-        const double reach = p.thickness + vx.lpNorm<1>() * p.dt;
+        const double reach = p.thickness + ball + (vx.lpNorm<1>() + netSpeeds[netId]) * p.dt;
         PlaneHit best;
         best.gap = 1e300;
         std::size_t tri[3] = {0, 0, 0};
@@ -409,55 +415,51 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
           if (!near) continue;
           const Vector3d surface =
               (velocityOf(net, ia) + velocityOf(net, ib) + velocityOf(net, ic)) * (1.0 / 3.0);
-          const auto hit = pointTriangle(x, vx - surface, pa, pb, pc, p);
+          const auto hit = pointTriangle(x, vx - surface, pa, pb, pc, p, 0, ball, true);
           if (!hit.hit || hit.gap >= best.gap) continue;
           best = hit;
           tri[0] = ia, tri[1] = ib, tri[2] = ic;
         }
         if (!best.hit) continue;
+        detail::RigidNetContact c;
+        c.rigidId = rigidId;
+        c.netId = netId;
+        c.count = 3;
         const double w[3] = {best.closest.wa, best.closest.wb, best.closest.wc};
-        double invSurface = 0;
-        Vector3d surfaceVelocity = Vector3d::Zero();
-        for (int k = 0; k < 3; ++k) {
-          // The triangle point's inverse mass: sum of w^2 / m over its nodes (pinned: 0).
-          invSurface +=
-              w[k] * w[k] * effectiveInvMass(net, adjacent[netId], tri[k], best.normal, p);
-          surfaceVelocity += velocityOf(net, tri[k]) * w[k];
-        }
-        if (invSurface + invRigid == 0) continue;
-        // best.normal points to the rigid's side: the triangle is pushed against it.
-        const Vector3d n = best.normal * -1.0;
-        candidates.push_back({netId,
-                              &net,
-                              {tri[0], tri[1], tri[2]},
-                              {w[0], w[1], w[2]},
-                              3,
-                              n,
-                              best.distance,
-                              (surfaceVelocity - vx).dot(n),
-                              invSurface,
-                              r});
+        for (int k = 0; k < 3; ++k) c.nodes[k] = tri[k], c.w[k] = w[k];
+        // best.normal points to the rigid's side: the triangle is pushed against it. The contact
+        // point on the rigid is its surface towards the triangle.
+        c.normal = best.normal * -1.0;
+        c.r = r + c.normal * ball;
+        c.distance = best.distance;
+        contacts.push_back(c);
       }
     }
-    const double share =
-        invRigid * static_cast<double>(std::max<std::size_t>(1, candidates.size()));
-    for (const auto& c : candidates) {
-      const double magnitude = contactMagnitude(c.distance, c.vn, c.invNet + share, p);
-      if (magnitude <= 0) continue;
-      ++out.contacts;
-      const Vector3d f = c.normal * magnitude;  // on the net
-      auto& forces = forcesOf(out, c.netId, *c.net);
-      for (int k = 0; k < c.count; ++k) {
-        if (invMass(*c.net, c.nodes[k]) > 0) addTo(forces, c.nodes[k], f * c.w[k]);
-      }
-      totalForce -= f;
-      totalTorque -= c.r.cross(f);
-      touched = true;
+  }
+  const auto impulses = detail::solveRigidNetContacts(nets, rigids, contacts, p);
+  std::map<std::uint64_t, std::pair<Vector3d, Vector3d>> onRigids;  // force, torque
+  for (std::size_t i = 0; i < impulses.shared.size(); ++i) {
+    const auto& c = contacts[i];
+    const double total = impulses.shared[i] + impulses.locked[i];
+    if (total <= 0) continue;
+    ++out.contacts;
+    auto& [force, torque] =
+        onRigids.try_emplace(c.rigidId, Vector3d::Zero(), Vector3d::Zero()).first->second;
+    force -= c.normal * (total / p.dt);
+    torque -= c.r.cross(c.normal * (total / p.dt));
+    if (impulses.shared[i] <= 0) continue;
+    const Net& net = nets.at(c.netId);
+    const Vector3d f = c.normal * (impulses.shared[i] / p.dt);  // on the net
+    auto& forces = forcesOf(out, c.netId, net);
+    for (int k = 0; k < c.count; ++k) {
+      if (invMass(net, c.nodes[k]) > 0) addTo(forces, c.nodes[k], f * c.w[k]);
     }
-    if (touched && !kinematic) {
-      out.rigidForces[rigidId] =
-          msg::ForceEvent{msg::toVec3(totalForce), msg::toVec3(totalTorque), body.position, p.dt};
-    }
+  }
+  for (const auto& [rigidId, sum] : onRigids) {
+    const auto& body = rigids.at(rigidId);
+    if (!(body.mass > 0) || !std::isfinite(body.mass)) continue;
+    out.rigidForces[rigidId] =
+        msg::ForceEvent{msg::toVec3(sum.first), msg::toVec3(sum.second), body.position, p.dt};
   }
   if (memory) *memory = std::move(next);
   return out;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace vrflow::massspring {
@@ -56,7 +57,77 @@ void addSpringForces(const Net& net, std::span<double> forces) {
   addSpringForces(net, net.springs, forces);
 }
 
-double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible) {
+double feasibleFraction(const Net& net, std::span<const double> from, std::span<const double> to) {
+  constexpr double kTolerance = 1e-9;
+  // Each spring's constraint holds on an interval of t that contains 0, so the smallest root over
+  // the springs is safe.
+  double t = 1.0;
+  for (const auto& s : net.springs) {
+    if (s.maxStretch <= 0) continue;
+    const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
+    const double limit = s.maxStretch * s.restLength * (1 - 0.5 * kTolerance);
+    double aa = 0, bb = 0, cc = -limit * limit, now = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double d = from[b + k] - from[a + k];
+      const double e = (to[b + k] - to[a + k]) - d;
+      aa += e * e;
+      bb += d * e;
+      cc += d * d;
+      now += (to[b + k] - to[a + k]) * (to[b + k] - to[a + k]);
+    }
+    if (now <= limit * limit || aa <= 0) continue;
+    if (cc >= 0) {
+      t = 0;  // the start was not inside this limit: stay there
+      continue;
+    }
+    t = std::min(t, (-bb + std::sqrt(std::max(0.0, bb * bb - aa * cc))) / aa);
+  }
+  return t;
+}
+
+namespace {
+
+double springLength(const Net& net, const Spring& s) {
+  const auto a = net.position(s.a), b = net.position(s.b);
+  return std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                   (b[2] - a[2]) * (b[2] - a[2]));
+}
+
+/// length / (maxStretch * restLength), computed as maxConstraintRatio does.
+double constraintRatio(const Net& net, const Spring& s) {
+  return springLength(net, s) / (s.maxStretch * s.restLength);
+}
+
+/// The local back-off: the nodes of every spring still beyond its limit go back to `feasible`
+/// (their motion of this sub-step is cut), and so do, round after round, the nodes of springs
+/// that this back-off stretched beyond their limits, until every limit holds. A spring whose two
+/// nodes went back is as it was in `feasible`, inside its limit, so the rounds end; the rest of
+/// the net keeps its motion. The position change, divided by h, goes into the velocity.
+void backOffLocally(Net& net, std::span<const double> feasible, double invH) {
+  std::vector<std::uint8_t> back(net.nodeCount(), 0);
+  auto moveBack = [&](std::uint32_t node) {
+    if (back[node]) return false;
+    back[node] = 1;
+    for (std::size_t k = 3 * std::size_t{node}; k < 3 * std::size_t{node} + 3; ++k) {
+      net.velocities[k] += (feasible[k] - net.positions[k]) * invH;
+      net.positions[k] = feasible[k];
+    }
+    return true;
+  };
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (const auto& s : net.springs) {
+      if (s.maxStretch <= 0 || (back[s.a] && back[s.b]) || constraintRatio(net, s) <= 1.0) continue;
+      const bool a = moveBack(s.a), b = moveBack(s.b);
+      moved = moved || a || b;
+    }
+  }
+}
+
+}  // namespace
+
+double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible,
+                         std::span<double> multipliers) {
   bool any = false;
   for (const auto& s : net.springs) any = any || s.maxStretch > 0;
   if (!any) return 0.0;
@@ -65,65 +136,72 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
   const double invH = 1.0 / h;
   constexpr double kTolerance = 1e-9;
   constexpr double kSkip = (1 + 0.1 * kTolerance) * (1 + 0.1 * kTolerance);
-  constexpr double kViolated = (1 + kTolerance) * (1 + kTolerance);
   const std::size_t count = net.springs.size();
-  bool violated = true;
-  for (int iteration = 0; iteration < maxIterations && violated; ++iteration) {
-    violated = false;
+  std::vector<double> scratch;
+  if (multipliers.size() != count) {
+    scratch.assign(count, 0.0);
+    multipliers = scratch;
+  }
+  // Moves the ends of spring s together by `amount` (inverse-mass weighted, along d of length
+  // `length`; negative moves them apart), the change divided by h going into the velocities.
+  auto apply = [&](const Spring& s, double wa, double wb, double d0, double d1, double d2,
+                   double length, double amount) {
+    const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
+    const double scale = amount / length;
+    addOpposite(x, a, b, wa * scale, wb * scale, d0, d1, d2);
+    addOpposite(v, a, b, wa * scale, wb * scale, d0, d1, d2, invH);
+  };
+  // Warm start: the corrections that held the net at the end of the last sub-step are applied
+  // again first (a net hanging at its limits needs about the same ones every sub-step).
+  for (std::size_t index = 0; index < count; ++index) {
+    const auto& s = net.springs[index];
+    if (s.maxStretch <= 0 || !(multipliers[index] > 0) || !std::isfinite(multipliers[index])) {
+      multipliers[index] = 0;
+      continue;
+    }
+    const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
+    const double wa = net.pinned[s.a] ? 0.0 : 1.0 / net.masses[s.a];
+    const double wb = net.pinned[s.b] ? 0.0 : 1.0 / net.masses[s.b];
+    const double d0 = x[b] - x[a], d1 = x[b + 1] - x[a + 1], d2 = x[b + 2] - x[a + 2];
+    const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+    if (wa + wb == 0 || length < 1e-12) {
+      multipliers[index] = 0;
+      continue;
+    }
+    apply(s, wa, wb, d0, d1, d2, length, multipliers[index]);
+  }
+  // Projected Gauss-Seidel on the inequalities length <= limit: each spring's correction is
+  // accumulated in its multiplier (mass-weighted length, >= 0); a spring whose multiplier would
+  // turn negative is let go (its ends move apart to where they would be without it).
+  bool moving = true;
+  for (int iteration = 0; iteration < maxIterations && moving; ++iteration) {
+    moving = false;
     // Symmetric Gauss-Seidel: forward, then backward sweeps (corrections travel both ways).
-    for (std::size_t index = 0; index < count; ++index) {
-      const auto& s = net.springs[iteration % 2 == 0 ? index : count - 1 - index];
+    for (std::size_t n = 0; n < count; ++n) {
+      const std::size_t index = iteration % 2 == 0 ? n : count - 1 - n;
+      const auto& s = net.springs[index];
       if (s.maxStretch <= 0) continue;
       const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
       const double limit = s.maxStretch * s.restLength;
       const double d0 = x[b] - x[a], d1 = x[b + 1] - x[a + 1], d2 = x[b + 2] - x[a + 2];
       const double squared = d0 * d0 + d1 * d1 + d2 * d2;
-      if (squared <= limit * limit * kSkip) continue;
-      if (squared > limit * limit * kViolated) violated = true;
-      const double length = std::sqrt(squared);
+      if (multipliers[index] == 0 && squared <= limit * limit * kSkip) continue;
       const double wa = net.pinned[s.a] ? 0.0 : 1.0 / net.masses[s.a];
       const double wb = net.pinned[s.b] ? 0.0 : 1.0 / net.masses[s.b];
-      if (wa + wb == 0) continue;
-      // Aim slightly inside the limit so rounding leaves the length at or below it. The
-      // position change, divided by h, goes into the velocity.
-      const double excess = (length - limit * (1 - 0.5 * kTolerance)) / (length * (wa + wb));
-      const double ca = wa * excess, cb = wb * excess;
-      addOpposite(x, a, b, ca, cb, d0, d1, d2);
-      addOpposite(v, a, b, ca, cb, d0, d1, d2, invH);
+      const double length = std::sqrt(squared);
+      if (wa + wb == 0 || length < 1e-12) continue;
+      // Aim slightly inside the limit so rounding leaves the length at or below it.
+      const double error = length - limit * (1 - 0.5 * kTolerance);
+      const double total = std::max(0.0, multipliers[index] + error / (wa + wb));
+      const double amount = total - multipliers[index];
+      if (amount == 0) continue;
+      multipliers[index] = total;
+      apply(s, wa, wb, d0, d1, d2, length, amount);
+      if (std::abs(amount) * (wa + wb) > 0.5 * kTolerance * limit) moving = true;
     }
   }
-  if (maxConstraintRatio(net) > 1.0 && feasible.size() == net.positions.size()) {
-    // Not converged: back off along the segment from the feasible positions to these, to the
-    // largest fraction t at which every limited spring holds (each spring's constraint holds on
-    // an interval of t that contains 0, so the smallest root over the springs is safe).
-    double t = 1.0;
-    for (const auto& s : net.springs) {
-      if (s.maxStretch <= 0) continue;
-      const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
-      const double limit = s.maxStretch * s.restLength * (1 - 0.5 * kTolerance);
-      double aa = 0, bb = 0, cc = -limit * limit, now = 0;
-      for (int k = 0; k < 3; ++k) {
-        const double d = feasible[b + k] - feasible[a + k];
-        const double e = (x[b + k] - x[a + k]) - d;
-        aa += e * e;
-        bb += d * e;
-        cc += d * d;
-        now += (x[b + k] - x[a + k]) * (x[b + k] - x[a + k]);
-      }
-      if (now <= limit * limit || aa <= 0) continue;
-      if (cc >= 0) {
-        t = 0;  // the start was not inside this limit: stay there
-        continue;
-      }
-      t = std::min(t, (-bb + std::sqrt(std::max(0.0, bb * bb - aa * cc))) / aa);
-    }
-    t = std::max(0.0, t * (1 - 1e-12));
-    for (std::size_t i = 0; i < net.positions.size(); ++i) {
-      const double backed = feasible[i] + t * (x[i] - feasible[i]);
-      v[i] += (backed - x[i]) * invH;
-      x[i] = backed;
-    }
-  }
+  if (maxConstraintRatio(net) > 1.0 && feasible.size() == net.positions.size())
+    backOffLocally(net, feasible, invH);
   return maxConstraintRatio(net);
 }
 
@@ -132,6 +210,9 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
   const double h = options.dt / options.substeps;
   std::vector<double> forces(3 * n);
   std::vector<double> start;
+  auto& warm = options.warmStart;
+  if (warm.size() != net.springs.size()) warm.assign(net.springs.size(), 0.0);
+  const std::span<double> multipliers = warm;
   double worst = maxConstraintRatio(net);
   for (int sub = 0; sub < options.substeps; ++sub) {
     for (std::size_t i = 0; i < n; ++i) {
@@ -157,9 +238,57 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
         net.positions[3 * i + k] += h * net.velocities[3 * i + k];
       }
     }
-    worst = enforceMaxStretch(net, h, options.constraintIterations, start);
+    worst = enforceMaxStretch(net, h, options.constraintIterations, start, multipliers);
   }
   return worst;
+}
+
+double fastestSpringFrequency(const Net& net, int iterations) {
+  const std::size_t n = net.nodeCount();
+  // Power iteration on A = M^-1/2 K M^-1/2 (symmetric, positive semi-definite), pinned nodes
+  // held at zero. The start vector is fixed and irregular so that it is orthogonal to no mode.
+  std::vector<double> scale(3 * n, 0.0), v(3 * n, 0.0), w(3 * n), z(3 * n);
+  std::uint64_t seed = 0x9e3779b97f4a7c15ULL;
+  for (std::size_t i = 0; i < 3 * n; ++i) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    if (net.pinned[i / 3]) continue;
+    scale[i] = 1.0 / std::sqrt(net.masses[i / 3]);
+    v[i] = static_cast<double>(seed >> 11) * 0x1.0p-53 - 0.5;
+  }
+  double best = 0.0;
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    double norm = 0;
+    for (double x : v) norm += x * x;
+    if (!(norm > 0) || !std::isfinite(norm)) break;
+    for (std::size_t i = 0; i < 3 * n; ++i) w[i] = v[i] * scale[i];
+    std::fill(z.begin(), z.end(), 0.0);
+    for (const auto& s : net.springs) {
+      const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
+      const double d0 = net.positions[b] - net.positions[a],
+                   d1 = net.positions[b + 1] - net.positions[a + 1],
+                   d2 = net.positions[b + 2] - net.positions[a + 2];
+      const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+      if (length < 1e-12 || s.stiffness <= 0) continue;
+      const double u0 = d0 / length, u1 = d1 / length, u2 = d2 / length;
+      const double across = s.stiffness * std::max(0.0, 1.0 - s.restLength / length);
+      const double e0 = w[b] - w[a], e1 = w[b + 1] - w[a + 1], e2 = w[b + 2] - w[a + 2];
+      const double along = (s.stiffness - across) * (u0 * e0 + u1 * e1 + u2 * e2);
+      // K_s e = k u u^T e + across (I - u u^T) e = (k - across) (u.e) u + across e.
+      addOpposite(z.data(), b, a, 1.0, 1.0, along * u0 + across * e0, along * u1 + across * e1,
+                  along * u2 + across * e2);
+    }
+    double quotient = 0, next = 0;
+    for (std::size_t i = 0; i < 3 * n; ++i) {
+      z[i] *= scale[i];
+      quotient += v[i] * z[i];
+      next += z[i] * z[i];
+    }
+    best = std::max(best, quotient / norm);
+    if (!(next > 0)) break;
+    const double inv = 1.0 / std::sqrt(next);
+    for (std::size_t i = 0; i < 3 * n; ++i) v[i] = z[i] * inv;
+  }
+  return std::sqrt(best);
 }
 
 double kineticEnergy(const Net& net) {
@@ -170,14 +299,6 @@ double kineticEnergy(const Net& net) {
   }
   return e;
 }
-
-namespace {
-double springLength(const Net& net, const Spring& s) {
-  const auto a = net.position(s.a), b = net.position(s.b);
-  return std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
-                   (b[2] - a[2]) * (b[2] - a[2]));
-}
-}  // namespace
 
 double elasticEnergy(const Net& net) {
   double e = 0;

@@ -28,11 +28,13 @@ struct ContactParams {
   double thickness = 0.02;  ///< contact distance (m), > 0
   double beta = 0.2;        ///< fraction of the overlap removed per step, in [0, 1]
   double dt = 0.01;         ///< the outer step the forces are held for (s), > 0
-  /// Rigid contacts only: a node weighs its mass plus springMassWeight * dt^2 * (stiffness of
-  /// its springs along the contact normal), since a node held by stiff springs does not give way
-  /// like a free particle within one outer step. 0: free particles (a heavy rigid then sinks deep
-  /// into a net); large values overshoot. 0.01 was tuned on the box-on-net test (README).
+  /// Net / net and user contacts: a node weighs its mass plus springMassWeight * dt^2 *
+  /// (stiffness of its springs along the contact normal), since a node held by stiff springs does
+  /// not give way like a free particle within one outer step. 0: free particles; large values
+  /// overshoot. (Rigid contacts solve with the springs themselves and do not use it.)
   double springMassWeight = 0.01;
+  /// Rigid contacts: sequential-impulse sweeps of their velocity solve, in [1, 10000].
+  int iterations = 30;
 };
 Status validateContactParams(const ContactParams& params);
 
@@ -77,10 +79,20 @@ struct ContactMemory {
 ContactForces netCollisions(const std::map<std::uint64_t, Net>& nets, const ContactParams& params,
                             ContactMemory* memory = nullptr);
 
-/// Nodes of every net against every rigid shape (signed distance in the body frame), and the
-/// vertices of box, hull and mesh shapes against every net's surface triangles (so that a corner
-/// cannot slip between nodes), each side of a triangle as in netCollisions. All contacts of one
-/// rigid are gathered first and share its mass (each sees count / m_rigid as its inverse mass).
+/// Rigid / net contacts, solved with the nets' nodes in one velocity solve (sequential impulses,
+/// as Box2D and Bullet solve soft / rigid contact). Detection: nodes of every net against every
+/// rigid shape (signed distance in the body frame), and the vertices of box, hull and mesh shapes
+/// and the centres of spheres and capsule ends (with their radius) against every net's surface
+/// triangles, so that a corner or a small ball cannot slip between nodes. Detection is
+/// speculative (continuous in the normal direction): a pair still apart is a contact when it
+/// closes its gap within the step (gap < thickness + approach speed * dt). Response: the normal
+/// impulses that leave no contact approaching faster than it may close its gap to the thickness
+/// (and push an overlap out by beta of it per step), with the rigid's mass and inertia, the
+/// contacted nodes' masses, and every spring and maximum-stretch limit of the contacted nets in
+/// the same solve (`iterations` sweeps), so the net's stiffness and pins hold the rigid, not the
+/// contacted nodes' inertia alone. Only the contact impulses leave the solve, as forces held for
+/// dt: node forces, and one ForceEvent per touched rigid (sum at its centre of mass, torque about
+/// it). Rigids, nets and contacts in id order (deterministic).
 ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
                             const std::map<std::uint64_t, RigidBody>& rigids,
                             const ContactParams& params, ContactMemory* memory = nullptr);
