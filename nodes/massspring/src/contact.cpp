@@ -108,8 +108,8 @@ Vector3d persistent(const Vector3d& a, const Vector3d& b) {
 /// a haptic tool's coupling, other interactors' contacts), which the contact force sent now is
 /// applied together with: measured from its last two steps, the velocity change not made by
 /// this interactor's force (`before`: last step's records; `now`: this step's, sent filled in
-/// later). A contact solved without it lets a light rigid pushed by a strong force (a 0.2 kg
-/// haptic tool on a 2000 N/m coupling) sink by that force's dt^2 / m every step.
+/// later; none without `before`). A contact solved without it lets a light rigid pushed by a strong
+/// force (a 0.2 kg haptic tool on a 2000 N/m coupling) sink by that force's dt^2 / m every step.
 std::map<std::uint64_t, Vector3d> externalDrift(
     const std::map<std::uint64_t, RigidBody>& rigids, const ContactParams& p,
     const std::map<std::uint64_t, ContactMemory::Motion>* before,
@@ -341,7 +341,14 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
       fastest = std::max(fastest, velocityOf(net, i).lpNorm<1>());
     netSpeeds[netId] = fastest;
   }
-  const auto drift = externalDrift(rigids, p, memory ? &memory->motions : nullptr, next.motions);
+  if (memory) next.emptyCalls = memory->emptyCalls, next.started = memory->started;
+  if (!next.started) {
+    if (nets.empty() && rigids.empty()) ++next.emptyCalls;
+    next.started = !(nets.empty() && rigids.empty());
+  }
+  const bool sequential = memory && next.emptyCalls == 0;
+  const auto drift =
+      externalDrift(rigids, p, sequential ? &memory->motions : nullptr, next.motions);
   std::vector<detail::RigidNetContact> contacts;
   for (const auto& [rigidId, body] : rigids) {
     const auto box = msg::worldBounds(body.shape, body.position, body.orientation);

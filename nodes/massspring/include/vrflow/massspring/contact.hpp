@@ -85,6 +85,11 @@ struct ContactMemory {
     bool measured = false;  ///< external holds a measurement
   };
   std::map<std::uint64_t, Motion> motions;
+  /// Calls before the first that saw a rigid or a net: an initial message on the interactor's
+  /// objects (states one iteration old) shows as one empty call. The measurement above needs
+  /// the sequential wiring (0): it is off otherwise.
+  int emptyCalls = 0;
+  bool started = false;
 };
 
 /// Nodes of every net against the surface triangles of every other net (nets without a surface
