@@ -106,7 +106,9 @@ void solveSpring(NetState& state, SpringRow& row, double dt) {
         (target - row.soft) / (1.0 + (dt * dt * row.stiffness + dt * row.damping) / row.invW);
     row.soft += delta;
     applySpring(state, row, u, delta);
-    d = predicted(state, row, dt);
+    // The nodes' velocities moved by delta (wa + wb) along u: the end-of-step vector by dt times
+    // that (no need to read the nodes again).
+    d += u * (dt * delta / row.invW);
     length = d.norm();
     if (length < 1e-12) return;
     u = d / length;
