@@ -35,6 +35,18 @@ struct Trial {
   double worstLimit = 0;  // largest length / limit of a limited spring over the run
 };
 
+// One step of the net (id 1) under the contact forces of `forces`; returns the force event on
+// the body (id 2), if any.
+const msg::ForceEvent* stepNet(Net& net, const ContactForces& forces, const StepOptions& options) {
+  const auto onNet = forces.nodeForces.find(1);
+  step(net,
+       onNet == forces.nodeForces.end() ? std::span<const double>{}
+                                        : std::span<const double>(onNet->second),
+       options);
+  const auto onBody = forces.rigidForces.find(2);
+  return onBody == forces.rigidForces.end() ? nullptr : &onBody->second;
+}
+
 // Steps the net and the body together for `steps` 10 ms steps, calling `watch` after each.
 Trial simulate(const GridParams& grid, Box body, int steps, bool collide,
                const std::function<void(const Trial&, int)>& watch = {}, int settle = 0) {
@@ -52,14 +64,7 @@ Trial simulate(const GridParams& grid, Box body, int steps, bool collide,
     rigids[2] = r.body.body;
     const auto forces = collide ? rigidContacts(nets, rigids, contact, &memory) : ContactForces{};
     r.contacts += forces.contacts;
-    const auto onNet = forces.nodeForces.find(1);
-    step(r.net,
-         onNet == forces.nodeForces.end() ? std::span<const double>{}
-                                          : std::span<const double>(onNet->second),
-         options);
-    const auto onBody = forces.rigidForces.find(2);
-    integrate(r.body, onBody == forces.rigidForces.end() ? nullptr : &onBody->second, kGravity,
-              options.dt);
+    integrate(r.body, stepNet(r.net, forces, options), kGravity, options.dt);
     r.worstLimit = std::max(r.worstLimit, maxConstraintRatio(r.net));
     if (watch) watch(r, s);
   }
@@ -220,13 +225,8 @@ TEST(RigidNetContact, HapticToolPressedByAStiffCouplingStaysOnTheNet) {
     nets[1] = r.net;
     rigids[2] = r.body.body;
     const auto forces = rigidContacts(nets, rigids, contact, &memory);
-    const auto onNet = forces.nodeForces.find(1);
-    step(r.net,
-         onNet == forces.nodeForces.end() ? std::span<const double>{}
-                                          : std::span<const double>(onNet->second),
-         options);
-    const auto onBody = forces.rigidForces.find(2);
-    held = onBody == forces.rigidForces.end() ? Vec3{} : onBody->second.force;
+    const auto* onBody = stepNet(r.net, forces, options);
+    held = onBody ? onBody->force : Vec3{};
     if (s >= 150) {  // pressed and settled
       lowest = std::min(lowest, x - surfaceHeight(r.net, 0.95, 0.95));
       weakest = std::min(weakest, held[1]);
