@@ -188,6 +188,7 @@ Status validateContactParams(const ContactParams& p) {
     return makeError("contact: spring mass weight must be >= 0");
   if (p.iterations < 1 || p.iterations > 10000)
     return makeError("contact: iterations must be in [1, 10000]");
+  if (!asEigen(p.gravity).allFinite()) return makeError("contact: gravity must be finite");
   return {};
 }
 
