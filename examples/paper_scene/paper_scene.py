@@ -32,13 +32,19 @@ def build():
                        " dt = 3.0 is beyond the explicit limit of 2 and it blows up. ")
                    ).input("events", initial_messages=1)
     collisions = a.module("net-collisions", "massspring/collision", local, comment=(
-        " Net collisions and rigid/net contacts are smooth interactions: one initial message lets\n"
-        "         them run beside the animators on states one iteration old (section 4.2 of the"
-        " paper),\n"
-        "         while rigid contacts stay sequential with their animators."
-        " ")).input("objects", initial_messages=1)
-    net_contacts = a.module("net-contacts", "massspring/rigid",
-                            local).input("objects", initial_messages=1)
+        " Net collisions are a smooth interaction: one initial message lets them run beside the
+"
+        "         animators on states one iteration old (section 4.2 of the paper). Rigid"
+        " contacts and
+"
+        "         rigid/net contacts stay sequential with their animators: rigid/net
+"
+        "         contact is solved with the net's nodes on the current state, which is what"
+        " keeps a
+"
+        "         heavy or fast object from passing through the net (issue 26). "
+        )).input("objects", initial_messages=1)
+    net_contacts = a.module("net-contacts", "massspring/rigid", local)
     camera = a.module("camera", "viewer/viewer", local, output_dir=".", prefix="demo",
                       eye=(1.2, 3.2, 6.2), target=(0, 0.4, 0))
 

@@ -130,7 +130,7 @@ TEST_F(EditorDocument, EditingAParameterOfThePaperSceneKeepsEveryComment) {
   EXPECT_NE(text.find("<param name=\"mass\" value=\"9\"/>"), std::string::npos);
   EXPECT_EQ(commentsIn(text), comments);
   // The comment about smooth interactions still comes just before net-collisions.
-  const std::size_t smooth = text.find("Net collisions and rigid/net contacts");
+  const std::size_t smooth = text.find("Net collisions are a smooth interaction");
   ASSERT_NE(smooth, std::string::npos);
   EXPECT_EQ(text.find("<module id=", smooth), text.find("<module id=\"net-collisions\""));
   EXPECT_TRUE(reporter_.messages.isEmpty()) << reporter_.messages.join("\n").toStdString();

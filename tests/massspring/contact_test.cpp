@@ -246,5 +246,16 @@ TEST(MassSpringContact, ClosestPointOnTriangle) {
   EXPECT_NEAR(edge.point[2], 0.5, 1e-15);
 }
 
+TEST(ContactParams, GravityMustBeFinite) {
+  ContactParams p;
+  EXPECT_TRUE(validateContactParams(p));
+  p.gravity = {0, std::nan(""), 0};
+  const auto status = validateContactParams(p);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message, "contact: gravity must be finite");
+  p.gravity = {0, 0, INFINITY};
+  EXPECT_FALSE(validateContactParams(p));
+}
+
 }  // namespace
 }  // namespace vrflow::massspring

@@ -35,6 +35,18 @@ struct Trial {
   double worstLimit = 0;  // largest length / limit of a limited spring over the run
 };
 
+// One step of the net (id 1) under the contact forces of `forces`; returns the force event on
+// the body (id 2), if any.
+const msg::ForceEvent* stepNet(Net& net, const ContactForces& forces, const StepOptions& options) {
+  const auto onNet = forces.nodeForces.find(1);
+  step(net,
+       onNet == forces.nodeForces.end() ? std::span<const double>{}
+                                        : std::span<const double>(onNet->second),
+       options);
+  const auto onBody = forces.rigidForces.find(2);
+  return onBody == forces.rigidForces.end() ? nullptr : &onBody->second;
+}
+
 // Steps the net and the body together for `steps` 10 ms steps, calling `watch` after each.
 Trial simulate(const GridParams& grid, Box body, int steps, bool collide,
                const std::function<void(const Trial&, int)>& watch = {}, int settle = 0) {
@@ -52,14 +64,7 @@ Trial simulate(const GridParams& grid, Box body, int steps, bool collide,
     rigids[2] = r.body.body;
     const auto forces = collide ? rigidContacts(nets, rigids, contact, &memory) : ContactForces{};
     r.contacts += forces.contacts;
-    const auto onNet = forces.nodeForces.find(1);
-    step(r.net,
-         onNet == forces.nodeForces.end() ? std::span<const double>{}
-                                          : std::span<const double>(onNet->second),
-         options);
-    const auto onBody = forces.rigidForces.find(2);
-    integrate(r.body, onBody == forces.rigidForces.end() ? nullptr : &onBody->second, kGravity,
-              options.dt);
+    integrate(r.body, stepNet(r.net, forces, options), kGravity, options.dt);
     r.worstLimit = std::max(r.worstLimit, maxConstraintRatio(r.net));
     if (watch) watch(r, s);
   }
@@ -181,6 +186,59 @@ TEST(RigidNetContact, MomentumExchangedEqualsGravityImpulse) {
   EXPECT_GT(r.contacts, 0u);
   // The net received the contact's momentum: more than gravity's 8 kg x 9.81 m/s downwards.
   EXPECT_LT(endNet[1] - startNet[1], grid.mass * kGravity[1] * time - 1.0);
+}
+
+// A haptic tool (examples/interactive): a 0.2 kg ball of radius 12 cm held by a 2000 N/m,
+// 2 N s/m virtual coupling to a hand that goes down 6 cm into the hanging net and stays there.
+// The tool is integrated at 1 kHz under the coupling, gravity and the contact force of the last
+// 10 ms step (what the haptic module does behind a repeat filter). The coupling's force (~13 N)
+// moves the light tool by 0.65 m/s per step: a contact solve blind to it let the tool sink
+// through the net and then pulled it down (issue 26).
+TEST(RigidNetContact, HapticToolPressedByAStiffCouplingStaysOnTheNet) {
+  const double mass = 0.2, radius = 0.12, stiffness = 2000, damping = 2, tick = 0.001;
+  Trial r{*generateGrid(paperNet()), makeBox({}, mass, {0.95, 1.4, 0.95})};
+  r.body.body.shape = msg::Shape::sphere(radius);
+  StepOptions options;
+  options.gravity = kGravity;
+  for (int s = 0; s < 200; ++s) step(r.net, {}, options);  // the net hangs at rest
+  const double surface = surfaceHeight(r.net, 0.95, 0.95);
+  const double bottom = surface + radius - 0.06;  // the hand's lowest point
+  ContactParams contact;
+  contact.dt = options.dt;
+  ContactMemory memory;
+  std::map<std::uint64_t, Net> nets;
+  std::map<std::uint64_t, RigidBody> rigids;
+  Vec3 held{};  // the contact force on the tool over the current step
+  double x = 1.4, v = 0, lowest = 1e300, weakest = 1e300;
+  for (int s = 0; s < 200; ++s) {
+    for (int t = 0; t < 10; ++t) {
+      const double time = (10 * s + t) * tick;
+      const double hand = time < 1.0 ? 1.4 + (bottom - 1.4) * time : bottom;
+      const double handSpeed = time < 1.0 ? bottom - 1.4 : 0.0;
+      const double a =
+          (stiffness * (hand - x) + damping * (handSpeed - v) + held[1]) / mass + kGravity[1];
+      x += tick * v + 0.5 * tick * tick * a;
+      v += tick * a;
+    }
+    r.body.body.position[1] = x;
+    r.body.body.linearVelocity[1] = v;
+    nets[1] = r.net;
+    rigids[2] = r.body.body;
+    const auto forces = rigidContacts(nets, rigids, contact, &memory);
+    const auto* onBody = stepNet(r.net, forces, options);
+    held = onBody ? onBody->force : Vec3{};
+    if (s >= 150) {  // pressed and settled
+      lowest = std::min(lowest, x - surfaceHeight(r.net, 0.95, 0.95));
+      weakest = std::min(weakest, held[1]);
+    }
+  }
+  std::printf(
+      "haptic tool: centre at least %.4f m above the net under it, contact force at "
+      "least %.2f N up while pressed\n",
+      lowest, weakest);
+  EXPECT_GT(lowest, 0.5 * radius);  // on the net, its centre well above it
+  // The net holds the tool against the coupling's pull (2000 N/m x up to 6 cm, less its weight).
+  EXPECT_GT(weakest, 5.0);
 }
 
 TEST(RigidNetContact, LightBoxStillRestsOnTheNet) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 #include "rigid_solve.hpp"
@@ -93,6 +95,44 @@ PlaneHit pointTriangle(const Vector3d& x, const Vector3d& relative, const Vector
   return out;
 }
 
+/// The part of a that b confirms, per component: the smaller magnitude where both have the same
+/// sign, else 0 (what persists over two steps, not a one-step kick).
+Vector3d persistent(const Vector3d& a, const Vector3d& b) {
+  Vector3d out = Vector3d::Zero();
+  for (int k = 0; k < 3; ++k)
+    if (a[k] * b[k] > 0) out[k] = std::copysign(std::min(std::abs(a[k]), std::abs(b[k])), a[k]);
+  return out;
+}
+
+/// The velocity each dynamic rigid will gain over the coming step from its other forces (gravity,
+/// a haptic tool's coupling, other interactors' contacts), which the contact force sent now is
+/// applied together with: measured from its last two steps, the velocity change not made by
+/// this interactor's force (`before`: last step's records; `now`: this step's, sent filled in
+/// later; none without `before`). A contact solved without it lets a light rigid pushed by a strong
+/// force (a 0.2 kg haptic tool on a 2000 N/m coupling) sink by that force's dt^2 / m every step.
+std::map<std::uint64_t, Vector3d> externalDrift(
+    const std::map<std::uint64_t, RigidBody>& rigids, const ContactParams& p,
+    const std::map<std::uint64_t, ContactMemory::Motion>* before,
+    std::map<std::uint64_t, ContactMemory::Motion>& now) {
+  std::map<std::uint64_t, Vector3d> out;
+  for (const auto& [id, body] : rigids) {
+    if (!(body.mass > 0) || !std::isfinite(body.mass)) continue;
+    auto& motion = now[id];
+    motion.velocity = body.linearVelocity;
+    if (!before) continue;
+    const auto found = before->find(id);
+    if (found == before->end()) continue;
+    const Vector3d gained = asEigen(body.linearVelocity) - asEigen(found->second.velocity) -
+                            asEigen(found->second.sent);
+    motion.external = msg::toVec3(gained / p.dt);
+    motion.measured = true;
+    if (found->second.measured)
+      out[id] = p.dt * persistent(gained / p.dt - asEigen(p.gravity),
+                                  asEigen(found->second.external) - asEigen(p.gravity));
+  }
+  return out;
+}
+
 /// Springs touching each node (CSR), to weigh a node with the springs that hold it.
 struct Adjacency {
   std::vector<std::size_t> start;
@@ -148,6 +188,7 @@ Status validateContactParams(const ContactParams& p) {
     return makeError("contact: spring mass weight must be >= 0");
   if (p.iterations < 1 || p.iterations > 10000)
     return makeError("contact: iterations must be in [1, 10000]");
+  if (!asEigen(p.gravity).allFinite()) return makeError("contact: gravity must be finite");
   return {};
 }
 
@@ -301,12 +342,23 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
       fastest = std::max(fastest, velocityOf(net, i).lpNorm<1>());
     netSpeeds[netId] = fastest;
   }
+  if (memory) next.emptyCalls = memory->emptyCalls, next.started = memory->started;
+  if (!next.started) {
+    if (nets.empty() && rigids.empty()) ++next.emptyCalls;
+    next.started = !(nets.empty() && rigids.empty());
+  }
+  const bool sequential = memory && next.emptyCalls == 0;
+  const auto drift =
+      externalDrift(rigids, p, sequential ? &memory->motions : nullptr, next.motions);
   std::vector<detail::RigidNetContact> contacts;
   for (const auto& [rigidId, body] : rigids) {
     const auto box = msg::worldBounds(body.shape, body.position, body.orientation);
+    const auto drifting = drift.find(rigidId);
+    const Vector3d linear = asEigen(body.linearVelocity) +
+                            (drifting != drift.end() ? drifting->second : Vector3d::Zero());
     // Nets whose box (grown by the thickness and one step of the relative motion) misses the
     // rigid's box are skipped.
-    const double speed = asEigen(body.linearVelocity).lpNorm<1>();
+    const double speed = linear.lpNorm<1>();
     const double spin = asEigen(body.angularVelocity).lpNorm<1>();
     double radius = 0;
     for (int k = 0; k < 3; ++k) radius = std::max(radius, 0.5 * (box.max[k] - box.min[k]));
@@ -323,7 +375,7 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
     };
     const bool kinematic = !(body.mass > 0) || !std::isfinite(body.mass);
     auto pointVelocity = [&](const Vector3d& r) -> Vector3d {
-      return asEigen(body.linearVelocity) + asEigen(body.angularVelocity).cross(r);
+      return linear + asEigen(body.angularVelocity).cross(r);
     };
     const auto orientation = asEigen(body.orientation);
     // Nodes against the shape.
@@ -436,7 +488,7 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
       }
     }
   }
-  const auto impulses = detail::solveRigidNetContacts(nets, rigids, contacts, p);
+  const auto impulses = detail::solveRigidNetContacts(nets, rigids, drift, contacts, p);
   std::map<std::uint64_t, std::pair<Vector3d, Vector3d>> onRigids;  // force, torque
   for (std::size_t i = 0; i < impulses.shared.size(); ++i) {
     const auto& c = contacts[i];
@@ -460,6 +512,8 @@ ContactForces rigidContacts(const std::map<std::uint64_t, Net>& nets,
     if (!(body.mass > 0) || !std::isfinite(body.mass)) continue;
     out.rigidForces[rigidId] =
         msg::ForceEvent{msg::toVec3(sum.first), msg::toVec3(sum.second), body.position, p.dt};
+    if (const auto motion = next.motions.find(rigidId); motion != next.motions.end())
+      motion->second.sent = msg::toVec3(sum.first * (p.dt / body.mass));
   }
   if (memory) *memory = std::move(next);
   return out;

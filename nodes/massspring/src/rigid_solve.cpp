@@ -106,7 +106,9 @@ void solveSpring(NetState& state, SpringRow& row, double dt) {
         (target - row.soft) / (1.0 + (dt * dt * row.stiffness + dt * row.damping) / row.invW);
     row.soft += delta;
     applySpring(state, row, u, delta);
-    d = predicted(state, row, dt);
+    // The nodes' velocities moved by delta (wa + wb) along u: the end-of-step vector by dt times
+    // that (no need to read the nodes again).
+    d += u * (dt * delta / row.invW);
     length = d.norm();
     if (length < 1e-12) return;
     u = d / length;
@@ -123,6 +125,7 @@ void solveSpring(NetState& state, SpringRow& row, double dt) {
 
 ContactImpulses solveRigidNetContacts(const std::map<std::uint64_t, Net>& nets,
                                       const std::map<std::uint64_t, RigidBody>& rigids,
+                                      const std::map<std::uint64_t, Eigen::Vector3d>& drift,
                                       const std::vector<RigidNetContact>& contacts,
                                       const ContactParams& p) {
   std::vector<double> impulses(contacts.size(), 0.0);
@@ -131,7 +134,11 @@ ContactImpulses solveRigidNetContacts(const std::map<std::uint64_t, Net>& nets,
   std::map<std::uint64_t, BodyState> bodies;
   std::map<std::uint64_t, NetState> states;
   for (const auto& c : contacts) {
-    if (!bodies.count(c.rigidId)) bodies.emplace(c.rigidId, bodyState(rigids.at(c.rigidId)));
+    if (!bodies.count(c.rigidId)) {
+      auto body = bodyState(rigids.at(c.rigidId));
+      if (const auto found = drift.find(c.rigidId); found != drift.end()) body.v += found->second;
+      bodies.emplace(c.rigidId, body);
+    }
     if (!states.count(c.netId)) {
       const Net& net = nets.at(c.netId);
       NetState s{&net, net.velocities, std::vector<double>(net.nodeCount(), 0.0)};

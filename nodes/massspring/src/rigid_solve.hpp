@@ -41,10 +41,12 @@ struct ContactImpulses {
 /// no more; an overlap is pushed out by beta of it per step, at most kMaxPushSpeed), with the
 /// rigids' masses and inertias, the nodes' masses, the nets' springs (implicit: the spring force
 /// at the end of the step) and their maximum-stretch limits (at the end-of-step positions) in one
-/// solve. Pinned nodes and kinematic rigids are infinitely heavy. Deterministic: a fixed order,
-/// p.iterations sweeps.
+/// solve. Pinned nodes and kinematic rigids are infinitely heavy. A rigid moves over the step at
+/// its velocity plus its `drift` (what its other forces add; none if absent). Deterministic: a
+/// fixed order, p.iterations sweeps.
 ContactImpulses solveRigidNetContacts(const std::map<std::uint64_t, Net>& nets,
                                       const std::map<std::uint64_t, RigidBody>& rigids,
+                                      const std::map<std::uint64_t, Eigen::Vector3d>& drift,
                                       const std::vector<RigidNetContact>& contacts,
                                       const ContactParams& p);
 

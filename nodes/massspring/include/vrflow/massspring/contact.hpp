@@ -35,6 +35,10 @@ struct ContactParams {
   double springMassWeight = 0.01;
   /// Rigid contacts: sequential-impulse sweeps of their velocity solve, in [1, 10000].
   int iterations = 30;
+  /// Rigid contacts: the acceleration of the field that pulls the rigids and the nets' nodes
+  /// alike (m/s^2). A rigid's other forces count in its contacts only as far as they differ from
+  /// it (rigidContacts).
+  msg::Vec3 gravity{0, -9.81, 0};
 };
 Status validateContactParams(const ContactParams& params);
 
@@ -70,6 +74,22 @@ struct ContactMemory {
   };
   std::map<std::tuple<std::uint64_t, std::uint64_t, std::uint32_t>, Plane> planes;
   std::map<std::tuple<std::uint64_t, std::uint32_t, std::uint64_t>, int> sides;
+  /// rigidContacts: each touched or nearby dynamic rigid's velocity when last seen, the velocity
+  /// change the contact force sent to it then gives it over a step, and the acceleration the
+  /// other forces on it (gravity, a haptic tool's coupling, other contacts) gave it over the step
+  /// before (see rigidContacts).
+  struct Motion {
+    msg::Vec3 velocity{};
+    msg::Vec3 sent{};
+    msg::Vec3 external{};
+    bool measured = false;  ///< external holds a measurement
+  };
+  std::map<std::uint64_t, Motion> motions;
+  /// Calls before the first that saw a rigid or a net: an initial message on the interactor's
+  /// objects (states one iteration old) shows as one empty call. The measurement above needs
+  /// the sequential wiring (0): it is off otherwise.
+  int emptyCalls = 0;
+  bool started = false;
 };
 
 /// Nodes of every net against the surface triangles of every other net (nets without a surface
