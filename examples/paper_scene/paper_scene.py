@@ -32,16 +32,12 @@ def build():
                        " dt = 3.0 is beyond the explicit limit of 2 and it blows up. ")
                    ).input("events", initial_messages=1)
     collisions = a.module("net-collisions", "massspring/collision", local, comment=(
-        " Net collisions are a smooth interaction: one initial message lets them run beside the
-"
+        " Net collisions are a smooth interaction: one initial message lets them run beside the\n"
         "         animators on states one iteration old (section 4.2 of the paper). Rigid"
-        " contacts and
-"
-        "         rigid/net contacts stay sequential with their animators: rigid/net
-"
+        " contacts and\n"
+        "         rigid/net contacts stay sequential with their animators: rigid/net\n"
         "         contact is solved with the net's nodes on the current state, which is what"
-        " keeps a
-"
+        " keeps a\n"
         "         heavy or fast object from passing through the net (issue 26). "
         )).input("objects", initial_messages=1)
     net_contacts = a.module("net-contacts", "massspring/rigid", local)
