@@ -71,7 +71,11 @@ TEST(PaperScene, AfterTwoHundredIterationsEverythingRestsAboveTheGroundAndApart)
     if (b["kinematic"].get<bool>()) continue;
     ++dynamic;
     const auto velocity = b["linearVelocity"].get<std::vector<double>>();
-    EXPECT_LT(norm(velocity), 0.1) << "body " << i << " still moves";
+    // The four objects on the net ride its swing a little longer since the net no longer
+    // freezes at its stretch limits (issue 26): at most 0.15 m/s here; the 300-iteration test
+    // (TheNetStaysBounded...) holds them below 0.1 m/s at its end.
+    const bool onNet = b["boundsMin"][1].get<double>() > 0.3;
+    EXPECT_LT(norm(velocity), onNet ? 0.15 : 0.1) << "body " << i << " still moves";
     EXPECT_LT(norm(b["angularVelocity"].get<std::vector<double>>()), 2.0) << "body " << i;
     // The ground's top face is at y = -0.002.
     EXPECT_GT(b["boundsMin"][1].get<double>(), -0.002 - 0.01)
