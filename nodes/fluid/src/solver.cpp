@@ -250,6 +250,8 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
     if (!prepared[b].kinematic && m.inLiquid[b] == 0.0) {
       forces.back().force = {};
       forces.back().torque = {};
+    } else {
+      detail::makeMassAware(prepared[b], m.settings.density, m.settings.gravity, forces.back());
     }
   }
 

@@ -221,13 +221,14 @@ struct FluidSolver::Impl {
 
   void classify(const std::vector<PreparedBody>& bodies);
 
-  // Per body: 1 when one of its cells holds particles or shares a face with a liquid cell, else
-  // 0 (doubles, for the reduction over blocks). A body out of the liquid is in air: its cells
-  // are classified as air (p = 0), so that pressure cannot reach it through the cells of another
-  // body it touches (a net's node lying on the water, a floating box under it), and it gets no
-  // force.
+  // Per body: 1 when it gets the liquid's force (cells.cpp: a rigid body with a submerged cell,
+  // a net node touching the liquid), else 0 (doubles, for the reduction over blocks). A body
+  // that does not even touch the liquid (no cell holding particles or sharing a face with a
+  // liquid cell) is in air: its cells are classified as air (p = 0), so that pressure cannot
+  // reach it through the cells of another body it touches (a net's node lying on the water, a
+  // floating box under it).
   std::vector<double> inLiquid;
-  void dryBodiesOutOfLiquid(std::size_t bodyCount);
+  void dryBodiesOutOfLiquid(const std::vector<PreparedBody>& bodies);
 
   void particlesToGrid();
   // The particle loops of the two transfers, compiled twice (VRFLOW_FLUID_HOT in their
