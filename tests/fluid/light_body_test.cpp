@@ -1,5 +1,6 @@
-// Light bodies in the liquid (issue 26): the mass-aware coupling keeps a net of 20 g nodes
-// (the paper scene's true 8 kg) stable on the water, and a body with no wet cell gets no force.
+// Light bodies in the liquid (issue 26): the nodes' own force (buoyancy and implicit drag,
+// node_coupling.hpp) keeps a net of 20 g nodes (the paper scene's true 8 kg) stable on the
+// water, and a rigid body with no wet cell gets no force.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -104,14 +105,20 @@ TEST(LightBodyCoupling, NetAtItsTrueMassStaysOnTheWaterForThreeSeconds) {
       "8 kg net on the pool, 300 iterations: largest velocity change from the liquid in one step "
       "%.3f m/s, fastest node %.3f m/s, nodes y %.3f..%.3f, volume %+.2f %%\n",
       scene.kick, fastest, lowest, highest, 100.0 * (volume / scene.volume0 - 1.0));
-  // Measured 0.38 m/s; 3.4 m/s with the force applied as the projection gave it (a node 26
-  // times lighter than the water it displaces thrown up at 340 m/s^2).
-  EXPECT_LT(scene.kick, 1.0);
+  // The largest change is Archimedes: a 20 g node's 5 cm sphere displaces 26 times its mass, so
+  // its buoyancy alone can change its velocity by 2.6 m/s in a step (2.2 measured; 3.4 m/s with
+  // the old force as the projection gave it, which threw nodes up at 340 m/s^2). It may not
+  // exceed that and the drag, which never reverses a node's velocity relative to the liquid.
+  EXPECT_LT(scene.kick,
+            1000.0 * 9.81 * 4.0 / 3.0 * 3.14159265 * 0.05 * 0.05 * 0.05 / 0.02 * 0.01 + fastest);
   // The net alone (no liquid force) reaches 4.5 m/s while sagging onto its stretch limits: the
   // 20 g nodes on 300 N/m springs, one sub-step of 10 ms. The liquid must not add to that.
   EXPECT_LT(fastest, 6.0);
   EXPECT_GT(lowest, 0.5);  // on the water, not through it
-  EXPECT_LE(highest, 0.95 + 1e-9);
+  // Measured 0.959: five nodes that bounced off the water rose 9 mm above the pins when the
+  // massspring solver's back-off froze the whole net (iteration 47; the same freeze happens
+  // without any liquid force, nodes/fluid/README.md). Thrown nodes went metres up.
+  EXPECT_LE(highest, 0.95 + 0.02);
   EXPECT_NEAR(volume / scene.volume0, 1.0, 0.02);
 }
 
@@ -143,34 +150,41 @@ TEST(LightBodyCoupling, BodyJustAboveTheSurfaceGetsExactlyZeroForce) {
   EXPECT_GT(wet->front().force[1], 0.0);
 }
 
-// A light sphere held under water, then released: the mass-aware force gives it the
-// acceleration of a sphere that must push the liquid aside (added mass), not the 26-fold
-// buoyancy over its own mass.
-TEST(LightBodyCoupling, ReleasedLightSphereRisesWithItsAddedMass) {
-  auto tank = testing::makeTank(testing::smallTank(12, 16, 12), 0.6);
+// A light sphere held under water, then released: the liquid gives it its buoyancy (drag is zero
+// at rest), and as it rises the implicit drag holds it at the terminal speed of a sphere,
+// 0.5 rho C_d pi r^2 v^2 = rho g V - m g, however light it is (it is 18 times lighter than the
+// water: its buoyancy alone would accelerate it at 17 g).
+TEST(LightBodyCoupling, ReleasedLightSphereRisesAtTheDragsTerminalSpeed) {
+  auto tank = testing::makeTank(testing::smallTank(12, 24, 12), 1.0);
   PointMass node;
   node.id = 2;
   node.position = {0.3, 0.3, 0.3};
   node.mass = 0.05;
   node.radius = 0.06;
   for (int step = 0; step < 3; ++step) ASSERT_TRUE(tank->step(0.01, {}, {node}).ok());
-  auto forces = tank->step(0.01, {}, {node});
-  ASSERT_TRUE(forces.ok());
   const double displaced = 1000.0 * 4.0 / 3.0 * 3.14159265 * 0.06 * 0.06 * 0.06;
-  const double added = 0.5 * (displaced - node.mass);
-  // Released from rest: (m + m_a) a = (displaced - m) g, and the animator adds its own gravity.
-  const double expected = node.mass * ((displaced - node.mass) * 9.81 / (node.mass + added) + 9.81);
-  const double f = forces->front().force[1];
+  const double terminal =
+      std::sqrt((displaced - node.mass) * 9.81 / (0.5 * 1000.0 * 0.47 * 3.14159265 * 0.06 * 0.06));
+  double fastest = 0.0, first = 0.0;
+  for (int step = 0; step < 30 && node.position[1] < 0.75; ++step) {
+    auto forces = tank->step(0.01, {}, {node});
+    ASSERT_TRUE(forces.ok());
+    const double f = forces->front().force[1];
+    if (step == 0) first = f;
+    node.velocity[1] += (f / node.mass - 9.81) * 0.01;
+    node.position[1] += node.velocity[1] * 0.01;
+    fastest = std::max(fastest, node.velocity[1]);
+  }
   std::printf(
-      "light sphere under water: force %.3f N, added-mass answer %.3f N, its buoyancy "
-      "%.3f N\n",
-      f, expected, displaced * 9.81);
-  // A 2.4-cell sphere 18 times lighter than water: the projection's pressure on it falls short
-  // of its buoyancy (the liquid partly flows into the light body's cells), so it gets about
-  // half the added-mass answer (0.70 N of 1.37 N measured); never the 8.9 N of buoyancy over its
-  // own 50 g.
-  EXPECT_GT(f, 0.4 * expected);
-  EXPECT_LT(f, 1.35 * expected);
+      "light sphere under water: force at release %.3f N (buoyancy %.3f N), fastest rise %.3f "
+      "m/s (terminal speed in still water %.3f m/s)\n",
+      first, displaced * 9.81, fastest, terminal);
+  EXPECT_NEAR(first, displaced * 9.81, 0.02 * displaced * 9.81);
+  EXPECT_GT(node.position[1], 0.5);  // it does rise
+  // Measured 1.57 times the still-water speed: the reaction pushes the liquid around it up with
+  // it, and the drag is taken against that liquid (the node's own wake: README, Known limits).
+  // Without the drag it would rise at 17 g, 5 m/s after the 0.3 s.
+  EXPECT_LT(fastest, 2.0 * terminal);
 }
 
 }  // namespace

@@ -227,15 +227,4 @@ BodyForce finishBodyForce(const PreparedBody& body, const double* sums, double d
   return out;
 }
 
-void makeMassAware(const PreparedBody& body, double liquidDensity, const msg::Vec3& gravity,
-                   BodyForce& force) {
-  if (!body.point || force.cells == 0) return;
-  const double volume = body.mass / body.density;
-  const double added = kAddedMassCoefficient * std::max(0.0, liquidDensity * volume - body.mass);
-  const double share = body.mass / (body.mass + added);
-  for (std::size_t a = 0; a < 3; ++a) {
-    force.force[a] = share * (force.force[a] - added * gravity[a]);
-  }
-}
-
 }  // namespace vrflow::fluid::detail

@@ -14,7 +14,7 @@ namespace vrflow::fluid::detail {
 struct PreparedBody {
   std::uint64_t id = 0;
   std::uint32_t index = 0;
-  bool point = false;      ///< a mass-spring node: no torque reported
+  bool point = false;      ///< a mass-spring node (only validated: node_coupling.hpp)
   bool kinematic = false;  ///< a moving wall for the liquid
   msg::Shape shape;
   msg::Vec3 position{};
@@ -54,18 +54,5 @@ void bodyForceSums(const Grid& grid, const PreparedBody& body, int bodyIndex,
                    const int kEnd[3], double* sums);
 /// Force and torque from the summed changes: mass times the mean change per axis, over dt.
 BodyForce finishBodyForce(const PreparedBody& body, const double* sums, double dt);
-
-/// Added-mass coefficient of the mass-aware coupling (0.5: a sphere in potential flow).
-inline constexpr double kAddedMassCoefficient = 0.5;
-/// Makes the liquid's force on a wet net node (a point mass) mass-aware. The projection sees a
-/// node lighter than the liquid as a light blob the liquid flows into, and the animator applies
-/// the force explicitly to the node's own mass m: a 20 g node of 5 cm took up to 3.4 m/s in one
-/// step. The node is given the liquid it pushes aside as added mass, m_a =
-/// kAddedMassCoefficient x (displaced liquid mass - m) (none for nodes at least as dense as the
-/// liquid), and the force becomes the one whose explicit step gives the acceleration
-/// (F + m g) / (m + m_a): m (F - m_a g) / (m + m_a). A node in equilibrium (F = -m g) keeps its
-/// force. Rigid bodies and nodes that covered no face (cells == 0) are left as they are.
-void makeMassAware(const PreparedBody& body, double liquidDensity, const msg::Vec3& gravity,
-                   BodyForce& force);
 
 }  // namespace vrflow::fluid::detail

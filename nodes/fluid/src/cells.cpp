@@ -222,12 +222,8 @@ void FluidSolver::Impl::dryBodiesOutOfLiquid(const std::vector<PreparedBody>& bo
       cellDensity[c] = settings.density;
     }
   }
-  // A net's node (a sphere of about one or two cells) keeps the force as soon as it touches the
-  // liquid: its lowest cell is often its only one, and waiting for it to be submerged let the
-  // nodes fall half a cell into the water before any force (particles thrown at 6 m/s in the
-  // paper scene, against 1.7 m/s).
   inLiquid.assign(bodyCount, 0.0);
-  for (std::size_t b = 0; b < bodyCount; ++b) inLiquid[b] = wet[2 * b + (bodies[b].point ? 0 : 1)];
+  for (std::size_t b = 0; b < bodyCount; ++b) inLiquid[b] = wet[2 * b + 1];
 }
 
 void FluidSolver::Impl::fillPlane(int a, int k, double* value, const unsigned char* ok,
