@@ -143,7 +143,6 @@ BodyForce nodeForce(const Grid& g, const PointMass& node, const double* slots, d
   out.duration = dt;
   if (!nodeInGrid(g, node)) return out;
   const double r = node.radius;
-  const double volume = 4.0 / 3.0 * std::numbers::pi * r * r * r;
   const double below = submergedVolume(r, node.position[1], nodeLiquidLevel(g, node, slots));
   msg::Vec3 liquid = node.velocity;  // an axis with no face next to liquid: no drag along it
   int faces = 0;
@@ -170,10 +169,19 @@ BodyForce nodeForce(const Grid& g, const PointMass& node, const double* slots, d
     relative[a] = node.velocity[a] - liquid[a];
     speed2 += relative[a] * relative[a];
   }
-  const double k = 0.5 * liquidDensity * kSphereDragCoefficient * std::numbers::pi * r * r *
-                   std::sqrt(speed2) * (below / volume);
-  const double implicitK = k / (1.0 + k * dt / node.mass);
+  // The submerged part's frontal area: across y the largest horizontal section below the level
+  // (the waterline disc, the equator once half under), along x and z the circular segment the
+  // cap shows from the side.
+  const double d =
+      std::clamp(nodeLiquidLevel(g, node, slots) - (node.position[1] - r), 0.0, 2.0 * r);
+  const double disc = std::numbers::pi * (d < r ? d * (2.0 * r - d) : r * r);
+  const double c = std::clamp((r - d) / r, -1.0, 1.0);
+  const double segment = r * r * (std::acos(c) - c * std::sqrt(1.0 - c * c));
+  const double speed = std::sqrt(speed2);
   for (std::size_t a = 0; a < 3; ++a) {
+    const double area = a == 1 ? disc : segment;
+    const double k = 0.5 * liquidDensity * kSphereDragCoefficient * area * speed;
+    const double implicitK = k / (1.0 + k * dt / node.mass);
     out.force[a] = -liquidDensity * below * gravity[a] - implicitK * relative[a];
   }
   return out;

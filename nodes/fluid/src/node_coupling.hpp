@@ -44,8 +44,9 @@ void gatherNodeSlots(const NodeGridView& view, const PointMass& node, double* sl
 double nodeLiquidLevel(const Grid& grid, const PointMass& node, const double* slots);
 /// Volume of the part of a sphere of radius r whose centre is at height y below the level.
 double submergedVolume(double r, double y, double level);
-/// The force on the node over dt from the combined slots: buoyancy -rho V_sub g, and the drag
-/// 0.5 rho C_d pi r^2 |v - u| (V_sub / V) made implicit for the node's mass (k / (1 + k dt / m)),
+/// The force on the node over dt from the combined slots: buoyancy -rho V_sub g, and per axis the
+/// drag 0.5 rho C_d A |v - u| (A the submerged part's frontal area across that axis) made
+/// implicit for the node's mass (k / (1 + k dt / m)),
 /// so that it never reverses the node's velocity relative to the liquid in one step. `cells` is
 /// the number of faces next to liquid around the node, at least 1 for a node in the grid.
 BodyForce nodeForce(const Grid& grid, const PointMass& node, const double* slots,
