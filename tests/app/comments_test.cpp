@@ -72,7 +72,7 @@ TEST(Comments, EditingAParameterOfThePaperSceneKeepsEveryComment) {
   ASSERT_GE(before.size(), 5u);
   EXPECT_EQ(commentsIn(saved), before);
   // Each comment still precedes the same element.
-  for (const char* kept : {"The net weighs 100 kg here", "The liquid: animator"}) {
+  for (const char* kept : {"The net weighs its true 8 kg", "The liquid: animator"}) {
     const std::size_t at = saved.find(kept);
     ASSERT_NE(at, std::string::npos) << kept;
     const std::size_t next = saved.find("<module id=\"", at);

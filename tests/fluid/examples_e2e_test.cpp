@@ -276,5 +276,60 @@ TEST(BuoyancyExample, LightBoxFloatsHalfSubmergedAndHeavyBoxRestsOnTheFloor) {
   EXPECT_EQ(leftovers(), "");
 }
 
+// The paper scene with the liquid and the net at its true 8 kg (issue 26): 300 iterations (3 s at
+// dt 0.01) stay stable. Every node finite, slow at the end, inside the net's box; the water's
+// volume within the fluid's 2 %, no particle out of the grid; the objects sane.
+TEST(PaperSceneFluidExample, NetAtItsTrueMassStaysStableThreeSecondsWithTheWater) {
+  TempDir dir;
+  const auto result =
+      runApp(dir, exampleForTest("paper_scene", "paper_scene_fluid.xml", {}), 300, 400);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::ifstream netFile(dir.file("net-final.txt"));
+  std::string word;
+  int version = 0, nodes = 0;
+  netFile >> word >> version >> word >> nodes;
+  ASSERT_EQ(nodes, 400);
+  double totalMass = 0.0, fastest = 0.0, lowest = 1e9, highest = -1e9;
+  for (int i = 0; i < nodes; ++i) {
+    double x[3], mass = 0.0, v[3];
+    int pinned = 0;
+    netFile >> x[0] >> x[1] >> x[2] >> mass >> pinned >> v[0] >> v[1] >> v[2];
+    ASSERT_TRUE(netFile.good()) << "node " << i;
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_TRUE(std::isfinite(x[k]) && std::isfinite(v[k])) << "node " << i;
+    }
+    totalMass += mass;
+    fastest = std::max(fastest, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    lowest = std::min(lowest, x[1]);
+    highest = std::max(highest, x[1]);
+    // The net's box: its 1.9 m square between the pinned corners, 5 cm either side.
+    EXPECT_TRUE(x[0] >= 0.25 && x[0] <= 2.25 && std::abs(x[2]) <= 1.0) << "node " << i;
+  }
+  const auto fluid = readJson(dir.file("fluid-final.json"));
+  const double v0 = fluid["initialVolume"].get<double>(), v = fluid["volume"].get<double>();
+  std::printf(
+      "paper scene, 8 kg net, 300 iterations: nodes y %.3f..%.3f, fastest node %.3f m/s, volume "
+      "%+.2f %%, fastest particle %.2f m/s\n",
+      lowest, highest, fastest, 100.0 * (v / v0 - 1.0), fluid["maxSpeed"].get<double>());
+  EXPECT_NEAR(totalMass, 8.0, 1e-9);
+  EXPECT_LT(fastest, 1.0);
+  EXPECT_GT(lowest, 0.5);  // held by the water (the pool is 0.85 m deep), not through it
+  EXPECT_LE(highest, 0.95 + 1e-9);
+  EXPECT_NEAR(v / v0, 1.0, 0.02);
+  EXPECT_LT(fluid["maxSpeed"].get<double>(), 5.0);
+  const double gridMin[3] = {0.25, 0.0, -1.0}, gridMax[3] = {2.25, 4.0, 1.0};
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GE(fluid["particlesMin"][k].get<double>(), gridMin[k]);
+    EXPECT_LE(fluid["particlesMax"][k].get<double>(), gridMax[k]);
+  }
+  const auto bodies = readJson(dir.file("bodies-final.json"));
+  for (const auto& b : bodies["bodies"]) {
+    if (b["kinematic"].get<bool>()) continue;
+    EXPECT_GT(b["boundsMin"][1].get<double>(), -0.012) << "below the ground";
+    EXPECT_LT(b["boundsMax"][1].get<double>(), 1.6) << "thrown up";
+  }
+  EXPECT_EQ(leftovers(), "");
+}
+
 }  // namespace
 }  // namespace vrflow::testing

@@ -21,8 +21,8 @@ TEST(FluidNodeForces, SubmergedNodesForceReachesTheNetInTheMassspringFormat) {
   nodes[0].radius = 0.06;
   nodes[1].id = 77;
   nodes[1].index = 6;
-  nodes[1].position = {0.3, 0.2, 0.3};
-  nodes[1].radius = 0.001;  // smaller than a cell: covers no face, gets no record
+  nodes[1].position = {0.3, 0.2, 0.9};
+  nodes[1].radius = 0.06;  // outside the grid: gets no record
   auto forces = tank->step(0.01, {}, nodes);
   ASSERT_TRUE(forces.ok());
   ASSERT_EQ(forces->size(), 2u);

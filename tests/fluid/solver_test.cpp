@@ -116,7 +116,7 @@ TEST(FluidSolver, AnyThreadCountGivesTheSameBitsAsOneThread) {
     for (int b = 0; b < 2; ++b) {
       bodies[b].id = static_cast<std::uint64_t>(b + 1);
       bodies[b].shape = msg::Shape::box({0.06, 0.06, 0.06});
-      bodies[b].position = {0.2, b == 0 ? 0.34 : 0.15, 0.2 + 0.4 * b};
+      bodies[b].position = {0.2, b == 0 ? 0.26 : 0.15, 0.2 + 0.4 * b};
       bodies[b].mass = (b == 0 ? 500.0 : 2000.0) * 0.12 * 0.12 * 0.12;
     }
     for (int step = 0; step < 25; ++step) {

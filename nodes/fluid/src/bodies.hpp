@@ -14,7 +14,7 @@ namespace vrflow::fluid::detail {
 struct PreparedBody {
   std::uint64_t id = 0;
   std::uint32_t index = 0;
-  bool point = false;      ///< a mass-spring node: no torque reported
+  bool point = false;      ///< a mass-spring node (only validated: node_coupling.hpp)
   bool kinematic = false;  ///< a moving wall for the liquid
   msg::Shape shape;
   msg::Vec3 position{};

@@ -103,7 +103,7 @@ void FluidSolver::Impl::classify(const std::vector<PreparedBody>& bodies) {
     if (particlesInCell[c] > 0 && kind[c] == detail::kAir) kind[c] = detail::kLiquid;
   }
   exchangeBytes(kind, grid.nx * grid.ny, grid.nz);
-  dryBodiesOutOfLiquid(bodies.size());
+  dryBodiesOutOfLiquid(bodies);
   markRowsWithMatter();
   // Volume control: each liquid cell away from the surface asks for a divergence that brings
   // its particle count back to particlesPerCell (cells next to air are partly full by nature).
@@ -147,44 +147,83 @@ void FluidSolver::Impl::classify(const std::vector<PreparedBody>& bodies) {
   exchangeCells(theta);
 }
 
-void FluidSolver::Impl::dryBodiesOutOfLiquid(std::size_t bodyCount) {
-  inLiquid.assign(bodyCount, 0.0);
+void FluidSolver::Impl::dryBodiesOutOfLiquid(const std::vector<PreparedBody>& bodies) {
+  const std::size_t bodyCount = bodies.size();
+  // Per body: (touches the liquid, has a submerged cell), doubles for the reduction over blocks.
+  std::vector<double> wet(2 * bodyCount, 0.0);
   const int dims[3] = {grid.nx, grid.ny, grid.nz};
-  // Body cells of this block holding particles (outside the shape, inside the cell), and from
-  // each of its liquid cells the body cells beside it (kinds and cellBody are known one plane
-  // beyond the slab).
+  // "Down" is the axis and sign of gravity's largest component (none without gravity: every
+  // liquid neighbour then submerges a body cell, whatever side it is on).
+  int downAxis = -1, downSign = 0;
+  double strongest = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double g = settings.gravity[static_cast<std::size_t>(a)];
+    if (std::abs(g) > strongest) {
+      strongest = std::abs(g);
+      downAxis = a;
+      downSign = g < 0.0 ? -1 : 1;
+    }
+  }
+  // Twice a liquid cell's particle count above particlesPerCell: its surface lies above its
+  // centre (the ghost-fluid surface sits (n / n0 - 0.5) cells from it).
+  const int halfFull = settings.particlesPerCell;
+  // Whether the liquid cell c submerges the body cell b on its `side` (-1, +1) along axis a;
+  // `face` is the face between them.
+  auto submerges = [&](std::size_t c, std::size_t b, int a, int side, std::size_t face) {
+    if (a != downAxis) return 2 * particlesInCell[c] > halfFull;  // beside
+    if (side == downSign) return true;                            // the liquid lies on it
+    return faceBody[a][face] == cellBody[b];                      // it dips into the liquid
+  };
+  auto mark = [&](std::size_t b, bool submerged) {
+    wet[2 * b] = 1.0;
+    if (submerged) wet[2 * b + 1] = 1.0;
+  };
+  // A body touches the liquid when one of its cells holds particles (outside the shape, inside
+  // the cell) or shares a face with a liquid cell: its cells stay pressure unknowns, so the
+  // liquid feels it. A body cell is submerged when it holds particles, when a liquid cell lies
+  // on it, when a liquid cell beside it is more than half full (the surface there is above the
+  // body cell's centre), or when the body reaches down into the liquid cell under it (the face
+  // between them is the body's). A body resting on the surface, its shape above the liquid
+  // cells, touches it without a submerged cell: the liquid holds it up, but the pressure there
+  // is the surface's and the body gets no force. Each relation is judged by the block holding
+  // the liquid cell (kinds, cellBody and faceBody are known one plane beyond the slab).
   for (int k = k0; k < k1; ++k) {
     for (int j = 0; j < grid.ny; ++j) {
       for (int i = 0; i < grid.nx; ++i) {
         const std::size_t c = grid.cell(i, j, k);
         if (kind[c] == detail::kBody && particlesInCell[c] > 0) {
-          inLiquid[static_cast<std::size_t>(cellBody[c])] = 1.0;
+          mark(static_cast<std::size_t>(cellBody[c]), true);
         }
         if (kind[c] != detail::kLiquid) continue;
         const int idx[3] = {i, j, k};
         for (int a = 0; a < 3; ++a) {
-          if (idx[a] > 0 && kind[c - stride(a)] == detail::kBody) {
-            inLiquid[static_cast<std::size_t>(cellBody[c - stride(a)])] = 1.0;
+          const std::size_t below = c - stride(a), above = c + stride(a);
+          if (idx[a] > 0 && kind[below] == detail::kBody) {
+            mark(static_cast<std::size_t>(cellBody[below]),
+                 submerges(c, below, a, -1, grid.face(a, i, j, k)));
           }
-          if (idx[a] + 1 < dims[a] && kind[c + stride(a)] == detail::kBody) {
-            inLiquid[static_cast<std::size_t>(cellBody[c + stride(a)])] = 1.0;
+          if (idx[a] + 1 < dims[a] && kind[above] == detail::kBody) {
+            mark(static_cast<std::size_t>(cellBody[above]),
+                 submerges(c, above, a, 1, grid.face(a, i + (a == 0), j + (a == 1), k + (a == 2))));
           }
         }
       }
     }
   }
-  combineBodies(inLiquid, 1, true);
+  combineBodies(wet, 2, true);
   // Every block rasterised every body that reaches its planes and the plane beyond them, so
   // each turns the same cells to air there.
   const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
   const std::size_t cFrom = plane * static_cast<std::size_t>(std::max(0, k0 - 1));
   const std::size_t cTo = plane * static_cast<std::size_t>(std::min(grid.nz, k1 + 1));
   for (std::size_t c = cFrom; c < cTo; ++c) {
-    if (kind[c] == detail::kBody && inLiquid[static_cast<std::size_t>(cellBody[c])] == 0.0) {
+    if (kind[c] == detail::kBody && wet[2 * static_cast<std::size_t>(cellBody[c])] == 0.0) {
       kind[c] = detail::kAir;
       cellDensity[c] = settings.density;
     }
   }
+  inLiquid.assign(bodyCount, 0.0);
+  for (std::size_t b = 0; b < bodyCount; ++b) inLiquid[b] = wet[2 * b + 1];
 }
 
 void FluidSolver::Impl::fillPlane(int a, int k, double* value, const unsigned char* ok,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "node_coupling.hpp"
 #include "solver_impl.hpp"
 
 namespace vrflow::fluid {
@@ -68,10 +69,10 @@ void FluidSolver::setLocalBodies(bool local) {
   impl_->localBodies = local;
 }
 
-void FluidSolver::Impl::uniteBodies(const std::vector<PreparedBody>& bodies) {
-  unionKeys.clear();
-  unionHolder.clear();
-  unionOfBody.clear();
+void FluidSolver::Impl::uniteBodies(const BodyKeys& bodies, BodyUnion& out) {
+  out.keys.clear();
+  out.holder.clear();
+  out.ofBody.clear();
   if (!comm || !localBodies) return;
   // Every block sends its list to every block as records (rank, id high, id low, index): whole
   // numbers below 2^32, exact in doubles.
@@ -80,9 +81,9 @@ void FluidSolver::Impl::uniteBodies(const std::vector<PreparedBody>& bodies) {
   mine.reserve(bodies.size() * kRecord);
   for (const auto& body : bodies) {
     mine.push_back(comm->rank());
-    mine.push_back(static_cast<double>(body.id >> 32));
-    mine.push_back(static_cast<double>(body.id & 0xffffffffu));
-    mine.push_back(body.index);
+    mine.push_back(static_cast<double>(body.first >> 32));
+    mine.push_back(static_cast<double>(body.first & 0xffffffffu));
+    mine.push_back(body.second);
   }
   const std::vector<std::vector<double>> outgoing(static_cast<std::size_t>(comm->size()), mine);
   const auto all = comm->exchange(outgoing, kRecord);
@@ -101,36 +102,35 @@ void FluidSolver::Impl::uniteBodies(const std::vector<PreparedBody>& bodies) {
     return a.key != b.key ? a.key < b.key : a.rank < b.rank;
   });
   for (const auto& h : held) {
-    if (!unionKeys.empty() && unionKeys.back() == h.key) continue;  // a higher block holds it too
-    unionKeys.push_back(h.key);
-    unionHolder.push_back(h.rank);
+    if (!out.keys.empty() && out.keys.back() == h.key) continue;  // a higher block holds it too
+    out.keys.push_back(h.key);
+    out.holder.push_back(h.rank);
   }
-  for (const auto& body : bodies) {
-    const std::pair<std::uint64_t, std::uint32_t> key{body.id, body.index};
-    unionOfBody.push_back(static_cast<std::size_t>(
-        std::lower_bound(unionKeys.begin(), unionKeys.end(), key) - unionKeys.begin()));
+  for (const auto& key : bodies) {
+    out.ofBody.push_back(static_cast<std::size_t>(
+        std::lower_bound(out.keys.begin(), out.keys.end(), key) - out.keys.begin()));
   }
 }
 
-void FluidSolver::Impl::combineBodies(std::vector<double>& values, std::size_t width,
-                                      bool maximum) {
+void FluidSolver::Impl::combineOver(const BodyUnion& over, std::vector<double>& values,
+                                    std::size_t width, bool maximum) {
   if (!comm) return;
   if (!localBodies) {  // every block holds the same list
     if (values.empty()) return;
     maximum ? comm->max(values) : comm->sum(values);
     return;
   }
-  if (unionKeys.empty()) return;  // no block holds a body
+  if (over.keys.empty()) return;  // no block holds a body
   // A block that does not hold a body adds 0 (or its maximum 0), as a block holding it with no
   // face in its planes would: the same bits as when every block holds every body.
-  unionScratch.assign(unionKeys.size() * width, 0.0);
-  for (std::size_t b = 0; b < unionOfBody.size(); ++b) {
+  unionScratch.assign(over.keys.size() * width, 0.0);
+  for (std::size_t b = 0; b < over.ofBody.size(); ++b) {
     std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(b * width), width,
-                unionScratch.begin() + static_cast<std::ptrdiff_t>(unionOfBody[b] * width));
+                unionScratch.begin() + static_cast<std::ptrdiff_t>(over.ofBody[b] * width));
   }
   maximum ? comm->max(unionScratch) : comm->sum(unionScratch);
-  for (std::size_t b = 0; b < unionOfBody.size(); ++b) {
-    std::copy_n(unionScratch.begin() + static_cast<std::ptrdiff_t>(unionOfBody[b] * width), width,
+  for (std::size_t b = 0; b < over.ofBody.size(); ++b) {
+    std::copy_n(unionScratch.begin() + static_cast<std::ptrdiff_t>(over.ofBody[b] * width), width,
                 values.begin() + static_cast<std::ptrdiff_t>(b * width));
   }
 }
@@ -199,19 +199,22 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   auto& m = *impl_;
   if (auto status = validateTimeStep(m.settings, dt); !status) return status.error();
   std::vector<PreparedBody> prepared;
-  prepared.reserve(bodies.size() + points.size());
+  prepared.reserve(bodies.size());
+  Impl::BodyKeys bodyKeys, nodeKeys;
   for (const auto& body : bodies) {
     auto p = detail::prepareBody(body, m.settings.density);
     if (!p) return p.error();
     prepared.push_back(std::move(*p));
+    bodyKeys.emplace_back(body.id, 0u);
   }
+  // Nodes are checked as bodies are, then coupled on their own (node_coupling.hpp).
   for (const auto& point : points) {
-    auto p = detail::preparePoint(point);
-    if (!p) return p.error();
-    prepared.push_back(std::move(*p));
+    if (auto p = detail::preparePoint(point); !p) return p.error();
+    nodeKeys.emplace_back(point.id, point.index);
   }
 
-  m.uniteBodies(prepared);
+  m.uniteBodies(bodyKeys, m.bodyUnion);
+  m.uniteBodies(nodeKeys, m.nodeUnion);
   m.pushParticlesOut(prepared);
   m.migrate();
   m.sortParticles();
@@ -220,12 +223,38 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   m.extrapolate(m.u, 2);
   m.enforceBodies(prepared);
   m.zeroWalls(m.u);
+  // The nodes' forces from the liquid as it is at the start of the step (level and velocity).
+  const detail::NodeGridView view{&m.grid,
+                                  m.k0,
+                                  m.k1,
+                                  {m.kEnd(0), m.kEnd(1), m.kEnd(2)},
+                                  &m.kind,
+                                  &m.particlesInCell,
+                                  m.settings.particlesPerCell,
+                                  m.u};
+  std::vector<double> nodeSlots(points.size() * detail::kNodeSlots, 0.0);
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    detail::gatherNodeSlots(view, points[p], &nodeSlots[p * detail::kNodeSlots]);
+  }
+  m.combineOver(m.nodeUnion, nodeSlots, detail::kNodeSlots, false);
+  std::vector<BodyForce> nodeForces;
+  nodeForces.reserve(points.size());
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    nodeForces.push_back(detail::nodeForce(m.grid, points[p], &nodeSlots[p * detail::kNodeSlots],
+                                           m.settings.density, m.settings.gravity, dt));
+    nodeForces.back().reported = m.reports(m.nodeUnion, p);
+  }
   for (int a = 0; a < 3; ++a) {
     const double dv = m.settings.gravity[static_cast<std::size_t>(a)] * dt;
     m.forOwnFacesThreaded(a, [&](std::size_t f, int, int, int) {
       m.uOld[a][f] = m.u[a][f];
       m.u[a][f] += dv;
     });
+  }
+  // The liquid gives the nodes' momentum (their reaction, before the projection).
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    detail::applyNodeReaction(view, points[p], &nodeSlots[p * detail::kNodeSlots], nodeForces[p],
+                              m.settings.density, dt, m.u);
   }
   m.enforceBodies(prepared, true);
   m.zeroWalls(m.u);
@@ -240,18 +269,17 @@ Result<std::vector<BodyForce>> FluidSolver::step(double dt, const std::vector<Ri
   }
   m.combineBodies(sums, detail::kBodySums, false);
   std::vector<BodyForce> forces;
-  forces.reserve(prepared.size());
+  forces.reserve(prepared.size() + points.size());
   for (std::size_t b = 0; b < prepared.size(); ++b) {
     forces.push_back(detail::finishBodyForce(prepared[b], &sums[b * detail::kBodySums], dt));
-    if (m.localBodies && m.comm) {
-      forces.back().reported = m.unionHolder[m.unionOfBody[b]] == m.comm->rank();
-    }
+    forces.back().reported = m.reports(m.bodyUnion, b);
     // A body in air: the faces it shares with a wet body's cells changed, but not for it.
     if (!prepared[b].kinematic && m.inLiquid[b] == 0.0) {
       forces.back().force = {};
       forces.back().torque = {};
     }
   }
+  forces.insert(forces.end(), nodeForces.begin(), nodeForces.end());
 
   // Faces touching no liquid or body cell kept the pre-projection value; give them the
   // projected neighbours' instead so particles near the surface see the new field.

@@ -54,18 +54,30 @@ struct FluidSolver::Impl {
   double maxDiv = 0.0;
   double lastDt = 1.0;
   BlockComm* comm = nullptr;
-  // Blocks holding their own body lists (setLocalBodies): the union of every block's bodies,
-  // keyed (id, index) in order, the lowest block holding each, and where each body of this
-  // block's list sits in the union.
+  // Blocks holding their own body lists (setLocalBodies): the union of every block's bodies
+  // (and, apart, of its nets' nodes), keyed (id, index) in order, the lowest block holding each,
+  // and where each body of this block's list sits in the union.
   bool localBodies = false;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> unionKeys;
-  std::vector<int> unionHolder;
-  std::vector<std::size_t> unionOfBody;
-  void uniteBodies(const std::vector<PreparedBody>& bodies);
+  struct BodyUnion {
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keys;
+    std::vector<int> holder;
+    std::vector<std::size_t> ofBody;
+  };
+  BodyUnion bodyUnion, nodeUnion;
+  using BodyKeys = std::vector<std::pair<std::uint64_t, std::uint32_t>>;
+  void uniteBodies(const BodyKeys& keys, BodyUnion& out);
   // Per-body values (`width` per body, in the order of this block's list) combined over every
   // block: summed, or the maximum taken. Collective whenever there is a block link.
   std::vector<double> unionScratch;
-  void combineBodies(std::vector<double>& values, std::size_t width, bool maximum);
+  void combineBodies(std::vector<double>& values, std::size_t width, bool maximum) {
+    combineOver(bodyUnion, values, width, maximum);
+  }
+  void combineOver(const BodyUnion& over, std::vector<double>& values, std::size_t width,
+                   bool maximum);
+  // Whether this block reports body b of the union `over` (the lowest block holding it).
+  bool reports(const BodyUnion& over, std::size_t b) const {
+    return !(localBodies && comm) || over.holder[over.ofBody[b]] == comm->rank();
+  }
   std::uint64_t rng = 1;
 
   double nextJitter() {  // splitmix64 -> [-0.5, 0.5)
@@ -221,13 +233,14 @@ struct FluidSolver::Impl {
 
   void classify(const std::vector<PreparedBody>& bodies);
 
-  // Per body: 1 when one of its cells holds particles or shares a face with a liquid cell, else
-  // 0 (doubles, for the reduction over blocks). A body out of the liquid is in air: its cells
-  // are classified as air (p = 0), so that pressure cannot reach it through the cells of another
-  // body it touches (a net's node lying on the water, a floating box under it), and it gets no
-  // force.
+  // Per rigid body: 1 when it gets the liquid's force (cells.cpp: it has a submerged cell), else
+  // 0 (doubles, for the reduction over blocks). A body that does not even touch the liquid (no
+  // cell holding particles or sharing a face with a liquid cell) is in air: its cells are
+  // classified as air (p = 0), so that pressure cannot reach it through the cells of another
+  // body it touches (a box resting on a floating box). Net nodes are not bodies of the grid
+  // (node_coupling.hpp).
   std::vector<double> inLiquid;
-  void dryBodiesOutOfLiquid(std::size_t bodyCount);
+  void dryBodiesOutOfLiquid(const std::vector<PreparedBody>& bodies);
 
   void particlesToGrid();
   // The particle loops of the two transfers, compiled twice (VRFLOW_FLUID_HOT in their
