@@ -106,7 +106,7 @@ TEST(LightBodyCoupling, NetAtItsTrueMassStaysOnTheWaterForThreeSeconds) {
       "%.3f m/s, fastest node %.3f m/s, nodes y %.3f..%.3f, volume %+.2f %%\n",
       scene.kick, fastest, lowest, highest, 100.0 * (volume / scene.volume0 - 1.0));
   // A 20 g node's 5 cm sphere displaces 26 times its mass: its buoyancy alone could change its
-  // velocity by 2.6 m/s in a step (0.68 m/s measured; 3.4 m/s with the old force as the
+  // velocity by 2.6 m/s in a step (0.38 m/s measured; 3.4 m/s with the old force as the
   // projection gave it, which threw nodes up at 340 m/s^2). The bound is that and the drag,
   // which never reverses a node's velocity relative to the liquid.
   EXPECT_LT(scene.kick,
