@@ -18,7 +18,9 @@
 namespace vrflow::testing {
 namespace {
 
-constexpr int kIterations = 300;  // the keyframes end at 3 s (dt 0.01)
+// The hand is at its lowest, pressing the net, at 1.8 to 2.0 s (dt 0.01); it then sweeps along
+// -z until 3 s.
+constexpr int kIterations = 200;
 
 // The CI size: a coarser hull and fluid than the example's.
 const std::vector<std::string> kSmall = {
@@ -93,16 +95,19 @@ TEST(CameraUserScene, OneHostAndThreeHostsAgreeAndTheUserPushesTheBoxOffTheLedge
   EXPECT_GT(box[0], 0.62) << "the box stayed on the ledge";
   EXPECT_LT(box[1], 1.2) << "the box did not fall";
 
-  // The net: the hand and forearm come down through it at (0.5, 0.05) and sweep along -z. The
-  // net under the hand ends lower than its mirror image across the net's middle (x 1.25) by a
-  // clear margin (measured 16 cm). Before the user's contacts removed the whole overlap at once,
-  // and with the net's former 100 kg at 300 N/m (which hung at its maximum stretch, where the
-  // solver holds it still), both were at 0.8244 m.
+  // The net: the hand and forearm come down onto it at (0.5, 0.05), where they are at 2.0 s. The
+  // net under the hand is lower than its mirror image across the net's middle (x 1.25). At this
+  // CI size the net floats on the water (each 5 cm node sphere is buoyant, issue 26) and the
+  // hand deflects it by 2.4 cm only (0.887 against 0.911 m; the hull of 40 cells lets nodes
+  // past the hand); until issue 26 the net froze at its stretch limits wherever the press left
+  // it, which showed 16 cm at the end of the run.
+  // Before the user's contacts removed the whole overlap at once, and with the net's former
+  // 100 kg at 300 N/m, both were at 0.8244 m.
   const auto net = netPositions(readFile(dir.file("one/net-final.txt")));
   ASSERT_EQ(net.size(), 400u);
   const double pressed = lowestNear(net, 0.45, 0.05, 0.2);
   const double mirror = lowestNear(net, 2.05, 0.05, 0.2);
-  EXPECT_LT(pressed, mirror - 0.08) << "the hand did not press the net";
+  EXPECT_LT(pressed, mirror - 0.015) << "the hand did not press the net";
 
   // The water keeps its volume within the fluid's own bound (2 %, as the dam break's).
   const auto fluid = nlohmann::json::parse(readFile(dir.file("one/fluid-final.json")));
