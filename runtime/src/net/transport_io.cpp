@@ -128,23 +128,28 @@ void Transport::Impl::checkTimers() {
   }
 }
 
+void Transport::Impl::queueCredits(Link& link, bool all) {
+  std::erase_if(link.owed, [&](Channel* c) {
+    if (c->creditsToSend == 0) return true;
+    if (!all && c->creditsToSend < creditBatch(c->remote) && link.out.empty()) return false;
+    std::byte count[4];
+    put32(count, c->creditsToSend);
+    queueControl(link, FrameType::Credit, c->remote.channel, count, sizeof count);
+    ++link.stats.creditFramesSent;
+    c->creditsToSend = 0;
+    return true;
+  });
+}
+
 void Transport::Impl::loop() {
+  ioThreadOf = this;
   std::vector<pollfd> fds;
   while (running.load()) {
     // Credits for what was routed into the connections' queues: in batches, or along with
     // frames that leave anyway (a reply, a heartbeat), never a segment of their own per message.
     {
       std::lock_guard lock(mutex);
-      for (auto& [channel, c] : channels) {
-        if (c->remote.outgoing || c->creditsToSend == 0) continue;
-        auto it = linkOfPeer.find(c->remote.peer);
-        if (it == linkOfPeer.end()) continue;
-        if (c->creditsToSend < creditBatch(c->remote) && it->second->out.empty()) continue;
-        std::byte count[4];
-        put32(count, c->creditsToSend);
-        queueControl(*it->second, FrameType::Credit, channel, count, sizeof count);
-        c->creditsToSend = 0;
-      }
+      for (auto& [peer, link] : linkOfPeer) queueCredits(*link, false);
     }
     fds.clear();
     fds.push_back({wakeFd, POLLIN, 0});

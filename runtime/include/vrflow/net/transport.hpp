@@ -70,6 +70,8 @@ struct TransportOptions {
 struct LinkStats {
   int peer = -1;
   uint64_t messagesSent = 0, bytesSent = 0, messagesReceived = 0, bytesReceived = 0;
+  uint64_t creditFramesSent =
+      0;  ///< credit frames queued (most ride with a message: docs/transport.md)
   int64_t clockOffsetNs = 0;  ///< peer's steady clock minus ours, from heartbeats (approximate)
 };
 
