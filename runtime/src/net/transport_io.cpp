@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <utility>
 
 #include "transport_impl.hpp"
 
@@ -38,10 +39,12 @@ void Transport::Impl::readFrom(Link& link) {
       fail(link, status.error().message);
       return;
     }
-    if (onArrival) onArrival();
-    if (static_cast<std::size_t>(n) <
-        (direct.size() >= kDirectReadMin ? direct.size() : readBuffer.size()))
-      return;
+    // Routed once a frame that moves something is complete (not per chunk of a large one).
+    if (std::exchange(routable, false) && onArrival) onArrival();
+    // A short read into the buffer drained the socket. A large payload read straight into
+    // shared memory goes on while the sender keeps it coming (until EAGAIN), without a poll
+    // (and a wake-up) per chunk.
+    if (direct.size() < kDirectReadMin && static_cast<std::size_t>(n) < readBuffer.size()) return;
   }
 }
 
