@@ -80,6 +80,7 @@ int Transport::Impl::writeLocked(Link& link) {
       return errno;
     }
     link.lastSentNs = nowNs();
+    ++link.stats.writeCalls;
     std::size_t done = static_cast<std::size_t>(n) + link.headOffset;
     while (!link.out.empty() && done >= link.out.front().total()) {
       done -= link.out.front().total();
