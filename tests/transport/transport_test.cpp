@@ -38,27 +38,28 @@ TransportOptions optionsFor(int index, const Secret& secret) {
   return o;
 }
 
-RemoteConnection channel0(bool outgoing) {
+// Connection `channel` with capacity 4, from module `from` (on host `fromHost`) to module `to`
+// on the other host, as seen from the sending host (outgoing) or the receiving one.
+RemoteConnection connection(uint32_t channel, const char* from, int fromHost, const char* to,
+                            bool outgoing) {
   RemoteConnection r;
-  r.channel = 0;
-  r.connection.from = {"p", "out"};
-  r.connection.to = {"q", "in"};
+  r.channel = channel;
+  r.connection.from = {from, "out"};
+  r.connection.to = {to, "in"};
   r.connection.capacity = 4;
-  r.peer = outgoing ? 1 : 0;
+  r.peer = outgoing ? 1 - fromHost : fromHost;
   r.outgoing = outgoing;
   return r;
 }
 
+// Connection 0: p.out (host a) -> q.in (host b).
+RemoteConnection channel0(bool outgoing) {
+  return connection(0, "p", 0, "q", outgoing);
+}
+
 // Connection 1, the way back: q.out (host b) -> p.in (host a).
 RemoteConnection channel1(bool outgoing) {
-  RemoteConnection r;
-  r.channel = 1;
-  r.connection.from = {"q", "out"};
-  r.connection.to = {"p", "in"};
-  r.connection.capacity = 4;
-  r.peer = outgoing ? 0 : 1;
-  r.outgoing = outgoing;
-  return r;
+  return connection(1, "q", 1, "p", outgoing);
 }
 
 // Reads from a raw socket until the peer closes it (true) or 10 s pass (false).
