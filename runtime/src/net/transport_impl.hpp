@@ -172,8 +172,8 @@ struct Transport::Impl {
   std::atomic<bool> stopped{false};
   std::atomic<bool> wakePending{false};
   std::function<void()> onArrival;
-  bool routable =
-      false;  ///< a message, close or credit was read since the last onArrival (I/O thread)
+  /// A message, close or credit frame was read since the last onArrival (I/O thread).
+  bool routable = false;
   std::vector<std::byte> readBuffer = std::vector<std::byte>(kReadBufferBytes);
   uint64_t listenPausedUntilNs = 0;  ///< accept() back-off (I/O thread)
   uint64_t acceptBackoffNs = 0;
