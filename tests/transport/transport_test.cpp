@@ -38,15 +38,28 @@ TransportOptions optionsFor(int index, const Secret& secret) {
   return o;
 }
 
-RemoteConnection channel0(bool outgoing) {
+// Connection `channel` with capacity 4, from module `from` (on host `fromHost`) to module `to`
+// on the other host, as seen from the sending host (outgoing) or the receiving one.
+RemoteConnection connection(uint32_t channel, const char* from, int fromHost, const char* to,
+                            bool outgoing) {
   RemoteConnection r;
-  r.channel = 0;
-  r.connection.from = {"p", "out"};
-  r.connection.to = {"q", "in"};
+  r.channel = channel;
+  r.connection.from = {from, "out"};
+  r.connection.to = {to, "in"};
   r.connection.capacity = 4;
-  r.peer = outgoing ? 1 : 0;
+  r.peer = outgoing ? 1 - fromHost : fromHost;
   r.outgoing = outgoing;
   return r;
+}
+
+// Connection 0: p.out (host a) -> q.in (host b).
+RemoteConnection channel0(bool outgoing) {
+  return connection(0, "p", 0, "q", outgoing);
+}
+
+// Connection 1, the way back: q.out (host b) -> p.in (host a).
+RemoteConnection channel1(bool outgoing) {
+  return connection(1, "q", 1, "p", outgoing);
 }
 
 // Reads from a raw socket until the peer closes it (true) or 10 s pass (false).
@@ -87,7 +100,7 @@ struct LinkedPair {
   std::optional<ipc::Segment> segA, segB;
 };
 
-::testing::AssertionResult link(LinkedPair& pair, std::size_t segmentBytes) {
+::testing::AssertionResult link(LinkedPair& pair, std::size_t segmentBytes, bool wayBack = false) {
   const Secret secret = newSecret();
   auto a = Transport::listen(optionsFor(0, secret));
   auto b = Transport::listen(optionsFor(1, secret));
@@ -103,6 +116,10 @@ struct LinkedPair {
   pair.b->attachSegment(*pair.segB);
   pair.a->addConnection(channel0(true));
   pair.b->addConnection(channel0(false));
+  if (wayBack) {
+    pair.a->addConnection(channel1(false));
+    pair.b->addConnection(channel1(true));
+  }
   const std::vector<PeerAddress> peers{{0, "127.0.0.1", pair.a->port()},
                                        {1, "127.0.0.2", pair.b->port()}};
   auto linkB = std::async(std::launch::async, [&] { return pair.b->connectPeers(peers); });
@@ -241,6 +258,49 @@ TEST(Transport, LargeMessagesArriveIntactAndInOrderUnderCreditFlowControl) {
   stopA.get();
   a->stop();
   b->stop();
+}
+
+// Waits (at most 10 s) until `transport` has one message for `channel`; drops it.
+bool receiveOne(Transport& transport, uint32_t channel) {
+  Collect into;
+  bool closed = false;
+  for (int i = 0; i < 20000 && into.messages.empty(); ++i) {
+    transport.receive(channel, into, closed);
+    if (into.messages.empty()) std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  return into.messages.size() == 1;
+}
+
+TEST(Transport, ARequestReplyExchangeSendsTheCreditsWithTheRepliesInOneWriteEach) {
+  LinkedPair pair;
+  ASSERT_TRUE(link(pair, 16 << 20, true));
+  auto toB = pair.a->makeSink(0);
+  auto toA = pair.b->makeSink(1);
+  ASSERT_EQ(pair.b->linkStats().size(), 1u);
+  const LinkStats before = pair.b->linkStats()[0];
+  // Capacity 4: credits are owed back every 2 messages. Before, each batch left in a write
+  // (and a wake-up of the peer's I/O thread) of its own: 60 writes for 40 replies.
+  constexpr uint64_t kRounds = 40;
+  for (uint64_t i = 0; i < kRounds; ++i) {
+    ASSERT_TRUE(toB->hasSpace()) << "round " << i << ": a got no credits back";
+    toB->push(ipc::BlockRef(&*pair.segA, emptyMessageIn(*pair.segA, msg::Stamps{})));
+    ASSERT_TRUE(receiveOne(*pair.b, 0)) << "round " << i;
+    ASSERT_TRUE(toA->hasSpace()) << "round " << i << ": b got no credits back";
+    toA->push(ipc::BlockRef(&*pair.segB, emptyMessageIn(*pair.segB, msg::Stamps{})));
+    ASSERT_TRUE(receiveOne(*pair.a, 1)) << "round " << i;
+  }
+  const LinkStats after = pair.b->linkStats()[0];
+  EXPECT_EQ(after.messagesSent - before.messagesSent, kRounds);
+  EXPECT_GE(after.creditFramesSent - before.creditFramesSent, kRounds / 2) << "credits went back";
+  // One write per reply, its credit inside; a heartbeat or two if the machine stalls for 0.2 s.
+  EXPECT_LE(after.writeCalls - before.writeCalls, kRounds + 4);
+  EXPECT_EQ(pair.a->fatalError(), "");
+  EXPECT_EQ(pair.b->fatalError(), "");
+  auto finishA = std::async(std::launch::async, [&] { pair.a->finish(2); });
+  pair.b->finish(2);
+  finishA.get();
+  pair.a->stop();
+  pair.b->stop();
 }
 
 TEST(Transport, APeerWithoutTheSecretIsRefused) {

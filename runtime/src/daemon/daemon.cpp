@@ -15,6 +15,8 @@ namespace vrflow::daemon {
 namespace {
 
 constexpr int64_t kIdleSleepNs = 100'000'000;
+// The routing thread's sleep when an I/O thread held the routing lock (and passes for it).
+constexpr int64_t kContendedSleepNs = 1'000'000;
 
 uint64_t nowNs() {
   return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -136,23 +138,31 @@ void Daemon::shutdown() {
 
 void Daemon::Impl::routeArrivals() {
   auto& bell = segment.header().daemonBell;
-  std::unique_lock lock(routingMutex, std::try_to_lock);
-  if (!lock.owns_lock() || !running.load(std::memory_order_acquire)) {
-    bell.ring();  // the routing thread is at it (or the daemon is not routing): it passes again
-    return;
-  }
   // A few passes at most: the I/O thread also reads frames and sends heartbeats, and local
   // modules that keep producing would keep pass() busy for ever (a peer then sees no heartbeat
   // for its timeout). What is still moving after them is the routing thread's.
   constexpr int kMaxArrivalPasses = 4;
-  for (int i = 0; i < kMaxArrivalPasses; ++i) {
-    if (!pass()) {
-      // A filter asked for a timer: the routing thread, asleep, must know when to wake.
-      if (graph->wakeAtNs != 0) bell.ring();
+  int passes = 0;
+  do {
+    std::unique_lock lock(routingMutex, std::try_to_lock);
+    if (!lock.owns_lock() || !running.load(std::memory_order_acquire)) {
+      bell.ring();  // the routing thread is at it (or the daemon is not routing): it passes again
       return;
     }
-  }
-  bell.ring();
+    bool settled = false;
+    for (; passes < kMaxArrivalPasses && !settled; ++passes) settled = !pass();
+    // Unsettled: the rest is the routing thread's. A filter asked for a timer: the routing
+    // thread, asleep, must know when to wake.
+    const bool ring = !settled || graph->wakeAtNs != 0;
+    lock.unlock();
+    if (ring) {
+      bell.ring();
+      return;
+    }
+    // Against loop(): it stores passWanted, then tries the lock; we let go of the lock, then
+    // look at passWanted. One of the two sees the other.
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+  } while (passWanted.exchange(false));
 }
 
 void Daemon::Impl::loop() {
@@ -161,7 +171,19 @@ void Daemon::Impl::loop() {
   uint64_t lastSnapshot = 0;
   while (running.load(std::memory_order_acquire)) {
     const uint32_t seen = bell.prepare();
-    std::unique_lock lock(routingMutex);
+    std::unique_lock lock(routingMutex, std::try_to_lock);
+    if (!lock.owns_lock()) {
+      // A transport's I/O thread is routing what arrived (routeArrivals): rather than block on
+      // the mutex (a futex wait, and a wake-up when it lets go), ask it to pass again when done.
+      passWanted.store(true);
+      std::atomic_thread_fence(std::memory_order_seq_cst);
+      if (!lock.try_lock()) {
+        // Briefly: a filter's timer, or the checks below, are looked at again soon.
+        bell.sleep(seen, kContendedSleepNs);
+        continue;
+      }
+      passWanted.store(false);  // this thread passes now
+    }
     bool progressed = false;
     while (pass()) progressed = true;
     const uint64_t now = nowNs();

@@ -50,6 +50,9 @@ struct Daemon::Impl {
   /// The routing network (graph, queues, sources): held by the thread that routes, the routing
   /// thread or a transport's I/O thread on arrivals (routeArrivals).
   std::mutex routingMutex;
+  /// The routing thread, rung while an I/O thread held routingMutex, left the pass to it: the
+  /// I/O thread passes again once it lets go (no block on the mutex, no wake-up to hand back).
+  std::atomic<bool> passWanted{false};
   std::atomic<bool> running{false};
   bool built = false;  ///< the network was fully built (shutdown() has something to drain)
   std::size_t lastBuffered = 0;  ///< messages buffered after the previous pass

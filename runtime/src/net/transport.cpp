@@ -81,18 +81,22 @@ class RemoteSink final : public ipc::Sink {
       if (t_->stopped.load()) return;  // stop() has dropped what links held
       auto it = t_->linkOfPeer.find(c_->remote.peer);
       if (it == t_->linkOfPeer.end()) return;  // the link is gone: the run is failing already
+      Link& link = *it->second;
+      const bool idle = link.out.empty();
+      // Credits owed to the peer leave with this message, in the same writev: a request-reply
+      // exchange never sends a credit frame of its own (nor wakes the peer's I/O thread for it).
+      t_->queueCredits(link, true);
       OutItem item;
       encodeHeader({FrameType::Message, c_->remote.channel, static_cast<uint32_t>(message.size())},
                    item.head.data());
       item.headBytes = kFrameHeaderBytes;
       item.message = std::move(message);
-      Link& link = *it->second;
       link.out.push_back(std::move(item));
       // A link idle for a while is written at once from this (the routing) thread: one thread
       // hop less on the latency path. A stream (messages back to back) is left to the I/O
       // thread, which gathers what accumulates into one writev.
-      if (link.out.size() == 1 && nowNs() - link.lastSentNs > kImmediateAfterIdleNs &&
-          t_->writeLocked(link) == 0 && link.out.empty()) {
+      if (idle && nowNs() - link.lastSentNs > kImmediateAfterIdleNs && t_->writeLocked(link) == 0 &&
+          link.out.empty()) {
         return;
       }
     }
@@ -137,12 +141,16 @@ std::size_t Transport::receive(uint32_t channel, ipc::Sink& sink, bool& closed) 
       c.inbox.pop_front();
       ++moved;
     }
+    if (moved > 0 && c.creditsToSend == 0) {
+      auto it = t.linkOfPeer.find(c.remote.peer);
+      if (it != t.linkOfPeer.end()) it->second->owed.push_back(&c);
+    }
     c.creditsToSend += static_cast<uint32_t>(moved);
     creditsDue = moved > 0 && c.creditsToSend >= creditBatch(c.remote);
     closed = c.closedByPeer && c.inbox.empty();
     if (closed) t.changed.notify_all();  // settle() waits on it
   }
-  if (creditsDue) t.wake();  // the I/O thread sends them
+  if (creditsDue) t.wake();  // the I/O thread sends them (on that thread: its next round)
   return moved;
 }
 

@@ -109,6 +109,8 @@ struct OutItem {
   std::size_t total() const { return headBytes + (message.valid() ? message.size() : 0); }
 };
 
+struct Channel;
+
 struct Link {
   int fd = -1;
   int peer = -1;  ///< -1 until a Hello names it
@@ -122,6 +124,7 @@ struct Link {
   uint64_t pendingHandle = 0;  ///< a message being received
   std::deque<OutItem> out;     ///< guarded by Impl::mutex
   std::size_t headOffset = 0;  ///< bytes of out.front() already written (I/O thread)
+  std::vector<Channel*> owed;  ///< incoming channels of this peer owing credits; guarded by mutex
   uint64_t openedNs = 0, lastReceivedNs = 0, lastSentNs = 0;
   LinkStats stats;
 };
@@ -146,6 +149,10 @@ struct Channel {
   bool sentClose = false;
 };
 
+// The transport whose I/O thread this is (nullptr on any other thread): what the I/O thread
+// queues while it routes is written by its own loop, so it never rings itself.
+inline thread_local const Transport::Impl* ioThreadOf = nullptr;
+
 struct Transport::Impl {
   TransportOptions options;
   int listenFd = -1;
@@ -165,13 +172,17 @@ struct Transport::Impl {
   std::atomic<bool> stopped{false};
   std::atomic<bool> wakePending{false};
   std::function<void()> onArrival;
+  /// A message, close or credit frame was read since the last onArrival (I/O thread).
+  bool routable = false;
   std::vector<std::byte> readBuffer = std::vector<std::byte>(kReadBufferBytes);
   uint64_t listenPausedUntilNs = 0;  ///< accept() back-off (I/O thread)
   uint64_t acceptBackoffNs = 0;
   bool loggedAcceptFailure = false;
   int loggedRefusals = 0;
 
+  bool onIoThread() const { return ioThreadOf == this; }
   void wake() {
+    if (onIoThread()) return;  // the loop looks at every link before it polls again
     if (!wakePending.exchange(true)) {
       const uint64_t one = 1;
       [[maybe_unused]] auto n = write(wakeFd, &one, sizeof one);
@@ -191,6 +202,10 @@ struct Transport::Impl {
     item.headBytes = kFrameHeaderBytes + bytes;
     link.out.push_back(std::move(item));
   }
+  // Queues the credits that the link's incoming channels owe: all of them when `all` (a frame
+  // leaves now anyway, they ride in its system call), else those owing a batch, or all when
+  // the link has other frames waiting. The caller holds `mutex`.
+  void queueCredits(Link& link, bool all);
   ~Impl() {
     if (wakeFd >= 0) close(wakeFd);
   }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <utility>
 
 #include "transport_impl.hpp"
 
@@ -38,10 +39,12 @@ void Transport::Impl::readFrom(Link& link) {
       fail(link, status.error().message);
       return;
     }
-    if (onArrival) onArrival();
-    if (static_cast<std::size_t>(n) <
-        (direct.size() >= kDirectReadMin ? direct.size() : readBuffer.size()))
-      return;
+    // Routed once a frame that moves something is complete (not per chunk of a large one).
+    if (std::exchange(routable, false) && onArrival) onArrival();
+    // A short read into the buffer drained the socket. A large payload read straight into
+    // shared memory goes on while the sender keeps it coming (until EAGAIN), without a poll
+    // (and a wake-up) per chunk.
+    if (direct.size() < kDirectReadMin && static_cast<std::size_t>(n) < readBuffer.size()) return;
   }
 }
 
@@ -77,6 +80,7 @@ int Transport::Impl::writeLocked(Link& link) {
       return errno;
     }
     link.lastSentNs = nowNs();
+    ++link.stats.writeCalls;
     std::size_t done = static_cast<std::size_t>(n) + link.headOffset;
     while (!link.out.empty() && done >= link.out.front().total()) {
       done -= link.out.front().total();
@@ -128,23 +132,28 @@ void Transport::Impl::checkTimers() {
   }
 }
 
+void Transport::Impl::queueCredits(Link& link, bool all) {
+  std::erase_if(link.owed, [&](Channel* c) {
+    if (c->creditsToSend == 0) return true;
+    if (!all && c->creditsToSend < creditBatch(c->remote) && link.out.empty()) return false;
+    std::byte count[4];
+    put32(count, c->creditsToSend);
+    queueControl(link, FrameType::Credit, c->remote.channel, count, sizeof count);
+    ++link.stats.creditFramesSent;
+    c->creditsToSend = 0;
+    return true;
+  });
+}
+
 void Transport::Impl::loop() {
+  ioThreadOf = this;
   std::vector<pollfd> fds;
   while (running.load()) {
     // Credits for what was routed into the connections' queues: in batches, or along with
     // frames that leave anyway (a reply, a heartbeat), never a segment of their own per message.
     {
       std::lock_guard lock(mutex);
-      for (auto& [channel, c] : channels) {
-        if (c->remote.outgoing || c->creditsToSend == 0) continue;
-        auto it = linkOfPeer.find(c->remote.peer);
-        if (it == linkOfPeer.end()) continue;
-        if (c->creditsToSend < creditBatch(c->remote) && it->second->out.empty()) continue;
-        std::byte count[4];
-        put32(count, c->creditsToSend);
-        queueControl(*it->second, FrameType::Credit, channel, count, sizeof count);
-        c->creditsToSend = 0;
-      }
+      for (auto& [peer, link] : linkOfPeer) queueCredits(*link, false);
     }
     fds.clear();
     fds.push_back({wakeFd, POLLIN, 0});

@@ -144,6 +144,7 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
         std::lock_guard lock(mutex);
         if (it->second->closedByPeer) return makeError("message after close on a connection");
         it->second->inbox.push_back(std::move(message));
+        routable = true;
         ++link.stats.messagesReceived;
         link.stats.bytesReceived += header.length;
       }
@@ -158,6 +159,7 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
       }
       std::lock_guard lock(mutex);
       it->second->closedByPeer = true;
+      routable = true;
       changed.notify_all();  // settle() waits on it
       return {};
     }
@@ -169,6 +171,7 @@ Status Transport::Impl::onFrame(Link& link, const FrameHeader& header,
                          ", not one of this link");
       }
       it->second->credits.fetch_add(get32(payload.data()));
+      routable = true;  // a sink that had no room may take what waits for it
       return {};
     }
     case FrameType::Heartbeat: {

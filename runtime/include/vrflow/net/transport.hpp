@@ -70,6 +70,9 @@ struct TransportOptions {
 struct LinkStats {
   int peer = -1;
   uint64_t messagesSent = 0, bytesSent = 0, messagesReceived = 0, bytesReceived = 0;
+  /// Credit frames queued, and writev calls made: a credit owed when a message leaves rides in
+  /// that message's call (docs/transport.md, "Data path").
+  uint64_t creditFramesSent = 0, writeCalls = 0;
   int64_t clockOffsetNs = 0;  ///< peer's steady clock minus ours, from heartbeats (approximate)
 };
 
