@@ -109,5 +109,22 @@ TEST(RigidNetNetwork, BadContactParameterFailsTheRunWithTheModulesMessage) {
   EXPECT_NE(result.err.find("beta"), std::string::npos) << result.err;
 }
 
+// The interactor's `gravity` (the field acceleration its solve takes off the rigids' measured
+// other forces): a value that is not 3 finite numbers stops the run before any step, with the
+// application file's line, the module and the parameter named.
+TEST(RigidNetNetwork, BadGravityFailsTheRunNamingTheModuleAndTheParameter) {
+  for (const std::string bad : {"0 nan 0", "0 -9.81", "0 1e999 0"}) {
+    TempDir dir;
+    const auto result = run(dir, app(R"(<param name="gravity" value=")" + bad + R"("/>)"), 10);
+    EXPECT_NE(result.exitCode, 0) << bad;
+    const std::string out = result.out + result.err;
+    EXPECT_NE(out.find("app.xml:"), std::string::npos) << bad << ": " << out;
+    EXPECT_NE(out.find("parameter 'gravity' of module 'touch' (massspring/rigid)"),
+              std::string::npos)
+        << bad << ": " << out;
+    EXPECT_FALSE(std::ifstream(dir.file("bodies.json")).good()) << bad << ": nothing ran";
+  }
+}
+
 }  // namespace
 }  // namespace vrflow::massspring

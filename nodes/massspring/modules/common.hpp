@@ -3,6 +3,7 @@
 // Helpers shared by the mass-spring modules: parameter parsing with clear errors, sending
 // per-node forces as "massspring node forces" events, and the loop of the interactors.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -132,11 +133,12 @@ int runInteractor(Module& module, const InteractorPorts& ports, const std::strin
 }
 
 /// The whole main of a contact interactor (collision, rigid): starts the module, reads the
-/// contact parameters (thickness, beta, dt, spring-mass-weight; dt is the fallback time step
-/// when the run has none) and runs the interactor loop, where
-/// `forcesOf(scene, contact, &memory)` builds each forces message. Returns the exit status.
+/// contact parameters (thickness, beta, dt, spring-mass-weight, and `gravity` where `withGravity`;
+/// dt is the fallback time step when the run has none), validates them (an error names the
+/// parameter) and runs the interactor loop, where `forcesOf(scene, contact, &memory)` builds each
+/// forces message. Returns the exit status.
 template <typename ForcesOf>
-int runContactInteractor(const char* program, ForcesOf forcesOf) {
+int runContactInteractor(const char* program, ForcesOf forcesOf, bool withGravity = false) {
   Module module;
   const auto ports = startInteractor(module, program);
   if (!ports) return 2;
@@ -145,7 +147,15 @@ int runContactInteractor(const char* program, ForcesOf forcesOf) {
   contact.thickness = params.number("thickness");
   contact.beta = params.number("beta");
   const double fallbackDt = params.number("dt");
+  contact.dt = fallbackDt;
   contact.springMassWeight = params.number("spring-mass-weight");
+  if (withGravity) {
+    contact.gravity = params.vec3("gravity");
+    if (!std::all_of(contact.gravity.begin(), contact.gravity.end(),
+                     [](double g) { return std::isfinite(g); }))
+      params.fail("parameter 'gravity' must be 3 finite numbers (m/s^2)");
+  }
+  if (auto status = validateContactParams(contact); !status) params.fail(status.error().message);
   if (params.report()) return 2;
   ContactMemory memory;
   return runInteractor(module, *ports, program, [&](const SceneCopy& scene) {

@@ -27,5 +27,6 @@ int main() {
         if (const auto frame = scene.userCaptureIteration())
           out.builder().addInt64Stamp(camera::kUsedCaptureIterationStamp, *frame);
         return out;
-      });
+      },
+      /*withGravity=*/true);
 }

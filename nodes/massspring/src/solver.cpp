@@ -1,6 +1,7 @@
 #include "vrflow/massspring/solver.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -124,6 +125,41 @@ void backOffLocally(Net& net, std::span<const double> feasible, double invH) {
   }
 }
 
+/// A set of spring indices walked in index order, forward or backward, while members are added
+/// ahead of the walk (a bit per spring).
+class SweepSet {
+ public:
+  explicit SweepSet(std::size_t count) : bits_((count + 63) / 64, 0), count_(count) {}
+  void insert(std::size_t i) { bits_[i / 64] |= std::uint64_t{1} << (i % 64); }
+  void erase(std::size_t i) { bits_[i / 64] &= ~(std::uint64_t{1} << (i % 64)); }
+  /// The first member at or after `from`; the count when none.
+  std::size_t next(std::size_t from) const {
+    std::size_t word = from / 64;
+    if (word >= bits_.size()) return count_;
+    std::uint64_t bits = bits_[word] & (~std::uint64_t{0} << (from % 64));
+    while (bits == 0) {
+      if (++word == bits_.size()) return count_;
+      bits = bits_[word];
+    }
+    return 64 * word + static_cast<std::size_t>(std::countr_zero(bits));
+  }
+  /// The last member before `end`; the count when none.
+  std::size_t previous(std::size_t end) const {
+    if (end == 0) return count_;
+    std::size_t word = (end - 1) / 64;
+    std::uint64_t bits = bits_[word] & (~std::uint64_t{0} >> (63 - (end - 1) % 64));
+    while (bits == 0) {
+      if (word == 0) return count_;
+      bits = bits_[--word];
+    }
+    return 64 * word + 63 - static_cast<std::size_t>(std::countl_zero(bits));
+  }
+
+ private:
+  std::vector<std::uint64_t> bits_;
+  std::size_t count_;
+};
+
 }  // namespace
 
 double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const double> feasible,
@@ -142,6 +178,33 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
     scratch.assign(count, 0.0);
     multipliers = scratch;
   }
+  // Each node's inverse mass (pinned: 0).
+  std::vector<double> inverseMass(net.nodeCount());
+  for (std::size_t i = 0; i < net.nodeCount(); ++i)
+    inverseMass[i] = net.pinned[i] ? 0.0 : 1.0 / net.masses[i];
+  // The springs a sweep visits: a spring found within its limit and pulling nothing stays so
+  // until one of its nodes moves, so it leaves the set and comes back when a correction moves one
+  // of its nodes (the limited springs of each node, CSR). The sweeps do what they did over every
+  // spring, without reading the others.
+  std::vector<std::size_t> start(net.nodeCount() + 1, 0), limited;
+  for (const auto& s : net.springs) {
+    if (s.maxStretch <= 0) continue;
+    ++start[s.a + 1];
+    ++start[s.b + 1];
+  }
+  for (std::size_t i = 0; i < net.nodeCount(); ++i) start[i + 1] += start[i];
+  limited.resize(start.back());
+  SweepSet visit(count);
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t index = 0; index < count; ++index) {
+      const auto& s = net.springs[index];
+      if (s.maxStretch <= 0) continue;
+      limited[fill[s.a]++] = index;
+      limited[fill[s.b]++] = index;
+      visit.insert(index);
+    }
+  }
   // Moves the ends of spring s together by `amount` (inverse-mass weighted, along d of length
   // `length`; negative moves them apart), the change divided by h going into the velocities.
   auto apply = [&](const Spring& s, double wa, double wb, double d0, double d1, double d2,
@@ -150,6 +213,8 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
     const double scale = amount / length;
     addOpposite(x, a, b, wa * scale, wb * scale, d0, d1, d2);
     addOpposite(v, a, b, wa * scale, wb * scale, d0, d1, d2, invH);
+    for (const std::uint32_t node : {s.a, s.b})
+      for (std::size_t k = start[node]; k < start[node + 1]; ++k) visit.insert(limited[k]);
   };
   // Warm start: the corrections that held the net at the end of the last sub-step are applied
   // again first (a net hanging at its limits needs about the same ones every sub-step).
@@ -160,8 +225,7 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
       continue;
     }
     const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
-    const double wa = net.pinned[s.a] ? 0.0 : 1.0 / net.masses[s.a];
-    const double wb = net.pinned[s.b] ? 0.0 : 1.0 / net.masses[s.b];
+    const double wa = inverseMass[s.a], wb = inverseMass[s.b];
     const double d0 = x[b] - x[a], d1 = x[b + 1] - x[a + 1], d2 = x[b + 2] - x[a + 2];
     const double length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
     if (wa + wb == 0 || length < 1e-12) {
@@ -177,17 +241,19 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
   for (int iteration = 0; iteration < maxIterations && moving; ++iteration) {
     moving = false;
     // Symmetric Gauss-Seidel: forward, then backward sweeps (corrections travel both ways).
-    for (std::size_t n = 0; n < count; ++n) {
-      const std::size_t index = iteration % 2 == 0 ? n : count - 1 - n;
+    const bool forward = iteration % 2 == 0;
+    for (std::size_t index = forward ? visit.next(0) : visit.previous(count); index < count;
+         index = forward ? visit.next(index + 1) : visit.previous(index)) {
       const auto& s = net.springs[index];
-      if (s.maxStretch <= 0) continue;
       const std::size_t a = 3 * std::size_t{s.a}, b = 3 * std::size_t{s.b};
       const double limit = s.maxStretch * s.restLength;
       const double d0 = x[b] - x[a], d1 = x[b + 1] - x[a + 1], d2 = x[b + 2] - x[a + 2];
       const double squared = d0 * d0 + d1 * d1 + d2 * d2;
-      if (multipliers[index] == 0 && squared <= limit * limit * kSkip) continue;
-      const double wa = net.pinned[s.a] ? 0.0 : 1.0 / net.masses[s.a];
-      const double wb = net.pinned[s.b] ? 0.0 : 1.0 / net.masses[s.b];
+      if (multipliers[index] == 0 && squared <= limit * limit * kSkip) {
+        visit.erase(index);
+        continue;
+      }
+      const double wa = inverseMass[s.a], wb = inverseMass[s.b];
       const double length = std::sqrt(squared);
       if (wa + wb == 0 || length < 1e-12) continue;
       // Aim slightly inside the limit so rounding leaves the length at or below it.
