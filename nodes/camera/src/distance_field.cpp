@@ -178,6 +178,50 @@ float toFloat(Squared squared) {
   return squared == kFar ? kNoVoxel : static_cast<float>(squared);
 }
 
+// An outside voxel's value: its distance to the nearest inside centre less half a voxel.
+float outsideValue(Squared squared, float h) {
+  return squared == kFar ? kNoVoxel : (std::sqrt(static_cast<float>(squared)) - 0.5f) * h;
+}
+
+// `box` grown by `cells` on every side, within the grid.
+Box grown(const Box& box, const GridSpec& s, int cells) {
+  return {{std::max(box.lo[0] - cells, 0), std::max(box.lo[1] - cells, 0),
+           std::max(box.lo[2] - cells, 0)},
+          {std::min(box.hi[0] + cells, s.nx), std::min(box.hi[1] + cells, s.ny),
+           std::min(box.hi[2] + cells, s.nz)}};
+}
+
+// The field over `outsideBox` (which holds every inside voxel), min(value, clamp), and `clamp`
+// beyond it; then every inside voxel's negative distance to the outside.
+std::vector<float> fieldOver(const VoxelGrid& grid, const Box& occupied, const Box& outsideBox,
+                             float clamp, int threads) {
+  const GridSpec& s = grid.spec;
+  const auto h = static_cast<float>(s.voxelSize);
+  std::vector<float> field(s.count(), clamp);
+  transformBox(grid, outsideBox, 1, threads, [&](int boxJ, int boxK, const Squared* row) {
+    float* out =
+        &field[s.index(outsideBox.lo[0], outsideBox.lo[1] + boxJ, outsideBox.lo[2] + boxK)];
+    for (int i = 0; i < outsideBox.nx(); ++i) out[i] = std::min(outsideValue(row[i], h), clamp);
+  });
+  // Only inside voxels need their distance to the outside, and each has a nearest outside voxel
+  // in the occupied bounding box grown by one voxel (clamping any other onto that box's border
+  // layer, which is outside, brings it no farther): the transform runs on that box alone.
+  if (occupied.count() == 0) return field;  // nothing inside
+  transformBox(grid, occupied, 0, threads, [&](int boxJ, int boxK, const Squared* row) {
+    const int j = occupied.lo[1] + boxJ, k = occupied.lo[2] + boxK;
+    for (int i = occupied.lo[0]; i < occupied.hi[0]; ++i) {
+      const std::size_t n = s.index(i, j, k);
+      if (!grid.occupied[n]) continue;
+      // Beyond the grid counts as outside: an inside voxel is at most its distance to the
+      // border plus one from an outside centre.
+      const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
+      const auto squared = static_cast<float>(row[i - occupied.lo[0]]);
+      field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
+    }
+  });
+  return field;
+}
+
 }  // namespace
 
 std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target, int threads) {
@@ -190,32 +234,27 @@ std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target,
 }
 
 std::vector<float> signedDistanceField(const VoxelGrid& grid, int threads) {
+  return fieldOver(grid, occupiedBox(grid), wholeGrid(grid.spec),
+                   std::numeric_limits<float>::infinity(), threads);
+}
+
+std::vector<float> signedDistanceFieldInBand(const VoxelGrid& grid, double band, int threads) {
+  assert(band >= 0);  // NaN and negative bands are the caller's bug
   const GridSpec& s = grid.spec;
-  const auto h = static_cast<float>(s.voxelSize);
-  std::vector<float> field(s.count());
-  transformBox(grid, wholeGrid(s), 1, threads, [&](int j, int k, const Squared* row) {
-    float* out = &field[s.index(0, j, k)];
-    for (int i = 0; i < s.nx; ++i)
-      out[i] = row[i] == kFar ? kNoVoxel : (std::sqrt(static_cast<float>(row[i])) - 0.5f) * h;
-  });
-  // Only inside voxels need their distance to the outside, and each has a nearest outside voxel
-  // in the occupied bounding box grown by one voxel (clamping any other onto that box's border
-  // layer, which is outside, brings it no farther): the transform runs on that box alone.
-  const Box box = occupiedBox(grid);
-  if (box.count() == 0) return field;  // nothing inside
-  transformBox(grid, box, 0, threads, [&](int boxJ, int boxK, const Squared* row) {
-    const int j = box.lo[1] + boxJ, k = box.lo[2] + boxK;
-    for (int i = box.lo[0]; i < box.hi[0]; ++i) {
-      const std::size_t n = s.index(i, j, k);
-      if (!grid.occupied[n]) continue;
-      // Beyond the grid counts as outside: an inside voxel is at most its distance to the
-      // border plus one from an outside centre.
-      const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
-      const auto squared = static_cast<float>(row[i - box.lo[0]]);
-      field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
-    }
-  });
-  return field;
+  const Box occupied = occupiedBox(grid);
+  if (occupied.count() == 0) return std::vector<float>(s.count(), kNoVoxel);  // no surface
+  const auto clamp = static_cast<float>(band);
+  if (!(band < (s.nx + s.ny + s.nz) * s.voxelSize))  // the band holds the whole grid
+    return fieldOver(grid, occupied, wholeGrid(s), clamp, threads);
+  // A voxel beyond the occupied box (already grown by one) grown by `cells` is, along one axis,
+  // over `cells` + 1 voxels from every inside centre: its value is over (cells + 1/2) voxels,
+  // beyond the band. Inside the grown box the transform is exact: it holds every inside voxel.
+  const int cells = static_cast<int>(std::ceil(band / s.voxelSize));
+  return fieldOver(grid, occupied, grown(occupied, s, cells), clamp, threads);
+}
+
+double fieldBandFor(double reach, const GridSpec& spec) {
+  return reach + 2 * std::sqrt(3.0) * spec.voxelSize;
 }
 
 }  // namespace vrflow::camera
