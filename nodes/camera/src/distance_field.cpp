@@ -20,15 +20,30 @@ constexpr Squared kFar = std::numeric_limits<Squared>::max();
 // (Felzenszwalb and Huttenlocher's lower envelope of the parabolas rooted at the finite samples).
 // The intersections are compared by cross-multiplying integers, without a division: the
 // envelope is the one the rational intersections give. The scratch is sized once per part.
+//
+// Samples over `limit` count as far, and an output over it may be any value over it: an output
+// within the limit comes from a sample within it (f[v] <= d[q]), so it is exact. The whole
+// transform keeps that: every value within the limit is exact, every other is over it.
 class LineEnvelope {
  public:
-  explicit LineEnvelope(int n) : v_(static_cast<std::size_t>(n)), f_(static_cast<std::size_t>(n)) {}
+  LineEnvelope(int n, Squared limit)
+      : v_(static_cast<std::size_t>(n)), f_(static_cast<std::size_t>(n)), limit_(limit) {
+    reach_ = static_cast<int>(std::sqrt(static_cast<double>(limit)));
+    while (std::int64_t{reach_ + 1} * (reach_ + 1) <= limit) ++reach_;
+    while (std::int64_t{reach_} * reach_ > limit) --reach_;
+  }
+
+  /// How far a sample within the limit can spread a value within it.
+  int reach() const { return reach_; }
 
   void operator()(Squared* data, int n) {
+    // A line of targets only stays so (most of the inside transform's lines, and a vectorised
+    // scan is cheaper than the envelope).
+    if (std::all_of(data, data + n, [](Squared d) { return d == 0; })) return;
     // v_[0..k]: the roots of the envelope's parabolas, left to right; f_: their f + v^2.
     int k = -1;
     for (int q = 0; q < n; ++q) {
-      if (data[q] == kFar) continue;
+      if (data[q] > limit_) continue;
       const std::int64_t fq = std::int64_t{data[q]} + std::int64_t{q} * q;
       // Parabola k is hidden when q's intersection with it is not right of its own with k - 1.
       while (k > 0 && (fq - f_[k]) * (v_[k] - v_[k - 1]) <= (f_[k] - f_[k - 1]) * (q - v_[k])) --k;
@@ -40,13 +55,15 @@ class LineEnvelope {
     // Parabola m is the lowest from its intersection with m - 1 to its intersection with m + 1:
     // the samples between take its value. A rational intersection's double rounds to no other
     // integer ceiling (an integer quotient is exact, any other is over 1 / (2n) from one).
-    int q = 0;
+    // Samples over `reach_` from every root are over the limit and keep their input, which was.
+    int q = static_cast<int>(std::max<std::int64_t>(v_[0] - reach_, 0));
+    const int last = static_cast<int>(std::min<std::int64_t>(v_[k] + reach_ + 1, n));
     for (int m = 0; m <= k; ++m) {
-      int end = n;
+      int end = last;
       if (m < k) {
         const double s =
             static_cast<double>(f_[m + 1] - f_[m]) / static_cast<double>(2 * (v_[m + 1] - v_[m]));
-        end = static_cast<int>(std::ceil(std::clamp(s, 0.0, static_cast<double>(n))));
+        end = static_cast<int>(std::ceil(std::clamp(s, 0.0, static_cast<double>(last))));
       }
       const std::int64_t root = v_[m], lowest = f_[m] - root * root;
       for (; q < end; ++q) data[q] = static_cast<Squared>(lowest + (q - root) * (q - root));
@@ -56,6 +73,8 @@ class LineEnvelope {
  private:
   std::vector<std::int64_t> v_;
   std::vector<std::int64_t> f_;
+  Squared limit_;
+  int reach_;
 };
 
 // The box [lo, hi) of a grid whose transform is computed, and the output's layout over it.
@@ -104,10 +123,16 @@ void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap*
 
 // The exact squared distance over the box to the nearest target voxel of the box: the gaps
 // along z, then per z slice the envelope along x (contiguous rows) and along y (the slice
-// transposed into the scratch). Each finished row (j, k) of the box goes to emit(j, k, row).
+// transposed into the scratch). Values within `limit` are exact, the others are over it
+// (LineEnvelope); kNoLimit: all exact. Per slice, only the rectangle within the envelope's reach
+// of the samples within the limit is transposed, spread along y and emitted: every row (j, k)
+// of the box that holds a value within the limit goes to emit(j, k, row, iBegin, iEnd) with the
+// columns [iBegin, iEnd) that may (the caller has the rest as over the limit already).
+constexpr Squared kNoLimit = kFar - 1;
+
 template <typename Emit>
 void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, int threads,
-                  Emit&& emit) {
+                  Squared limit, Emit&& emit) {
   const int nx = box.nx(), ny = box.ny(), nz = box.nz();
   const std::size_t sliceSize = box.slice();
   assert(nz < kFarGap);
@@ -115,35 +140,53 @@ void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, in
   gapsAlongZ(grid, box, target, gaps.get(), threads);
   forParts(threads, static_cast<std::size_t>(nz), [&](std::size_t kBegin, std::size_t kEnd) {
     std::vector<Squared> slice(sliceSize), transposed(sliceSize);
-    LineEnvelope alongX(nx), alongY(ny);
+    LineEnvelope alongX(nx, limit), alongY(ny, limit);
+    const auto within = [limit](Squared d) { return d <= limit; };
     for (std::size_t k = kBegin; k < kEnd; ++k) {
       const Gap* gap = &gaps[k * sliceSize];
-      bool any = false;
+      int iLo = nx, iHi = -1, jLo = ny, jHi = -1;  // the samples within the limit
       for (int j = 0; j < ny; ++j) {
         Squared* row = &slice[static_cast<std::size_t>(j) * nx];
         const Gap* rowGap = gap + static_cast<std::size_t>(j) * nx;
         bool rowAny = false;
         for (int i = 0; i < nx; ++i) {
           const Squared g = rowGap[i];
-          rowAny |= g != kFarGap;
           row[i] = g == kFarGap ? kFar : g * g;
+          rowAny |= row[i] <= limit;
         }
-        if (rowAny) alongX(row, nx);
-        any |= rowAny;
+        if (!rowAny) continue;
+        iLo = std::min(iLo, static_cast<int>(std::find_if(row, row + nx, within) - row));
+        iHi = std::max(iHi, static_cast<int>(std::find_if(std::make_reverse_iterator(row + nx),
+                                                          std::make_reverse_iterator(row), within)
+                                                 .base() -
+                                             row) -
+                                1);
+        jLo = std::min(jLo, j);
+        jHi = j;
+        alongX(row, nx);
       }
-      if (any) {
-        for (int j = 0; j < ny; ++j)
-          for (int i = 0; i < nx; ++i)
-            transposed[static_cast<std::size_t>(i) * ny + j] =
-                slice[static_cast<std::size_t>(j) * nx + i];
-        for (int i = 0; i < nx; ++i) alongY(&transposed[static_cast<std::size_t>(i) * ny], ny);
-        for (int j = 0; j < ny; ++j)
-          for (int i = 0; i < nx; ++i)
-            slice[static_cast<std::size_t>(j) * nx + i] =
-                transposed[static_cast<std::size_t>(i) * ny + j];
+      if (iHi < 0) {
+        // Nothing within the limit: all far, which only an unlimited transform emits.
+        if (limit == kNoLimit)
+          for (int j = 0; j < ny; ++j)
+            emit(j, static_cast<int>(k), &slice[static_cast<std::size_t>(j) * nx], 0, nx);
+        continue;
       }
+      const int iBegin = std::max(iLo - alongX.reach(), 0);
+      const int iEnd = std::min(iHi + alongX.reach() + 1, nx);
+      const int jBegin = std::max(jLo - alongY.reach(), 0);
+      const int jEnd = std::min(jHi + alongY.reach() + 1, ny);
       for (int j = 0; j < ny; ++j)
-        emit(j, static_cast<int>(k), &slice[static_cast<std::size_t>(j) * nx]);
+        for (int i = iBegin; i < iEnd; ++i)
+          transposed[static_cast<std::size_t>(i) * ny + j] =
+              slice[static_cast<std::size_t>(j) * nx + i];
+      for (int i = iBegin; i < iEnd; ++i) alongY(&transposed[static_cast<std::size_t>(i) * ny], ny);
+      for (int j = jBegin; j < jEnd; ++j) {
+        Squared* row = &slice[static_cast<std::size_t>(j) * nx];
+        for (int i = iBegin; i < iEnd; ++i)
+          row[i] = transposed[static_cast<std::size_t>(i) * ny + j];
+        emit(j, static_cast<int>(k), row, iBegin, iEnd);
+      }
     }
   });
 }
@@ -192,33 +235,40 @@ Box grown(const Box& box, const GridSpec& s, int cells) {
 }
 
 // The field over `outsideBox` (which holds every inside voxel), min(value, clamp), and `clamp`
-// beyond it; then every inside voxel's negative distance to the outside.
+// beyond it; then every inside voxel's negative distance to the outside. `limit` (squared
+// voxels) must hold every outside value up to the clamp: a value over it becomes the clamp.
 std::vector<float> fieldOver(const VoxelGrid& grid, const Box& occupied, const Box& outsideBox,
-                             float clamp, int threads) {
+                             float clamp, Squared limit, int threads) {
   const GridSpec& s = grid.spec;
   const auto h = static_cast<float>(s.voxelSize);
-  std::vector<float> field(s.count(), clamp);
-  transformBox(grid, outsideBox, 1, threads, [&](int boxJ, int boxK, const Squared* row) {
-    float* out =
-        &field[s.index(outsideBox.lo[0], outsideBox.lo[1] + boxJ, outsideBox.lo[2] + boxK)];
-    for (int i = 0; i < outsideBox.nx(); ++i) out[i] = std::min(outsideValue(row[i], h), clamp);
-  });
+  const float far = std::min(kNoVoxel, clamp);
+  std::vector<float> field(s.count(), far);
+  transformBox(
+      grid, outsideBox, 1, threads, limit,
+      [&](int boxJ, int boxK, const Squared* row, int iBegin, int iEnd) {
+        float* out =
+            &field[s.index(outsideBox.lo[0], outsideBox.lo[1] + boxJ, outsideBox.lo[2] + boxK)];
+        for (int i = iBegin; i < iEnd; ++i)
+          out[i] = row[i] > limit ? far : std::min(outsideValue(row[i], h), clamp);
+      });
   // Only inside voxels need their distance to the outside, and each has a nearest outside voxel
   // in the occupied bounding box grown by one voxel (clamping any other onto that box's border
   // layer, which is outside, brings it no farther): the transform runs on that box alone.
   if (occupied.count() == 0) return field;  // nothing inside
-  transformBox(grid, occupied, 0, threads, [&](int boxJ, int boxK, const Squared* row) {
-    const int j = occupied.lo[1] + boxJ, k = occupied.lo[2] + boxK;
-    for (int i = occupied.lo[0]; i < occupied.hi[0]; ++i) {
-      const std::size_t n = s.index(i, j, k);
-      if (!grid.occupied[n]) continue;
-      // Beyond the grid counts as outside: an inside voxel is at most its distance to the
-      // border plus one from an outside centre.
-      const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
-      const auto squared = static_cast<float>(row[i - occupied.lo[0]]);
-      field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
-    }
-  });
+  transformBox(
+      grid, occupied, 0, threads, kNoLimit,
+      [&](int boxJ, int boxK, const Squared* row, int /*iBegin*/, int /*iEnd*/) {
+        const int j = occupied.lo[1] + boxJ, k = occupied.lo[2] + boxK;
+        for (int i = occupied.lo[0]; i < occupied.hi[0]; ++i) {
+          const std::size_t n = s.index(i, j, k);
+          if (!grid.occupied[n]) continue;
+          // Beyond the grid counts as outside: an inside voxel is at most its distance to the
+          // border plus one from an outside centre.
+          const int border = 1 + std::min({i, j, k, s.nx - 1 - i, s.ny - 1 - j, s.nz - 1 - k});
+          const auto squared = static_cast<float>(row[i - occupied.lo[0]]);
+          field[n] = -(std::min(std::sqrt(squared), static_cast<float>(border)) - 0.5f) * h;
+        }
+      });
   return field;
 }
 
@@ -226,16 +276,17 @@ std::vector<float> fieldOver(const VoxelGrid& grid, const Box& occupied, const B
 
 std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target, int threads) {
   const GridSpec& s = grid.spec;
-  std::vector<float> d(s.count());
-  transformBox(grid, wholeGrid(s), target, threads, [&](int j, int k, const Squared* row) {
-    std::transform(row, row + s.nx, &d[s.index(0, j, k)], toFloat);
-  });
+  std::vector<float> d(s.count(), kNoVoxel);
+  transformBox(grid, wholeGrid(s), target, threads, kNoLimit,
+               [&](int j, int k, const Squared* row, int iBegin, int iEnd) {
+                 std::transform(row + iBegin, row + iEnd, &d[s.index(iBegin, j, k)], toFloat);
+               });
   return d;
 }
 
 std::vector<float> signedDistanceField(const VoxelGrid& grid, int threads) {
   return fieldOver(grid, occupiedBox(grid), wholeGrid(grid.spec),
-                   std::numeric_limits<float>::infinity(), threads);
+                   std::numeric_limits<float>::infinity(), kNoLimit, threads);
 }
 
 std::vector<float> signedDistanceFieldInBand(const VoxelGrid& grid, double band, int threads) {
@@ -245,12 +296,16 @@ std::vector<float> signedDistanceFieldInBand(const VoxelGrid& grid, double band,
   if (occupied.count() == 0) return std::vector<float>(s.count(), kNoVoxel);  // no surface
   const auto clamp = static_cast<float>(band);
   if (!(band < (s.nx + s.ny + s.nz) * s.voxelSize))  // the band holds the whole grid
-    return fieldOver(grid, occupied, wholeGrid(s), clamp, threads);
+    return fieldOver(grid, occupied, wholeGrid(s), clamp, kNoLimit, threads);
   // A voxel beyond the occupied box (already grown by one) grown by `cells` is, along one axis,
   // over `cells` + 1 voxels from every inside centre: its value is over (cells + 1/2) voxels,
   // beyond the band. Inside the grown box the transform is exact: it holds every inside voxel.
-  const int cells = static_cast<int>(std::ceil(band / s.voxelSize));
-  return fieldOver(grid, occupied, grown(occupied, s, cells), clamp, threads);
+  // Within it, a value up to the band is a squared distance up to (band / h + 1/2)^2 voxels^2:
+  // the limit is that with a voxel to spare for the float rounding.
+  const double cells = band / s.voxelSize;
+  const auto limit = static_cast<Squared>(std::floor((cells + 1.5) * (cells + 1.5)));
+  return fieldOver(grid, occupied, grown(occupied, s, static_cast<int>(std::ceil(cells))), clamp,
+                   limit, threads);
 }
 
 double fieldBandFor(double reach, const GridSpec& spec) {
