@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <string>
@@ -62,31 +63,50 @@ struct Frame {
   VoxelGrid exact;
 };
 
-double msPerFrame(int frames, int repeats, const std::function<void(int)>& work) {
+// The process's CPU time (ms), all its threads: on a loaded machine the wall time measures the
+// others' work as well.
+double cpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+// The best wall and CPU ms per frame of a stage (each the least over the passes).
+struct Timing {
+  double ms = 1e30;
+  double cpuMs = 1e30;
+};
+
+Timing msPerFrame(int frames, int repeats, const std::function<void(int)>& work) {
   work(0);  // warm the caches and OpenCV's buffers
-  double best = 1e30;
+  Timing best;
   for (int r = 0; r < repeats; ++r) {
+    const double c0 = cpuMs();
     const auto t0 = std::chrono::steady_clock::now();
     for (int n = 0; n < frames; ++n) work(n);
     const auto t1 = std::chrono::steady_clock::now();
-    best = std::min(best, std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
+    best.cpuMs = std::min(best.cpuMs, (cpuMs() - c0) / frames);
+    best.ms =
+        std::min(best.ms, std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
   }
   return best;
 }
 
 // Best ms per frame of each of `variants` alternatives: `repeats` passes, each running every
 // variant over every frame in turn (after one warm-up frame each).
-std::vector<double> bestOfAlternating(std::size_t variants, int frames, int repeats,
+std::vector<Timing> bestOfAlternating(std::size_t variants, int frames, int repeats,
                                       const std::function<void(std::size_t, int)>& work) {
   for (std::size_t v = 0; v < variants; ++v) work(v, 0);
-  std::vector<double> best(variants, 1e30);
+  std::vector<Timing> best(variants);
   for (int r = 0; r < repeats; ++r)
     for (std::size_t v = 0; v < variants; ++v) {
+      const double c0 = cpuMs();
       const auto t0 = std::chrono::steady_clock::now();
       for (int n = 0; n < frames; ++n) work(v, n);
       const auto t1 = std::chrono::steady_clock::now();
-      best[v] =
-          std::min(best[v], std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
+      best[v].cpuMs = std::min(best[v].cpuMs, (cpuMs() - c0) / frames);
+      best[v].ms =
+          std::min(best[v].ms, std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
     }
   return best;
 }
@@ -108,14 +128,16 @@ struct Line {
   double load;
   double band;  // the fast distance field's band (m); its bits are compared within it
 
-  void print(const std::string& stage, const char* code, int threads, double ms, double iou,
+  void print(const std::string& stage, const char* code, int threads, Timing t, double iou,
              int same = -1) const {
     std::printf(
         "{\"cameras\": %d, \"width\": %d, \"height\": %d, \"voxels\": %d, \"stage\": \"%s\", "
-        "\"code\": \"%s\", \"threads\": %d, \"ms_per_frame\": %.3f, \"iou\": %s, "
+        "\"code\": \"%s\", \"threads\": %d, \"ms_per_frame\": %.3f, \"cpu_ms_per_frame\": %s, "
+        "\"iou\": %s, "
         "\"same_bits_as_reference\": %s, \"field_band_m\": %.4f, \"load\": %.2f, "
         "\"machine\": \"%s\"}\n",
-        cameras, size.width, size.height, voxels, stage.c_str(), code, threads, ms,
+        cameras, size.width, size.height, voxels, stage.c_str(), code, threads, t.ms,
+        t.cpuMs < 0 ? "null" : std::to_string(t.cpuMs).c_str(),
         iou < 0 ? "null" : std::to_string(iou).c_str(),
         same < 0 ? "null" : (same ? "true" : "false"), band, load, host.c_str());
     std::fflush(stdout);
@@ -162,7 +184,7 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
   };
   std::vector<int> threadCounts{1};
   if (threads > 1) threadCounts.push_back(threads);
-  const std::vector<double> tSilhouette =
+  const std::vector<Timing> tSilhouette =
       bestOfAlternating(threadCounts.size(), frames, repeats,
                         [&](std::size_t v, int n) { silhouettes(n, threadCounts[v]); });
   for (std::size_t v = 0; v < threadCounts.size(); ++v)
@@ -212,11 +234,17 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
     hullAndField(v, n);
     mesh(v, n);
   };
-  const std::vector<double> tHull = bestOfAlternating(variants, frames, repeats, hull);
-  const std::vector<double> tField = bestOfAlternating(variants, frames, repeats, field);
-  const std::vector<double> tMesh = bestOfAlternating(variants, frames, repeats, mesh);
-  const std::vector<double> tHullField = bestOfAlternating(variants, frames, repeats, hullAndField);
-  const std::vector<double> tChain = bestOfAlternating(variants, frames, repeats, chain);
+  const std::vector<Timing> tHull = bestOfAlternating(variants, frames, repeats, hull);
+  const std::vector<Timing> tField = bestOfAlternating(variants, frames, repeats, field);
+  const std::vector<Timing> tMesh = bestOfAlternating(variants, frames, repeats, mesh);
+  // This round's before: the library's field over the whole grid (signedDistanceField).
+  std::vector<float> wholeField;
+  const std::vector<Timing> tWholeField =
+      bestOfAlternating(variants - 1, frames, repeats, [&](std::size_t v, int n) {
+        wholeField = signedDistanceField(at(out[v + 1].hulls, n), threadCounts[v]);
+      });
+  const std::vector<Timing> tHullField = bestOfAlternating(variants, frames, repeats, hullAndField);
+  const std::vector<Timing> tChain = bestOfAlternating(variants, frames, repeats, chain);
   line.print("reference_hull", "reference", 1, tHull[0], meanIoU(out[0]));
   line.print("reference_distance_field", "reference", 1, tField[0], -1);
   line.print("reference_mesh", "reference", 1, tMesh[0], -1);
@@ -238,6 +266,7 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
     }
     const int t = threadCounts[v - 1];
     line.print("hull", "fast", t, tHull[v], meanIoU(after), sameHulls);
+    line.print("whole_distance_field", "fast", t, tWholeField[v - 1], -1);
     line.print("distance_field", "fast", t, tField[v], -1, sameFields);
     line.print("mesh", "fast", t, tMesh[v], -1, sameMeshes);
     line.print("chain_hull_field", "fast", t, tHullField[v], meanIoU(after),
@@ -248,7 +277,7 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
   if (baseline) {
     double sum = 0;
     const int baselineFrames = std::min(frames, 3);
-    const double tBaseline = msPerFrame(baselineFrames, 1, [&](int n) {
+    const Timing tBaseline = msPerFrame(baselineFrames, 1, [&](int n) {
       auto carved = carveVisualHullBaseline(at(views, n), spec);
       sum += intersectionOverUnion(*carved, at(input, n).exact);
     });
@@ -266,11 +295,11 @@ void runModules(int cameraCount, cv::Size size, int voxels, int iterations,
     return;
   }
   const Line line{cameraCount, size, voxels, host, loadAverage(), -1};
-  line.print("modules_capture", "fast", 1, times.captureMs, -1);
-  line.print("modules_silhouette", "fast", 1, times.silhouetteMs, -1);
-  line.print("modules_hull", "fast", 1, times.hullMs, -1);
-  line.print("modules_animator", "fast", 1, times.animatorMs, -1);
-  line.print("modules_wall", "fast", 1, times.wallMsPerFrame, -1);
+  line.print("modules_capture", "fast", 1, {times.captureMs, -1}, -1);
+  line.print("modules_silhouette", "fast", 1, {times.silhouetteMs, -1}, -1);
+  line.print("modules_hull", "fast", 1, {times.hullMs, -1}, -1);
+  line.print("modules_animator", "fast", 1, {times.animatorMs, -1}, -1);
+  line.print("modules_wall", "fast", 1, {times.wallMsPerFrame, -1}, -1);
 }
 
 }  // namespace

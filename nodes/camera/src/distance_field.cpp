@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <type_traits>
 
 #include "parallel_parts.hpp"
 
@@ -101,7 +102,8 @@ void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap*
   forParts(threads, static_cast<std::size_t>(ny), [&](std::size_t jBegin, std::size_t jEnd) {
     const std::size_t rows = jEnd - jBegin;
     std::vector<Gap> run(rows * nx);
-    auto scan = [&](int k, bool backward) {
+    // `backward` is a type, so each scan's loop is compiled (and vectorised) without a branch.
+    auto scan = [&](int k, auto backward) {
       for (std::size_t j = jBegin; j < jEnd; ++j) {
         const std::uint8_t* occupied =
             &grid.occupied[s.index(box.lo[0], box.lo[1] + static_cast<int>(j), box.lo[2] + k)];
@@ -110,14 +112,17 @@ void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap*
         for (int i = 0; i < nx; ++i) {
           const Gap next = static_cast<Gap>(gap[i] + (gap[i] != kFarGap));
           gap[i] = occupied[i] == target ? Gap{0} : next;
-          out[i] = backward ? std::min(out[i], gap[i]) : gap[i];
+          if constexpr (decltype(backward)::value)
+            out[i] = std::min(out[i], gap[i]);
+          else
+            out[i] = gap[i];
         }
       }
     };
     std::fill(run.begin(), run.end(), kFarGap);
-    for (int k = 0; k < nz; ++k) scan(k, false);
+    for (int k = 0; k < nz; ++k) scan(k, std::false_type{});
     std::fill(run.begin(), run.end(), kFarGap);
-    for (int k = nz - 1; k >= 0; --k) scan(k, true);
+    for (int k = nz - 1; k >= 0; --k) scan(k, std::true_type{});
   });
 }
 
