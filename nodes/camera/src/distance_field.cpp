@@ -102,7 +102,7 @@ void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap*
   forParts(threads, static_cast<std::size_t>(ny), [&](std::size_t jBegin, std::size_t jEnd) {
     const std::size_t rows = jEnd - jBegin;
     std::vector<Gap> run(rows * nx);
-    // `backward` is a type, so each scan's loop is compiled (and vectorised) without a branch.
+    // `backward` is a type: each scan's loop is compiled without the branch.
     auto scan = [&](int k, auto backward) {
       for (std::size_t j = jBegin; j < jEnd; ++j) {
         const std::uint8_t* occupied =
@@ -133,9 +133,11 @@ void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap*
 // of the samples within the limit is transposed, spread along y and emitted: every row (j, k)
 // of the box that holds a value within the limit goes to emit(j, k, row, iBegin, iEnd) with the
 // columns [iBegin, iEnd) that may (the caller has the rest as over the limit already).
+// kToNonTargets: the caller reads only the voxels that are not targets, so only the rectangle of
+// those is spread along y and emitted (the rows along x are whole, so it needs no margin).
 constexpr Squared kNoLimit = kFar - 1;
 
-template <typename Emit>
+template <bool kToNonTargets = false, typename Emit>
 void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, int threads,
                   Squared limit, Emit&& emit) {
   const int nx = box.nx(), ny = box.ny(), nz = box.nz();
@@ -146,10 +148,11 @@ void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, in
   forParts(threads, static_cast<std::size_t>(nz), [&](std::size_t kBegin, std::size_t kEnd) {
     std::vector<Squared> slice(sliceSize), transposed(sliceSize);
     LineEnvelope alongX(nx, limit), alongY(ny, limit);
-    const auto within = [limit](Squared d) { return d <= limit; };
+    // The samples that make the rectangle.
+    const auto marked = [limit](Squared d) { return kToNonTargets ? d != 0 : d <= limit; };
     for (std::size_t k = kBegin; k < kEnd; ++k) {
       const Gap* gap = &gaps[k * sliceSize];
-      int iLo = nx, iHi = -1, jLo = ny, jHi = -1;  // the samples within the limit
+      int iLo = nx, iHi = -1, jLo = ny, jHi = -1;  // the marked samples
       for (int j = 0; j < ny; ++j) {
         Squared* row = &slice[static_cast<std::size_t>(j) * nx];
         const Gap* rowGap = gap + static_cast<std::size_t>(j) * nx;
@@ -157,12 +160,12 @@ void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, in
         for (int i = 0; i < nx; ++i) {
           const Squared g = rowGap[i];
           row[i] = g == kFarGap ? kFar : g * g;
-          rowAny |= row[i] <= limit;
+          rowAny |= marked(row[i]);
         }
         if (!rowAny) continue;
-        iLo = std::min(iLo, static_cast<int>(std::find_if(row, row + nx, within) - row));
+        iLo = std::min(iLo, static_cast<int>(std::find_if(row, row + nx, marked) - row));
         iHi = std::max(iHi, static_cast<int>(std::find_if(std::make_reverse_iterator(row + nx),
-                                                          std::make_reverse_iterator(row), within)
+                                                          std::make_reverse_iterator(row), marked)
                                                  .base() -
                                              row) -
                                 1);
@@ -172,15 +175,14 @@ void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, in
       }
       if (iHi < 0) {
         // Nothing within the limit: all far, which only an unlimited transform emits.
-        if (limit == kNoLimit)
+        if (!kToNonTargets && limit == kNoLimit)
           for (int j = 0; j < ny; ++j)
             emit(j, static_cast<int>(k), &slice[static_cast<std::size_t>(j) * nx], 0, nx);
         continue;
       }
-      const int iBegin = std::max(iLo - alongX.reach(), 0);
-      const int iEnd = std::min(iHi + alongX.reach() + 1, nx);
-      const int jBegin = std::max(jLo - alongY.reach(), 0);
-      const int jEnd = std::min(jHi + alongY.reach() + 1, ny);
+      const int margin = kToNonTargets ? 0 : alongX.reach();
+      const int iBegin = std::max(iLo - margin, 0), iEnd = std::min(iHi + margin + 1, nx);
+      const int jBegin = std::max(jLo - margin, 0), jEnd = std::min(jHi + margin + 1, ny);
       for (int j = 0; j < ny; ++j)
         for (int i = iBegin; i < iEnd; ++i)
           transposed[static_cast<std::size_t>(i) * ny + j] =
@@ -260,7 +262,7 @@ std::vector<float> fieldOver(const VoxelGrid& grid, const Box& occupied, const B
   // in the occupied bounding box grown by one voxel (clamping any other onto that box's border
   // layer, which is outside, brings it no farther): the transform runs on that box alone.
   if (occupied.count() == 0) return field;  // nothing inside
-  transformBox(
+  transformBox<true>(
       grid, occupied, 0, threads, kNoLimit,
       [&](int boxJ, int boxK, const Squared* row, int /*iBegin*/, int /*iEnd*/) {
         const int j = occupied.lo[1] + boxJ, k = occupied.lo[2] + boxK;
