@@ -53,21 +53,16 @@ class LineEnvelope {
       f_[k] = fq;
     }
     if (k < 0) return;  // nothing to spread along this line
-    // Parabola m is the lowest from its intersection with m - 1 to its intersection with m + 1:
-    // the samples between take its value. A rational intersection's double rounds to no other
-    // integer ceiling (an integer quotient is exact, any other is over 1 / (2n) from one).
+    // Parabola m + 1 is below parabola m from their intersection on: from the first sample q
+    // with f_[m + 1] - f_[m] <= 2 q (v_[m + 1] - v_[m]), compared in integers (no division).
     // Samples over `reach_` from every root are over the limit and keep their input, which was.
-    int q = static_cast<int>(std::max<std::int64_t>(v_[0] - reach_, 0));
+    const int first = static_cast<int>(std::max<std::int64_t>(v_[0] - reach_, 0));
     const int last = static_cast<int>(std::min<std::int64_t>(v_[k] + reach_ + 1, n));
-    for (int m = 0; m <= k; ++m) {
-      int end = last;
-      if (m < k) {
-        const double s =
-            static_cast<double>(f_[m + 1] - f_[m]) / static_cast<double>(2 * (v_[m + 1] - v_[m]));
-        end = static_cast<int>(std::ceil(std::clamp(s, 0.0, static_cast<double>(last))));
-      }
-      const std::int64_t root = v_[m], lowest = f_[m] - root * root;
-      for (; q < end; ++q) data[q] = static_cast<Squared>(lowest + (q - root) * (q - root));
+    int m = 0;
+    for (int q = first; q < last; ++q) {
+      while (m < k && f_[m + 1] - f_[m] <= 2 * std::int64_t{q} * (v_[m + 1] - v_[m])) ++m;
+      const std::int64_t d = q - v_[m];
+      data[q] = static_cast<Squared>(f_[m] - v_[m] * v_[m] + d * d);
     }
   }
 
