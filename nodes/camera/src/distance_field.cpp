@@ -38,8 +38,8 @@ class LineEnvelope {
   int reach() const { return reach_; }
 
   void operator()(Squared* data, int n) {
-    // A line of targets only stays so (most of the inside transform's lines, and a vectorised
-    // scan is cheaper than the envelope).
+    // A line of targets only stays so (most of the inside transform's lines; a scan is cheaper
+    // than the envelope).
     if (std::all_of(data, data + n, [](Squared d) { return d == 0; })) return;
     // v_[0..k]: the roots of the envelope's parabolas, left to right; f_: their f + v^2.
     int k = -1;
