@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <type_traits>
+#include <utility>
 
 #include "parallel_parts.hpp"
 
@@ -86,11 +87,27 @@ struct Box {
 // The 1D distance along z (in voxels) from every voxel of the box to the nearest target voxel
 // of its column, by a forward and a backward scan over whole rows of columns at once (slices in
 // order: contiguous and vectorisable); kFarGap where the column has no target.
+// With `columns`, only the columns of each row that hold a target are scanned (the others have
+// no target: the caller takes them as far without reading them).
 using Gap = std::uint16_t;
 constexpr Gap kFarGap = std::numeric_limits<Gap>::max();
 
+// Per grid row j, the columns [begin[j], end[j]) that hold an occupied voxel in some slice
+// (begin >= end: none).
+struct Columns {
+  std::vector<int> begin, end;
+};
+
+// The part [from, to) of the box's row j that `columns` (all when null) may hold targets in.
+std::pair<int, int> rowColumns(const Box& box, const Columns* columns, int j) {
+  if (columns == nullptr) return {0, box.nx()};
+  const auto at = static_cast<std::size_t>(box.lo[1] + j);
+  const int from = std::clamp(columns->begin[at] - box.lo[0], 0, box.nx());
+  return {from, std::clamp(columns->end[at] - box.lo[0], from, box.nx())};
+}
+
 void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap* gaps,
-                int threads) {
+                const Columns* columns, int threads) {
   const GridSpec& s = grid.spec;
   const int nx = box.nx(), ny = box.ny(), nz = box.nz();
   const std::size_t sliceSize = box.slice();
@@ -104,7 +121,8 @@ void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap*
             &grid.occupied[s.index(box.lo[0], box.lo[1] + static_cast<int>(j), box.lo[2] + k)];
         Gap* gap = &run[(j - jBegin) * nx];
         Gap* out = &gaps[static_cast<std::size_t>(k) * sliceSize + j * nx];
-        for (int i = 0; i < nx; ++i) {
+        const auto [from, to] = rowColumns(box, columns, static_cast<int>(j));
+        for (int i = from; i < to; ++i) {
           const Gap next = static_cast<Gap>(gap[i] + (gap[i] != kFarGap));
           gap[i] = occupied[i] == target ? Gap{0} : next;
           if constexpr (decltype(backward)::value)
@@ -132,14 +150,16 @@ void gapsAlongZ(const VoxelGrid& grid, const Box& box, std::uint8_t target, Gap*
 // those is spread along y and emitted (the rows along x are whole, so it needs no margin).
 constexpr Squared kNoLimit = kFar - 1;
 
+// `columns` (null: all): where the targets may be, for the gaps along z.
 template <bool kToNonTargets = false, typename Emit>
 void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, int threads,
-                  Squared limit, Emit&& emit) {
+                  Squared limit, const Columns* columns, Emit&& emit) {
   const int nx = box.nx(), ny = box.ny(), nz = box.nz();
   const std::size_t sliceSize = box.slice();
   assert(nz < kFarGap);
-  std::unique_ptr<Gap[]> gaps(new Gap[box.count()]);  // every element written before it is read
-  gapsAlongZ(grid, box, target, gaps.get(), threads);
+  // Every element read is written first (the rows' columns of `columns`).
+  std::unique_ptr<Gap[]> gaps(new Gap[box.count()]);
+  gapsAlongZ(grid, box, target, gaps.get(), columns, threads);
   forParts(threads, static_cast<std::size_t>(nz), [&](std::size_t kBegin, std::size_t kEnd) {
     std::vector<Squared> slice(sliceSize), transposed(sliceSize);
     LineEnvelope alongX(nx, limit), alongY(ny, limit);
@@ -152,7 +172,10 @@ void transformBox(const VoxelGrid& grid, const Box& box, std::uint8_t target, in
         Squared* row = &slice[static_cast<std::size_t>(j) * nx];
         const Gap* rowGap = gap + static_cast<std::size_t>(j) * nx;
         bool rowAny = false;
-        for (int i = 0; i < nx; ++i) {
+        const auto [from, to] = rowColumns(box, columns, j);
+        std::fill(row, row + from, kFar);
+        std::fill(row + to, row + nx, kFar);
+        for (int i = from; i < to; ++i) {
           const Squared g = rowGap[i];
           row[i] = g == kFarGap ? kFar : g * g;
           rowAny |= marked(row[i]);
@@ -198,10 +221,14 @@ Box wholeGrid(const GridSpec& s) {
 }
 
 // The occupied voxels' bounding box grown by one voxel within the grid; empty (hi = lo) when
-// nothing is occupied.
-Box occupiedBox(const VoxelGrid& grid) {
+// nothing is occupied. With `columns`, also each row's columns that hold an occupied voxel.
+Box occupiedBox(const VoxelGrid& grid, Columns* columns = nullptr) {
   const GridSpec& s = grid.spec;
   cv::Vec3i lo(s.nx, s.ny, s.nz), hi(0, 0, 0);
+  if (columns != nullptr) {
+    columns->begin.assign(static_cast<std::size_t>(s.ny), s.nx);
+    columns->end.assign(static_cast<std::size_t>(s.ny), 0);
+  }
   for (int k = 0; k < s.nz; ++k)
     for (int j = 0; j < s.ny; ++j) {
       const std::uint8_t* row = &grid.occupied[s.index(0, j, k)];
@@ -213,6 +240,12 @@ Box occupiedBox(const VoxelGrid& grid) {
       lo = {std::min(lo[0], static_cast<int>(first - row)), std::min(lo[1], j), std::min(lo[2], k)};
       hi = {std::max(hi[0], static_cast<int>(last.base() - row)), std::max(hi[1], j + 1),
             std::max(hi[2], k + 1)};
+      if (columns != nullptr) {
+        int& begin = columns->begin[static_cast<std::size_t>(j)];
+        int& end = columns->end[static_cast<std::size_t>(j)];
+        begin = std::min(begin, static_cast<int>(first - row));
+        end = std::max(end, static_cast<int>(last.base() - row));
+      }
     }
   if (hi[0] == 0) return {{0, 0, 0}, {0, 0, 0}};
   return {{std::max(lo[0] - 1, 0), std::max(lo[1] - 1, 0), std::max(lo[2] - 1, 0)},
@@ -239,14 +272,14 @@ Box grown(const Box& box, const GridSpec& s, int cells) {
 // The field over `outsideBox` (which holds every inside voxel), min(value, clamp), and `clamp`
 // beyond it; then every inside voxel's negative distance to the outside. `limit` (squared
 // voxels) must hold every outside value up to the clamp: a value over it becomes the clamp.
-std::vector<float> fieldOver(const VoxelGrid& grid, const Box& occupied, const Box& outsideBox,
-                             float clamp, Squared limit, int threads) {
+std::vector<float> fieldOver(const VoxelGrid& grid, const Box& occupied, const Columns& columns,
+                             const Box& outsideBox, float clamp, Squared limit, int threads) {
   const GridSpec& s = grid.spec;
   const auto h = static_cast<float>(s.voxelSize);
   const float far = std::min(kNoVoxel, clamp);
   std::vector<float> field(s.count(), far);
   transformBox(
-      grid, outsideBox, 1, threads, limit,
+      grid, outsideBox, 1, threads, limit, &columns,
       [&](int boxJ, int boxK, const Squared* row, int iBegin, int iEnd) {
         float* out =
             &field[s.index(outsideBox.lo[0], outsideBox.lo[1] + boxJ, outsideBox.lo[2] + boxK)];
@@ -258,7 +291,7 @@ std::vector<float> fieldOver(const VoxelGrid& grid, const Box& occupied, const B
   // layer, which is outside, brings it no farther): the transform runs on that box alone.
   if (occupied.count() == 0) return field;  // nothing inside
   transformBox<true>(
-      grid, occupied, 0, threads, kNoLimit,
+      grid, occupied, 0, threads, kNoLimit, nullptr,
       [&](int boxJ, int boxK, const Squared* row, int /*iBegin*/, int /*iEnd*/) {
         const int j = occupied.lo[1] + boxJ, k = occupied.lo[2] + boxK;
         for (int i = occupied.lo[0]; i < occupied.hi[0]; ++i) {
@@ -279,7 +312,7 @@ std::vector<float> fieldOver(const VoxelGrid& grid, const Box& occupied, const B
 std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target, int threads) {
   const GridSpec& s = grid.spec;
   std::vector<float> d(s.count(), kNoVoxel);
-  transformBox(grid, wholeGrid(s), target, threads, kNoLimit,
+  transformBox(grid, wholeGrid(s), target, threads, kNoLimit, nullptr,
                [&](int j, int k, const Squared* row, int iBegin, int iEnd) {
                  std::transform(row + iBegin, row + iEnd, &d[s.index(iBegin, j, k)], toFloat);
                });
@@ -287,18 +320,21 @@ std::vector<float> squaredDistanceTo(const VoxelGrid& grid, std::uint8_t target,
 }
 
 std::vector<float> signedDistanceField(const VoxelGrid& grid, int threads) {
-  return fieldOver(grid, occupiedBox(grid), wholeGrid(grid.spec),
+  Columns columns;
+  const Box occupied = occupiedBox(grid, &columns);
+  return fieldOver(grid, occupied, columns, wholeGrid(grid.spec),
                    std::numeric_limits<float>::infinity(), kNoLimit, threads);
 }
 
 std::vector<float> signedDistanceFieldInBand(const VoxelGrid& grid, double band, int threads) {
   assert(band >= 0);  // NaN and negative bands are the caller's bug
   const GridSpec& s = grid.spec;
-  const Box occupied = occupiedBox(grid);
+  Columns columns;
+  const Box occupied = occupiedBox(grid, &columns);
   if (occupied.count() == 0) return std::vector<float>(s.count(), kNoVoxel);  // no surface
   const auto clamp = static_cast<float>(band);
   if (!(band < (s.nx + s.ny + s.nz) * s.voxelSize))  // the band holds the whole grid
-    return fieldOver(grid, occupied, wholeGrid(s), clamp, kNoLimit, threads);
+    return fieldOver(grid, occupied, columns, wholeGrid(s), clamp, kNoLimit, threads);
   // A voxel beyond the occupied box (already grown by one) grown by `cells` is, along one axis,
   // over `cells` + 1 voxels from every inside centre: its value is over (cells + 1/2) voxels,
   // beyond the band. Inside the grown box the transform is exact: it holds every inside voxel.
@@ -306,8 +342,8 @@ std::vector<float> signedDistanceFieldInBand(const VoxelGrid& grid, double band,
   // the limit is that with a voxel to spare for the float rounding.
   const double cells = band / s.voxelSize;
   const auto limit = static_cast<Squared>(std::floor((cells + 1.5) * (cells + 1.5)));
-  return fieldOver(grid, occupied, grown(occupied, s, static_cast<int>(std::ceil(cells))), clamp,
-                   limit, threads);
+  return fieldOver(grid, occupied, columns, grown(occupied, s, static_cast<int>(std::ceil(cells))),
+                   clamp, limit, threads);
 }
 
 double fieldBandFor(double reach, const GridSpec& spec) {
