@@ -2,6 +2,7 @@
 // nodes/camera/bench/reference_*.cpp) and as each other on any thread count.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "reference_chain.hpp"
@@ -66,6 +67,24 @@ TEST(FastChain, DistanceFieldAndMeshOfTheUsersHullEqualTheReferenceBitForBit) {
     EXPECT_TRUE(sameBits(sdf, reference::signedDistanceField(*hull))) << "phase " << phase;
     EXPECT_TRUE(sameMesh(meshHull(*hull, sdf), reference::meshHull(*hull, sdf)))
         << "phase " << phase;
+  }
+}
+
+// The field the benchmark's chain computes: the reference's within the band the example's
+// interactors read, the band beyond; the mesh from it is the reference's mesh.
+TEST(FastChain, BandedFieldOfTheUsersHullIsTheReferenceClampedAndGivesTheSameMesh) {
+  for (double phase : {0.5, 3.5}) {
+    const SyntheticUser user(wavingPose(phase));
+    const Rig rig(5, user);
+    auto hull = carveVisualHull(rig.views, userVolume(128));
+    ASSERT_TRUE(hull);
+    const double band = fieldBandFor(0.19, hull->spec);
+    std::vector<float> expected = reference::signedDistanceField(*hull);
+    const TriangleMesh expectedMesh = reference::meshHull(*hull, expected);
+    for (float& d : expected) d = std::min(d, static_cast<float>(band));
+    const std::vector<float> banded = signedDistanceFieldInBand(*hull, band, 2);
+    EXPECT_TRUE(sameBits(banded, expected)) << "phase " << phase;
+    EXPECT_TRUE(sameMesh(meshHull(*hull, banded), expectedMesh)) << "phase " << phase;
   }
 }
 

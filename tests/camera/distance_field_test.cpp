@@ -4,8 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 
+#include "vrflow/camera/synthetic_scene.hpp"
 #include "vrflow/camera/synthetic_user.hpp"
+#include "vrflow/camera/user_surface.hpp"
 
 namespace vrflow::camera {
 namespace {
@@ -73,19 +77,28 @@ TEST(DistanceField, SignedFieldEqualsBruteForceOnRandomGrids) {
 }
 
 // The largest |sdf - exact| over the grid, in voxels, for a solid of analytic signed distance.
+// With a finite `band`, the banded field: within the band against the analytic distance, and
+// where it holds the clamp, the analytic distance must be at least the band less a voxel.
 template <typename Distance>
-double worstErrorInVoxels(const GridSpec& spec, Distance exact) {
+double worstErrorInVoxels(const GridSpec& spec, Distance exact,
+                          double band = std::numeric_limits<double>::infinity()) {
   VoxelGrid grid(spec);
   for (int k = 0; k < spec.nz; ++k)
     for (int j = 0; j < spec.ny; ++j)
       for (int i = 0; i < spec.nx; ++i)
         grid.occupied[spec.index(i, j, k)] = exact(spec.centre(i, j, k)) <= 0 ? 1 : 0;
-  const std::vector<float> sdf = signedDistanceField(grid);
+  const std::vector<float> sdf =
+      std::isinf(band) ? signedDistanceField(grid) : signedDistanceFieldInBand(grid, band, 2);
+  const auto clamp = static_cast<float>(band);
   double worst = 0;
   for (int k = 0; k < spec.nz; ++k)
     for (int j = 0; j < spec.ny; ++j)
-      for (int i = 0; i < spec.nx; ++i)
-        worst = std::max(worst, std::abs(sdf[spec.index(i, j, k)] - exact(spec.centre(i, j, k))));
+      for (int i = 0; i < spec.nx; ++i) {
+        const float d = sdf[spec.index(i, j, k)];
+        const double truth = exact(spec.centre(i, j, k));
+        worst = std::max(
+            worst, d == clamp ? std::max(band - truth, 0.0) - spec.voxelSize : std::abs(d - truth));
+      }
   return worst / spec.voxelSize;
 }
 
@@ -109,6 +122,118 @@ TEST(DistanceField, CapsuleDistanceIsWithinOneVoxel) {
 TEST(DistanceField, AnEmptyGridIsFarEverywhere) {
   const VoxelGrid grid(GridSpec{{0, 0, 0}, 0.1, 4, 5, 6});
   for (float d : signedDistanceField(grid)) EXPECT_EQ(d, kNoVoxel);
+  for (float d : signedDistanceFieldInBand(grid, 0.2)) EXPECT_EQ(d, kNoVoxel);
+}
+
+// Whether two fields hold the same bits.
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+// The user's exact voxelisation in the benchmark's volume.
+VoxelGrid userGrid(int cells) {
+  return SyntheticUser(standingPose()).voxelize(userVolume(cells));
+}
+
+TEST(BandedDistanceField, EqualsTheWholeFieldWithinTheBandAndTheClampBeyond) {
+  for (int cells : {48, 64}) {
+    const VoxelGrid grid = userGrid(cells);
+    const std::vector<float> full = signedDistanceField(grid);
+    for (double band : {0.0, 0.5 * grid.spec.voxelSize, 0.05, 0.1, 0.23, 0.6}) {
+      const std::vector<float> banded = signedDistanceFieldInBand(grid, band, 2);
+      ASSERT_EQ(banded.size(), full.size());
+      const auto clamp = static_cast<float>(band);
+      std::size_t inBand = 0, clamped = 0, wrong = 0;
+      for (std::size_t n = 0; n < full.size(); ++n) {
+        const float expected = std::min(full[n], clamp);
+        wrong += std::memcmp(&banded[n], &expected, sizeof(float)) != 0;
+        (full[n] > clamp ? clamped : inBand) += 1;
+      }
+      EXPECT_EQ(wrong, 0u) << cells << "^3, band " << band;
+      EXPECT_GT(clamped, 0u) << "the band must leave voxels beyond it";
+      if (band > grid.spec.voxelSize) {
+        EXPECT_GT(inBand, grid.countOccupied()) << "the band must hold outside voxels too";
+      }
+    }
+  }
+}
+
+TEST(BandedDistanceField, EqualsBruteForceClampedOnRandomGrids) {
+  cv::RNG rng(23);
+  for (int trial = 0; trial < 30; ++trial) {
+    VoxelGrid grid(
+        GridSpec{{0, 0, 0}, 0.5, rng.uniform(1, 12), rng.uniform(1, 12), rng.uniform(1, 12)});
+    const double density = rng.uniform(0.0, 0.1);
+    for (auto& v : grid.occupied) v = rng.uniform(0.0, 1.0) < density ? 1 : 0;
+    const double band = rng.uniform(0.0, 3.0);
+    std::vector<float> expected = signedDistanceField(grid);
+    if (grid.countOccupied() > 0)
+      for (float& d : expected) d = std::min(d, static_cast<float>(band));
+    EXPECT_TRUE(sameBits(signedDistanceFieldInBand(grid, band), expected))
+        << "trial " << trial << ", band " << band;
+  }
+}
+
+TEST(BandedDistanceField, DoesNotDependOnTheThreadCount) {
+  const VoxelGrid grid = userGrid(64);
+  const std::vector<float> one = signedDistanceFieldInBand(grid, 0.2, 1);
+  for (int threads : {2, 3, 8})
+    EXPECT_TRUE(sameBits(signedDistanceFieldInBand(grid, 0.2, threads), one)) << threads;
+}
+
+TEST(BandedDistanceField, AnInfiniteBandIsTheWholeField) {
+  const VoxelGrid grid = userGrid(48);
+  EXPECT_TRUE(sameBits(signedDistanceFieldInBand(grid, std::numeric_limits<double>::infinity()),
+                       signedDistanceField(grid)));
+}
+
+TEST(BandedDistanceField, SphereAndCapsuleAreWithinOneVoxelInsideTheBand) {
+  const GridSpec spec = GridSpec::cube({-1, -1, -1}, 2.0, 64);
+  const double sphere = worstErrorInVoxels(
+      spec, [](const cv::Vec3d& p) { return cv::norm(p - cv::Vec3d(0.05, -0.1, 0.02)) - 0.55; },
+      0.2);
+  const Capsule capsule{{-0.5, -0.3, 0.1}, {0.45, 0.35, -0.2}, 0.22};
+  const double capsuleWorst = worstErrorInVoxels(
+      spec, [&](const cv::Vec3d& p) { return capsule.signedDistance(p); }, 0.2);
+  EXPECT_LE(sphere, 1.0);
+  EXPECT_LE(capsuleWorst, 1.0);
+}
+
+// The user as the interactors read it (UserSurface) from a field over the user's grid.
+UserSurface surfaceOf(const GridSpec& s, std::vector<float> sdf) {
+  UserSurface u;
+  u.dims = {static_cast<std::uint32_t>(s.nx), static_cast<std::uint32_t>(s.ny),
+            static_cast<std::uint32_t>(s.nz)};
+  const cv::Vec3d first = s.centre(0, 0, 0);
+  u.origin = {first[0], first[1], first[2]};
+  u.spacing = s.voxelSize;
+  u.sdf = std::move(sdf);
+  return u;
+}
+
+TEST(BandedDistanceField, ReadersWithinTheReachSeeTheWholeFieldsDistanceAndNormal) {
+  // The example's largest reach: a 0.15 m ball's centre plus the rigid interactor's 0.04 m.
+  const double reach = 0.19;
+  const VoxelGrid grid = userGrid(64);
+  const GridSpec& s = grid.spec;
+  const UserSurface full = surfaceOf(s, signedDistanceField(grid));
+  const UserSurface banded = surfaceOf(s, signedDistanceFieldInBand(grid, fieldBandFor(reach, s)));
+  cv::RNG rng(24);
+  int near = 0;
+  for (int n = 0; n < 200000; ++n) {
+    const msg::Vec3 p{rng.uniform(s.origin[0] - 0.1, s.origin[0] + s.nx * s.voxelSize + 0.1),
+                      rng.uniform(s.origin[1] - 0.1, s.origin[1] + s.ny * s.voxelSize + 0.1),
+                      rng.uniform(s.origin[2] - 0.1, s.origin[2] + s.nz * s.voxelSize + 0.1)};
+    const double d = banded.distance(p);
+    if (full.distance(p) < reach) {
+      ++near;
+      ASSERT_EQ(d, full.distance(p)) << p[0] << " " << p[1] << " " << p[2];
+      ASSERT_EQ(banded.normal(p), full.normal(p)) << p[0] << " " << p[1] << " " << p[2];
+    } else {
+      ASSERT_GE(d, reach) << "the band must not bring a far point within reach";
+    }
+  }
+  EXPECT_GT(near, 1000);
 }
 
 }  // namespace

@@ -86,7 +86,7 @@ std::string connection(const std::string& from, const std::string& to) {
 
 // The whole chain: captures, silhouettes, a merge, the hull in `slabs` slabs, the recorder.
 std::string chain(const Rig& rig, int slabs, const std::string& recording,
-                  const std::string& model = "static") {
+                  const std::string& model = "static", int hullThreads = 1) {
   std::string modules, connections;
   for (int n = 0; n < kCameras; ++n) {
     const std::string i = std::to_string(n);
@@ -107,7 +107,7 @@ std::string chain(const Rig& rig, int slabs, const std::string& recording,
       param("calibrations", rig.calibrationList()) + param("cells", std::to_string(kCells));
   std::string instances;
   if (slabs == 1) {
-    modules += module("hull", "hull", grid);
+    modules += module("hull", "hull", grid + param("threads", std::to_string(hullThreads)));
   } else {
     instances = "    <instance id=\"hull\" composite=\"camera_hull_slabs\" host=\"local\">\n" +
                 grid + param("slabs", std::to_string(slabs)) + "    </instance>\n";
@@ -155,9 +155,9 @@ std::vector<Frame> readRecording(const std::string& path) {
 }
 
 CommandResult runChain(const Rig& rig, int slabs, const std::string& recording, int iterations,
-                       const std::string& model = "static") {
-  const auto app =
-      rig.dir.write("chain" + std::to_string(slabs) + ".xml", chain(rig, slabs, recording, model));
+                       const std::string& model = "static", int hullThreads = 1) {
+  const auto app = rig.dir.write("chain" + std::to_string(slabs) + ".xml",
+                                 chain(rig, slabs, recording, model, hullThreads));
   return vrflow::testing::runVrflow(
       {"run", app, "--iterations", std::to_string(iterations), "--no-progress"}, 240);
 }
@@ -169,6 +169,7 @@ void expectNothingLeft() {
   EXPECT_TRUE(shm.empty()) << shm.front();
 }
 
+// The third run carves on 2 threads (parameter 'threads'): the same bits as the first.
 TEST(CameraModules, FiveCamerasGiveTheHullOfTheCapsulesInOneSlabOrTwoBitForBit) {
   Rig rig;
   const int iterations = kEmptyFrames + 3;
@@ -176,7 +177,7 @@ TEST(CameraModules, FiveCamerasGiveTheHullOfTheCapsulesInOneSlabOrTwoBitForBit) 
   ASSERT_EQ(one.exitCode, 0) << one.err;
   const auto two = runChain(rig, 2, rig.dir.file("two.bin"), iterations);
   ASSERT_EQ(two.exitCode, 0) << two.err;
-  const auto again = runChain(rig, 1, rig.dir.file("again.bin"), iterations);
+  const auto again = runChain(rig, 1, rig.dir.file("again.bin"), iterations, "static", 2);
   ASSERT_EQ(again.exitCode, 0) << again.err;
   expectNothingLeft();
 
@@ -199,7 +200,8 @@ TEST(CameraModules, FiveCamerasGiveTheHullOfTheCapsulesInOneSlabOrTwoBitForBit) 
     EXPECT_EQ(frame.slabs, 1u);
     EXPECT_EQ(slabbed[f].slabs, 2u);
     EXPECT_TRUE(frame.occupied == slabbed[f].occupied) << "frame " << f << ": 1 slab vs 2 slabs";
-    EXPECT_TRUE(frame.occupied == repeated[f].occupied) << "frame " << f << ": two runs";
+    EXPECT_TRUE(frame.occupied == repeated[f].occupied)
+        << "frame " << f << ": two runs, 1 and 2 threads";
     ASSERT_EQ(frame.spec.nx, kCells);
     EXPECT_EQ(frame.spec.origin, spec.origin);
     EXPECT_DOUBLE_EQ(frame.spec.voxelSize, spec.voxelSize);
@@ -371,6 +373,7 @@ TEST(CameraModules, HullRefusesABadSlabAndMasksThatDoNotMatchItsCalibrations) {
   for (const Case& c : {
            Case{calibrations + param("slab", "2/2"), "parameter 'slab': '2/2' is not K/N"},
            Case{calibrations + param("slab", "half"), "parameter 'slab': 'half'"},
+           Case{calibrations + param("threads", "0"), "threads"},
            Case{param("calibrations", rig.calibrations[0] + " " + rig.dir.file("nope.yml")),
                 "parameter 'calibrations': "},
            Case{param("calibrations", ""), "no calibration file given"},

@@ -75,5 +75,50 @@ TEST(Silhouette, AFrameBeforeAnyBackgroundIsAnError) {
   EXPECT_EQ(mask.error().message, "no background learnt before the first frame");
 }
 
+// Five cameras' extractors with a learnt room each, and one frame of the user in each camera.
+struct FiveCameras {
+  std::vector<CameraCalibration> cameras = cameraRing(5);
+  std::vector<SilhouetteExtractor> extractors;
+  std::vector<cv::Mat> images;
+
+  FiveCameras() {
+    const SyntheticUser user(standingPose());
+    for (int c = 0; c < 5; ++c) {
+      const CameraCalibration& camera = cameras[static_cast<std::size_t>(c)];
+      extractors.emplace_back(camera.imageSize);
+      for (std::uint64_t n = 0; n < 3; ++n)
+        EXPECT_TRUE(
+            extractors.back().learnBackground(renderBackground(camera.imageSize, c, 6.0, n + 1)));
+      images.push_back(renderUserImage(user, camera, c, 6.0, 99));
+    }
+  }
+};
+
+TEST(Silhouettes, EveryCameraOnTwoThreadsGivesEachCamerasOwnMask) {
+  FiveCameras rig;
+  std::vector<cv::Mat> one;
+  for (std::size_t c = 0; c < 5; ++c) one.push_back(*rig.extractors[c].extract(rig.images[c]));
+  for (int threads : {1, 2, 8}) {
+    auto masks = extractSilhouettes(rig.extractors, rig.images, threads);
+    ASSERT_TRUE(masks) << masks.error().message;
+    ASSERT_EQ(masks->size(), 5u);
+    for (std::size_t c = 0; c < 5; ++c)
+      EXPECT_EQ(cv::countNonZero((*masks)[c] != one[c]), 0) << "camera " << c << ", " << threads;
+  }
+}
+
+TEST(Silhouettes, AWrongImageOrCountIsOneErrorNamingTheCamera) {
+  FiveCameras rig;
+  rig.images[3] = cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(0));
+  auto masks = extractSilhouettes(rig.extractors, rig.images, 2);
+  ASSERT_FALSE(masks);
+  EXPECT_EQ(masks.error().message,
+            "camera 3: image of 320x240 where the camera's calibration says 640x480");
+  rig.images.pop_back();
+  masks = extractSilhouettes(rig.extractors, rig.images, 2);
+  ASSERT_FALSE(masks);
+  EXPECT_EQ(masks.error().message, "4 images for 5 cameras");
+}
+
 }  // namespace
 }  // namespace vrflow::camera

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <string>
@@ -62,31 +63,50 @@ struct Frame {
   VoxelGrid exact;
 };
 
-double msPerFrame(int frames, int repeats, const std::function<void(int)>& work) {
+// The process's CPU time (ms), all its threads: on a loaded machine the wall time measures the
+// others' work as well.
+double cpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+// The best wall and CPU ms per frame of a stage (each the least over the passes).
+struct Timing {
+  double ms = 1e30;
+  double cpuMs = 1e30;
+};
+
+Timing msPerFrame(int frames, int repeats, const std::function<void(int)>& work) {
   work(0);  // warm the caches and OpenCV's buffers
-  double best = 1e30;
+  Timing best;
   for (int r = 0; r < repeats; ++r) {
+    const double c0 = cpuMs();
     const auto t0 = std::chrono::steady_clock::now();
     for (int n = 0; n < frames; ++n) work(n);
     const auto t1 = std::chrono::steady_clock::now();
-    best = std::min(best, std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
+    best.cpuMs = std::min(best.cpuMs, (cpuMs() - c0) / frames);
+    best.ms =
+        std::min(best.ms, std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
   }
   return best;
 }
 
 // Best ms per frame of each of `variants` alternatives: `repeats` passes, each running every
 // variant over every frame in turn (after one warm-up frame each).
-std::vector<double> bestOfAlternating(std::size_t variants, int frames, int repeats,
+std::vector<Timing> bestOfAlternating(std::size_t variants, int frames, int repeats,
                                       const std::function<void(std::size_t, int)>& work) {
   for (std::size_t v = 0; v < variants; ++v) work(v, 0);
-  std::vector<double> best(variants, 1e30);
+  std::vector<Timing> best(variants);
   for (int r = 0; r < repeats; ++r)
     for (std::size_t v = 0; v < variants; ++v) {
+      const double c0 = cpuMs();
       const auto t0 = std::chrono::steady_clock::now();
       for (int n = 0; n < frames; ++n) work(v, n);
       const auto t1 = std::chrono::steady_clock::now();
-      best[v] =
-          std::min(best[v], std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
+      best[v].cpuMs = std::min(best[v].cpuMs, (cpuMs() - c0) / frames);
+      best[v].ms =
+          std::min(best[v].ms, std::chrono::duration<double, std::milli>(t1 - t0).count() / frames);
     }
   return best;
 }
@@ -106,16 +126,20 @@ struct Line {
   int voxels;
   const std::string& host;
   double load;
+  double band;  // the fast distance field's band (m); its bits are compared within it
 
-  void print(const std::string& stage, const char* code, int threads, double ms, double iou,
+  void print(const std::string& stage, const char* code, int threads, Timing t, double iou,
              int same = -1) const {
     std::printf(
         "{\"cameras\": %d, \"width\": %d, \"height\": %d, \"voxels\": %d, \"stage\": \"%s\", "
-        "\"code\": \"%s\", \"threads\": %d, \"ms_per_frame\": %.3f, \"iou\": %s, "
-        "\"same_bits_as_reference\": %s, \"load\": %.2f, \"machine\": \"%s\"}\n",
-        cameras, size.width, size.height, voxels, stage.c_str(), code, threads, ms,
+        "\"code\": \"%s\", \"threads\": %d, \"ms_per_frame\": %.3f, \"cpu_ms_per_frame\": %s, "
+        "\"iou\": %s, "
+        "\"same_bits_as_reference\": %s, \"field_band_m\": %.4f, \"load\": %.2f, "
+        "\"machine\": \"%s\"}\n",
+        cameras, size.width, size.height, voxels, stage.c_str(), code, threads, t.ms,
+        t.cpuMs < 0 ? "null" : std::to_string(t.cpuMs).c_str(),
         iou < 0 ? "null" : std::to_string(iou).c_str(),
-        same < 0 ? "null" : (same ? "true" : "false"), load, host.c_str());
+        same < 0 ? "null" : (same ? "true" : "false"), band, load, host.c_str());
     std::fflush(stdout);
   }
 };
@@ -128,10 +152,11 @@ struct StageOutputs {
 };
 
 void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats, bool baseline,
-             int threads, const std::string& host) {
-  const Line line{cameraCount, size, voxels, host, loadAverage()};
+             int threads, double reach, const std::string& host) {
   const std::vector<CameraCalibration> cameras = cameraRing(cameraCount, size);
   const GridSpec spec = userVolume(voxels);
+  const double band = fieldBandFor(reach, spec);
+  const Line line{cameraCount, size, voxels, host, loadAverage(), band};
   std::vector<SilhouetteExtractor> extractors;
   for (int c = 0; c < cameraCount; ++c) {
     extractors.emplace_back(size);
@@ -151,14 +176,19 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
     return vector[static_cast<std::size_t>(n)];
   };
   std::vector<std::vector<MaskView>> views(static_cast<std::size_t>(frames));
-  auto silhouettes = [&](int n) {
+  auto silhouettes = [&](int n, int silhouetteThreads) {
     auto& v = at(views, n);
     v.clear();
-    for (int c = 0; c < cameraCount; ++c)
-      v.push_back({&at(cameras, c), *at(extractors, c).extract(at(at(input, n).images, c))});
+    auto masks = *extractSilhouettes(extractors, at(input, n).images, silhouetteThreads);
+    for (int c = 0; c < cameraCount; ++c) v.push_back({&at(cameras, c), std::move(at(masks, c))});
   };
-  const double tSilhouette = msPerFrame(frames, repeats, silhouettes);
-  line.print("silhouette", "fast", 1, tSilhouette, -1);
+  std::vector<int> threadCounts{1};
+  if (threads > 1) threadCounts.push_back(threads);
+  const std::vector<Timing> tSilhouette =
+      bestOfAlternating(threadCounts.size(), frames, repeats,
+                        [&](std::size_t v, int n) { silhouettes(n, threadCounts[v]); });
+  for (std::size_t v = 0; v < threadCounts.size(); ++v)
+    line.print("silhouette", "fast", threadCounts[v], tSilhouette[v], -1);
   auto newOutputs = [&] {
     return StageOutputs{std::vector<VoxelGrid>(static_cast<std::size_t>(frames), VoxelGrid(spec)),
                         std::vector<std::vector<float>>(static_cast<std::size_t>(frames)),
@@ -174,8 +204,6 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
   // library's on 1 and on `threads` threads. Each stage is timed in passes that alternate the
   // variants, the best pass kept for each, so a load that changes during the run (the machine is
   // shared) weighs on all of them alike.
-  std::vector<int> threadCounts{1};
-  if (threads > 1) threadCounts.push_back(threads);
   const std::size_t variants = 1 + threadCounts.size();
   std::vector<StageOutputs> out;
   for (std::size_t v = 0; v < variants; ++v) out.push_back(newOutputs());
@@ -184,27 +212,43 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
     (void)carveVisualHull(at(views, n), 0, spec.nz, at(out[v].hulls, n), nullptr,
                           threadCounts[v - 1]);
   };
+  // The library's field is exact within the band the interactors read (--reach plus the
+  // sampling stencil, fieldBandFor) and the band beyond: its bits are compared with the
+  // reference's clamped to the band.
   auto field = [&](std::size_t v, int n) {
-    at(out[v].fields, n) = v == 0 ? reference::signedDistanceField(at(out[0].hulls, n))
-                                  : signedDistanceField(at(out[v].hulls, n), threadCounts[v - 1]);
+    at(out[v].fields, n) =
+        v == 0 ? reference::signedDistanceField(at(out[0].hulls, n))
+               : signedDistanceFieldInBand(at(out[v].hulls, n), band, threadCounts[v - 1]);
   };
   auto mesh = [&](std::size_t v, int n) {
     at(out[v].meshes, n) = v == 0 ? reference::meshHull(at(out[0].hulls, n), at(out[0].fields, n))
                                   : meshHull(at(out[v].hulls, n), at(out[v].fields, n));
   };
-  auto chain = [&](std::size_t v, int n) {
-    silhouettes(n);
+  // The target's chain: silhouettes to the hull and its distance field; `chain` adds the mesh.
+  auto hullAndField = [&](std::size_t v, int n) {
+    silhouettes(n, v == 0 ? 1 : threadCounts[v - 1]);
     hull(v, n);
     field(v, n);
+  };
+  auto chain = [&](std::size_t v, int n) {
+    hullAndField(v, n);
     mesh(v, n);
   };
-  const std::vector<double> tHull = bestOfAlternating(variants, frames, repeats, hull);
-  const std::vector<double> tField = bestOfAlternating(variants, frames, repeats, field);
-  const std::vector<double> tMesh = bestOfAlternating(variants, frames, repeats, mesh);
-  const std::vector<double> tChain = bestOfAlternating(variants, frames, repeats, chain);
+  const std::vector<Timing> tHull = bestOfAlternating(variants, frames, repeats, hull);
+  const std::vector<Timing> tField = bestOfAlternating(variants, frames, repeats, field);
+  const std::vector<Timing> tMesh = bestOfAlternating(variants, frames, repeats, mesh);
+  // This round's before: the library's field over the whole grid (signedDistanceField).
+  std::vector<float> wholeField;
+  const std::vector<Timing> tWholeField =
+      bestOfAlternating(variants - 1, frames, repeats, [&](std::size_t v, int n) {
+        wholeField = signedDistanceField(at(out[v + 1].hulls, n), threadCounts[v]);
+      });
+  const std::vector<Timing> tHullField = bestOfAlternating(variants, frames, repeats, hullAndField);
+  const std::vector<Timing> tChain = bestOfAlternating(variants, frames, repeats, chain);
   line.print("reference_hull", "reference", 1, tHull[0], meanIoU(out[0]));
   line.print("reference_distance_field", "reference", 1, tField[0], -1);
   line.print("reference_mesh", "reference", 1, tMesh[0], -1);
+  line.print("reference_chain_hull_field", "reference", 1, tHullField[0], meanIoU(out[0]));
   line.print("reference_chain", "reference", 1, tChain[0], meanIoU(out[0]));
   const StageOutputs& before = out[0];
   for (std::size_t v = 1; v < variants; ++v) {
@@ -212,23 +256,28 @@ void runCase(int cameraCount, cv::Size size, int voxels, int frames, int repeats
     bool sameHulls = true, sameFields = true, sameMeshes = true;
     for (int n = 0; n < frames; ++n) {
       sameHulls = sameHulls && at(after.hulls, n).occupied == at(before.hulls, n).occupied;
-      sameFields = sameFields && at(after.fields, n).size() == at(before.fields, n).size() &&
-                   std::memcmp(at(after.fields, n).data(), at(before.fields, n).data(),
-                               at(after.fields, n).size() * sizeof(float)) == 0;
+      std::vector<float> clamped = at(before.fields, n);
+      for (float& d : clamped) d = std::min(d, static_cast<float>(band));
+      sameFields = sameFields && at(after.fields, n).size() == clamped.size() &&
+                   std::memcmp(at(after.fields, n).data(), clamped.data(),
+                               clamped.size() * sizeof(float)) == 0;
       sameMeshes = sameMeshes && at(after.meshes, n).vertices == at(before.meshes, n).vertices &&
                    at(after.meshes, n).triangles == at(before.meshes, n).triangles;
     }
     const int t = threadCounts[v - 1];
     line.print("hull", "fast", t, tHull[v], meanIoU(after), sameHulls);
+    line.print("whole_distance_field", "fast", t, tWholeField[v - 1], -1);
     line.print("distance_field", "fast", t, tField[v], -1, sameFields);
     line.print("mesh", "fast", t, tMesh[v], -1, sameMeshes);
+    line.print("chain_hull_field", "fast", t, tHullField[v], meanIoU(after),
+               sameHulls && sameFields);
     line.print("chain", "fast", t, tChain[v], meanIoU(after),
                sameHulls && sameFields && sameMeshes);
   }
   if (baseline) {
     double sum = 0;
     const int baselineFrames = std::min(frames, 3);
-    const double tBaseline = msPerFrame(baselineFrames, 1, [&](int n) {
+    const Timing tBaseline = msPerFrame(baselineFrames, 1, [&](int n) {
       auto carved = carveVisualHullBaseline(at(views, n), spec);
       sum += intersectionOverUnion(*carved, at(input, n).exact);
     });
@@ -245,12 +294,12 @@ void runModules(int cameraCount, cv::Size size, int voxels, int iterations,
     std::fprintf(stderr, "vrflow-bench-camera: %s\n", times.error.c_str());
     return;
   }
-  const Line line{cameraCount, size, voxels, host, loadAverage()};
-  line.print("modules_capture", "fast", 1, times.captureMs, -1);
-  line.print("modules_silhouette", "fast", 1, times.silhouetteMs, -1);
-  line.print("modules_hull", "fast", 1, times.hullMs, -1);
-  line.print("modules_animator", "fast", 1, times.animatorMs, -1);
-  line.print("modules_wall", "fast", 1, times.wallMsPerFrame, -1);
+  const Line line{cameraCount, size, voxels, host, loadAverage(), -1};
+  line.print("modules_capture", "fast", 1, {times.captureMs, -1}, -1);
+  line.print("modules_silhouette", "fast", 1, {times.silhouetteMs, -1}, -1);
+  line.print("modules_hull", "fast", 1, {times.hullMs, -1}, -1);
+  line.print("modules_animator", "fast", 1, {times.animatorMs, -1}, -1);
+  line.print("modules_wall", "fast", 1, {times.wallMsPerFrame, -1}, -1);
 }
 
 }  // namespace
@@ -260,6 +309,9 @@ int main(int argc, char** argv) {
   bool quick = false, modules = true;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   int onlyCameras = 0, onlyVoxels = 0;
+  // The example's largest reach into the user's field: a 0.15 m ball's centre plus the rigid
+  // interactor's 0.04 m speculative distance.
+  double reach = 0.19;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--quick") {
@@ -268,37 +320,41 @@ int main(int argc, char** argv) {
       modules = false;
     } else if (arg == "--threads" && a + 1 < argc) {
       threads = std::atoi(argv[++a]);
+    } else if (arg == "--reach" && a + 1 < argc) {
+      reach = std::atof(argv[++a]);
     } else if (arg == "--case" && a + 2 < argc) {
       onlyCameras = std::atoi(argv[++a]);
       onlyVoxels = std::atoi(argv[++a]);
     } else {
-      std::fprintf(stderr,
-                   "usage: vrflow-bench-camera [--quick] [--no-modules] [--threads N] "
-                   "[--case CAMERAS VOXELS]\n(unknown or incomplete argument '%s')\n",
-                   arg.c_str());
+      std::fprintf(
+          stderr,
+          "usage: vrflow-bench-camera [--quick] [--no-modules] [--threads N] "
+          "[--reach METRES] [--case CAMERAS VOXELS]\n(unknown or incomplete argument '%s')\n",
+          arg.c_str());
       return 2;
     }
   }
-  if (threads < 1 || (onlyCameras != 0 && (onlyCameras < 1 || onlyVoxels < 2))) {
+  if (threads < 1 || !(reach >= 0 && reach < 100) ||
+      (onlyCameras != 0 && (onlyCameras < 1 || onlyVoxels < 2))) {
     std::fprintf(stderr,
-                 "vrflow-bench-camera: --threads must be >= 1, --case needs >= 1 camera "
-                 "and >= 2 voxels\n");
+                 "vrflow-bench-camera: --threads must be >= 1, --reach in [0, 100) m, --case "
+                 "needs >= 1 camera and >= 2 voxels\n");
     return 2;
   }
   const int frames = quick ? 2 : 10, repeats = quick ? 1 : 5;
   if (quick) {
-    runCase(5, {320, 240}, 32, frames, repeats, true, threads, host);
+    runCase(5, {320, 240}, 32, frames, repeats, true, threads, reach, host);
     if (modules) runModules(5, {320, 240}, 32, 8, host);
     return 0;
   }
   if (onlyCameras != 0) {
-    runCase(onlyCameras, {640, 480}, onlyVoxels, frames, repeats, true, threads, host);
+    runCase(onlyCameras, {640, 480}, onlyVoxels, frames, repeats, true, threads, reach, host);
     return 0;
   }
-  runCase(5, {640, 480}, 128, frames, repeats, true, threads, host);
+  runCase(5, {640, 480}, 128, frames, repeats, true, threads, reach, host);
   if (modules) runModules(5, {640, 480}, 128, 60, host);
-  runCase(5, {640, 480}, 64, frames, repeats, true, threads, host);
-  runCase(4, {640, 480}, 128, frames, repeats, false, threads, host);
-  runCase(3, {640, 480}, 128, frames, repeats, false, threads, host);
+  runCase(5, {640, 480}, 64, frames, repeats, true, threads, reach, host);
+  runCase(4, {640, 480}, 128, frames, repeats, false, threads, reach, host);
+  runCase(3, {640, 480}, 128, frames, repeats, false, threads, reach, host);
   return 0;
 }

@@ -51,6 +51,8 @@ int main() {
                 std::to_string(cells) + ")");
   const int k = std::stoi(parts[1]), n = std::stoi(parts[2]);
   const int zBegin = k * cells / n, zEnd = (k + 1) * cells / n;
+  // Threads of the carving (oneTBB, layers of blocks): the bits do not depend on them.
+  const auto threads = static_cast<int>(params.getInt("threads"));
   camera::VoxelGrid hull(spec);
   const std::uint64_t resourceId = module.newId();
   std::vector<camera::MaskView> views(cameras.size());
@@ -77,7 +79,7 @@ int main() {
                           ? camera::undistortMask(mask, cameras[c])
                           : mask;
     }
-    if (auto status = camera::carveVisualHull(views, zBegin, zEnd, hull); !status)
+    if (auto status = camera::carveVisualHull(views, zBegin, zEnd, hull, nullptr, threads); !status)
       return fail(status.error().message);
     const auto stamps = in.view().stamps();
     auto out = module.newMessage(camera::kHullSlabHeaderSize +

@@ -3,6 +3,8 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "parallel_parts.hpp"
+
 namespace vrflow::camera {
 
 SilhouetteExtractor::SilhouetteExtractor(cv::Size imageSize, const SilhouetteSettings& settings)
@@ -72,6 +74,24 @@ Result<cv::Mat> SilhouetteExtractor::extract(const cv::Mat& image,
   if (!settings_.fillHoles) cv::bitwise_and(kept, mask, kept);
   if (contours) *contours = std::move(outlines);
   return kept;
+}
+
+Result<std::vector<cv::Mat>> extractSilhouettes(std::vector<SilhouetteExtractor>& extractors,
+                                                const std::vector<cv::Mat>& images, int threads) {
+  if (images.size() != extractors.size())
+    return makeError(std::to_string(images.size()) + " images for " +
+                     std::to_string(extractors.size()) + " cameras");
+  std::vector<Result<cv::Mat>> masks(images.size(), cv::Mat());
+  forParts(threads, images.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) masks[c] = extractors[c].extract(images[c]);
+  });
+  std::vector<cv::Mat> out;
+  for (std::size_t c = 0; c < masks.size(); ++c) {
+    if (!masks[c])
+      return makeError("camera " + std::to_string(c) + ": " + masks[c].error().message);
+    out.push_back(std::move(*masks[c]));
+  }
+  return out;
 }
 
 }  // namespace vrflow::camera

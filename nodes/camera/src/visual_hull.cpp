@@ -6,6 +6,7 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 
 #include "parallel_parts.hpp"
@@ -216,9 +217,14 @@ Status carveVisualHull(const std::vector<MaskView>& views, int zBegin, int zEnd,
     return makeError("slab [" + std::to_string(zBegin) + ", " + std::to_string(zEnd) +
                      ") is not a non-empty range of the grid's " + std::to_string(hull.spec.nz) +
                      " z layers");
+  // Each camera's terms and integral image on its own thread (the same values on any count).
+  std::vector<std::optional<PreparedView>> made(views.size());
+  forParts(threads, views.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) made[v].emplace(views[v], hull.spec);
+  });
   std::vector<PreparedView> prepared;
   prepared.reserve(views.size());
-  for (const MaskView& view : views) prepared.emplace_back(view, hull.spec);
+  for (auto& view : made) prepared.push_back(std::move(*view));
   // Parts are whole layers of top blocks, each carved alone; the counts are summed in order.
   const auto layers = static_cast<std::size_t>((zEnd - zBegin + kTopBlock - 1) / kTopBlock);
   std::vector<CarveStats> partStats(layers);

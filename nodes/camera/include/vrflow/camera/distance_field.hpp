@@ -25,4 +25,18 @@ inline constexpr float kNoVoxel = 1e20f;
 /// an inside and an outside centre). Voxels beyond the grid count as outside. `threads`: as above.
 std::vector<float> signedDistanceField(const VoxelGrid& grid, int threads = 1);
 
+/// The signed distance field where the interactors read it: every value equals
+/// min(signedDistanceField(grid), float(band)) bit for bit (exact inside the body and up to
+/// `band` metres outside it, `band` beyond), and kNoVoxel everywhere when nothing is occupied.
+/// The outside transform runs only over the occupied voxels' box grown by the band, so it costs
+/// what the band holds, not the grid. `band` >= 0 (+infinity gives signedDistanceField).
+std::vector<float> signedDistanceFieldInBand(const VoxelGrid& grid, double band, int threads = 1);
+
+/// The band a field needs so that a reader that keeps only distances below `reach` (m) and
+/// samples the field trilinearly, with the normal from differences half a voxel apart
+/// (UserSurface), reads the same values as from the whole field: `reach` plus the 2 sqrt(3)
+/// voxels between the cells those samples touch (the field changes by at most the distance
+/// between two centres).
+double fieldBandFor(double reach, const GridSpec& spec);
+
 }  // namespace vrflow::camera

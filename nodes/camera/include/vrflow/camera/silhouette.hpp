@@ -44,4 +44,10 @@ class SilhouetteExtractor {
   cv::Mat kernel_;
 };
 
+/// One frame's masks, extractors[c] on images[c], the cameras shared over `threads` oneTBB
+/// threads (each extractor on one of them); the first camera's error in camera order.
+Result<std::vector<cv::Mat>> extractSilhouettes(std::vector<SilhouetteExtractor>& extractors,
+                                                const std::vector<cv::Mat>& images,
+                                                int threads = 1);
+
 }  // namespace vrflow::camera
