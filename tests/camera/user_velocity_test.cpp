@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -254,6 +255,29 @@ TEST(UserObject, RoundTripsThroughAMessageToWhatInteractorsSample) {
   builder.addDelete(11, msg::userType());
   ASSERT_TRUE(copy.apply(finish(builder)).ok());
   EXPECT_TRUE(copy.ready().empty());
+}
+
+TEST(UserObject, ABandedFrameIsTheWholeFrameWithItsFieldClampedAndTheSameMesh) {
+  const GridSpec spec = GridSpec::cube({-0.5, -0.5, -0.5}, 1.0, 48);
+  auto capsule = [](const cv::Vec3d& x) {
+    const double t = std::clamp(x[0], -0.2, 0.2);
+    return cv::norm(x - cv::Vec3d(t, 0.05, 0.0)) - 0.1;
+  };
+  const VoxelGrid grid = voxelize(spec, capsule);
+  const UserFrame whole = describeUser(grid);
+  const double band = 0.15;
+  const UserFrame banded = describeUser(grid, band, 2);
+  ASSERT_EQ(banded.sdf.size(), whole.sdf.size());
+  std::size_t clamped = 0;
+  for (std::size_t c = 0; c < whole.sdf.size(); ++c) {
+    EXPECT_EQ(banded.sdf[c], std::min(whole.sdf[c], static_cast<float>(band))) << "voxel " << c;
+    clamped += whole.sdf[c] > static_cast<float>(band) ? 1 : 0;
+  }
+  EXPECT_GT(clamped, spec.count() / 4) << "the band must clamp part of this grid";
+  EXPECT_EQ(banded.mesh.vertices, whole.mesh.vertices);
+  EXPECT_EQ(banded.mesh.triangles, whole.mesh.triangles);
+  EXPECT_EQ(banded.position, whole.position);
+  EXPECT_EQ(banded.voxels, whole.voxels);
 }
 
 TEST(UserObject, AFieldOfTheWrongKindOrGridIsAnErrorNamingTheUser) {

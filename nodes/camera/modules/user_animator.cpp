@@ -4,11 +4,14 @@
 // signed distance field and the velocity of its surface, estimated from this frame's distance
 // field and the previous one (user_velocity.hpp), stamped with the capture time and iteration of
 // the frame (capture_stamps.hpp). It takes no events: nothing pushes the user.
+#include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 
 #include "vrflow/camera/capture_stamps.hpp"
+#include "vrflow/camera/distance_field.hpp"
 #include "vrflow/camera/hull_message.hpp"
 #include "vrflow/camera/user_object.hpp"
 #include "vrflow/camera/user_velocity.hpp"
@@ -60,6 +63,16 @@ int main() {
   velocitySettings.smoothing = static_cast<int>(params.getInt("velocity-smoothing"));
   velocitySettings.band = params.getFloat("velocity-band");
   velocitySettings.frames = static_cast<int>(params.getInt("velocity-frames"));
+  const double fieldReach = params.getFloat("field-reach");
+  const int threads = static_cast<int>(params.getInt("threads"));
+  // The band the field is exact in: what the interactors read (field-reach) and what the surface
+  // velocity reads (its band and smoothing), with the margin of the readers' samples.
+  auto fieldBand = [&](const camera::GridSpec& spec) {
+    if (!(fieldReach > 0)) return std::numeric_limits<double>::infinity();
+    const double velocityReach =
+        withVelocity ? velocitySettings.band + velocitySettings.smoothing * spec.voxelSize : 0.0;
+    return camera::fieldBandFor(std::max(fieldReach, velocityReach), spec);
+  };
   camera::SurfaceChangeHistory history;
   camera::UserIds ids{module.newId(), module.newId(), module.newId(), module.newId()};
   std::optional<camera::UserFrame> previous;
@@ -74,7 +87,7 @@ int main() {
                    grid.error().message.c_str());
       return 1;
     }
-    camera::UserFrame frame = camera::describeUser(*grid);
+    camera::UserFrame frame = camera::describeUser(*grid, fieldBand(grid->spec), threads);
     const double time = module.simTime();
     if (withVelocity) {
       const bool sameGrid =

@@ -1,6 +1,7 @@
 #include "vrflow/camera/user_object.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "vrflow/camera/distance_field.hpp"
@@ -8,11 +9,12 @@
 
 namespace vrflow::camera {
 
-UserFrame describeUser(const VoxelGrid& grid) {
+UserFrame describeUser(const VoxelGrid& grid, double band, int threads) {
   UserFrame frame;
   const GridSpec& s = grid.spec;
   frame.spec = s;
-  frame.sdf = signedDistanceField(grid);
+  frame.sdf = std::isinf(band) ? signedDistanceField(grid, threads)
+                               : signedDistanceFieldInBand(grid, band, threads);
   frame.mesh = meshHull(grid, frame.sdf);
   double sum[3] = {0, 0, 0};
   int lo[3] = {s.nx, s.ny, s.nz}, hi[3] = {-1, -1, -1};

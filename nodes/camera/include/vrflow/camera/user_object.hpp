@@ -5,6 +5,7 @@
 // three dynamic resources the object names, sent before its chunk in the same message.
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "vrflow/camera/hull_mesh.hpp"
@@ -25,8 +26,11 @@ struct UserFrame {
   msg::Aabb bounds;             ///< box of the occupied voxels' cubes (the centre if none)
 };
 
-/// Distance field, mesh, centroid and bounds of `grid` (the velocity is left empty).
-UserFrame describeUser(const VoxelGrid& grid);
+/// Distance field, mesh, centroid and bounds of `grid` (the velocity is left empty). The field
+/// is signedDistanceFieldInBand(grid, band, threads): exact inside the body and up to `band` (m)
+/// outside it, `band` beyond; +infinity (the default) gives the whole field.
+UserFrame describeUser(const VoxelGrid& grid, double band = std::numeric_limits<double>::infinity(),
+                       int threads = 1);
 
 /// The ids a user animator draws once.
 struct UserIds {
