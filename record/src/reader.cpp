@@ -6,6 +6,7 @@
 #include <unistd.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -17,6 +18,41 @@ namespace {
 
 std::uint64_t padTo8(std::uint64_t n) {
   return (n + 7) & ~std::uint64_t{7};
+}
+
+// An upper bound of what one zstd frame (RFC 8878, section 3.1.1) decodes to, from its block
+// headers alone: a raw or RLE block decodes to its stated size, a compressed one to at most
+// 128 KiB (the format's block maximum). 0 for a frame whose headers do not hold together (it
+// will not decode either). zstd's own ZSTD_decompressBound returns the frame header's content
+// size when there is one, which is the claim this checks.
+std::uint64_t decodedBound(std::span<const std::byte> frame) {
+  constexpr std::uint64_t kBlockMaximum = 128 << 10;
+  if (frame.size() < 5) return 0;
+  // Magic, descriptor, window descriptor unless single-segment, dictionary id, content size.
+  const auto descriptor = std::to_integer<unsigned>(frame[4]);
+  const bool singleSegment = (descriptor & 0x20u) != 0, checksum = (descriptor & 4u) != 0;
+  constexpr std::size_t kDictionaryIdBytes[4] = {0, 1, 2, 4};
+  const unsigned contentSizeFlag = descriptor >> 6;
+  const std::size_t contentSizeBytes =
+      contentSizeFlag == 0 ? (singleSegment ? 1 : 0) : std::size_t{1} << contentSizeFlag;
+  std::size_t at =
+      5 + (singleSegment ? 0 : 1) + kDictionaryIdBytes[descriptor & 3u] + contentSizeBytes;
+  std::uint64_t bound = 0;
+  for (;;) {
+    if (at + 3 > frame.size()) return 0;
+    const std::uint32_t block = std::to_integer<std::uint32_t>(frame[at]) |
+                                std::to_integer<std::uint32_t>(frame[at + 1]) << 8 |
+                                std::to_integer<std::uint32_t>(frame[at + 2]) << 16;
+    const std::uint32_t type = (block >> 1) & 3u, size = block >> 3;
+    at += 3;
+    if (type == 3 || (type != 2 && size > kBlockMaximum)) return 0;
+    const std::size_t stored = type == 1 ? 1 : size;
+    if (stored > frame.size() - at) return 0;
+    at += stored;
+    bound += type == 2 ? kBlockMaximum : size;
+    if ((block & 1u) != 0) break;  // the last block
+  }
+  return at + (checksum ? 4 : 0) == frame.size() ? bound : 0;
 }
 
 }  // namespace
@@ -242,12 +278,27 @@ Result<std::vector<RecordView>> RecordingReader::readChunk(std::size_t i) {
     return errorAt(frameAt, "the zstd frame does not hold the chunk's " +
                                 std::to_string(c.rawBytes) + " bytes (corrupted)");
   }
+  // The sizes in the chunk and frame headers are only claims: what the frame's blocks can decode
+  // to bounds the memory taken, so a damaged or hostile file claiming gigabytes in a few bytes
+  // is refused before anything is allocated for it.
+  const std::uint64_t bound = decodedBound(compressed_);
+  if (bound < c.rawBytes) {
+    return errorAt(frameAt, "the zstd frame's blocks decode to at most " + std::to_string(bound) +
+                                " bytes, not the chunk's " + std::to_string(c.rawBytes) +
+                                " (corrupted)");
+  }
   raw_.resize(c.rawBytes);
   const std::size_t got =
       ZSTD_decompress(raw_.data(), raw_.size(), compressed_.data(), compressed_.size());
   if (ZSTD_isError(got) != 0 || got != c.rawBytes) {
     return errorAt(frameAt, std::string("the chunk does not decompress (corrupted): ") +
                                 (ZSTD_isError(got) != 0 ? ZSTD_getErrorName(got) : "short"));
+  }
+  // Every record takes at least its header: a count the chunk cannot hold is refused before
+  // anything is reserved for it.
+  if (std::uint64_t{c.records} * kRecordHeaderBytes > raw_.size()) {
+    return errorAt(c.offset, "the chunk claims " + std::to_string(c.records) + " records in " +
+                                 std::to_string(raw_.size()) + " bytes (corrupted)");
   }
   std::vector<RecordView> records;
   records.reserve(c.records);

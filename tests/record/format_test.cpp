@@ -2,6 +2,7 @@
 // readable; a file not closed is indexed by scanning; a truncated, a corrupted and a foreign-
 // version file are each one error naming the byte.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cstring>
 #include <filesystem>
@@ -229,6 +230,68 @@ TEST(RecordingFormat, ACorruptedChunkIsOneErrorNamingItsByte) {
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().message, path + ": byte " + std::to_string(chunk.offset) +
                                      ": the chunk header does not match the index (corrupted)");
+}
+
+// A chunk whose header, and whose zstd frame header, claim 2 GiB while the frame decodes to 32
+// bytes, and a chunk claiming 4 billion records in 32 bytes (what the fuzzer found): each is one
+// error naming its byte, and the reader's memory follows what the frame decodes to, not the
+// claims (before, the first allocated and zeroed the 2 GiB, the second threw bad_alloc).
+TEST(RecordingFormat, SizesAChunkOnlyClaimsCostNoMemoryAndAreOneError) {
+  TempDir dir;
+  const std::string path = dir.file("claims.vrrec");
+  writeSample(path);
+  std::uint64_t chunkAt = 0;
+  {
+    auto reader = RecordingReader::open(path);
+    ASSERT_TRUE(reader);
+    chunkAt = (*reader)->chunks()[0].offset;
+  }
+  const auto header = readBytes(path);
+  // A chunk after the sample's connection table, with no index (the reader scans for it).
+  const auto writeChunk = [&](std::uint32_t records, std::uint64_t claimedRaw,
+                              std::uint8_t rleBytes) {
+    std::vector<std::byte> frame(4 + 1 + 8 + 3 + 1);
+    vrflow::record::putU32(frame.data(), 0xFD2FB528);  // zstd frame magic
+    frame[4] = std::byte{0xE0};                        // single segment, 8-byte content size
+    vrflow::record::putU64(frame.data() + 5, claimedRaw);
+    const std::uint32_t block = (std::uint32_t{rleBytes} << 3) | (1u << 1) | 1u;  // last, RLE
+    frame[13] = std::byte(block & 0xff);
+    frame[14] = std::byte((block >> 8) & 0xff);
+    frame[15] = std::byte((block >> 16) & 0xff);
+    std::vector<std::byte> bytes(header.begin(), header.begin() + static_cast<long>(chunkAt));
+    std::vector<std::byte> chunk(vrflow::record::kChunkHeaderBytes);
+    vrflow::record::putU32(chunk.data(), vrflow::record::kChunkMagic);
+    vrflow::record::putU32(chunk.data() + 4, records);
+    vrflow::record::putU64(chunk.data() + 8, frame.size());
+    vrflow::record::putU64(chunk.data() + 16, claimedRaw);
+    bytes.insert(bytes.end(), chunk.begin(), chunk.end());
+    bytes.insert(bytes.end(), frame.begin(), frame.end());
+    writeBytes(path, bytes);
+  };
+  rusage before{};
+  getrusage(RUSAGE_SELF, &before);
+  writeChunk(1, std::uint64_t{2} << 30, 32);
+  auto reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader) << reader.error().message;
+  ASSERT_EQ((*reader)->chunks().size(), 1u);
+  auto records = (*reader)->readChunk(0);
+  ASSERT_FALSE(records);
+  EXPECT_EQ(records.error().message,
+            path + ": byte " + std::to_string(chunkAt + vrflow::record::kChunkHeaderBytes) +
+                ": the zstd frame's blocks decode to at most 32 bytes, not the chunk's 2147483648 "
+                "(corrupted)");
+  rusage after{};
+  getrusage(RUSAGE_SELF, &after);
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 512 << 10) << "KiB more at its peak";
+
+  writeChunk(0xFFFFFFFF, 32, 32);
+  reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader) << reader.error().message;
+  records = (*reader)->readChunk(0);
+  ASSERT_FALSE(records);
+  EXPECT_EQ(records.error().message, path + ": byte " + std::to_string(chunkAt) +
+                                         ": the chunk claims 4294967295 records in 32 bytes "
+                                         "(corrupted)");
 }
 
 // Chunks stored uncompressed (what the writer does while its compression thread is busy):
