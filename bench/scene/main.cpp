@@ -22,6 +22,12 @@
 // included; for the loop: its thread) and the load average; network lines add
 // "cpu_of_monolithic", their CPU time over the loop's of the same round: what the network adds
 // in work, which a loaded machine disturbs less than the wall-clock ratio.
+// Lines also carry "median_iteration_us": for the loop the median of its steps' wall times, for
+// the network the median time between consecutive iterations of the bodies' animator (from a
+// trace of the longer run, the measured iterations only); network lines add
+// "median_of_monolithic", the loop's median over the network's: the wall-clock ratio of a
+// typical iteration, which the other processes of a loaded machine disturb only in the
+// iterations they preempt (the mean-based "of_monolithic" pays for every preemption).
 #include <btBulletDynamicsCommon.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -137,16 +143,49 @@ struct Timing {
   double cpuSeconds = 0;
 };
 
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n == 0 ? 0 : n % 2 == 1 ? values[n / 2] : (values[n / 2 - 1] + values[n / 2]) / 2;
+}
+
+// The median time (us) between the starts of consecutive iterations of `module`, from iteration
+// `first` on, in a trace written by `vrflow run --trace`; 0 if the trace has too few.
+double medianPeriodUs(const fs::path& trace, const std::string& module, int first) {
+  std::ifstream in(trace);
+  const auto json = nlohmann::json::parse(in, nullptr, false);
+  if (json.is_discarded() || !json.contains("traceEvents")) return 0;
+  int tid = -1;
+  for (const auto& e : json["traceEvents"])
+    if (e.value("ph", "") == "M" && e.value("name", "") == "thread_name" &&
+        e["args"].value("name", "") == module)
+      tid = e["tid"].get<int>();
+  std::map<std::uint64_t, double> starts;  // by iteration
+  for (const auto& e : json["traceEvents"]) {
+    if (e.value("ph", "") != "X" || e.value("name", "") != "compute" || e.value("tid", -2) != tid)
+      continue;
+    const auto iteration = e["args"].value("iteration", std::uint64_t{0});
+    if (iteration >= static_cast<std::uint64_t>(first)) starts[iteration] = e["ts"].get<double>();
+  }
+  std::vector<double> periods;
+  for (auto it = starts.begin(); it != starts.end() && std::next(it) != starts.end(); ++it)
+    if (std::next(it)->first == it->first + 1)
+      periods.push_back(std::next(it)->second - it->second);
+  return periods.size() < 2 ? 0 : median(periods);
+}
+
 // Wall time of `vrflow run` for `iterations`, from its report (spawning included), and the CPU
 // time of all its processes, with the programs of `bin`.
+// With `trace`, the run also writes its trace there.
 Result<Timing> runNetwork(const Context& ctx, const fs::path& bin, const std::string& appFile,
-                          int iterations) {
+                          int iterations, const fs::path& trace = {}) {
   const fs::path report = ctx.work / "report.json";
   fs::remove(report);
-  const std::string command = "cd " + quote(ctx.work.string()) + " && " +
-                              quote((bin / "vrflow").string()) + " run " + quote(appFile) + " -n " +
-                              std::to_string(iterations) + " --no-progress --report " +
-                              quote(report.string()) + " > run.log 2>&1";
+  const std::string command =
+      "cd " + quote(ctx.work.string()) + " && " + quote((bin / "vrflow").string()) + " run " +
+      quote(appFile) + " -n " + std::to_string(iterations) + " --no-progress --report " +
+      quote(report.string()) + (trace.empty() ? "" : " --trace " + quote(trace.string())) +
+      " > run.log 2>&1";
   const double cpuBefore = cpuSeconds(RUSAGE_CHILDREN);
   if (const int status = std::system(command.c_str()); status != 0) {
     return makeError("vrflow run failed (status " + std::to_string(status) + "); see " +
@@ -161,6 +200,7 @@ Result<Timing> runNetwork(const Context& ctx, const fs::path& bin, const std::st
 struct Rate {
   double perSecond = 0;
   double cpuMsPerIteration = 0;
+  double medianIterationUs = 0;  ///< see the file's comment; 0 if unknown
 };
 
 // Steady-state rate of the network: the difference of two runs of different lengths cancels the
@@ -171,11 +211,14 @@ Result<Rate> networkRate(const Context& ctx, const fs::path& bin, int objects, b
   if (!appFile) return appFile.error();
   auto shorter = runNetwork(ctx, bin, *appFile, warm);
   if (!shorter) return shorter.error();
-  auto longer = runNetwork(ctx, bin, *appFile, warm + measured);
+  const fs::path trace = ctx.work / "trace.json";
+  fs::remove(trace);
+  auto longer = runNetwork(ctx, bin, *appFile, warm + measured, trace);
   if (!longer) return longer.error();
   const double seconds = longer->wallSeconds - shorter->wallSeconds;
   if (seconds <= 0) return makeError("the longer run was not longer; the machine is too noisy");
-  return Rate{measured / seconds, 1e3 * (longer->cpuSeconds - shorter->cpuSeconds) / measured};
+  return Rate{measured / seconds, 1e3 * (longer->cpuSeconds - shorter->cpuSeconds) / measured,
+              medianPeriodUs(trace, "bodies", warm)};
 }
 
 // The same solvers in one loop: what one iteration of the network computes, in the network's
@@ -318,23 +361,24 @@ class BulletWorld {
 template <typename Step>
 Rate loopRate(Step&& step, int warm, int measured) {
   for (int i = 0; i < warm; ++i) step();
+  std::vector<double> steps;
+  steps.reserve(static_cast<std::size_t>(measured));
   const double cpuBefore = cpuSeconds(RUSAGE_THREAD);
   const auto start = Clock::now();
-  for (int i = 0; i < measured; ++i) step();
+  for (int i = 0; i < measured; ++i) {
+    const auto before = Clock::now();
+    step();
+    steps.push_back(std::chrono::duration<double, std::micro>(Clock::now() - before).count());
+  }
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  return Rate{measured / wall, 1e3 * (cpuSeconds(RUSAGE_THREAD) - cpuBefore) / measured};
+  return Rate{measured / wall, 1e3 * (cpuSeconds(RUSAGE_THREAD) - cpuBefore) / measured,
+              median(std::move(steps))};
 }
 
 // The 1-minute load average (other work on the machine), or -1.
 double loadAverage() {
   double load[1];
   return getloadavg(load, 1) == 1 ? load[0] : -1;
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n == 0 ? 0 : n % 2 == 1 ? values[n / 2] : (values[n / 2 - 1] + values[n / 2]) / 2;
 }
 
 void print(const std::string& variant, int objects, double rate, const std::string& extra = {}) {
@@ -398,7 +442,7 @@ int main(int argc, char** argv) {
     std::vector<Variant> variants{{"network", false, ctx.bin}};
     if (objects == 20) variants.push_back({"network-sequential", true, ctx.bin});
     if (!ctx.baseline.empty()) variants.push_back({"network-baseline", false, ctx.baseline});
-    std::map<std::string, std::vector<double>> ratios, cpuRatios;
+    std::map<std::string, std::vector<double>> ratios, cpuRatios, medianRatios;
     for (int round = 0; round < rounds; ++round) {
       Monolithic mono;
       if (auto ok = mono.init(*bodies, objects == 20); !ok) {
@@ -406,10 +450,11 @@ int main(int argc, char** argv) {
         return 2;
       }
       const Rate monoRate = loopRate([&] { mono.step(); }, warm, measured);
-      char extra[200];
+      char extra[320];
       std::snprintf(extra, sizeof extra,
-                    ",\"cpu_ms_per_iteration\":%.3f,\"round\":%d,\"load_average\":%.1f",
-                    monoRate.cpuMsPerIteration, round, loadAverage());
+                    ",\"cpu_ms_per_iteration\":%.3f,\"median_iteration_us\":%.1f,\"round\":%d,"
+                    "\"load_average\":%.1f",
+                    monoRate.cpuMsPerIteration, monoRate.medianIterationUs, round, loadAverage());
       print("monolithic", objects, monoRate.perSecond, extra);
       if (objects == 20) {
         // Before issue 26's stable net, in the same round: the springs once per step.
@@ -436,20 +481,28 @@ int main(int argc, char** argv) {
         }
         const double ratio = network->perSecond / monoRate.perSecond;
         const double cpuRatio = network->cpuMsPerIteration / monoRate.cpuMsPerIteration;
+        const double medianRatio = network->medianIterationUs > 0
+                                       ? monoRate.medianIterationUs / network->medianIterationUs
+                                       : 0;
         ratios[variant.name].push_back(ratio);
         cpuRatios[variant.name].push_back(cpuRatio);
+        medianRatios[variant.name].push_back(medianRatio);
         std::snprintf(extra, sizeof extra,
                       ",\"of_monolithic\":%.3f,\"cpu_ms_per_iteration\":%.3f,"
-                      "\"cpu_of_monolithic\":%.3f,\"round\":%d,\"load_average\":%.1f",
-                      ratio, network->cpuMsPerIteration, cpuRatio, round, loadAverage());
+                      "\"cpu_of_monolithic\":%.3f,\"median_iteration_us\":%.1f,"
+                      "\"median_of_monolithic\":%.3f,\"round\":%d,\"load_average\":%.1f",
+                      ratio, network->cpuMsPerIteration, cpuRatio, network->medianIterationUs,
+                      medianRatio, round, loadAverage());
         print(variant.name, objects, network->perSecond, extra);
       }
     }
     for (const auto& [name, values] : ratios) {
       std::printf(
           "{\"variant\":\"%s\",\"objects\":%d,\"rounds\":%zu,"
-          "\"of_monolithic_median\":%.3f,\"cpu_of_monolithic_median\":%.3f}\n",
-          name.c_str(), objects, values.size(), median(values), median(cpuRatios[name]));
+          "\"of_monolithic_median\":%.3f,\"cpu_of_monolithic_median\":%.3f,"
+          "\"median_of_monolithic_median\":%.3f}\n",
+          name.c_str(), objects, values.size(), median(values), median(cpuRatios[name]),
+          median(medianRatios[name]));
     }
     BulletWorld bullet;
     for (const rigid::Body& b : *bodies) bullet.add(b);

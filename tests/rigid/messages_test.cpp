@@ -28,6 +28,7 @@ TEST(RigidMessages, AddThenUpdateRoundTripsThroughTheCopy) {
     const auto& e = copy.entries().at(b.id);
     EXPECT_TRUE(e.hasShape);
     EXPECT_TRUE(e.shapeChanged);
+    EXPECT_TRUE(e.stateChanged);
     EXPECT_EQ(e.body.shape, b.shape);
     EXPECT_EQ(e.body.kinematic, b.kinematic);
     EXPECT_EQ(e.body.position, b.position);
@@ -52,8 +53,12 @@ TEST(RigidMessages, AddThenUpdateRoundTripsThroughTheCopy) {
   EXPECT_TRUE(object->aabb(msg::RigidParam::kBounds));
   EXPECT_FALSE(object->vec3(msg::RigidParam::kLinearVelocity));
   EXPECT_FALSE(object->scalar(msg::RigidParam::kMass));
+  for (auto& [id, entry] : copy.entries()) entry.stateChanged = false;
   ASSERT_TRUE(copy.apply(*view2));
   EXPECT_EQ(copy.entries().at(moved.id).body.position, moved.position);
+  // Only the updated body is flagged: a reader refreshes its own copy of that one only.
+  for (const auto& [id, entry] : copy.entries())
+    EXPECT_EQ(entry.stateChanged, id == moved.id) << "body " << id;
 }
 
 TEST(RigidMessages, MaterialsTravelOnlyWhenABodyHasItsOwn) {

@@ -42,6 +42,9 @@ int main() {
       }
     }
     for (auto id : deleted) solver.removeBody(id);
+    // Only the bodies this message added or updated: the others' poses and velocities are
+    // already the solver's (the animator sends a body only when it changed; a settled scene
+    // sends almost none).
     for (auto& [id, entry] : copy.entries()) {
       if (!entry.hasShape) continue;
       if (entry.shapeChanged || !solver.contains(id)) {
@@ -50,10 +53,11 @@ int main() {
           return 1;
         }
         entry.shapeChanged = false;
-      } else {
+      } else if (entry.stateChanged) {
         const auto& b = entry.body;
         solver.setState(id, b.position, b.orientation, b.linearVelocity, b.angularVelocity);
       }
+      entry.stateChanged = false;
     }
     const double dt = module.timeStep() > 0 ? module.timeStep() : fallbackDt;
     solver.setUsers(users.ready());

@@ -64,6 +64,28 @@ double reboundVelocity(double e, double vn, double gap, double a, double dt) {
   return std::max(-0.5 * a * dt + std::sqrt(discriminant), 0.0);
 }
 
+// Axis 0 is the normal (from b to a), 1 and 2 the friction tangents. For each axis the
+// Jacobian's angular parts r x d and their images through the inverse inertia are precomputed.
+struct Constraint {
+  std::size_t a, b;
+  Eigen::Vector3d ra, rb;
+  std::array<Eigen::Vector3d, 3> dir, raxd, rbxd, ia, ib;
+  std::array<double, 3> mass, acc;
+  double target;
+  double friction;  // the pair's coefficient
+  Eigen::Vector3d accRoll;
+  RowMatrix3d rollMass;    // inverse of (Ia^-1 + Ib^-1)
+  bool rolls;              // a sphere or capsule is involved
+  btManifoldPoint* point;  // Bullet's point (warm starting), null for a user contact
+  Eigen::Vector3d surface = Eigen::Vector3d::Zero();  // b's surface velocity (users)
+};
+
+// A manifold in the order of its pair of ids.
+struct PairRef {
+  std::uint64_t lo, hi;
+  int index;
+};
+
 }  // namespace
 
 double combinedFriction(double a, double b, double fallback) {
@@ -232,6 +254,15 @@ struct RigidContactSolver::Impl {
   btDbvtBroadphase broadphase;
   btCollisionWorld world{&dispatcher, &broadphase, &config};
   std::map<std::uint64_t, std::unique_ptr<Entry>> entries;
+  // solve()'s dense per-body arrays, constraints and ordered manifolds, reused across steps.
+  struct Scratch {
+    std::vector<Entry*> bodies;
+    std::vector<double> invMass;
+    std::vector<RowMatrix3d> invInertia;
+    std::vector<Eigen::Vector3d> v, w, linear, angular;
+    std::vector<Constraint> constraints;
+    std::vector<PairRef> pairs;
+  } scratch;
 };
 
 RigidContactSolver::RigidContactSolver(ContactParams params)
@@ -293,15 +324,17 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   const ContactParams& p = params_;
 
   // Dense per-body arrays in id order; predicted velocities include the external acceleration.
+  // The arrays live in impl_ and keep their capacity from step to step: allocated anew, the
+  // constraints (about 0.6 KB each) took fresh pages from the kernel on every step.
   const std::size_t n = impl_->entries.size();
-  std::vector<Impl::Entry*> bodies;
-  bodies.reserve(n);
+  auto& [bodies, invMass, invInertia, v, w, linear, angular, constraints, pairs] = impl_->scratch;
+  bodies.clear();
   // Slot n stands for the captured users: infinite mass, at rest (their surface velocity is a
   // constraint's `surface`).
-  std::vector<double> invMass(n + 1, 0.0);
-  std::vector<RowMatrix3d> invInertia(n + 1, RowMatrix3d::Zero());
-  std::vector<Eigen::Vector3d> v(n + 1, Eigen::Vector3d::Zero()), w(n + 1, Eigen::Vector3d::Zero()),
-      linear(n + 1, Eigen::Vector3d::Zero()), angular(n + 1, Eigen::Vector3d::Zero());
+  invMass.assign(n + 1, 0.0);
+  invInertia.assign(n + 1, RowMatrix3d::Zero());
+  for (auto* vectors : {&v, &w, &linear, &angular}) vectors->assign(n + 1, Eigen::Vector3d::Zero());
+  constraints.clear();
   for (auto& [id, entry] : impl_->entries) {
     const std::size_t k = bodies.size();
     entry->dense = k;
@@ -323,22 +356,6 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   }
   impl_->restoreMeshPoints();
 
-  // Axis 0 is the normal (from b to a), 1 and 2 the friction tangents. For each axis the
-  // Jacobian's angular parts r x d and their images through the inverse inertia are precomputed.
-  struct Constraint {
-    std::size_t a, b;
-    Eigen::Vector3d ra, rb;
-    std::array<Eigen::Vector3d, 3> dir, raxd, rbxd, ia, ib;
-    std::array<double, 3> mass, acc;
-    double target;
-    double friction;  // the pair's coefficient
-    Eigen::Vector3d accRoll;
-    RowMatrix3d rollMass;    // inverse of (Ia^-1 + Ib^-1)
-    bool rolls;              // a sphere or capsule is involved
-    btManifoldPoint* point;  // Bullet's point (warm starting), null for a user contact
-    Eigen::Vector3d surface = Eigen::Vector3d::Zero();  // b's surface velocity (users)
-  };
-  std::vector<Constraint> constraints;
   auto velocityAlong = [&](const Constraint& c, int axis) {
     return v[c.a].dot(c.dir[axis]) + w[c.a].dot(c.raxd[axis]) - v[c.b].dot(c.dir[axis]) -
            w[c.b].dot(c.rbxd[axis]) - c.surface.dot(c.dir[axis]);
@@ -392,11 +409,7 @@ std::vector<std::pair<std::uint64_t, msg::ForceEvent>> RigidContactSolver::solve
   };
 
   // Manifolds in the order of their pair of ids (then Bullet's order, deterministic too).
-  struct PairRef {
-    std::uint64_t lo, hi;
-    int index;
-  };
-  std::vector<PairRef> pairs;
+  pairs.clear();
   const int manifolds = impl_->dispatcher.getNumManifolds();
   for (int m = 0; m < manifolds; ++m) {
     btPersistentManifold* manifold = impl_->dispatcher.getManifoldByIndexInternal(m);

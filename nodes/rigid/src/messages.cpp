@@ -66,6 +66,7 @@ Status RigidObjectCopy::apply(const msg::MessageView& message,
     const bool isNew = !entries_.contains(object->id());
     Entry& e = entries_[object->id()];
     e.body.id = object->id();
+    e.stateChanged = true;
     if (isNew) e.shapeChanged = true;
     if (auto v = object->vec3(P::kPosition)) e.body.position = *v;
     if (auto v = object->quat(P::kOrientation)) e.body.orientation = *v;

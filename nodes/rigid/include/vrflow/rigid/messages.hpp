@@ -34,6 +34,9 @@ class RigidObjectCopy {
     std::uint64_t shapeId = 0;
     bool hasShape = false;
     bool shapeChanged = false;  ///< set when the shape (or the body) is new since the last clear
+    /// set when an add or update chunk of the body arrived since the last clear: a reader that
+    /// keeps its own copy of the state (the contact solver) updates only these bodies
+    bool stateChanged = false;
   };
   /// Applies the message's rigid add/update/delete chunks and shape resources. Returns an error
   /// for a shape resource that does not decode. `deleted` receives removed ids when given.
