@@ -1,0 +1,53 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <span>
+#include <vector>
+
+#include "vrflow/camera/user_surface.hpp"
+#include "vrflow/massspring/net.hpp"
+
+// The captured user (nodes/camera's UserSurface: signed distance field and surface velocity) as a
+// kinematic collider inside the net's sub-steps, a position constraint like the maximum stretch.
+//
+// After a sub-step's integration, every free node closer than `thickness` to the user's surface
+// goes out along the field's gradient to that distance; its velocity relative to the user's
+// surface velocity there loses its approaching normal part (inelastic), and its tangential part
+// loses at most `friction` times that normal change (Coulomb). The user is infinitely heavy:
+// nothing pushes it. A node is tested along its path over the sub-step (continuous), so a fast
+// node cannot cross a thin hand between two sub-steps, and a node remembers the side it was last
+// outside on (a voxel hull moves by whole voxels and can swallow a node past the middle of a
+// hand, where the gradient points out of the far side): it goes out of the side it came from.
+// The field is the user's last frame, held over the outer step (a snapshot, as the external
+// forces are).
+
+namespace vrflow::massspring {
+
+/// The collider's settings.
+struct UserColliderParams {
+  double thickness = 0.02;  ///< distance kept between a node and the user's surface (m), > 0
+  double friction = 0.5;    ///< Coulomb coefficient between the net and the user, >= 0
+};
+Status validateUserColliderParams(const UserColliderParams& params);
+
+/// What the collider keeps between sub-steps and steps: for each user, each node's outward normal
+/// the last time it was near the user and outside it (zero: not seen).
+struct UserColliderMemory {
+  std::map<std::uint64_t, std::vector<msg::Vec3>> sides;
+};
+
+/// The users a net collides with inside its sub-steps (step()).
+struct UserColliders {
+  std::map<std::uint64_t, const camera::UserSurface*> users;  ///< by id, ready fields only
+  UserColliderParams params;
+  UserColliderMemory* memory = nullptr;  ///< keep one per net across steps; may be null
+};
+
+/// Projects the net's free nodes out of every user (in id order), `before` holding the nodes'
+/// positions at the start of the sub-step (xyz per node; empty: no path test). Returns how many
+/// node projections were made.
+std::size_t collideWithUsers(Net& net, std::span<const double> before,
+                             const UserColliders& colliders);
+
+}  // namespace vrflow::massspring
