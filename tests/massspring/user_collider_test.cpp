@@ -207,6 +207,30 @@ TEST(UserCollider, ABallNarrowerThanTheNetsSpacingPressesItAndDoesNotPassBetween
   EXPECT_GT(lowestAfterABallThroughACell(false), -0.02);
 }
 
+TEST(UserCollider, TheSurfaceSweepsFromTheFrameBeforeToTheLastOverTheSubSteps) {
+  // A node at the thickness above the sphere's top; the last frame has the sphere 1 cm higher.
+  const auto before = sphereUser({0, 0, 0}, {0, 1, 0});
+  const auto last = sphereUser({0, 0.01, 0}, {0, 1, 0});
+  UserColliders colliders;
+  colliders.users = {{last.id, &last}};
+  colliders.previous = {{before.id, &before}};
+  const double top = kRadius + 0.02;
+  // One tenth of the way (the first of 10 sub-steps): the node rises one tenth of the jump.
+  Net net = oneNode({0, top, 0}, {0, 0, 0});
+  EXPECT_EQ(collideWithUsers(net, net.positions, colliders, 0.1), 1u);
+  EXPECT_NEAR(net.position(0)[1], top + 0.001, 2e-4);
+  EXPECT_NEAR(net.velocity(0)[1], 1.0, 1e-6) << "at the surface's speed";
+  // At the end of the step, the last frame.
+  net = oneNode({0, top, 0}, {0, 0, 0});
+  EXPECT_EQ(collideWithUsers(net, net.positions, colliders, 1.0), 1u);
+  EXPECT_NEAR(net.position(0)[1], top + 0.01, 2e-4);
+  // Without the frame before, the whole jump at once.
+  colliders.previous.clear();
+  net = oneNode({0, top, 0}, {0, 0, 0});
+  EXPECT_EQ(collideWithUsers(net, net.positions, colliders, 0.1), 1u);
+  EXPECT_NEAR(net.position(0)[1], top + 0.01, 2e-4);
+}
+
 TEST(UserCollider, RejectsBadParameters) {
   EXPECT_FALSE(validateUserColliderParams({0, 0.5}));
   EXPECT_FALSE(validateUserColliderParams({0.02, -1}));

@@ -308,7 +308,8 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
       }
     }
     // The users hold the nodes they touch before the springs' limits are projected.
-    if (colliding) collideWithUsers(net, before, *users);
+    if (colliding)
+      collideWithUsers(net, before, *users, static_cast<double>(sub + 1) / options.substeps);
     worst = enforceMaxStretch(net, h, options.constraintIterations, start, multipliers);
   }
   return worst;

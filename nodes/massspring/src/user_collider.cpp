@@ -21,6 +21,58 @@ Vector3d nodeOf(std::span<const double> values, std::size_t i) {
   return {values[3 * i], values[3 * i + 1], values[3 * i + 2]};
 }
 
+/// A user's field over the sub-steps: its last frame blended in from the frame before by
+/// `alpha` (0: the frame before, 1: the last frame), so the surface sweeps over the outer step
+/// instead of jumping at its start. Without a frame before, the last frame.
+class Field {
+ public:
+  Field(const camera::UserSurface& now, const camera::UserSurface* before, double alpha)
+      : now_(now),
+        before_(before && before->ready() && alpha < 1 ? before : nullptr),
+        alpha_(alpha),
+        spacing(now.spacing),
+        bounds(now.bounds) {
+    if (!before_) return;
+    for (int k = 0; k < 3; ++k) {
+      bounds.min[k] = std::min(bounds.min[k], before_->bounds.min[k]);
+      bounds.max[k] = std::max(bounds.max[k], before_->bounds.max[k]);
+    }
+  }
+  double distance(const msg::Vec3& p) const {
+    const double d = now_.distance(p);
+    return before_ ? alpha_ * d + (1 - alpha_) * before_->distance(p) : d;
+  }
+  /// The blended field's unit gradient (central differences half a cell apart, as
+  /// UserSurface::normal); zero where it vanishes.
+  msg::Vec3 normal(const msg::Vec3& p) const {
+    if (!before_) return now_.normal(p);
+    const double h = 0.5 * spacing;
+    msg::Vec3 g{};
+    double norm = 0;
+    for (int a = 0; a < 3; ++a) {
+      msg::Vec3 lo = p, hi = p;
+      lo[a] -= h;
+      hi[a] += h;
+      g[a] = (distance(hi) - distance(lo)) / (2 * h);
+      norm += g[a] * g[a];
+    }
+    norm = std::sqrt(norm);
+    if (!(norm > 1e-6)) return {};
+    for (double& x : g) x /= norm;
+    return g;
+  }
+  msg::Vec3 velocityAt(const msg::Vec3& p) const { return now_.velocityAt(p); }
+
+ private:
+  const camera::UserSurface& now_;
+  const camera::UserSurface* before_;
+  double alpha_;
+
+ public:
+  const double spacing;
+  msg::Aabb bounds;  ///< both frames' boxes
+};
+
 /// Whether the box of the path a -> b meets `box` grown by `margin`.
 bool pathNearBox(const Vector3d& a, const Vector3d& b, const msg::Aabb& box, double margin) {
   for (int k = 0; k < 3; ++k) {
@@ -34,8 +86,7 @@ bool pathNearBox(const Vector3d& a, const Vector3d& b, const msg::Aabb& box, dou
 /// the gradient points away from `side` (the side the node came from: past the middle of a thin
 /// part) or vanishes, along `side`, by at least a cell, until it agrees again. Returns the outward
 /// normal where x ends (zero when neither the gradient nor a side says where out is).
-Vector3d pushOut(const camera::UserSurface& user, Vector3d& x, const Vector3d& side,
-                 double thickness) {
+Vector3d pushOut(const Field& user, Vector3d& x, const Vector3d& side, double thickness) {
   constexpr int kRounds = 32;
   const double tolerance = 1e-4 * thickness;
   Vector3d n = Vector3d::Zero();
@@ -57,8 +108,8 @@ Vector3d pushOut(const camera::UserSurface& user, Vector3d& x, const Vector3d& s
 
 /// The first point of the path a -> b (a outside) closer than `thickness` to the user, found by
 /// samples `step` apart and then bisection to the last point outside; false when none is.
-bool firstEntry(const camera::UserSurface& user, const Vector3d& a, const Vector3d& b,
-                double thickness, double step, Vector3d& entry) {
+bool firstEntry(const Field& user, const Vector3d& a, const Vector3d& b, double thickness,
+                double step, Vector3d& entry) {
   const double length = (b - a).norm();
   if (!(length > 0)) return false;
   const int samples = static_cast<int>(std::min(1000.0, std::ceil(length / step)));
@@ -102,9 +153,8 @@ struct Resolved {
   Vector3d point;
   Vector3d normal;
 };
-std::optional<Resolved> resolve(const camera::UserSurface& user, const Vector3d& from,
-                                const Vector3d& x, bool withPath, Vector3d& side, double thickness,
-                                double step) {
+std::optional<Resolved> resolve(const Field& user, const Vector3d& from, const Vector3d& x,
+                                bool withPath, Vector3d& side, double thickness, double step) {
   if (side.isZero(0.0) && withPath && user.distance(asVec3(from)) >= thickness)
     side = asEigen(user.normal(asVec3(from)));
   Vector3d target = x;
@@ -148,13 +198,17 @@ constexpr std::array<std::array<double, 3>, 4> kSurfacePoints{
 }  // namespace
 
 std::size_t collideWithUsers(Net& net, std::span<const double> before,
-                             const UserColliders& colliders) {
+                             const UserColliders& colliders, double blend) {
   const double thickness = colliders.params.thickness;
   const double friction = colliders.params.friction;
   const bool withPath = before.size() == net.positions.size();
   std::size_t projected = 0;
-  for (const auto& [userId, user] : colliders.users) {
-    if (!user || !user->ready()) continue;
+  for (const auto& [userId, surface] : colliders.users) {
+    if (!surface || !surface->ready()) continue;
+    const auto previous = colliders.previous.find(userId);
+    const Field field(*surface, previous == colliders.previous.end() ? nullptr : previous->second,
+                      blend);
+    const Field* user = &field;
     std::vector<msg::Vec3> scratch;
     std::vector<msg::Vec3>* sides = &scratch;
     if (colliders.memory) sides = &colliders.memory->sides[userId];

@@ -19,8 +19,12 @@
 // node cannot cross a thin hand between two sub-steps, and a node remembers the side it was last
 // outside on (a voxel hull moves by whole voxels and can swallow a node past the middle of a
 // hand, where the gradient points out of the far side): it goes out of the side it came from.
-// The field is the user's last frame, held over the outer step (a snapshot, as the external
-// forces are).
+// A voxel hull moves by whole frames: with the frame before given, the field the sub-steps see
+// sweeps from that frame to the last one over the outer step (the two distance fields blended),
+// so a moving hand pushes the net a little every sub-step, not its whole frame's motion in the
+// first one (which, through the springs' limits, threw the net's nodes at ten times the hand's
+// speed). The net therefore meets the user one frame late. The surface velocity is the last
+// frame's.
 
 namespace vrflow::massspring {
 
@@ -40,14 +44,17 @@ struct UserColliderMemory {
 /// The users a net collides with inside its sub-steps (step()).
 struct UserColliders {
   std::map<std::uint64_t, const camera::UserSurface*> users;  ///< by id, ready fields only
+  /// The frame before each user's last one, by id (may be empty: the last frame is held).
+  std::map<std::uint64_t, const camera::UserSurface*> previous;
   UserColliderParams params;
   UserColliderMemory* memory = nullptr;  ///< keep one per net across steps; may be null
 };
 
 /// Projects the net's free nodes out of every user (in id order), `before` holding the nodes'
-/// positions at the start of the sub-step (xyz per node; empty: no path test). Returns how many
-/// node projections were made.
+/// positions at the start of the sub-step (xyz per node; empty: no path test), `blend` where the
+/// field is between the frame before (0) and the last one (1). Returns how many points (nodes and
+/// surface points) were projected.
 std::size_t collideWithUsers(Net& net, std::span<const double> before,
-                             const UserColliders& colliders);
+                             const UserColliders& colliders, double blend = 1.0);
 
 }  // namespace vrflow::massspring
