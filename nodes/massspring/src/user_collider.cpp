@@ -69,8 +69,8 @@ class Field {
   double alpha_;
 
  public:
-  const double spacing;
-  msg::Aabb bounds;  ///< both frames' boxes
+  const double spacing;  ///< the last frame's cell spacing (m)
+  msg::Aabb bounds;      ///< both frames' boxes
 };
 
 /// Whether the box of the path a -> b meets `box` grown by `margin`.
