@@ -1,9 +1,12 @@
 // massspring/animator: owns one mass-spring net (generated, or loaded from a file) and integrates
-// it with internal sub-steps from the forces it receives (see vrflow/massspring/solver.hpp).
+// it with internal sub-steps from the forces it receives (see vrflow/massspring/solver.hpp), and
+// with the captured users it receives on `users` as kinematic colliders inside those sub-steps
+// (vrflow/massspring/user_collider.hpp).
 #include <cmath>
 #include <cstdio>
 
 #include "common.hpp"
+#include "vrflow/camera/user_copy.hpp"
 #include "vrflow/massspring/objects.hpp"
 #include "vrflow/massspring/solver.hpp"
 #include "vrflow/message/builtin_types.hpp"
@@ -13,8 +16,10 @@ int main() {
   using namespace vrflow::massspring;
   const char* program = "vrflow-massspring-animator";
   Module module;
-  const auto ports = startAnimator(module, program);
-  if (!ports) return 2;
+  // The animator's ports (start.hpp's AnimatorPorts) and the users, optional.
+  const AnimatorPorts ports{module.addInput("events"), module.addOutput("objects")};
+  const InputPort& usersIn = module.addInput("users");
+  if (!initOrReport(module, program)) return 2;
   modules::Params params(module, program);
   StepOptions options;
   options.dt = params.number("dt");
@@ -23,6 +28,13 @@ int main() {
   options.constraintIterations = params.integer("constraint-iterations");
   const msg::Vec3 g = params.vec3("gravity");
   options.gravity = {g[0], g[1], g[2]};
+  UserColliderMemory userMemory;
+  UserColliders colliders;
+  colliders.params.thickness = params.number("user-thickness");
+  colliders.params.friction = params.number("user-friction");
+  colliders.memory = &userMemory;
+  if (auto status = validateUserColliderParams(colliders.params); !status)
+    params.fail(status.error().message);
 
   Net net;
   const std::string file = params.text("file");
@@ -95,9 +107,15 @@ int main() {
   }
   double time = 0.0;
   bool warnedStretch = false;
+  camera::UserCopy users;
+  std::map<std::uint64_t, camera::UserSurface> lastFrames;  // the users the last step met
   while (module.wait()) {
+    if (const Message& user = module.get(usersIn); user.valid()) {
+      if (auto status = users.apply(user.view()); !status) warnings.warn(status.error().message);
+    }
+    colliders.users = users.ready();
     std::fill(external.begin(), external.end(), 0.0);
-    const Message& received = module.get(ports->events);
+    const Message& received = module.get(ports.events);
     if (received.valid()) {
       for (const auto chunk : received.view()) {
         const auto event = chunk.asEvent();
@@ -131,7 +149,9 @@ int main() {
       }
     }
     if (module.iteration() > 0) {
-      const double worst = step(net, external, options);
+      colliders.previous.clear();
+      for (const auto& [userId, frame] : lastFrames) colliders.previous[userId] = &frame;
+      const double worst = step(net, external, options, &colliders);
       if (worst > 1 + 1e-6 && !warnedStretch) {
         warnedStretch = true;
         warnings.warn("a spring is beyond its maximum stretch (worst length/limit " +
@@ -140,6 +160,8 @@ int main() {
                       "next steps");
       }
       time += options.dt;
+      lastFrames.clear();
+      for (const auto& [userId, frame] : colliders.users) lastFrames.emplace(userId, *frame);
     }
     auto out = module.newMessage(
         256 + net.nodeCount() * 56 +
@@ -150,7 +172,7 @@ int main() {
     builder.setSimTime(time);
     builder.setTimeStep(options.dt);
     writeNet(builder, id, net, module.iteration() == 0);
-    if (!module.put(ports->objects, std::move(out))) break;
+    if (!module.put(ports.objects, std::move(out))) break;
   }
   if (!stateFile.empty()) {
     if (auto status = saveNet(net, stateFile); !status) {

@@ -1,7 +1,9 @@
 // massspring/rigid: the rigid / mass-spring interactor. Nodes of every net against every rigid
 // shape (signed distance in the body frame); node forces to the nets, and to each touched rigid
 // one ForceEvent with the opposite total force at its centre of mass and the torque about it.
-// Nodes against every captured user (type `user`) too: node forces only, the user is immovable.
+// Nodes against every captured user (type `user`) too, unless `user-contacts` is false (where the
+// net's animator collides with the users inside its sub-steps): node forces only, the user is
+// immovable.
 #include <cstdio>
 
 #include "common.hpp"
@@ -19,7 +21,8 @@ int main() {
                     ContactMemory* memory) {
         auto result = rigidContacts(scene.nets(), scene.rigids(), contact, memory);
         const auto users = scene.users();
-        if (!users.empty()) addUserContacts(scene.nets(), users, contact, result, &userMemory);
+        if (!users.empty() && module.params().getBool("user-contacts"))
+          addUserContacts(scene.nets(), users, contact, result, &userMemory);
         auto out =
             modules::nodeForcesMessage(module, result.nodeForces, result.rigidForces.size() * 128);
         for (const auto& [id, force] : result.rigidForces) out.builder().addForce(id, force);

@@ -271,11 +271,13 @@ double enforceMaxStretch(Net& net, double h, int maxIterations, std::span<const 
   return maxConstraintRatio(net);
 }
 
-double step(Net& net, std::span<const double> externalForces, const StepOptions& options) {
+double step(Net& net, std::span<const double> externalForces, const StepOptions& options,
+            const UserColliders* users) {
   const std::size_t n = net.nodeCount();
   const double h = options.dt / options.substeps;
   std::vector<double> forces(3 * n);
-  std::vector<double> start;
+  std::vector<double> start, before;
+  const bool colliding = users && !users->users.empty();
   auto& warm = options.warmStart;
   if (warm.size() != net.springs.size()) warm.assign(net.springs.size(), 0.0);
   const std::span<double> multipliers = warm;
@@ -293,6 +295,7 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
       start = net.positions;
     else
       start.clear();
+    if (colliding) before = net.positions;
     for (std::size_t i = 0; i < n; ++i) {
       if (net.pinned[i]) {
         for (int k = 0; k < 3; ++k) net.velocities[3 * i + k] = 0.0;
@@ -304,6 +307,9 @@ double step(Net& net, std::span<const double> externalForces, const StepOptions&
         net.positions[3 * i + k] += h * net.velocities[3 * i + k];
       }
     }
+    // The users hold the nodes they touch before the springs' limits are projected.
+    if (colliding)
+      collideWithUsers(net, before, *users, static_cast<double>(sub + 1) / options.substeps);
     worst = enforceMaxStretch(net, h, options.constraintIterations, start, multipliers);
   }
   return worst;

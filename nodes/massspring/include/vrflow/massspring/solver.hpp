@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "vrflow/massspring/net.hpp"
+#include "vrflow/massspring/user_collider.hpp"
 
 // Explicit integration of a net with internal sub-steps.
 //
@@ -13,7 +14,9 @@
 // positions and velocities (when `internalSprings` is set). Each sub-step is symplectic
 // (semi-implicit) Euler: v += h f / m, then x += h v, for free nodes; pinned nodes never move.
 // After each sub-step the maximum-stretch constraint is projected (see enforceMaxStretch),
-// warm-started from the last sub-step's multipliers (StepOptions::warmStart).
+// warm-started from the last sub-step's multipliers (StepOptions::warmStart). With captured users
+// (user_collider.hpp), each sub-step's integration is followed by their collider first: the
+// nodes go out of the users, then the maximum stretch is projected.
 
 namespace vrflow::massspring {
 
@@ -66,9 +69,11 @@ double feasibleFraction(const Net& net, std::span<const double> from, std::span<
 /// approaches it from below. 0 when no free node has a spring with stiffness.
 double fastestSpringFrequency(const Net& net, int iterations = 300);
 
-/// Advances the net by one outer step. `externalForces` holds xyz per node (or is empty).
+/// Advances the net by one outer step. `externalForces` holds xyz per node (or is empty);
+/// `users`, when given, are collided with after every sub-step's integration (collideWithUsers).
 /// Returns the largest constraint ratio left (see enforceMaxStretch), 0 if no spring has a limit.
-double step(Net& net, std::span<const double> externalForces, const StepOptions& options);
+double step(Net& net, std::span<const double> externalForces, const StepOptions& options,
+            const UserColliders* users = nullptr);
 
 /// Energies: kinetic, elastic (sum of k/2 (L - L0)^2) and gravitational (-sum m g.x).
 double kineticEnergy(const Net& net);
