@@ -63,7 +63,7 @@ cat > "$dir/pingpong.xml" <<XML
 XML
 run=("$bin/vrflow" --packages "$dir/packages" launch "$dir/pingpong.xml" --backend local)
 load=$(cut -d' ' -f1-3 /proc/loadavg)
-perf stat -x, -e context-switches,cpu-migrations,task-clock -o "$dir/stat" -- "${run[@]}" \
+perf stat -x, -e context-switches,cpu-migrations,task-clock,page-faults -o "$dir/stat" -- "${run[@]}" \
   >/dev/null 2>"$dir/err1" || { cat "$dir/err1" >&2; exit 1; }
 perf trace -s -o "$dir/trace" -- "${run[@]}" >/dev/null 2>"$dir/err2" || { cat "$dir/err2" >&2; exit 1; }
 messages=$((2 * rounds))
@@ -83,6 +83,7 @@ awk -v n="$messages" -v r="$rounds" '
   }' "$dir/trace" > "$dir/syscalls"
 cs=$(awk -F, -v n="$messages" '$3 == "context-switches" { printf "%.3f", $1 / n }' "$dir/stat")
 mig=$(awk -F, -v n="$messages" '$3 == "cpu-migrations" { printf "%.3f", $1 / n }' "$dir/stat")
+faults=$(awk -F, -v n="$messages" '$3 == "page-faults" { printf "%.2f", $1 / n }' "$dir/stat")
 cpu=$(awk -F, -v n="$messages" '$3 == "task-clock" { printf "%.1f", $1 * 1000 / n }' "$dir/stat")
 median=$(sort -n "$dir/rtt" | awk '{ a[NR] = $1 } END { printf "%.1f", a[int((NR + 1) / 2)] / 2000 }')
-echo "{\"code\":\"$name\",\"bytes\":$size,\"round_trips\":$rounds,\"load_at_start\":\"$load\",\"per_one_way_message\":{\"context_switches\":$cs,\"cpu_migrations\":$mig,\"cpu_us\":$cpu,\"syscalls\":$(cat "$dir/syscalls")},\"one_way_us_median_under_perf_stat\":$median}"
+echo "{\"code\":\"$name\",\"bytes\":$size,\"round_trips\":$rounds,\"load_at_start\":\"$load\",\"per_one_way_message\":{\"context_switches\":$cs,\"cpu_migrations\":$mig,\"page_faults\":$faults,\"cpu_us\":$cpu,\"syscalls\":$(cat "$dir/syscalls")},\"one_way_us_median_under_perf_stat\":$median}"
