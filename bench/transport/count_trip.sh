@@ -1,8 +1,8 @@
 #!/bin/bash
 # Counts what a 64-byte message costs between two vrflow daemons over TCP (loopback), in units
 # that do not depend on the machine's load: per one-way message, the system calls of each
-# thread of the daemons and modules (perf trace -s), the context switches and CPU migrations of
-# the whole run (perf stat). A ping-pong of ROUND_TRIPS round trips (default 5000) between module
+# thread of the daemons and modules (perf trace -s), the context switches, CPU migrations and
+# page faults of the whole run (perf stat). A ping-pong of ROUND_TRIPS round trips (default 5000) between module
 # ping (host a, 127.0.0.1) and pong (host b, 127.0.0.2), started with `vrflow launch`.
 #   bench/transport/count_trip.sh NAME BINDIR [ROUND_TRIPS] [SIZE]
 # BINDIR holds vrflow, vrflow-daemon and vrflow-bench-peer (a build's bin/). One JSON line on

@@ -93,8 +93,8 @@ inline std::string peerName(int fd) {
 // TCP_NODELAY and non-blocking. Both socket buffers are left to the kernel's autotuning, as for
 // a plain socket (raw TCP): the receive buffer grows up to net.ipv4.tcp_rmem's maximum (32 MiB on
 // the project's machine). A fixed SO_RCVBUF turns autotuning off and is capped at
-// net.core.rmem_max (4 MiB, doubled); a fixed 8 MiB SO_SNDBUF let one writev copy 8 MiB before
-// the kernel sent any of it (see writeLocked).
+// net.core.rmem_max (4 MiB, doubled); a fixed 4 MiB SO_SNDBUF (doubled) let one writev copy
+// 8 MiB or more before the peer could read it (see writeLocked).
 inline void tuneSocket(int fd) {
   int one = 1;
   setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
