@@ -1,8 +1,8 @@
 #!/bin/bash
 # Counts what a 64-byte message costs between two vrflow daemons over TCP (loopback), in units
 # that do not depend on the machine's load: per one-way message, the system calls of each
-# thread of the daemons and modules (perf trace -s), the context switches and CPU migrations of
-# the whole run (perf stat). A ping-pong of ROUND_TRIPS round trips (default 5000) between module
+# thread of the daemons and modules (perf trace -s), the context switches, CPU migrations and
+# page faults of the whole run (perf stat). A ping-pong of ROUND_TRIPS round trips (default 5000) between module
 # ping (host a, 127.0.0.1) and pong (host b, 127.0.0.2), started with `vrflow launch`.
 #   bench/transport/count_trip.sh NAME BINDIR [ROUND_TRIPS] [SIZE]
 # BINDIR holds vrflow, vrflow-daemon and vrflow-bench-peer (a build's bin/). One JSON line on
@@ -63,7 +63,7 @@ cat > "$dir/pingpong.xml" <<XML
 XML
 run=("$bin/vrflow" --packages "$dir/packages" launch "$dir/pingpong.xml" --backend local)
 load=$(cut -d' ' -f1-3 /proc/loadavg)
-perf stat -x, -e context-switches,cpu-migrations,task-clock -o "$dir/stat" -- "${run[@]}" \
+perf stat -x, -e context-switches,cpu-migrations,task-clock,page-faults -o "$dir/stat" -- "${run[@]}" \
   >/dev/null 2>"$dir/err1" || { cat "$dir/err1" >&2; exit 1; }
 perf trace -s -o "$dir/trace" -- "${run[@]}" >/dev/null 2>"$dir/err2" || { cat "$dir/err2" >&2; exit 1; }
 messages=$((2 * rounds))
@@ -83,6 +83,7 @@ awk -v n="$messages" -v r="$rounds" '
   }' "$dir/trace" > "$dir/syscalls"
 cs=$(awk -F, -v n="$messages" '$3 == "context-switches" { printf "%.3f", $1 / n }' "$dir/stat")
 mig=$(awk -F, -v n="$messages" '$3 == "cpu-migrations" { printf "%.3f", $1 / n }' "$dir/stat")
+faults=$(awk -F, -v n="$messages" '$3 == "page-faults" { printf "%.2f", $1 / n }' "$dir/stat")
 cpu=$(awk -F, -v n="$messages" '$3 == "task-clock" { printf "%.1f", $1 * 1000 / n }' "$dir/stat")
 median=$(sort -n "$dir/rtt" | awk '{ a[NR] = $1 } END { printf "%.1f", a[int((NR + 1) / 2)] / 2000 }')
-echo "{\"code\":\"$name\",\"bytes\":$size,\"round_trips\":$rounds,\"load_at_start\":\"$load\",\"per_one_way_message\":{\"context_switches\":$cs,\"cpu_migrations\":$mig,\"cpu_us\":$cpu,\"syscalls\":$(cat "$dir/syscalls")},\"one_way_us_median_under_perf_stat\":$median}"
+echo "{\"code\":\"$name\",\"bytes\":$size,\"round_trips\":$rounds,\"load_at_start\":\"$load\",\"per_one_way_message\":{\"context_switches\":$cs,\"cpu_migrations\":$mig,\"page_faults\":$faults,\"cpu_us\":$cpu,\"syscalls\":$(cat "$dir/syscalls")},\"one_way_us_median_under_perf_stat\":$median}"

@@ -260,6 +260,45 @@ TEST(Transport, LargeMessagesArriveIntactAndInOrderUnderCreditFlowControl) {
   b->stop();
 }
 
+TEST(Transport, ALargeMessageLeavesInWritesOfAtMost256KiBSoThePeerReadsItAsItComes) {
+  // One writev holds the socket while it copies: the kernel sends what it copied (paced) only
+  // when the call returns. Before, one writev took up to the whole 8 MiB send buffer, and the
+  // peer began to read only after it; now it takes at most 256 KiB.
+  LinkedPair pair;
+  ASSERT_TRUE(link(pair, std::size_t{64} << 20));
+  constexpr std::size_t kBytes = 8u << 20;
+  std::vector<std::byte> fill(kBytes);
+  for (std::size_t i = 0; i < kBytes; ++i) fill[i] = static_cast<std::byte>(i * 131 + 7);
+  msg::VectorSink bytes(kBytes + 1024);
+  msg::MessageBuilder builder(bytes);
+  builder.addRawResource(1, true, fill);
+  const std::size_t used = builder.finish();
+  const uint64_t handle = pair.segA->allocate(used);
+  ASSERT_NE(handle, 0u);
+  std::memcpy(pair.segA->payload(handle), bytes.buffer().data(), used);
+  pair.segA->block(handle).used = used;
+  const LinkStats before = pair.a->linkStats()[0];
+  auto sink = pair.a->makeSink(0);
+  sink->push(ipc::BlockRef(&*pair.segA, handle));
+  sink->close();
+  Collect received;
+  ASSERT_TRUE(receiveUntilClosed(*pair.b, received));
+  ASSERT_EQ(received.messages.size(), 1u);
+  const auto arrived = received.messages[0].bytes();
+  ASSERT_EQ(arrived.size(), used);
+  EXPECT_EQ(std::memcmp(arrived.data(), bytes.buffer().data(), used), 0) << "every byte";
+  const LinkStats after = pair.a->linkStats()[0];
+  EXPECT_EQ(after.messagesSent - before.messagesSent, 1u);
+  EXPECT_GE(after.writeCalls - before.writeCalls, used / (256u << 10));
+  received.messages.clear();
+  EXPECT_EQ(pair.b->fatalError(), "");
+  auto finishA = std::async(std::launch::async, [&] { pair.a->finish(2); });
+  pair.b->finish(2);
+  finishA.get();
+  pair.a->stop();
+  pair.b->stop();
+}
+
 // Waits (at most 10 s) until `transport` has one message for `channel`; drops it.
 bool receiveOne(Transport& transport, uint32_t channel) {
   Collect into;

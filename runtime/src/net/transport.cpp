@@ -94,9 +94,10 @@ class RemoteSink final : public ipc::Sink {
       link.out.push_back(std::move(item));
       // A link idle for a while is written at once from this (the routing) thread: one thread
       // hop less on the latency path. A stream (messages back to back) is left to the I/O
-      // thread, which gathers what accumulates into one writev.
-      if (idle && nowNs() - link.lastSentNs > kImmediateAfterIdleNs && t_->writeLocked(link) == 0 &&
-          link.out.empty()) {
+      // thread, which gathers what accumulates into one writev, and so is what a large message
+      // has left after its first kImmediateWriteBytes (not written under the routing lock).
+      if (idle && nowNs() - link.lastSentNs > kImmediateAfterIdleNs &&
+          t_->writeLocked(link, kImmediateWriteBytes) == 0 && link.out.empty()) {
         return;
       }
     }

@@ -16,6 +16,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <cstring>
 #include <deque>
 #include <functional>
@@ -34,9 +35,16 @@
 
 namespace vrflow::net {
 
-inline constexpr std::size_t kReadBufferBytes = 256 * 1024;
+// Small frames are read in batches through this buffer; a large message's payload goes straight
+// into its block, except what the read that brought its header also took (copied, at most this).
+inline constexpr std::size_t kReadBufferBytes = 64 * 1024;
 inline constexpr std::size_t kDirectReadMin = 16 * 1024;
 inline constexpr int kMaxIov = 64;
+// Bytes per writev call (see writeLocked), and what the routing path writes at once on an idle
+// link before it leaves the rest of a large message to the I/O thread (it holds the routing
+// lock meanwhile).
+inline constexpr std::size_t kMaxWriteBytes = 256 * 1024;
+inline constexpr std::size_t kImmediateWriteBytes = 1024 * 1024;
 inline constexpr uint64_t kImmediateAfterIdleNs = 20'000;
 // accept() out of descriptors (EMFILE/ENFILE): the listening socket is left alone this long,
 // doubling up to the maximum, instead of being polled (and failing) in a loop.
@@ -82,12 +90,14 @@ inline std::string peerName(int fd) {
   return std::string(text) + ":" + std::to_string(ntohs(addr.sin_port));
 }
 
+// TCP_NODELAY and non-blocking. Both socket buffers are left to the kernel's autotuning, as for
+// a plain socket (raw TCP): the receive buffer grows up to net.ipv4.tcp_rmem's maximum (32 MiB on
+// the project's machine). A fixed SO_RCVBUF turns autotuning off and is capped at
+// net.core.rmem_max (4 MiB, doubled); a fixed 4 MiB SO_SNDBUF (doubled) let one writev copy
+// 8 MiB or more before the peer could read it (see writeLocked).
 inline void tuneSocket(int fd) {
   int one = 1;
   setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-  int buffer = 4 << 20;
-  setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &buffer, sizeof buffer);
-  setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &buffer, sizeof buffer);
   fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
 }
 
@@ -215,7 +225,7 @@ struct Transport::Impl {
   void loop();
   void readFrom(Link& link);
   void writeTo(Link& link);
-  int writeLocked(Link& link);
+  int writeLocked(Link& link, std::size_t budget = SIZE_MAX);
   Status onFrame(Link& link, const FrameHeader& header, std::span<const std::byte> payload);
   void fail(Link& link, const std::string& why);
   void checkTimers();

@@ -48,15 +48,19 @@ void Transport::Impl::readFrom(Link& link) {
   }
 }
 
-// Writes what the link has queued until the socket is full; the caller holds `mutex`. Returns
-// 0, or the errno of a failed write (the caller fails the link, outside the lock).
-int Transport::Impl::writeLocked(Link& link) {
-  while (!link.failed && link.fd >= 0 && !link.out.empty()) {
+// Writes what the link has queued until the socket is full, or `budget` bytes are written; the
+// caller holds `mutex`. Returns 0, or the errno of a failed write (the caller fails the link,
+// outside the lock). One writev takes at most kMaxWriteBytes: the kernel sends a large write's
+// segments (paced) only when the call lets go of the socket, so the peer starts reading after
+// the first chunk instead of after the whole socket buffer.
+int Transport::Impl::writeLocked(Link& link, std::size_t budget) {
+  while (!link.failed && link.fd >= 0 && !link.out.empty() && budget > 0) {
     iovec iov[kMaxIov];
     int count = 0;
+    std::size_t room = std::min(kMaxWriteBytes, budget);
     std::size_t skip = link.headOffset;
     for (auto& item : link.out) {
-      if (count + 2 > kMaxIov) break;
+      if (count + 2 > kMaxIov || room == 0) break;
       std::size_t headLeft = item.headBytes;
       const std::byte* head = item.head.data();
       if (skip >= item.headBytes) {
@@ -67,10 +71,17 @@ int Transport::Impl::writeLocked(Link& link) {
         headLeft -= skip;
         skip = 0;
       }
-      if (headLeft > 0) iov[count++] = {const_cast<std::byte*>(head), headLeft};
-      if (item.message.valid()) {
+      if (headLeft > 0) {
+        const std::size_t take = std::min(headLeft, room);
+        iov[count++] = {const_cast<std::byte*>(head), take};
+        room -= take;
+        if (take < headLeft) break;
+      }
+      if (item.message.valid() && room > 0) {
         auto bytes = item.message.bytes();
-        iov[count++] = {const_cast<std::byte*>(bytes.data() + skip), bytes.size() - skip};
+        const std::size_t take = std::min(bytes.size() - skip, room);
+        iov[count++] = {const_cast<std::byte*>(bytes.data() + skip), take};
+        room -= take;
         skip = 0;
       }
     }
@@ -81,6 +92,7 @@ int Transport::Impl::writeLocked(Link& link) {
     }
     link.lastSentNs = nowNs();
     ++link.stats.writeCalls;
+    budget -= std::min(budget, static_cast<std::size_t>(n));
     std::size_t done = static_cast<std::size_t>(n) + link.headOffset;
     while (!link.out.empty() && done >= link.out.front().total()) {
       done -= link.out.front().total();
