@@ -100,6 +100,15 @@ struct LinkedPair {
   std::optional<ipc::Segment> segA, segB;
 };
 
+// Finishes both ends at once (each waits for the other's goodbye) and stops them.
+void finishAndStop(LinkedPair& pair) {
+  auto finishA = std::async(std::launch::async, [&] { pair.a->finish(2); });
+  pair.b->finish(2);
+  finishA.get();
+  pair.a->stop();
+  pair.b->stop();
+}
+
 ::testing::AssertionResult link(LinkedPair& pair, std::size_t segmentBytes, bool wayBack = false) {
   const Secret secret = newSecret();
   auto a = Transport::listen(optionsFor(0, secret));
@@ -292,11 +301,7 @@ TEST(Transport, ALargeMessageLeavesInWritesOfAtMost256KiBSoThePeerReadsItAsItCom
   EXPECT_GE(after.writeCalls - before.writeCalls, used / (256u << 10));
   received.messages.clear();
   EXPECT_EQ(pair.b->fatalError(), "");
-  auto finishA = std::async(std::launch::async, [&] { pair.a->finish(2); });
-  pair.b->finish(2);
-  finishA.get();
-  pair.a->stop();
-  pair.b->stop();
+  finishAndStop(pair);
 }
 
 // Waits (at most 10 s) until `transport` has one message for `channel`; drops it.
@@ -335,11 +340,7 @@ TEST(Transport, ARequestReplyExchangeSendsTheCreditsWithTheRepliesInOneWriteEach
   EXPECT_LE(after.writeCalls - before.writeCalls, kRounds + 4);
   EXPECT_EQ(pair.a->fatalError(), "");
   EXPECT_EQ(pair.b->fatalError(), "");
-  auto finishA = std::async(std::launch::async, [&] { pair.a->finish(2); });
-  pair.b->finish(2);
-  finishA.get();
-  pair.a->stop();
-  pair.b->stop();
+  finishAndStop(pair);
 }
 
 TEST(Transport, APeerWithoutTheSecretIsRefused) {

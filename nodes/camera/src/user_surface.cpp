@@ -71,20 +71,7 @@ double UserSurface::distance(const msg::Vec3& p) const {
 
 msg::Vec3 UserSurface::normal(const msg::Vec3& p) const {
   if (!ready()) return {};
-  const double h = 0.5 * spacing;
-  msg::Vec3 g{};
-  double norm = 0;
-  for (int a = 0; a < 3; ++a) {
-    msg::Vec3 lo = p, hi = p;
-    lo[a] -= h;
-    hi[a] += h;
-    g[a] = (distance(hi) - distance(lo)) / (2 * h);
-    norm += g[a] * g[a];
-  }
-  norm = std::sqrt(norm);
-  if (!(norm > 1e-6)) return {};
-  for (double& x : g) x /= norm;
-  return g;
+  return unitGradient([this](const msg::Vec3& q) { return distance(q); }, p, 0.5 * spacing);
 }
 
 msg::Vec3 UserSurface::velocityAt(const msg::Vec3& p) const {

@@ -46,20 +46,8 @@ class Field {
   /// UserSurface::normal); zero where it vanishes.
   msg::Vec3 normal(const msg::Vec3& p) const {
     if (!before_) return now_.normal(p);
-    const double h = 0.5 * spacing;
-    msg::Vec3 g{};
-    double norm = 0;
-    for (int a = 0; a < 3; ++a) {
-      msg::Vec3 lo = p, hi = p;
-      lo[a] -= h;
-      hi[a] += h;
-      g[a] = (distance(hi) - distance(lo)) / (2 * h);
-      norm += g[a] * g[a];
-    }
-    norm = std::sqrt(norm);
-    if (!(norm > 1e-6)) return {};
-    for (double& x : g) x /= norm;
-    return g;
+    return camera::unitGradient([this](const msg::Vec3& q) { return distance(q); }, p,
+                                0.5 * spacing);
   }
   msg::Vec3 velocityAt(const msg::Vec3& p) const { return now_.velocityAt(p); }
 

@@ -7,6 +7,7 @@
 // mass-spring and fluid packages link it (vrflow::camera_user).
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -35,5 +36,25 @@ struct UserSurface {
   /// Velocity (m/s) of the user's surface near p; zero beyond the grid or without a field.
   msg::Vec3 velocityAt(const msg::Vec3& p) const;
 };
+
+/// The unit gradient at p of a distance function (central differences h apart on each axis);
+/// zero where it vanishes. UserSurface::normal is this over its own field; a reader blending two
+/// frames' fields uses it over the blend.
+template <class Distance>
+msg::Vec3 unitGradient(const Distance& distance, const msg::Vec3& p, double h) {
+  msg::Vec3 g{};
+  double norm = 0;
+  for (int a = 0; a < 3; ++a) {
+    msg::Vec3 lo = p, hi = p;
+    lo[a] -= h;
+    hi[a] += h;
+    g[a] = (distance(hi) - distance(lo)) / (2 * h);
+    norm += g[a] * g[a];
+  }
+  norm = std::sqrt(norm);
+  if (!(norm > 1e-6)) return {};
+  for (double& x : g) x /= norm;
+  return g;
+}
 
 }  // namespace vrflow::camera
