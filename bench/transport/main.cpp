@@ -1,5 +1,6 @@
 // vrflow-bench-transport: one JSON line per (transport, message size) on stdout; errors on
 // stderr; exit status 0 only when every selected transport produced all its results.
+#include <sched.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -60,7 +61,8 @@ int run(int argc, char** argv) {
   bool mpiRankMode = false;
   app.add_option("--transport", transport,
                  "Which transports to measure: all, or a comma-separated list of wakeup-floor, "
-                 "zeromq-ipc, mpi-shm, vrflow-shm, zeromq-tcp, raw-tcp, vrflow-tcp")
+                 "wakeup-floor-cross, zeromq-ipc, mpi-shm, vrflow-shm, zeromq-tcp, raw-tcp, "
+                 "vrflow-tcp")
       ->capture_default_str();
   app.add_option("--sizes", sizesText, "Message sizes, e.g. 64,4K,1M,16M (K, M: KiB, MiB)")
       ->capture_default_str();
@@ -93,9 +95,9 @@ int run(int argc, char** argv) {
     start = comma + 1;
   }
   for (const auto& name : chosen) {
-    static const std::vector<std::string> known{"all",     "wakeup-floor", "zeromq-ipc",
-                                                "mpi-shm", "vrflow-shm",   "zeromq-tcp",
-                                                "raw-tcp", "vrflow-tcp"};
+    static const std::vector<std::string> known{"all",        "wakeup-floor", "wakeup-floor-cross",
+                                                "zeromq-ipc", "mpi-shm",      "vrflow-shm",
+                                                "zeromq-tcp", "raw-tcp",      "vrflow-tcp"};
     if (std::find(known.begin(), known.end(), name) == known.end()) {
       std::cerr << "--transport: unknown transport '" << name << "'\n";
       return 2;
@@ -109,7 +111,21 @@ int run(int argc, char** argv) {
   bool ok = true;
   // The floor every local transport is compared with, measured first (it forks).
   if (selected("wakeup-floor")) {
-    ok = report(vrflow::bench::runWakeupFloor(settings)) && ok;
+    ok = report(vrflow::bench::runWakeupFloor(settings, false)) && ok;
+  }
+  // The same with the two processes on two different cores: what a wake-up of the other core
+  // costs. "all" leaves it out where this process may use one CPU only.
+  if (selected("wakeup-floor-cross")) {
+    const bool named =
+        std::find(chosen.begin(), chosen.end(), "wakeup-floor-cross") != chosen.end();
+    cpu_set_t cpus;
+    CPU_ZERO(&cpus);
+    const bool two = sched_getaffinity(0, sizeof cpus, &cpus) == 0 && CPU_COUNT(&cpus) >= 2;
+    if (named || two) {
+      ok = report(vrflow::bench::runWakeupFloor(settings, true)) && ok;
+    } else {
+      std::cerr << "wakeup-floor-cross: left out (this process may use one CPU only)\n";
+    }
   }
   if (selected("zeromq-ipc")) {
     ok = report(vrflow::bench::runZeromq(settings)) && ok;

@@ -104,9 +104,12 @@ std::string toJsonLine(const BenchResult& result);
 Result<BenchResult> parseJsonLine(std::string_view line);
 
 /// The floor of the local transports: a blocking futex wake-up between this process and a forked
-/// child per one-way trip (ipc::Doorbell and ipc::Ring, no daemon). Forks: call it while the
-/// process has a single thread.
-Result<std::vector<BenchResult>> runWakeupFloor(const BenchSettings& settings);
+/// child per one-way trip (ipc::Doorbell and ipc::Ring, no daemon), as "wakeup-floor". With
+/// `crossCores` ("wakeup-floor-cross") the two processes are pinned to two different CPUs of this
+/// process's set (an error with fewer than two): every wake-up is then of the other core, which
+/// the scheduler's own placement of two processes taking turns usually avoids. Forks: call it
+/// while the process has a single thread.
+Result<std::vector<BenchResult>> runWakeupFloor(const BenchSettings& settings, bool crossCores);
 
 /// ZeroMQ over ipc:// between this process and a forked child: REQ/REP ping-pong, then PAIR
 /// streaming. Forks, so it must be called while the process has a single thread.

@@ -7,6 +7,7 @@
 // pops them; a side sleeps only when the ring is full (sender) or empty (receiver).
 // The payload is never touched (as vrflow-shm re-sends a block by handle), so the size only
 // names the row these numbers are compared with.
+#include <sched.h>
 #include <signal.h>
 #include <sys/mman.h>
 #include <unistd.h>
@@ -65,6 +66,24 @@ class SharedMapping {
   Shared* shared_ = nullptr;
 };
 
+// The CPUs this process may run on, in order.
+std::vector<int> allowedCpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  std::vector<int> cpus;
+  if (sched_getaffinity(0, sizeof set, &set) != 0) return cpus;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &set)) cpus.push_back(cpu);
+  return cpus;
+}
+
+bool pinTo(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  return sched_setaffinity(0, sizeof set, &set) == 0;
+}
+
 // Sleeps on `bell` until `ready()` holds; false when `deadlineNs` passes first (the other side
 // is gone or stuck).
 template <typename Ready>
@@ -77,17 +96,29 @@ bool sleepUntil(ipc::Doorbell& bell, const Ready& ready, int64_t deadlineNs) {
   }
 }
 
-Result<BenchResult> floorSize(std::size_t bytes, const BenchSettings& settings) {
+// `crossCores`: the two processes are pinned to two different CPUs, so every wake-up is of a
+// process on the other core (an idle one, mostly: the waker sleeps right after); otherwise the
+// scheduler places them, and two processes that take turns usually share one core.
+Result<BenchResult> floorSize(std::size_t bytes, const BenchSettings& settings, bool crossCores) {
+  const char* name = crossCores ? "wakeup-floor-cross" : "wakeup-floor";
+  std::vector<int> cpus;
+  if (crossCores) {
+    cpus = allowedCpus();
+    if (cpus.size() < 2)
+      return makeError(std::string(name) + ": needs two CPUs this process may use, has " +
+                       std::to_string(cpus.size()));
+  }
   const IterationPlan plan = iterationPlan(bytes, settings.quick);
   const auto capacity = std::bit_ceil(static_cast<uint32_t>(streamQueueDepth(bytes)));
   SharedMapping mapping(capacity);
   Shared* shared = mapping.get();
-  if (shared == nullptr) return makeError("wakeup-floor: cannot map shared memory");
+  if (shared == nullptr) return makeError(std::string(name) + ": cannot map shared memory");
   const std::size_t rounds = plan.warmupMessages + plan.pingPongs;
   const std::size_t total = plan.warmupMessages + plan.streamMessages;
   const int64_t silence = std::chrono::nanoseconds(settings.peerTimeout).count();
 
   auto peer = ChildProcess::fork([&] {
+    if (crossCores && !pinTo(cpus[1])) return 5;
     // Echo each ball, then stream `total` handles.
     for (uint64_t i = 0; i < rounds; ++i) {
       const uint64_t sent = 2 * i + 1;
@@ -108,6 +139,22 @@ Result<BenchResult> floorSize(std::size_t bytes, const BenchSettings& settings) 
     return 0;
   });
   if (!peer) return peer.error();
+  // This process on the first CPU for the measurement, its own set again afterwards.
+  struct Restore {
+    std::vector<int> cpus;
+    ~Restore() {
+      if (cpus.empty()) return;
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      for (const int cpu : cpus) CPU_SET(cpu, &set);
+      sched_setaffinity(0, sizeof set, &set);
+    }
+  } restore;
+  if (crossCores) {
+    restore.cpus = cpus;
+    if (!pinTo(cpus[0]))
+      return makeError(std::string(name) + ": cannot pin to CPU " + std::to_string(cpus[0]));
+  }
 
   std::vector<std::int64_t> samples;
   samples.reserve(plan.pingPongs);
@@ -118,7 +165,8 @@ Result<BenchResult> floorSize(std::size_t bytes, const BenchSettings& settings) 
     shared->toPeer.ring();
     if (!sleepUntil(
             shared->toMain, [&] { return shared->ball.load() == sent + 1; }, start + silence)) {
-      return makeError("wakeup-floor: the peer " + peer->exitDescription() + " during ping-pong");
+      return makeError(std::string(name) + ": the peer " + peer->exitDescription() +
+                       " during ping-pong");
     }
     if (i >= plan.warmupMessages) samples.push_back(nowNs() - start);
   }
@@ -127,28 +175,36 @@ Result<BenchResult> floorSize(std::size_t bytes, const BenchSettings& settings) 
     uint64_t handle = 0;
     if (!sleepUntil(
             shared->toMain, [&] { return shared->ring.pop(handle); }, nowNs() + silence)) {
-      return makeError("wakeup-floor: the peer " + peer->exitDescription() + " during streaming");
+      return makeError(std::string(name) + ": the peer " + peer->exitDescription() +
+                       " during streaming");
     }
     shared->toPeer.ring();
-    if (handle != expected) return makeError("wakeup-floor: a handle arrived out of order");
+    if (handle != expected) return makeError(std::string(name) + ": a handle arrived out of order");
     if (expected == plan.warmupMessages) start = nowNs();
   }
   const std::int64_t end = nowNs();
   auto status = peer->wait(settings.peerTimeout);
   if (!status) return status.error();
-  if (*status != 0) return makeError("wakeup-floor: peer " + ChildProcess::describeExit(*status));
+  if (*status != 0)
+    return makeError(std::string(name) + ": peer " + ChildProcess::describeExit(*status) +
+                     (*status == 5 ? " (could not pin itself to a CPU)" : ""));
   const double rate =
       static_cast<double>(plan.streamMessages) / (static_cast<double>(end - start) * 1e-9);
-  return makeResult("wakeup-floor", bytes, samples, rate,
-                    "2 processes (fork), a 64-bit handle through shared memory and a blocking "
-                    "futex wake-up per one-way trip (ipc::Doorbell, ipc::Ring; no daemon); the "
-                    "payload is not touched");
+  return makeResult(
+      name, bytes, samples, rate,
+      std::string("2 processes (fork), a 64-bit handle through shared memory and a "
+                  "blocking futex wake-up per one-way trip (ipc::Doorbell, ipc::Ring; "
+                  "no daemon); the payload is not touched") +
+          (crossCores ? "; each process pinned to its own CPU (" + std::to_string(cpus[0]) +
+                            " and " + std::to_string(cpus[1]) + ")"
+                      : ""));
 }
 
 }  // namespace
 
-Result<std::vector<BenchResult>> runWakeupFloor(const BenchSettings& settings) {
-  return forEachSize(settings, [&](std::size_t bytes) { return floorSize(bytes, settings); });
+Result<std::vector<BenchResult>> runWakeupFloor(const BenchSettings& settings, bool crossCores) {
+  return forEachSize(settings,
+                     [&](std::size_t bytes) { return floorSize(bytes, settings, crossCores); });
 }
 
 }  // namespace vrflow::bench
