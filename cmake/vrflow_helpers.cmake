@@ -69,10 +69,11 @@ function(vrflow_add_executable name)
   target_link_libraries(${name} PRIVATE vrflow_warnings ${ARG_DEPS})
 endfunction()
 
-# vrflow_add_test(NAME SOURCES ... DEPS ... LABELS ...): one GoogleTest executable, registered
-# with CTest test by test, with the given labels.
+# vrflow_add_test(NAME SOURCES ... DEPS ... LABELS ... [RUN_SERIAL]): one GoogleTest executable,
+# registered with CTest test by test, with the given labels.
 function(vrflow_add_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT;PREFIX;RESOURCE_LOCK" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "RUN_SERIAL" "TIMEOUT;PREFIX;RESOURCE_LOCK" "SOURCES;DEPS;LABELS"
+                        ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE vrflow_warnings ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   if(NOT ARG_TIMEOUT)
@@ -85,14 +86,19 @@ function(vrflow_add_test name)
   # (docs/operations.md).
   # RESOURCE_LOCK names something tests share (an X display number): ctest -j never runs two
   # tests holding the same lock at once.
-  set(lock "")
+  set(exclusive "")
   if(ARG_RESOURCE_LOCK)
-    set(lock RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+    set(exclusive RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+  endif()
+  # RUN_SERIAL: ctest -j runs these tests alone (they watch state every run changes, such as
+  # what a run's start clears from /dev/shm).
+  if(ARG_RUN_SERIAL)
+    list(APPEND exclusive RUN_SERIAL ON)
   endif()
   gtest_discover_tests(${name}
     TEST_PREFIX "${ARG_PREFIX}"
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
-      ENVIRONMENT "XDG_STATE_HOME=${PROJECT_BINARY_DIR}/test-state" ${lock}
+      ENVIRONMENT "XDG_STATE_HOME=${PROJECT_BINARY_DIR}/test-state" ${exclusive}
     DISCOVERY_TIMEOUT 60)
 endfunction()
 

@@ -1,6 +1,8 @@
 // Open MPI's shared-memory files of an MPI job (vader segments) live in a folder the runtime
 // owns: none is left in /dev/shm itself when the runtime is killed with SIGKILL, and the folder
-// of a killed run is removed at the next start.
+// of a killed run is removed at the next start. Any run's start removes it, so these tests run
+// alone (RUN_SERIAL): another test's `vrflow run` starting meanwhile cleared the folder before
+// this test looked (the sanitizer suites, many runs on two cores, showed it).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
