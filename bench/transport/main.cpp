@@ -37,6 +37,17 @@ void warnIfBusy() {
   }
 }
 
+// On a VM guest whose idle cores halt at once, every wake-up of an idle core is slow: say so,
+// as the numbers then measure that more than the transports.
+void noteIdlePolicy() {
+  const std::string policy = vrflow::bench::idlePolicy();
+  if (policy == "haltpoll, guest_halt_poll_ns 0") {
+    std::cerr << "note: idle CPUs halt at once here (cpuidle " << policy
+              << "): a wake-up of an idle CPU is slow, and the local and TCP latencies measure it "
+                 "(docs/shared-memory.md)\n";
+  }
+}
+
 // Prints a transport's results, or its error; returns whether it succeeded.
 bool report(const Result<std::vector<BenchResult>>& results) {
   if (!results) {
@@ -104,6 +115,7 @@ int run(int argc, char** argv) {
     }
   }
   warnIfBusy();
+  noteIdlePolicy();
   const auto selected = [&chosen](const char* name) {
     return std::find(chosen.begin(), chosen.end(), "all") != chosen.end() ||
            std::find(chosen.begin(), chosen.end(), name) != chosen.end();

@@ -41,6 +41,22 @@ std::string machineDescription() {
   return description;
 }
 
+std::string idlePolicy() {
+  // What an idle core does here decides what waking it costs (docs/shared-memory.md): a VM guest
+  // whose cores halt at once pays tens of microseconds per wake-up of an idle core.
+  static const std::string policy = [] {
+    std::ifstream driverFile("/sys/devices/system/cpu/cpuidle/current_driver");
+    std::string driver;
+    if (!std::getline(driverFile, driver) || driver.empty()) return std::string("unknown");
+    if (driver != "haltpoll") return driver;
+    std::ifstream pollFile("/sys/module/haltpoll/parameters/guest_halt_poll_ns");
+    std::string poll;
+    if (!std::getline(pollFile, poll) || poll.empty()) return driver;
+    return driver + ", guest_halt_poll_ns " + poll;
+  }();
+  return policy;
+}
+
 std::string toJsonLine(const BenchResult& result) {
   const nlohmann::ordered_json line = {
       {"transport", result.transport},
@@ -49,6 +65,7 @@ std::string toJsonLine(const BenchResult& result) {
       {"one_way_us_p99", roundTo(result.oneWayUsP99, 1000.0)},
       {"msgs_per_s", roundTo(result.msgsPerS, 10.0)},
       {"machine", machineDescription()},
+      {"cpuidle", idlePolicy()},
       {"detail", result.detail},
   };
   return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);

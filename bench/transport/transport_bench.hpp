@@ -97,7 +97,12 @@ Result<std::vector<BenchResult>> runEachSize(
 /// "CPU model, N cores" of this machine, from /proc/cpuinfo and the online CPU count.
 std::string machineDescription();
 
-/// The result as one JSON object (no trailing newline), with the machine description added.
+/// The kernel's cpuidle driver ("unknown" when not readable); for `haltpoll` (a KVM guest) with
+/// its guest_halt_poll_ns: "haltpoll, guest_halt_poll_ns 0" means idle cores halt at once.
+std::string idlePolicy();
+
+/// The result as one JSON object (no trailing newline), with the machine description and its idle
+/// policy added.
 std::string toJsonLine(const BenchResult& result);
 
 /// Reads back a line written by toJsonLine (used to collect the MPI ranks' results).
