@@ -1,6 +1,5 @@
 // vrflow-bench-transport: one JSON line per (transport, message size) on stdout; errors on
 // stderr; exit status 0 only when every selected transport produced all its results.
-#include <sched.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -130,10 +129,7 @@ int run(int argc, char** argv) {
   if (selected("wakeup-floor-cross")) {
     const bool named =
         std::find(chosen.begin(), chosen.end(), "wakeup-floor-cross") != chosen.end();
-    cpu_set_t cpus;
-    CPU_ZERO(&cpus);
-    const bool two = sched_getaffinity(0, sizeof cpus, &cpus) == 0 && CPU_COUNT(&cpus) >= 2;
-    if (named || two) {
+    if (named || vrflow::bench::allowedCpus().size() >= 2) {
       ok = report(vrflow::bench::runWakeupFloor(settings, true)) && ok;
     } else {
       std::cerr << "wakeup-floor-cross: left out (this process may use one CPU only)\n";

@@ -97,6 +97,9 @@ Result<std::vector<BenchResult>> runEachSize(
 /// "CPU model, N cores" of this machine, from /proc/cpuinfo and the online CPU count.
 std::string machineDescription();
 
+/// The CPUs this process may run on (its affinity mask), in order.
+std::vector<int> allowedCpus();
+
 /// The kernel's cpuidle driver ("unknown" when not readable); for `haltpoll` (a KVM guest) with
 /// its guest_halt_poll_ns: "haltpoll, guest_halt_poll_ns 0" means idle cores halt at once.
 std::string idlePolicy();

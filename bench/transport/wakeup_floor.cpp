@@ -17,6 +17,8 @@
 #include <chrono>
 #include <cstdint>
 #include <new>
+#include <span>
+#include <vector>
 
 #include "child_process.hpp"
 #include "transport_bench.hpp"
@@ -66,21 +68,11 @@ class SharedMapping {
   Shared* shared_ = nullptr;
 };
 
-// The CPUs this process may run on, in order.
-std::vector<int> allowedCpus() {
+// Lets this process run on `cpus` only.
+bool runOn(std::span<const int> cpus) {
   cpu_set_t set;
   CPU_ZERO(&set);
-  std::vector<int> cpus;
-  if (sched_getaffinity(0, sizeof set, &set) != 0) return cpus;
-  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
-    if (CPU_ISSET(cpu, &set)) cpus.push_back(cpu);
-  return cpus;
-}
-
-bool pinTo(int cpu) {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(cpu, &set);
+  for (const int cpu : cpus) CPU_SET(cpu, &set);
   return sched_setaffinity(0, sizeof set, &set) == 0;
 }
 
@@ -118,7 +110,7 @@ Result<BenchResult> floorSize(std::size_t bytes, const BenchSettings& settings, 
   const int64_t silence = std::chrono::nanoseconds(settings.peerTimeout).count();
 
   auto peer = ChildProcess::fork([&] {
-    if (crossCores && !pinTo(cpus[1])) return 5;
+    if (crossCores && !runOn(std::span(cpus).subspan(1, 1))) return 5;
     // Echo each ball, then stream `total` handles.
     for (uint64_t i = 0; i < rounds; ++i) {
       const uint64_t sent = 2 * i + 1;
@@ -143,16 +135,12 @@ Result<BenchResult> floorSize(std::size_t bytes, const BenchSettings& settings, 
   struct Restore {
     std::vector<int> cpus;
     ~Restore() {
-      if (cpus.empty()) return;
-      cpu_set_t set;
-      CPU_ZERO(&set);
-      for (const int cpu : cpus) CPU_SET(cpu, &set);
-      sched_setaffinity(0, sizeof set, &set);
+      if (!cpus.empty()) runOn(cpus);
     }
   } restore;
   if (crossCores) {
     restore.cpus = cpus;
-    if (!pinTo(cpus[0]))
+    if (!runOn(std::span(cpus).subspan(0, 1)))
       return makeError(std::string(name) + ": cannot pin to CPU " + std::to_string(cpus[0]));
   }
 
