@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the runtime, its modules, the fluid's thread pool and the unit/end-to-end tests with a sanitizer (ASAN =
-# address + undefined behaviour, TSAN = threads) in a tree of their own, and runs those tests
+# Builds the runtime, its modules, the fluid's thread pool and the unit/end-to-end tests with a
+# sanitizer (ASAN = address + undefined behaviour, TSAN = threads) in a tree of their own, and
+# runs those tests
 # there. Warnings are not errors here: GCC 12 reports false maybe-uninitialized warnings in
 # libstdc++ under -fsanitize at -O1. Usage: run_sanitized.sh ASAN|TSAN SOURCE_DIR BUILD_DIR
 set -euo pipefail

@@ -147,7 +147,8 @@ TEST(FluidWorkers, PoolsComeAndGoWhileTheirHelpersSleepOrSpin) {
   for (int i = 0; i < 20; ++i) {
     const Workers workers(3);
     runOnce(workers, 3, 9);
-    if (i % 2 == 0) std::this_thread::sleep_for(std::chrono::microseconds(3 * Workers::kSpinMicros));
+    if (i % 2 == 0)
+      std::this_thread::sleep_for(std::chrono::microseconds(3 * Workers::kSpinMicros));
   }
   SUCCEED();
 }
