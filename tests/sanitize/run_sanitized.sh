@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # Builds the runtime, its modules, the fluid's thread pool and the unit/end-to-end tests with a
 # sanitizer (ASAN = address + undefined behaviour, TSAN = threads) in a tree of their own, and
-# runs those tests
-# there. Warnings are not errors here: GCC 12 reports false maybe-uninitialized warnings in
-# libstdc++ under -fsanitize at -O1. Usage: run_sanitized.sh ASAN|TSAN SOURCE_DIR BUILD_DIR
+# runs those tests there. Warnings are not errors here: GCC 12 reports false maybe-uninitialized
+# warnings in libstdc++ under -fsanitize at -O1. Usage: run_sanitized.sh ASAN|TSAN SOURCE_DIR BUILD_DIR
 set -euo pipefail
 type=$1 src=$2 build=$3
 launcher=()
