@@ -222,8 +222,12 @@ struct FluidSolver::Impl {
   std::vector<std::size_t> planeStart;  ///< after sorting: first particle of each plane k0..k1
   std::vector<double> posScratch, velScratch;
   // Stable counting sort of the particles by cell (memory order), for cache-friendly transfers
-  // and an order that does not depend on history.
+  // and an order that does not depend on history. With several threads each counts and moves
+  // the particles of its part of the array (the advection's parts); a cell takes part 0's
+  // particles first, then part 1's, so the order is the serial one.
   void sortParticles();
+  std::vector<std::vector<std::uint32_t>> partCounts;  ///< per part, per cell of the slab
+  void setPlaneStarts();  // planeStart from sortStart (before the particles are moved)
 
   // Pushes particles out of the bodies. Per cell (CSR: bodiesAt[c] to bodiesAt[c + 1] in
   // bodyList), the bodies whose bounds reach it; only those are tested.
