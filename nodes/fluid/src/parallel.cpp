@@ -1,5 +1,7 @@
 #include "parallel.hpp"
 
+#include <sched.h>
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -20,13 +22,13 @@ inline void cpuRelax() {
 #endif
 }
 
-/// Spins until `word` differs from `seen` for at most Workers::kSpinMicros, then sleeps on it
-/// until it does; returns the value it saw.
+/// Spins until `word` differs from `seen` for at most spinMicros, then sleeps on it until it
+/// does; returns the value it saw.
 template <typename T>
-T awaitChange(const std::atomic<T>& word, T seen) {
+T awaitChange(const std::atomic<T>& word, T seen, int spinMicros) {
   using Clock = std::chrono::steady_clock;
-  const auto until = Clock::now() + std::chrono::microseconds(Workers::kSpinMicros);
-  for (unsigned spins = 1;; ++spins) {
+  const auto until = Clock::now() + std::chrono::microseconds(spinMicros);
+  for (unsigned spins = 1; spinMicros > 0; ++spins) {
     const T now = word.load(std::memory_order_acquire);
     if (now != seen) return now;
     cpuRelax();
@@ -47,6 +49,7 @@ struct Workers::Pool {
   // caller writes the next job only once `pending` is zero, so no helper still reads the last.
   std::atomic<std::uint32_t> epoch{0};
   std::atomic<int> pending{0};
+  int spinMicros = 0;
   bool stop = false;
   void (*call)(void*, int) = nullptr;
   void* context = nullptr;
@@ -64,7 +67,7 @@ struct Workers::Pool {
     tInsidePart = true;
     std::uint32_t seen = 0;
     for (;;) {
-      seen = awaitChange(epoch, seen);
+      seen = awaitChange(epoch, seen, spinMicros);
       if (stop) return;
       if (part < parts) {
         try {
@@ -86,13 +89,28 @@ struct Workers::Pool {
 
   void awaitHelpers() {
     int left = pending.load(std::memory_order_acquire);
-    while (left != 0) left = awaitChange(pending, left);
+    while (left != 0) left = awaitChange(pending, left, spinMicros);
   }
 };
 
+namespace {
+
+/// The CPUs the calling thread (and the helpers it starts) may run on, or 0 when unknown.
+int allowedCpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) != 0) return 0;
+  return CPU_COUNT(&set);
+}
+
+}  // namespace
+
 Workers::Workers(int threads) : threads_(threads < 1 ? 1 : threads) {
   if (threads_ == 1) return;
+  const int cpus = allowedCpus();
+  spinMicros_ = cpus == 0 || cpus >= threads_ ? kSpinMicros : 0;
   pool_ = std::make_unique<Pool>();
+  pool_->spinMicros = spinMicros_;
   pool_->helpers.reserve(static_cast<std::size_t>(threads_ - 1));
   for (int h = 1; h < threads_; ++h) {
     pool_->helpers.emplace_back([pool = pool_.get(), h] { pool->helperLoop(h); });

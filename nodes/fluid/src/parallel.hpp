@@ -16,9 +16,11 @@
 // A helper therefore waits for the next loop by spinning for at most kSpinMicros after its part,
 // then sleeps on a futex (std::atomic::wait); the caller waits for the helpers the same way. So a
 // block that steps keeps its helpers awake between its loops, and a block that waits for its
-// inputs has no thread spinning after kSpinMicros. (OpenMP was not used: libgomp's spin length is
-// fixed when the library loads and made two threads five times slower than one on a loaded
-// 2-core machine.)
+// inputs has no thread spinning after kSpinMicros. When the process may run on fewer CPUs than
+// it has threads (an MPI rank bound to one core, `taskset`), a spinning thread would take its
+// core from the thread it waits for: then no thread spins. (OpenMP was not used: libgomp's spin
+// length is fixed when the library loads and made two threads five times slower than one on a
+// loaded 2-core machine.)
 
 namespace vrflow::fluid::detail {
 
@@ -34,6 +36,9 @@ class Workers {
   Workers& operator=(const Workers&) = delete;
 
   int threads() const { return threads_; }
+  /// How long this pool's threads spin before they sleep: kSpinMicros, or 0 when the process
+  /// was allowed fewer CPUs than threads() when the pool was made.
+  int spinMicros() const { return spinMicros_; }
 
   /// Runs f(part, begin, end) over `parts` consecutive ranges of [0, n) (part r = [n r /
   /// parts, n (r + 1) / parts)), part r on thread r, and returns when all are done. `parts` is
@@ -60,6 +65,7 @@ class Workers {
   void dispatch(int parts, void (*call)(void*, int), void* context) const;
 
   int threads_ = 1;
+  int spinMicros_ = 0;
   std::unique_ptr<Pool> pool_;
 };
 

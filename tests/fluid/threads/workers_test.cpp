@@ -3,6 +3,7 @@
 // part, whether the helpers spin or sleep between them; a part's exception reaches the caller
 // and the pool goes on; a loop started from inside a part runs on the calling thread.
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <atomic>
 #include <chrono>
@@ -141,6 +142,38 @@ TEST(FluidWorkers, NoThreadCountBelowOne) {
   EXPECT_EQ(none.threads(), 1);
   EXPECT_EQ(negative.threads(), 1);
   EXPECT_EQ(runOnce(none, 1, 5)[0].end, 5u);
+}
+
+// A pool with more threads than the CPUs it may use (a rank bound to one core) does not spin:
+// a spinning helper would hold the core its caller needs.
+TEST(FluidWorkers, NoSpinningWhenThereAreMoreThreadsThanAllowedCpus) {
+  cpu_set_t before;
+  ASSERT_EQ(sched_getaffinity(0, sizeof(before), &before), 0);
+  int first = -1;
+  for (int c = 0; c < CPU_SETSIZE && first < 0; ++c) {
+    if (CPU_ISSET(c, &before)) first = c;
+  }
+  ASSERT_GE(first, 0);
+  if (CPU_COUNT(&before) >= 2) {
+    const Workers spinning(2);
+    EXPECT_EQ(spinning.spinMicros(), Workers::kSpinMicros);
+  }
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(first, &one);
+  ASSERT_EQ(sched_setaffinity(0, sizeof(one), &one), 0);
+  {
+    const Workers bound(2);
+    EXPECT_EQ(bound.spinMicros(), 0);
+    std::vector<int> count(100, 0);
+    for (int i = 0; i < 200; ++i) {
+      bound.forRanges(2, count.size(), [&](std::size_t, std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) ++count[k];
+      });
+    }
+    for (int c : count) EXPECT_EQ(c, 200);
+  }
+  ASSERT_EQ(sched_setaffinity(0, sizeof(before), &before), 0);
 }
 
 TEST(FluidWorkers, PoolsComeAndGoWhileTheirHelpersSleepOrSpin) {
