@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Builds the runtime, its modules, the fluid's thread pool and the unit/end-to-end tests with a
-# sanitizer (ASAN = address + undefined behaviour, TSAN = threads) in a tree of their own, and
-# runs those tests there. Warnings are not errors here: GCC 12 reports false maybe-uninitialized
-# warnings in libstdc++ under -fsanitize at -O1. Usage: run_sanitized.sh ASAN|TSAN SOURCE_DIR BUILD_DIR
+# Builds the runtime, its modules and the unit/end-to-end tests with a sanitizer (ASAN =
+# address + undefined behaviour, TSAN = threads) in a tree of their own, and runs those tests
+# there. Warnings are not errors here: GCC 12 reports false maybe-uninitialized warnings in
+# libstdc++ under -fsanitize at -O1. Usage: run_sanitized.sh ASAN|TSAN SOURCE_DIR BUILD_DIR
 set -euo pipefail
 type=$1 src=$2 build=$3
 launcher=()
@@ -16,7 +16,7 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
 cd "$build"
 status=0
-ctest --output-on-failure -j "$(nproc)" -L 'runtime|message|app|transport|launcher|threads' || status=$?
+ctest --output-on-failure -j "$(nproc)" -L 'runtime|message|app|transport|launcher' || status=$?
 if [ "$status" -ne 0 ] && [ -s Testing/Temporary/LastTestsFailed.log ]; then
   # The failures' own output again, last, where a log cut to its tail still shows it.
   echo "=== output of the failed tests (${type}) ==="

@@ -20,9 +20,9 @@ constexpr int kSweeps = 2;             // before and after the coarse correction
 constexpr int kCycles = 2;             // visits of the next level per cycle: a W-cycle
 constexpr double kCoarseScale = 1.6;   // piecewise-constant interpolation's missing factor
 constexpr std::size_t kCoarsestCells = 256;
-// Levels smaller than this run on one thread: a pass over them is shorter than handing a part to
-// an awake helper. (16384 with the oneTBB arena; 2048 with the solver's pool took the 32 x 64 x 32
-// coupled case's CG from 6.4-7.1 to 4.8-6.3 ms a step on 2 threads, alternated on the 2-core VM.)
+// Levels smaller than this run on one thread: a pass over them is shorter than handing half of it
+// to a worker. (16384 until 2026-11-27; 2048 took the benchmark's coupled 32 x 64 x 32 case's CG
+// on 2 threads from 4.9-7.1 to 4.4-5.3 ms a step, alternated on the 2-core VM.)
 constexpr std::size_t kThreadedCells = 2048;
 
 // Calls f(k) for every plane of a level, on the solver's threads when the level is large.
