@@ -63,56 +63,41 @@ void FluidSolver::Impl::sortParticles() {
   sortStart[c0] = 0;
   posScratch.resize(pos.size());
   velScratch.resize(vel.size());
-  auto move = [&](std::size_t p, std::size_t to) {
-    for (int d = 0; d < 3; ++d) {
-      posScratch[3 * to + d] = pos[3 * p + d];
-      velScratch[3 * to + d] = vel[3 * p + d];
+  // Each part counts its particles per cell; the counts then become the first place of each
+  // part's particles in each cell (part 0's first: the serial order), and each part moves its own.
+  partCounts.resize(static_cast<std::size_t>(parts));
+  workers->forRanges(parts, n, [&](std::size_t part, std::size_t p0, std::size_t p1) {
+    auto& count = partCounts[part];
+    count.assign(c1 - c0, 0);
+    for (std::size_t p = p0; p < p1; ++p) ++count[sortCell[p] - c0];
+  });
+  for (std::size_t c = c0; c < c1; ++c) {
+    std::size_t at = sortStart[c];
+    for (auto& count : partCounts) {
+      const std::uint32_t here = count[c - c0];
+      count[c - c0] = static_cast<std::uint32_t>(at);
+      at += here;
     }
-  };
-  if (parts == 1) {
-    std::fill(particlesInCell.begin() + static_cast<std::ptrdiff_t>(c0),
-              particlesInCell.begin() + static_cast<std::ptrdiff_t>(c1), 0);
-    for (std::size_t p = 0; p < n; ++p) ++particlesInCell[sortCell[p]];
-    for (std::size_t c = c0; c < c1; ++c) {
-      sortStart[c + 1] = sortStart[c] + static_cast<std::size_t>(particlesInCell[c]);
-    }
-    setPlaneStarts();
-    for (std::size_t p = 0; p < n; ++p) move(p, sortStart[sortCell[p]]++);
-  } else {
-    partCounts.resize(static_cast<std::size_t>(parts));
-    workers->forRanges(parts, n, [&](std::size_t part, std::size_t p0, std::size_t p1) {
-      auto& count = partCounts[part];
-      count.assign(c1 - c0, 0);
-      for (std::size_t p = p0; p < p1; ++p) ++count[sortCell[p] - c0];
-    });
-    // Per cell, the parts' counts become the first place of each part's particles.
-    for (std::size_t c = c0; c < c1; ++c) {
-      std::size_t at = sortStart[c];
-      for (auto& count : partCounts) {
-        const std::uint32_t here = count[c - c0];
-        count[c - c0] = static_cast<std::uint32_t>(at);
-        at += here;
-      }
-      particlesInCell[c] = static_cast<int>(at - sortStart[c]);
-      sortStart[c + 1] = at;
-    }
-    setPlaneStarts();
-    workers->forRanges(parts, n, [&](std::size_t part, std::size_t p0, std::size_t p1) {
-      auto& next = partCounts[part];
-      for (std::size_t p = p0; p < p1; ++p) move(p, next[sortCell[p] - c0]++);
-    });
+    particlesInCell[c] = static_cast<int>(at - sortStart[c]);
+    sortStart[c + 1] = at;
   }
-  pos.swap(posScratch);
-  vel.swap(velScratch);
-  cellsKnown = false;
-}
-
-void FluidSolver::Impl::setPlaneStarts() {
-  const std::size_t plane = static_cast<std::size_t>(grid.nx) * grid.ny;
   planeStart.resize(static_cast<std::size_t>(k1 - k0) + 1);
   for (int k = k0; k <= k1; ++k) {
     planeStart[static_cast<std::size_t>(k - k0)] = sortStart[plane * static_cast<std::size_t>(k)];
   }
+  workers->forRanges(parts, n, [&](std::size_t part, std::size_t p0, std::size_t p1) {
+    auto& next = partCounts[part];
+    for (std::size_t p = p0; p < p1; ++p) {
+      const std::size_t to = next[sortCell[p] - c0]++;
+      for (int d = 0; d < 3; ++d) {
+        posScratch[3 * to + d] = pos[3 * p + d];
+        velScratch[3 * to + d] = vel[3 * p + d];
+      }
+    }
+  });
+  pos.swap(posScratch);
+  vel.swap(velScratch);
+  cellsKnown = false;
 }
 
 void FluidSolver::Impl::pushParticlesOut(const std::vector<PreparedBody>& bodies) {

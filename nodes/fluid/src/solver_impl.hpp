@@ -227,7 +227,6 @@ struct FluidSolver::Impl {
   // particles first, then part 1's, so the order is the serial one.
   void sortParticles();
   std::vector<std::vector<std::uint32_t>> partCounts;  ///< per part, per cell of the slab
-  void setPlaneStarts();  // planeStart from sortStart (before the particles are moved)
 
   // Pushes particles out of the bodies. Per cell (CSR: bodiesAt[c] to bodiesAt[c + 1] in
   // bodyList), the bodies whose bounds reach it; only those are tested.
